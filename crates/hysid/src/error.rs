@@ -1,0 +1,151 @@
+//! The library's one error type.
+//!
+//! Every message is a single line that says what is wrong, where (file, line, channel, sample,
+//! parameter) and, where there is one, what to do about it. Numerical non-convergence of an
+//! iterative estimator is *not* an error: it is reported in the estimator's report
+//! (see [`crate::estimate::Termination`]).
+
+use std::path::PathBuf;
+
+/// Errors raised by hysid.
+#[non_exhaustive]
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be opened, read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file concerned.
+        path: PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+
+    /// A CSV file is malformed (ragged rows, no header, bad quoting).
+    #[error("{}: line {line}: {message}", path.display())]
+    Csv {
+        /// The file concerned.
+        path: PathBuf,
+        /// One-based line number in the file.
+        line: u64,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// A column asked for by name does not exist.
+    #[error("{}: no column named '{column}' (the header has: {available}); pick one of those", path.display())]
+    MissingColumn {
+        /// The file concerned.
+        path: PathBuf,
+        /// The column that was asked for.
+        column: String,
+        /// The header's column names, comma-separated.
+        available: String,
+    },
+
+    /// A cell of a CSV file is not a number.
+    #[error("{}: line {line}, column '{column}': '{text}' is not a number; fix or remove that row", path.display())]
+    NotNumeric {
+        /// The file concerned.
+        path: PathBuf,
+        /// One-based line number in the file.
+        line: u64,
+        /// Column name.
+        column: String,
+        /// The offending cell.
+        text: String,
+    },
+
+    /// A sample is NaN or infinite.
+    #[error("channel '{channel}', sample {index}: value {value} is not finite; remove or interpolate it")]
+    NonFinite {
+        /// Channel name.
+        channel: String,
+        /// Zero-based sample index.
+        index: usize,
+        /// The value found.
+        value: f64,
+    },
+
+    /// Data that cannot be used as given (unequal lengths, bad sample time, empty file...).
+    #[error("invalid data: {0}")]
+    InvalidData(String),
+
+    /// Fewer samples than the estimator needs for the number of parameters.
+    #[error(
+        "too few samples: {samples} usable samples for {parameters} parameters; \
+         give at least {needed} samples"
+    )]
+    TooFewSamples {
+        /// Usable samples.
+        samples: usize,
+        /// Parameters to estimate.
+        parameters: usize,
+        /// Minimum number of samples needed.
+        needed: usize,
+    },
+
+    /// The input does not excite the system enough to identify the model.
+    #[error("input '{channel}' does not excite the system: {reason}")]
+    NotExciting {
+        /// Input channel name.
+        channel: String,
+        /// Why it is not exciting and what to do.
+        reason: String,
+    },
+
+    /// The discrete Coleman–Hodgdon recursion left its valid range: α·|Δx(t)| > 1.
+    #[error(
+        "input moves too fast at sample {index}: alpha*|dx| = {product:.4} > 1 \
+         (alpha = {alpha}, dx = {dx}); sample faster or scale the input down"
+    )]
+    RateLimit {
+        /// Zero-based sample index.
+        index: usize,
+        /// The hysteresis parameter α.
+        alpha: f64,
+        /// The input increment Δx(t).
+        dx: f64,
+        /// α·|Δx(t)|.
+        product: f64,
+    },
+
+    /// A model parameter value is not acceptable.
+    #[error("parameter {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// Parameter name (literature symbol).
+        name: String,
+        /// The value given.
+        value: f64,
+        /// Why it is not acceptable.
+        reason: String,
+    },
+
+    /// A model or estimator configuration is inconsistent.
+    #[error("invalid configuration: {0}")]
+    Config(String),
+
+    /// A least-squares problem is singular or numerically rank deficient.
+    #[error("singular regression: {0}")]
+    Singular(String),
+
+    /// A simulation produced non-finite values (the model diverged).
+    #[error("simulation diverged at sample {index}: {reason}")]
+    Diverged {
+        /// Zero-based sample index where a non-finite value first appeared.
+        index: usize,
+        /// What diverged.
+        reason: String,
+    },
+
+    /// A saved model or report could not be (de)serialised.
+    #[error("model file {}: {message}", path.display())]
+    ModelFile {
+        /// The file concerned.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Shorthand for results in this crate.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,716 @@
+//! A bounded Levenberg–Marquardt engine for nonlinear least squares, min S(θ) = Σ rᵢ(θ)².
+//!
+//! # Method
+//!
+//! Each iteration solves the damped Gauss–Newton system (Marquardt 1963)
+//!
+//! ```text
+//! (JᵀJ + λ·D) δ = −Jᵀr,      D = diag(JᵀJ)  (floored at 1e-12·max diag)
+//! ```
+//!
+//! for the free parameters, where J = ∂r/∂θ. Scaling by diag(JᵀJ) makes the step invariant to
+//! the parameters' units. The damping λ follows Nielsen's rule (λ·max(1/3, 1 − (2ρ − 1)³) on
+//! success, λ·ν with ν doubling on failure), where ρ is the ratio of the actual to the
+//! predicted decrease of S.
+//!
+//! **Bounds** are handled by a projected step with an active set: a parameter sitting on a
+//! bound whose gradient pushes it outward is held for that step, the reduced system is solved
+//! and the trial point is projected onto the box. The predicted decrease uses the projected step.
+//!
+//! **Diverging trials**: a trial point whose residuals cannot be computed (the simulation blows
+//! up or errors) counts as a failed step (λ grows) and is reported in
+//! [`LmReport::rejected_trials`]; it never aborts the fit.
+//!
+//! The problem supplies residuals and, optionally, the normal equations JᵀJ, Jᵀr directly
+//! (models with analytic sensitivities stream them without storing J, which keeps 10⁶-sample
+//! fits in a few MB). Otherwise J is built by forward finite differences, one column per free
+//! parameter, in parallel (rayon).
+//!
+//! # Why not the `levenberg-marquardt` crate
+//! It needs the whole Jacobian in memory and offers no bounds, per-iteration callback or
+//! "expected improvement" stop; every one of those is needed here, and the core algorithm is
+//! short.
+
+use super::Termination;
+use crate::{Error, Result};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// The normal equations of a least-squares problem at one point, for the free parameters.
+#[derive(Clone, Debug)]
+pub struct NormalEquations {
+    /// JᵀJ (free × free).
+    pub jtj: DMatrix<f64>,
+    /// Jᵀr (free).
+    pub jtr: DVector<f64>,
+    /// S = Σ r².
+    pub cost: f64,
+}
+
+/// A nonlinear least-squares problem min Σ rᵢ(θ)².
+pub trait LeastSquaresProblem: Sync {
+    /// Length of the full parameter vector θ (fixed parameters included).
+    fn n_params(&self) -> usize;
+
+    /// Number of residuals.
+    fn n_residuals(&self) -> usize;
+
+    /// Writes r(θ) into `r` (length [`n_residuals`](Self::n_residuals)). An error, or a
+    /// non-finite value, marks θ as a point where the model cannot be evaluated.
+    fn residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()>;
+
+    /// Optionally the normal equations at θ for the parameters `free`, computed analytically.
+    /// `None` (the default) makes the engine use finite differences.
+    fn normal_equations(&self, _theta: &[f64], _free: &[usize]) -> Option<Result<NormalEquations>> {
+        None
+    }
+
+    /// The sum of squares below which the fit is exact to working precision (default 0).
+    fn cost_floor(&self) -> f64 {
+        0.0
+    }
+}
+
+/// One accepted iteration, as passed to the progress callback and kept in the history.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct IterationRecord {
+    /// Iteration number (1-based).
+    pub iteration: usize,
+    /// S = Σ r² after the iteration.
+    pub cost: f64,
+    /// The damping λ used.
+    pub lambda: f64,
+    /// The full parameter vector after the iteration.
+    pub theta: Vec<f64>,
+}
+
+/// What a progress callback asks the engine to do next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Control {
+    /// Go on.
+    Continue,
+    /// Stop now and report [`Termination::Stopped`].
+    Stop,
+}
+
+/// Settings of the engine.
+#[derive(Clone, Debug)]
+pub struct LmConfig {
+    /// Maximum number of iterations (Jacobian evaluations).
+    pub max_iterations: usize,
+    /// Stop when both the actual and the predicted relative decrease of S in an accepted step
+    /// fall below this (Gunnar et al. 2006 use 0.01 % = 1e-4, MATLAB's "expected improvement").
+    pub improvement_tolerance: f64,
+    /// Stop when the relative step ‖δ‖/(‖θ‖ + tol) falls below this.
+    pub step_tolerance: f64,
+    /// Stop when every |cos| between r and a column of J falls below this (MINPACK's gtol).
+    pub gradient_tolerance: f64,
+    /// Initial damping relative to max diag(JᵀJ).
+    pub initial_damping: f64,
+    /// Relative finite-difference step (times max(|θⱼ|, 1e-3·typical)).
+    pub fd_step: f64,
+}
+
+impl Default for LmConfig {
+    fn default() -> Self {
+        Self {
+            max_iterations: 100,
+            improvement_tolerance: 1e-10,
+            step_tolerance: 1e-12,
+            gradient_tolerance: 1e-12,
+            initial_damping: 1e-3,
+            fd_step: 1e-7,
+        }
+    }
+}
+
+/// Result of a Levenberg–Marquardt run.
+#[derive(Clone, Debug)]
+pub struct LmReport {
+    /// The final full parameter vector.
+    pub theta: Vec<f64>,
+    /// Indices of the free parameters.
+    pub free: Vec<usize>,
+    /// Final S = Σ r².
+    pub cost: f64,
+    /// S at the start.
+    pub initial_cost: f64,
+    /// Number of residuals N.
+    pub n_residuals: usize,
+    /// Iterations performed.
+    pub iterations: usize,
+    /// Residual evaluations (trial points and finite differences).
+    pub function_evaluations: usize,
+    /// Trial points rejected because the model could not be evaluated there.
+    pub rejected_trials: usize,
+    /// Why the search stopped.
+    pub termination: Termination,
+    /// Accepted iterations.
+    pub history: Vec<IterationRecord>,
+    /// JᵀJ of the free parameters at the final point (for the covariance).
+    pub jtj: DMatrix<f64>,
+    /// Wall-clock time.
+    pub elapsed_s: f64,
+}
+
+/// Parameter covariance derived from an [`LmReport`].
+#[derive(Clone, Debug)]
+pub struct Covariance {
+    /// Full-size covariance (zero rows/columns for fixed parameters).
+    pub matrix: DMatrix<f64>,
+    /// Standard deviations (0 for fixed parameters, NaN when not identifiable).
+    pub std: Vec<f64>,
+    /// Correlation matrix of the full vector (identity entries for fixed parameters).
+    pub correlation: DMatrix<f64>,
+    /// Residual variance estimate σ² = S/(N − p_free).
+    pub sigma2: f64,
+    /// Free parameters that the data cannot determine (singular information matrix).
+    pub unidentifiable: Vec<usize>,
+}
+
+impl LmReport {
+    /// Covariance σ²(JᵀJ)⁻¹ of the free parameters, σ² = S/(N − p), the asymptotic covariance
+    /// of an output-error estimate with white residuals (Ljung 1999, §9.3).
+    pub fn covariance(&self) -> Covariance {
+        let n_theta = self.theta.len();
+        let p = self.free.len();
+        let sigma2 = self.cost / (self.n_residuals.saturating_sub(p)).max(1) as f64;
+        let mut matrix = DMatrix::zeros(n_theta, n_theta);
+        let mut unidentifiable = Vec::new();
+        if p > 0 {
+            let (inv, null) = scaled_inverse(&self.jtj);
+            unidentifiable = null.into_iter().map(|k| self.free[k]).collect();
+            for (a, &i) in self.free.iter().enumerate() {
+                for (b, &j) in self.free.iter().enumerate() {
+                    matrix[(i, j)] = sigma2 * inv[(a, b)];
+                }
+            }
+        }
+        let std: Vec<f64> = (0..n_theta)
+            .map(|i| {
+                if unidentifiable.contains(&i) {
+                    f64::NAN
+                } else {
+                    matrix[(i, i)].max(0.0).sqrt()
+                }
+            })
+            .collect();
+        let correlation = DMatrix::from_fn(n_theta, n_theta, |i, j| {
+            if i == j {
+                1.0
+            } else if std[i] > 0.0 && std[j] > 0.0 {
+                matrix[(i, j)] / (std[i] * std[j])
+            } else {
+                0.0
+            }
+        });
+        Covariance {
+            matrix,
+            std,
+            correlation,
+            sigma2,
+            unidentifiable,
+        }
+    }
+}
+
+/// Pseudo-inverse of a symmetric positive semi-definite matrix after scaling it to unit
+/// diagonal; also returns the indices that dominate its (numerical) null space.
+fn scaled_inverse(a: &DMatrix<f64>) -> (DMatrix<f64>, Vec<usize>) {
+    let p = a.nrows();
+    let s: Vec<f64> = (0..p)
+        .map(|i| a[(i, i)].max(f64::MIN_POSITIVE).sqrt())
+        .collect();
+    let scaled = DMatrix::from_fn(p, p, |i, j| a[(i, j)] / (s[i] * s[j]));
+    let eig = scaled.symmetric_eigen();
+    let lmax = eig.eigenvalues.max();
+    let mut inv = DMatrix::zeros(p, p);
+    let mut null = Vec::new();
+    for k in 0..p {
+        let l = eig.eigenvalues[k];
+        let v = eig.eigenvectors.column(k);
+        if l > 1e-13 * lmax {
+            inv += v * v.transpose() / l;
+        } else {
+            let big = v.amax();
+            null.extend((0..p).filter(|&i| v[i].abs() > 0.3 * big));
+        }
+    }
+    null.sort_unstable();
+    null.dedup();
+    (
+        DMatrix::from_fn(p, p, |i, j| inv[(i, j)] / (s[i] * s[j])),
+        null,
+    )
+}
+
+/// Minimises Σ r(θ)² from `theta0` over the box [lower, upper] for the parameters in `free`.
+///
+/// `callback` is called after every accepted iteration; returning [`Control::Stop`] ends the
+/// search. Errors only when the model cannot be evaluated at `theta0` (or differentiated
+/// there); every later difficulty is a [`Termination`] reason.
+pub fn minimize(
+    problem: &dyn LeastSquaresProblem,
+    theta0: &[f64],
+    free: &[usize],
+    lower: &[f64],
+    upper: &[f64],
+    config: &LmConfig,
+    callback: &mut dyn FnMut(&IterationRecord) -> Control,
+) -> Result<LmReport> {
+    let start = Instant::now();
+    let mut state = State::new(problem, theta0, free, lower, upper, config)?;
+    let termination = state.run(callback)?;
+    Ok(state.into_report(termination, start.elapsed().as_secs_f64()))
+}
+
+/// The engine's working state.
+struct State<'a> {
+    problem: &'a dyn LeastSquaresProblem,
+    config: &'a LmConfig,
+    free: Vec<usize>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    theta: Vec<f64>,
+    residuals: Vec<f64>,
+    system: NormalEquations,
+    initial_cost: f64,
+    lambda: f64,
+    nu: f64,
+    iterations: usize,
+    fevals: usize,
+    rejected: usize,
+    history: Vec<IterationRecord>,
+}
+
+/// Outcome of one damped step.
+enum StepOutcome {
+    Accepted { rel_actual: f64, rel_predicted: f64 },
+    Rejected,
+    TooSmall,
+}
+
+impl<'a> State<'a> {
+    fn new(
+        problem: &'a dyn LeastSquaresProblem,
+        theta0: &[f64],
+        free: &[usize],
+        lower: &[f64],
+        upper: &[f64],
+        config: &'a LmConfig,
+    ) -> Result<Self> {
+        let mut residuals = vec![0.0; problem.n_residuals()];
+        problem.residuals(theta0, &mut residuals)?;
+        if let Some(i) = residuals.iter().position(|r| !r.is_finite()) {
+            return Err(Error::Diverged {
+                index: i,
+                reason:
+                    "the model cannot be simulated from its initial parameters (non-finite output)"
+                        .into(),
+            });
+        }
+        let mut state = Self {
+            problem,
+            config,
+            free: free.to_vec(),
+            lower: lower.to_vec(),
+            upper: upper.to_vec(),
+            theta: theta0.to_vec(),
+            residuals,
+            system: NormalEquations {
+                jtj: DMatrix::zeros(0, 0),
+                jtr: DVector::zeros(0),
+                cost: 0.0,
+            },
+            initial_cost: 0.0,
+            lambda: 0.0,
+            nu: 2.0,
+            iterations: 0,
+            fevals: 1,
+            rejected: 0,
+            history: Vec::new(),
+        };
+        state.system = state.normal_equations()?;
+        state.initial_cost = state.system.cost;
+        let max_diag = (0..free.len())
+            .map(|i| state.system.jtj[(i, i)])
+            .fold(0.0, f64::max);
+        state.lambda = config.initial_damping * max_diag.max(f64::MIN_POSITIVE);
+        Ok(state)
+    }
+
+    fn run(
+        &mut self,
+        callback: &mut dyn FnMut(&IterationRecord) -> Control,
+    ) -> Result<Termination> {
+        if self.free.is_empty() {
+            return Ok(Termination::NothingToEstimate);
+        }
+        loop {
+            if self.system.cost <= self.problem.cost_floor() {
+                return Ok(Termination::ZeroResidual);
+            }
+            if self.gradient_is_small() {
+                return Ok(Termination::GradientBelowTolerance);
+            }
+            if self.iterations >= self.config.max_iterations {
+                return Ok(Termination::MaxIterations);
+            }
+            self.iterations += 1;
+            let outcome = self.damped_step();
+            match outcome {
+                StepOutcome::TooSmall => return Ok(Termination::StepBelowTolerance),
+                StepOutcome::Rejected => return Ok(Termination::NoDescent),
+                StepOutcome::Accepted {
+                    rel_actual,
+                    rel_predicted,
+                } => {
+                    let record = IterationRecord {
+                        iteration: self.iterations,
+                        cost: self.system.cost,
+                        lambda: self.lambda,
+                        theta: self.theta.clone(),
+                    };
+                    let control = callback(&record);
+                    self.history.push(record);
+                    if control == Control::Stop {
+                        return Ok(Termination::Stopped);
+                    }
+                    let tol = self.config.improvement_tolerance;
+                    if rel_actual < tol && rel_predicted < tol {
+                        return Ok(Termination::ImprovementBelowTolerance {
+                            relative: rel_actual,
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    /// Tries damped steps with growing λ until one decreases S; recomputes the normal
+    /// equations at the new point.
+    fn damped_step(&mut self) -> StepOutcome {
+        const MAX_FAILURES: usize = 60;
+        let mut trial = vec![0.0; self.residuals.len()];
+        for _ in 0..MAX_FAILURES {
+            let Some(candidate) = self.candidate() else {
+                self.grow_damping();
+                continue;
+            };
+            let step_norm = candidate
+                .iter()
+                .zip(&self.theta)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let theta_norm = self.theta.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let tol = self.config.step_tolerance;
+            if step_norm <= tol * (theta_norm + tol) {
+                return StepOutcome::TooSmall;
+            }
+            let predicted = self.predicted_decrease(&candidate);
+            self.fevals += 1;
+            let cost = match self.problem.residuals(&candidate, &mut trial) {
+                Ok(()) if trial.iter().all(|r| r.is_finite()) => {
+                    trial.iter().map(|r| r * r).sum::<f64>()
+                }
+                _ => {
+                    self.rejected += 1;
+                    self.grow_damping();
+                    continue;
+                }
+            };
+            let old = self.system.cost;
+            let rho = (old - cost) / predicted;
+            if cost < old && predicted > 0.0 && rho > 1e-4 {
+                // Evaluate the new point's normal equations before committing, so that a
+                // failure there is a rejected step, not an abort.
+                let saved = std::mem::replace(&mut self.theta, candidate);
+                std::mem::swap(&mut self.residuals, &mut trial);
+                match self.normal_equations() {
+                    Ok(system) => {
+                        self.system = system;
+                        self.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                        self.nu = 2.0;
+                        return StepOutcome::Accepted {
+                            rel_actual: (old - cost) / old,
+                            rel_predicted: predicted / old,
+                        };
+                    }
+                    Err(_) => {
+                        self.theta = saved;
+                        std::mem::swap(&mut self.residuals, &mut trial);
+                        self.rejected += 1;
+                    }
+                }
+            }
+            self.grow_damping();
+        }
+        StepOutcome::Rejected
+    }
+
+    fn grow_damping(&mut self) {
+        self.lambda *= self.nu;
+        self.nu *= 2.0;
+    }
+
+    /// The projected trial point for the current λ, or None when the damped system cannot be
+    /// factorised.
+    fn candidate(&self) -> Option<Vec<f64>> {
+        let g = &self.system.jtr;
+        let active: Vec<bool> = self
+            .free
+            .iter()
+            .enumerate()
+            .map(|(k, &i)| {
+                (self.theta[i] <= self.lower[i] && g[k] > 0.0)
+                    || (self.theta[i] >= self.upper[i] && g[k] < 0.0)
+            })
+            .collect();
+        let idx: Vec<usize> = (0..self.free.len()).filter(|&k| !active[k]).collect();
+        if idx.is_empty() {
+            return None;
+        }
+        let jtj = &self.system.jtj;
+        let max_diag = (0..self.free.len())
+            .map(|k| jtj[(k, k)])
+            .fold(0.0, f64::max);
+        let floor = 1e-12 * max_diag.max(f64::MIN_POSITIVE);
+        let m = idx.len();
+        let a = DMatrix::from_fn(m, m, |r, c| {
+            let v = jtj[(idx[r], idx[c])];
+            if r == c {
+                v + self.lambda * jtj[(idx[r], idx[r])].max(floor)
+            } else {
+                v
+            }
+        });
+        let rhs = DVector::from_fn(m, |r, _| -g[idx[r]]);
+        let delta = a.cholesky()?.solve(&rhs);
+        let mut theta = self.theta.clone();
+        for (r, &k) in idx.iter().enumerate() {
+            let i = self.free[k];
+            theta[i] = (theta[i] + delta[r]).clamp(self.lower[i], self.upper[i]);
+        }
+        theta.iter().all(|v| v.is_finite()).then_some(theta)
+    }
+
+    /// S − ‖r + Jδ‖² for the step δ = candidate − θ.
+    fn predicted_decrease(&self, candidate: &[f64]) -> f64 {
+        let delta = DVector::from_iterator(
+            self.free.len(),
+            self.free.iter().map(|&i| candidate[i] - self.theta[i]),
+        );
+        -2.0 * delta.dot(&self.system.jtr) - (delta.transpose() * &self.system.jtj * &delta)[(0, 0)]
+    }
+
+    fn gradient_is_small(&self) -> bool {
+        let s = self.system.cost;
+        (0..self.free.len()).all(|k| {
+            let col = self.system.jtj[(k, k)];
+            col == 0.0
+                || self.system.jtr[k].abs() <= self.config.gradient_tolerance * (col * s).sqrt()
+        })
+    }
+
+    /// The normal equations at the current θ, analytic when the problem offers them.
+    fn normal_equations(&mut self) -> Result<NormalEquations> {
+        if let Some(system) = self.problem.normal_equations(&self.theta, &self.free) {
+            self.fevals += 1;
+            let system = system?;
+            if !system.cost.is_finite() {
+                return Err(Error::Diverged {
+                    index: 0,
+                    reason: "non-finite cost".into(),
+                });
+            }
+            return Ok(system);
+        }
+        self.finite_difference_system()
+    }
+
+    /// Forward-difference Jacobian, one column per free parameter, computed in parallel.
+    fn finite_difference_system(&mut self) -> Result<NormalEquations> {
+        let n = self.residuals.len();
+        let columns: Vec<Result<Vec<f64>>> = self
+            .free
+            .par_iter()
+            .map(|&i| {
+                fd_column(
+                    self.problem,
+                    &self.theta,
+                    &self.residuals,
+                    i,
+                    self.lower[i],
+                    self.upper[i],
+                    self.config.fd_step,
+                )
+            })
+            .collect();
+        self.fevals += self.free.len();
+        let mut jac = DMatrix::zeros(n, self.free.len());
+        for (k, column) in columns.into_iter().enumerate() {
+            jac.set_column(k, &DVector::from_vec(column?));
+        }
+        let r = DVector::from_column_slice(&self.residuals);
+        Ok(NormalEquations {
+            jtj: jac.tr_mul(&jac),
+            jtr: jac.tr_mul(&r),
+            cost: r.norm_squared(),
+        })
+    }
+
+    fn into_report(self, termination: Termination, elapsed_s: f64) -> LmReport {
+        LmReport {
+            theta: self.theta,
+            free: self.free,
+            cost: self.system.cost,
+            initial_cost: self.initial_cost,
+            n_residuals: self.residuals.len(),
+            iterations: self.iterations,
+            function_evaluations: self.fevals,
+            rejected_trials: self.rejected,
+            termination,
+            history: self.history,
+            jtj: self.system.jtj,
+            elapsed_s,
+        }
+    }
+}
+
+/// One forward-difference column ∂r/∂θᵢ, stepping inward when the forward step would leave the
+/// box or cannot be evaluated.
+fn fd_column(
+    problem: &dyn LeastSquaresProblem,
+    theta: &[f64],
+    r0: &[f64],
+    i: usize,
+    lower: f64,
+    upper: f64,
+    rel_step: f64,
+) -> Result<Vec<f64>> {
+    let h = rel_step * theta[i].abs().max(1e-3);
+    let mut r = vec![0.0; r0.len()];
+    for step in [h, -h] {
+        let moved = theta[i] + step;
+        if moved > upper || moved < lower {
+            continue;
+        }
+        let mut t = theta.to_vec();
+        t[i] = moved;
+        let actual = moved - theta[i];
+        if problem.residuals(&t, &mut r).is_ok() && r.iter().all(|v| v.is_finite()) {
+            return Ok(r.iter().zip(r0).map(|(a, b)| (a - b) / actual).collect());
+        }
+    }
+    Err(Error::Diverged {
+        index: 0,
+        reason: format!(
+            "cannot differentiate with respect to parameter {i}: the model fails on both sides"
+        ),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Exponential decay y = a·exp(−b t) sampled at 30 points.
+    struct Decay {
+        t: Vec<f64>,
+        y: Vec<f64>,
+    }
+
+    impl LeastSquaresProblem for Decay {
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn n_residuals(&self) -> usize {
+            self.t.len()
+        }
+        fn residuals(&self, p: &[f64], r: &mut [f64]) -> Result<()> {
+            if p[1] < -5.0 {
+                return Err(Error::Diverged {
+                    index: 0,
+                    reason: "test".into(),
+                });
+            }
+            for ((ri, t), y) in r.iter_mut().zip(&self.t).zip(&self.y) {
+                *ri = y - p[0] * (-p[1] * t).exp();
+            }
+            Ok(())
+        }
+    }
+
+    fn decay() -> Decay {
+        let t: Vec<f64> = (0..30).map(|k| k as f64 * 0.1).collect();
+        let y = t.iter().map(|t| 2.5 * (-1.3 * t).exp()).collect();
+        Decay { t, y }
+    }
+
+    #[test]
+    fn recovers_exact_parameters_from_far_start() {
+        let p = decay();
+        let inf = f64::INFINITY;
+        let report = minimize(
+            &p,
+            &[0.5, 4.0],
+            &[0, 1],
+            &[-inf, -inf],
+            &[inf, inf],
+            &LmConfig::default(),
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
+        assert!((report.theta[0] - 2.5).abs() < 1e-9, "{:?}", report);
+        assert!((report.theta[1] - 1.3).abs() < 1e-9);
+    }
+
+    #[test]
+    fn respects_bounds_and_fixed_parameters() {
+        let p = decay();
+        let report = minimize(
+            &p,
+            &[1.0, 1.0],
+            &[0, 1],
+            &[0.0, 0.0],
+            &[2.0, 10.0],
+            &LmConfig::default(),
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
+        assert_eq!(report.theta[0], 2.0);
+        let fixed = minimize(
+            &p,
+            &[2.5, 1.0],
+            &[1],
+            &[0.0, 0.0],
+            &[10.0, 10.0],
+            &LmConfig::default(),
+            &mut |_| Control::Continue,
+        )
+        .unwrap();
+        assert_eq!(fixed.theta[0], 2.5);
+        assert!((fixed.theta[1] - 1.3).abs() < 1e-9);
+        assert_eq!(fixed.covariance().std[0], 0.0);
+    }
+
+    #[test]
+    fn callback_can_stop() {
+        let p = decay();
+        let inf = f64::INFINITY;
+        let report = minimize(
+            &p,
+            &[0.5, 4.0],
+            &[0, 1],
+            &[-inf, -inf],
+            &[inf, inf],
+            &LmConfig::default(),
+            &mut |_| Control::Stop,
+        )
+        .unwrap();
+        assert_eq!(report.termination, Termination::Stopped);
+        assert_eq!(report.iterations, 1);
+    }
+}
