@@ -15,6 +15,7 @@
 //! * [`signal`]: excitation signals and noise, all seeded.
 //! * [`metrics`]: fit %, RMSE and information criteria.
 //! * [`examples`]: the project's numerical examples (MODELS.md §1.6).
+//! * [`fitted`]: fitted models and their JSON model files.
 //!
 //! Results that do not converge are reported in the estimator's report, never hidden;
 //! bad input is an [`Error`] with a one-line message.
@@ -31,6 +32,7 @@ pub mod data;
 pub mod error;
 pub mod estimate;
 pub mod examples;
+pub mod fitted;
 pub mod metrics;
 pub mod model;
 pub mod signal;

@@ -26,7 +26,9 @@ use super::levenberg_marquardt::{Control, IterationRecord, LmConfig};
 use super::linear_ls::{least_squares, LsSolution};
 use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel, SensitivitySink};
 use super::parameters::{Parameter, ParameterSet};
-use super::switching::{fit_with_switching_updates, Switching};
+use super::switching::{
+    fit_with_switching_updates, place_threshold, Switching, ThresholdPosterior,
+};
 use super::Termination;
 use crate::data::IdData;
 use crate::model::coleman_hodgdon::switching;
@@ -241,8 +243,23 @@ pub struct HysteresisFit {
     pub separated: SeparatedFit,
     /// Step 3: the output-error refinement (estimate, standard deviations, report).
     pub output_error: OutputErrorFit,
+    /// What the data say about the threshold d; the reported d is its mean.
+    pub threshold: ThresholdPosterior,
     /// The final model.
     pub model: ColemanHodgdon,
+    /// Wall-clock time.
+    pub elapsed_s: f64,
+}
+
+impl HysteresisFit {
+    /// Reported standard deviations ([`ChForm::parameter_names`] order): asymptotic, with
+    /// the truncated-normal one for d (see [`super::switching`]).
+    pub fn std(&self) -> Vec<f64> {
+        let mut std = self.output_error.std().to_vec();
+        let d = std.len() - 1;
+        std[d] = self.threshold.std;
+        std
+    }
 }
 
 /// Settings of the hysteresis-alone identification.
@@ -281,6 +298,7 @@ impl HysteresisIdentification {
         data: &IdData,
         callback: &mut dyn FnMut(&IterationRecord) -> Control,
     ) -> Result<HysteresisFit> {
+        let clock = std::time::Instant::now();
         check_excitation(data, self.form.n_params())?;
         let separated = self.separated_regression(data)?;
         let structure = |switching| HysteresisStructure {
@@ -303,7 +321,8 @@ impl HysteresisIdentification {
         };
         let switched =
             fit_with_switching_updates(&structure, data, &params, &estimator, self.scan, callback)?;
-        let output_error = switched.fit;
+        let d_index = self.form.n_params() - 1;
+        let (output_error, threshold) = place_threshold(&structure, data, switched.fit, d_index)?;
         let model = ColemanHodgdon::from_params(self.form, &output_error.parameters.values())?;
         if model.alpha() >= alpha_max * (1.0 - 1e-9) {
             return Err(rate_error(data, model.alpha()));
@@ -311,7 +330,9 @@ impl HysteresisIdentification {
         Ok(HysteresisFit {
             separated,
             output_error,
+            threshold,
             model,
+            elapsed_s: clock.elapsed().as_secs_f64(),
         })
     }
 

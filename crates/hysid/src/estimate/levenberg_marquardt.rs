@@ -99,14 +99,15 @@ pub enum Control {
 pub struct LmConfig {
     /// Maximum number of iterations (Jacobian evaluations).
     pub max_iterations: usize,
-    /// Stop when both the actual and the predicted relative decrease of S in an accepted step
-    /// fall below this (Gunnar et al. 2006 use 0.01 % = 1e-4, MATLAB's "expected improvement").
+    /// Stop when the relative decrease of S that the next step predicts, or both the actual
+    /// and the predicted decrease of an accepted step, fall below this (Gunnar et al. 2006
+    /// use 0.01 % = 1e-4, MATLAB's "expected improvement").
     pub improvement_tolerance: f64,
     /// Stop when the relative step ‖δ‖/(‖θ‖ + tol) falls below this.
     pub step_tolerance: f64,
     /// Stop when every |cos| between r and a column of J falls below this (MINPACK's gtol).
     pub gradient_tolerance: f64,
-    /// Initial damping relative to max diag(JᵀJ).
+    /// Initial damping λ₀ (dimensionless: the damping term is λ·diag(JᵀJ)).
     pub initial_damping: f64,
     /// Relative finite-difference step (times max(|θⱼ|, 1e-3·typical)).
     pub fd_step: f64,
@@ -333,10 +334,8 @@ impl<'a> State<'a> {
         };
         state.system = state.normal_equations()?;
         state.initial_cost = state.system.cost;
-        let max_diag = (0..free.len())
-            .map(|i| state.system.jtj[(i, i)])
-            .fold(0.0, f64::max);
-        state.lambda = config.initial_damping * max_diag.max(f64::MIN_POSITIVE);
+        // D = diag(JᵀJ) carries the scale, so λ itself is dimensionless.
+        state.lambda = config.initial_damping;
         Ok(state)
     }
 
@@ -353,6 +352,12 @@ impl<'a> State<'a> {
             }
             if self.gradient_is_small() {
                 return Ok(Termination::GradientBelowTolerance);
+            }
+            // MATLAB's "expected improvement": what the next step promises, before paying for
+            // a trial simulation.
+            let expected = self.expected_improvement();
+            if expected < self.config.improvement_tolerance {
+                return Ok(Termination::ImprovementBelowTolerance { relative: expected });
             }
             if self.iterations >= self.config.max_iterations {
                 return Ok(Termination::MaxIterations);
@@ -386,6 +391,23 @@ impl<'a> State<'a> {
                 }
             }
         }
+    }
+
+    /// The relative decrease of S that the Gauss–Newton step predicts (infinite when no step
+    /// can be solved for, so the search goes on and λ adapts).
+    fn expected_improvement(&self) -> f64 {
+        // The Gauss–Newton step (λ → 0), unprojected: how far the quadratic model still is
+        // from its minimum. The damped step would shrink with λ, and a step clipped by a
+        // bound can promise little while other directions still have much to give.
+        let Some((idx, delta)) = self.step_vector(1e-12) else {
+            return f64::INFINITY;
+        };
+        let g = DVector::from_fn(idx.len(), |r, _| self.system.jtr[idx[r]]);
+        let h = DMatrix::from_fn(idx.len(), idx.len(), |r, c| {
+            self.system.jtj[(idx[r], idx[c])]
+        });
+        let predicted = -2.0 * delta.dot(&g) - (delta.transpose() * h * &delta)[(0, 0)];
+        predicted / self.system.cost
     }
 
     /// Tries damped steps with growing λ until one decreases S; recomputes the normal
@@ -458,17 +480,32 @@ impl<'a> State<'a> {
     /// The projected trial point for the current λ, or None when the damped system cannot be
     /// factorised.
     fn candidate(&self) -> Option<Vec<f64>> {
+        self.candidate_with(self.lambda)
+    }
+
+    /// The projected trial point for damping `lambda`.
+    fn candidate_with(&self, lambda: f64) -> Option<Vec<f64>> {
+        let (idx, delta) = self.step_vector(lambda)?;
+        let mut theta = self.theta.clone();
+        for (r, &k) in idx.iter().enumerate() {
+            let i = self.free[k];
+            theta[i] = (theta[i] + delta[r]).clamp(self.lower[i], self.upper[i]);
+        }
+        theta.iter().all(|v| v.is_finite()).then_some(theta)
+    }
+
+    /// The damped step for the free parameters that are not held by an active bound: their
+    /// positions in `free` and the step, before projection onto the box.
+    fn step_vector(&self, lambda: f64) -> Option<(Vec<usize>, DVector<f64>)> {
         let g = &self.system.jtr;
-        let active: Vec<bool> = self
-            .free
-            .iter()
-            .enumerate()
-            .map(|(k, &i)| {
-                (self.theta[i] <= self.lower[i] && g[k] > 0.0)
-                    || (self.theta[i] >= self.upper[i] && g[k] < 0.0)
+        let idx: Vec<usize> = (0..self.free.len())
+            .filter(|&k| {
+                let i = self.free[k];
+                let held = (self.theta[i] <= self.lower[i] && g[k] > 0.0)
+                    || (self.theta[i] >= self.upper[i] && g[k] < 0.0);
+                !held
             })
             .collect();
-        let idx: Vec<usize> = (0..self.free.len()).filter(|&k| !active[k]).collect();
         if idx.is_empty() {
             return None;
         }
@@ -481,19 +518,14 @@ impl<'a> State<'a> {
         let a = DMatrix::from_fn(m, m, |r, c| {
             let v = jtj[(idx[r], idx[c])];
             if r == c {
-                v + self.lambda * jtj[(idx[r], idx[r])].max(floor)
+                v + lambda * jtj[(idx[r], idx[r])].max(floor)
             } else {
                 v
             }
         });
         let rhs = DVector::from_fn(m, |r, _| -g[idx[r]]);
         let delta = a.cholesky()?.solve(&rhs);
-        let mut theta = self.theta.clone();
-        for (r, &k) in idx.iter().enumerate() {
-            let i = self.free[k];
-            theta[i] = (theta[i] + delta[r]).clamp(self.lower[i], self.upper[i]);
-        }
-        theta.iter().all(|v| v.is_finite()).then_some(theta)
+        delta.iter().all(|v| v.is_finite()).then_some((idx, delta))
     }
 
     /// S − ‖r + Jδ‖² for the step δ = candidate − θ.

@@ -100,6 +100,25 @@ impl OutputErrorFit {
     pub fn std(&self) -> &[f64] {
         &self.covariance.std
     }
+
+    /// The same fit moved to the parameter vector `theta` (e.g. a constrained correction):
+    /// outputs, fit % and losses are recomputed by simulating `model`; the covariance and the
+    /// optimiser's history are kept.
+    pub fn at(&self, model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<Self> {
+        let weights = vec![1.0; model.n_outputs()];
+        let problem = OutputErrorProblem::new(model, data, weights, 0)?;
+        let mut r = vec![0.0; problem.n_residuals()];
+        problem.residuals(theta, &mut r)?;
+        let mut report = self.report.clone();
+        report.theta = theta.to_vec();
+        report.cost = r.iter().map(|v| v * v).sum();
+        let mut parameters = self.parameters.clone();
+        parameters.set_values(theta);
+        let covariance = self.covariance.clone();
+        let mut moved = summarize(&problem, parameters, report)?;
+        moved.covariance = covariance;
+        Ok(moved)
+    }
 }
 
 impl OutputError {
@@ -369,23 +388,21 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
 /// Accumulates JᵀJ, Jᵀr and Σr² row by row, in blocks so the rank-k update runs through a
 /// matrix product instead of a scalar double loop per sample.
 struct Accumulator {
-    p: usize,
-    block: Vec<f64>,
-    residuals: Vec<f64>,
+    block: DMatrix<f64>,
+    residuals: DVector<f64>,
     rows: usize,
     jtj: DMatrix<f64>,
     jtr: DVector<f64>,
     cost: f64,
 }
 
-const BLOCK_ROWS: usize = 256;
+const BLOCK_ROWS: usize = 512;
 
 impl Accumulator {
     fn new(p: usize) -> Self {
         Self {
-            p,
-            block: vec![0.0; BLOCK_ROWS * p],
-            residuals: vec![0.0; BLOCK_ROWS],
+            block: DMatrix::zeros(BLOCK_ROWS, p),
+            residuals: DVector::zeros(BLOCK_ROWS),
             rows: 0,
             jtj: DMatrix::zeros(p, p),
             jtr: DVector::zeros(p),
@@ -395,9 +412,8 @@ impl Accumulator {
 
     #[inline]
     fn add(&mut self, row: &[f64], r: f64) {
-        // Column-major block: element (i, k) at k·BLOCK_ROWS + i.
         for (k, v) in row.iter().enumerate() {
-            self.block[k * BLOCK_ROWS + self.rows] = *v;
+            self.block[(self.rows, k)] = *v;
         }
         self.residuals[self.rows] = r;
         self.cost += r * r;
@@ -411,12 +427,10 @@ impl Accumulator {
         if self.rows == 0 {
             return;
         }
-        let j = DMatrix::from_column_slice(BLOCK_ROWS, self.p, &self.block);
-        let rv = DVector::from_column_slice(&self.residuals);
-        let j = j.rows(0, self.rows);
-        let rv = rv.rows(0, self.rows);
-        self.jtj += j.tr_mul(&j);
-        self.jtr += j.tr_mul(&rv);
+        let j = self.block.rows(0, self.rows);
+        let r = self.residuals.rows(0, self.rows);
+        self.jtj.gemm_tr(1.0, &j, &j, 1.0);
+        self.jtr.gemv_tr(1.0, &j, &r, 1.0);
         self.rows = 0;
     }
 

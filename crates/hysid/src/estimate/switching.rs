@@ -11,8 +11,8 @@
 //! 1. **Fixed point on h** (the internal-variable idea of Vörös 2015 applied to the output
 //!    error): hold h fixed, which makes the criterion smooth (d still moves the outer segment
 //!    of f), fit, re-classify the samples with the new d̂, repeat until the classification
-//!    no longer changes. A cycle ends the loop with the best classification by the true
-//!    criterion.
+//!    no longer changes. A cycle, or a re-classification that does not lower the true
+//!    criterion, ends the loop with the best classification by the true criterion.
 //! 2. **Interval scan**: the criterion restricted to one interval of d is smooth and equals
 //!    the frozen-h criterion there, so fitting with d bounded to each of a set of intervals
 //!    around d̂ (a coarse pass over d̂ ± 3s, then every neighbour of the best) and keeping the
@@ -20,11 +20,12 @@
 //!    noise-free data only the true interval fits exactly, which is what recovers every
 //!    parameter to working precision.
 
-use super::levenberg_marquardt::{Control, IterationRecord};
+use super::levenberg_marquardt::{Control, IterationRecord, LmReport};
 use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel};
 use super::parameters::ParameterSet;
 use crate::data::IdData;
 use crate::Result;
+use nalgebra::{DMatrix, DVector};
 
 /// The switching h(t) = (|x(t)| > d) of every experiment, held fixed during a fit.
 pub type Switching = Vec<Vec<bool>>;
@@ -55,10 +56,17 @@ pub struct ThresholdPosterior {
 /// The truncated-normal description of d (see the module docs) for the estimate `d_hat` with
 /// smooth standard deviation `smooth_std`.
 pub fn threshold_posterior(data: &IdData, d_hat: f64, smooth_std: f64) -> ThresholdPosterior {
-    let edges = magnitudes(data);
-    let i = edges.partition_point(|&e| e <= d_hat);
-    let lower = if i == 0 { 0.0 } else { edges[i - 1] };
-    let upper = edges.get(i).copied().unwrap_or(f64::INFINITY);
+    // The neighbouring magnitudes by one pass (no sort: records can be long).
+    let (mut lower, mut upper) = (0.0f64, f64::INFINITY);
+    for e in data.experiments() {
+        for m in e.input(0).iter().skip(1).map(|x| x.abs()) {
+            if m <= d_hat {
+                lower = lower.max(m);
+            } else {
+                upper = upper.min(m);
+            }
+        }
+    }
     let (mean, std) = truncated_normal(d_hat, smooth_std, lower, upper);
     ThresholdPosterior {
         lower,
@@ -69,25 +77,104 @@ pub fn threshold_posterior(data: &IdData, d_hat: f64, smooth_std: f64) -> Thresh
     }
 }
 
+/// Moves d to the mean of its [`threshold_posterior`] and the other free parameters to their
+/// conditional optimum for that d (−H_oo⁻¹H_od·Δd with H = JᵀJ, exact for the locally
+/// quadratic smooth part); one simulation refreshes the fit statistics, the covariance is kept.
+/// `d_index` is the position of d in the parameter vector.
+pub fn place_threshold<M: OutputErrorModel>(
+    make: &dyn Fn(Option<Switching>) -> M,
+    data: &IdData,
+    fit: OutputErrorFit,
+    d_index: usize,
+) -> Result<(OutputErrorFit, ThresholdPosterior)> {
+    let d_hat = fit.parameters.get(d_index).value;
+    let threshold = threshold_posterior(data, d_hat, fit.std()[d_index]);
+    if threshold.mean == d_hat {
+        return Ok((fit, threshold));
+    }
+    let mut theta = fit.parameters.values();
+    for (i, delta) in conditional_shift(&fit.report, d_index, threshold.mean - d_hat) {
+        theta[i] += delta;
+    }
+    theta[d_index] = threshold.mean;
+    let moved = fit.at(&make(Some(classify(data, threshold.mean))), data, &theta)?;
+    Ok((moved, threshold))
+}
+
+/// The change of the other free parameters that keeps the quadratic model of the criterion
+/// at its conditional minimum when parameter `fixed` moves by `delta`: −H_oo⁻¹H_od·delta.
+fn conditional_shift(report: &LmReport, fixed: usize, delta: f64) -> Vec<(usize, f64)> {
+    let Some(kd) = report.free.iter().position(|&i| i == fixed) else {
+        return Vec::new();
+    };
+    let others: Vec<usize> = (0..report.free.len()).filter(|&k| k != kd).collect();
+    let h = &report.jtj;
+    let h_oo = DMatrix::from_fn(others.len(), others.len(), |r, c| h[(others[r], others[c])]);
+    let h_od = DVector::from_fn(others.len(), |r, _| h[(others[r], kd)]);
+    match h_oo.cholesky() {
+        Some(chol) => {
+            let step = chol.solve(&h_od) * (-delta);
+            others
+                .iter()
+                .zip(step.iter())
+                .map(|(&k, &s)| (report.free[k], s))
+                .collect()
+        }
+        None => Vec::new(),
+    }
+}
+
 /// Mean and standard deviation of N(μ, s²) truncated to [a, b].
 fn truncated_normal(mu: f64, s: f64, a: f64, b: f64) -> (f64, f64) {
     if !(s > 0.0) || !s.is_finite() {
-        return (mu, s.max(0.0));
+        return (mu.clamp(a, b), 0.0);
     }
-    let (za, zb) = ((a - mu) / s, (b - mu) / s);
-    let z = normal_cdf(zb) - normal_cdf(za);
-    if z < 1e-300 {
-        // Numerically empty mass: μ lies far outside; the nearest end is the answer.
-        let end = if mu < a { a } else { b };
-        return (end, 0.0);
+    if b.is_finite() {
+        return truncated_moments_by_quadrature(mu, s, a, b);
     }
-    let (pa, pb) = (normal_pdf(za), normal_pdf(zb));
-    // z·φ(z) → 0 at ±∞; written so infinite ends do not produce NaN.
-    let zpa = if za.is_finite() { za * pa } else { 0.0 };
-    let zpb = if zb.is_finite() { zb * pb } else { 0.0 };
-    let shift = (pa - pb) / z;
-    let var = s * s * (1.0 + (zpa - zpb) / z - shift * shift);
-    (mu + s * shift, var.max(0.0).sqrt())
+    // Half-infinite interval [a, ∞): the closed form (inverse Mills ratio).
+    let za = (a - mu) / s;
+    let tail = 1.0 - normal_cdf(za);
+    if tail < 1e-300 {
+        return (a, 0.0);
+    }
+    let lambda = normal_pdf(za) / tail;
+    let var = s * s * (1.0 + za * lambda - lambda * lambda);
+    (mu + s * lambda, var.max(0.0).sqrt())
+}
+
+/// Moments of the truncated normal on a finite [a, b] by composite Simpson quadrature of the
+/// density relative to its largest value on the interval; no cancellation, whatever the ratio
+/// of the interval to s (closed forms lose all digits when the interval is narrow).
+fn truncated_moments_by_quadrature(mu: f64, s: f64, a: f64, b: f64) -> (f64, f64) {
+    const PANELS: usize = 256;
+    // Beyond 12 s from the peak the density is below e^-72 of its maximum: leave it out, so a
+    // narrow normal inside a wide interval is still resolved by the panels.
+    let peak = mu.clamp(a, b);
+    let (a, b) = (a.max(peak - 12.0 * s), b.min(peak + 12.0 * s));
+    let log_density = |x: f64| -0.5 * (((x - mu) / s).powi(2) - ((peak - mu) / s).powi(2));
+    let h = (b - a) / PANELS as f64;
+    let (mut m0, mut m1, mut m2) = (0.0, 0.0, 0.0);
+    for i in 0..=PANELS {
+        let w = if i == 0 || i == PANELS {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        let x = a + i as f64 * h;
+        let f = w * log_density(x).exp();
+        let dx = x - peak;
+        m0 += f;
+        m1 += f * dx;
+        m2 += f * dx * dx;
+    }
+    if m0 <= 0.0 {
+        return (peak, 0.0);
+    }
+    let mean = m1 / m0;
+    ((peak + mean), (m2 / m0 - mean * mean).max(0.0).sqrt())
 }
 
 fn normal_pdf(z: f64) -> f64 {
@@ -191,9 +278,13 @@ fn fixed_point<M: OutputErrorModel>(
             });
         }
         let actual = true_cost(&make(None), data, &fit.parameters.values())?;
-        if best.as_ref().is_none_or(|(c, _)| actual < *c) {
-            best = Some((actual, fit.clone()));
+        // Re-classifying must pay: once the true criterion stops falling, the best
+        // classification so far stands (long records otherwise creep through many nearly
+        // equal classifications).
+        if best.as_ref().is_some_and(|(c, _)| actual >= *c) {
+            break;
         }
+        best = Some((actual, fit.clone()));
         visited.push(std::mem::replace(&mut h, h_new));
         if visited.contains(&h) {
             break;
@@ -230,7 +321,7 @@ fn scan_intervals<M: OutputErrorModel>(
     let d_hat = params.get(d_index).value;
     let radius = 3.0 * start.std()[d_index];
     let mut results: Vec<(usize, OutputErrorFit)> = Vec::new();
-    let mut try_interval = |interval: usize, results: &mut Vec<(usize, OutputErrorFit)>| {
+    let try_interval = |interval: usize, results: &mut Vec<(usize, OutputErrorFit)>| {
         if !results.iter().any(|(i, _)| *i == interval) {
             if let Some(fit) =
                 fit_in_interval(make, data, params, estimator, &edges, interval, d_index)

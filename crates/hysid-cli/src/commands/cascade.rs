@@ -1,0 +1,237 @@
+//! Reporting and plotting a cascade identification (shared by `demo voros` and
+//! `identify cascade`).
+
+use crate::cli::UncertaintyArg;
+use crate::output::ensure_dir;
+use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
+use crate::report::{Report, Row};
+use anyhow::Result;
+use hysid::estimate::cascade::CascadeFit;
+use hysid::estimate::Uncertainty;
+use hysid::fitted::FittedModel;
+use hysid::metrics;
+use hysid::model::HysteresisCascade;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// The estimator setting for a command-line choice.
+pub fn uncertainty(arg: UncertaintyArg, replicates: usize) -> Uncertainty {
+    match arg {
+        UncertaintyArg::Asymptotic => Uncertainty::Asymptotic,
+        UncertaintyArg::Bootstrap => Uncertainty::Bootstrap(replicates),
+    }
+}
+
+/// The fitted model with the reported standard deviations.
+pub fn fitted(fit: &CascadeFit) -> FittedModel {
+    FittedModel::Cascade {
+        model: fit.model.clone(),
+        std: fit.std(),
+    }
+}
+
+/// Table rows: estimate ± std, with the truth and the initial values when known.
+pub fn rows(fit: &CascadeFit, truth: Option<&[f64]>, initial: Option<&[f64]>) -> Vec<Row> {
+    let names = fit.output_error.parameters.names();
+    let est = fit.model.params();
+    let std = fit.std();
+    names
+        .into_iter()
+        .enumerate()
+        .map(|(i, name)| Row {
+            name,
+            truth: truth.map(|t| t[i]),
+            initial: initial.and_then(|p| p.get(i).copied()),
+            estimate: est[i],
+            std: std[i],
+        })
+        .collect()
+}
+
+/// The JSON report of a cascade fit on output `y`.
+pub fn report(
+    fit: &CascadeFit,
+    y: &[f64],
+    uncertainty: Uncertainty,
+    extra: serde_json::Value,
+) -> Report {
+    let oe = &fit.output_error;
+    let yhat = &oe.simulated[0][0];
+    let key_term = fit.key_term.as_ref().map(|k| {
+        json!({
+            "termination": k.termination.to_string(),
+            "iterations": k.history.len().saturating_sub(1),
+            "history": k.history,
+            "equation_error": k.costs,
+        })
+    });
+    let mut details = json!({
+        "admissibility": fit.model.hysteresis.admissibility(),
+        "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
+        "threshold": fit.threshold,
+        "switching_consistent": fit.switching_consistent,
+        "key_term_iteration": key_term,
+        "output_error_history": oe.report.history,
+        "candidates": fit.candidates.iter().map(|c| json!({"origin": c.origin, "cost": c.cost, "start": c.start, "refined": c.refined})).collect::<Vec<_>>(),
+        "asymptotic_std": oe.std(),
+        "bootstrap": fit.bootstrap.as_ref().map(|b| json!({"replicates": b.replicates.len(), "failed": b.failed, "std": b.std})),
+    });
+    if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
+        obj.extend(more);
+    }
+    Report {
+        model: fitted(fit).to_file(),
+        fit_percent: metrics::fit_percent(y, yhat),
+        rmse: metrics::rmse(y, yhat),
+        iterations: oe.report.iterations,
+        termination: oe.report.termination.to_string(),
+        termination_code: oe.report.termination.clone(),
+        elapsed_s: fit.elapsed_s,
+        samples: y.len(),
+        loss: oe.loss,
+        fpe: oe.fpe,
+        aic: oe.aic,
+        uncertainty: match uncertainty {
+            Uncertainty::Asymptotic => "asymptotic".into(),
+            Uncertainty::Bootstrap(n) => {
+                format!("parametric bootstrap, {n} replicates (threshold d: truncated normal)")
+            }
+        },
+        details,
+    }
+}
+
+/// Prints the lines under the table: the paper's iteration, the final fit, warnings.
+pub fn print_summary(fit: &CascadeFit, report: &Report) {
+    if let Some(k) = &fit.key_term {
+        println!(
+            "  paper iteration (key-term separation): {} iterations, {}",
+            k.history.len().saturating_sub(1),
+            k.termination
+        );
+    }
+    let oe = &fit.output_error;
+    println!(
+        "  output-error fit: {} iterations, {} function evaluations, {}",
+        oe.report.iterations, oe.report.function_evaluations, oe.report.termination
+    );
+    println!(
+        "  fit {:.2} %   RMSE {:.4e}   FPE {:.4e}   time {:.2} s   std: {}",
+        report.fit_percent, report.rmse, report.fpe, fit.elapsed_s, report.uncertainty
+    );
+    let adm = fit.model.hysteresis.admissibility();
+    if !adm.holds {
+        println!(
+            "  warning: the identified hysteresis is not admissible: {}",
+            adm.violations.join("; ")
+        );
+    }
+    if !fit.model.linear.is_stable() {
+        println!(
+            "  warning: the identified linear block is unstable (spectral radius {:.4})",
+            fit.model.linear.spectral_radius()
+        );
+    }
+    if !fit.switching_consistent {
+        println!("  note: the switching function did not settle; the best classification found is reported");
+    }
+}
+
+/// Writes the cascade plots into `dir`; returns the files written.
+pub fn plots(
+    dir: &Path,
+    fit: &CascadeFit,
+    x: &[f64],
+    y: &[f64],
+    truth: Option<&HysteresisCascade>,
+) -> Result<Vec<PathBuf>> {
+    ensure_dir(dir)?;
+    let mut files = Vec::new();
+    let v_est = fit.model.hysteresis.simulate_unchecked(x, 0.0);
+    let v_true = truth.map(|t| t.hysteresis.simulate_unchecked(x, 0.0));
+    // Hysteresis loops (paper Figs. 4 and 8).
+    let mut loops = Figure::new(
+        "Hysteresis loops: v against x",
+        "x (hysteresis input)",
+        "v (hysteresis output)",
+    );
+    if let Some(v) = &v_true {
+        loops = loops.with(Series::line("true", x, v));
+    }
+    loops = loops.with(Series::dashed("identified", x, &v_est));
+    files.push(save(dir, "loops.svg", |p| plot(p, &loops))?);
+    // Input (paper Figs. 5 and 9).
+    let input = Figure::new("Input x", "sample", "x").with(Series::indexed("x", x, Style::Line));
+    files.push(save(dir, "input.svg", |p| plot(p, &input))?);
+    // Measured against simulated output.
+    let yhat = &fit.output_error.simulated[0][0];
+    let title = format!(
+        "Output: measured and simulated (fit {:.2} %)",
+        metrics::fit_percent(y, yhat)
+    );
+    let output = Figure::new(&title, "sample", "y")
+        .with(Series::indexed("measured", y, Style::Line))
+        .with(Series::indexed("simulated", yhat, Style::DashedLine));
+    files.push(save(dir, "output.svg", |p| plot(p, &output))?);
+    // Parameter estimates per iteration (paper Figs. 6–7 and 10–11).
+    let names = fit.output_error.parameters.names();
+    let truth_params = truth.map(|t| t.params());
+    if let Some(k) = fit.key_term.as_ref().filter(|k| k.history.len() > 1) {
+        let title = "Paper iteration (key-term separation): estimates per iteration";
+        files.push(save(dir, "paper_iteration.svg", |p| {
+            convergence(p, title, &names, &k.history, truth_params.as_deref())
+        })?);
+    }
+    let lm: Vec<Vec<f64>> = fit
+        .output_error
+        .report
+        .history
+        .iter()
+        .map(|r| r.theta.clone())
+        .collect();
+    if !lm.is_empty() {
+        let title = "Output-error fit: estimates per iteration";
+        files.push(save(dir, "output_error_iterations.svg", |p| {
+            convergence(p, title, &names, &lm, truth_params.as_deref())
+        })?);
+    }
+    Ok(files)
+}
+
+/// One panel per parameter: its value per iteration, and the true value when known.
+fn convergence(
+    path: &Path,
+    title: &str,
+    names: &[String],
+    history: &[Vec<f64>],
+    truth: Option<&[f64]>,
+) -> Result<()> {
+    let iterations: Vec<f64> = (0..history.len()).map(|i| i as f64).collect();
+    let columns: Vec<Vec<f64>> = (0..names.len())
+        .map(|j| history.iter().map(|h| h[j]).collect())
+        .collect();
+    let range = (0.0, (history.len().max(2) - 1) as f64);
+    let panels: Vec<Figure> = names
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let mut fig = Figure::new(name, "iteration", name).with(Series::new(
+                "estimate",
+                iterations.as_slice(),
+                columns[j].as_slice(),
+                Style::Line,
+            ));
+            if let Some(t) = truth {
+                fig = fig.with(hline("true", range, t[j]));
+            }
+            fig
+        })
+        .collect();
+    plot_panels(path, title, &panels, 2)
+}
+
+fn save(dir: &Path, name: &str, draw: impl FnOnce(&Path) -> Result<()>) -> Result<PathBuf> {
+    let path = dir.join(name);
+    draw(&path)?;
+    Ok(path)
+}

@@ -1,0 +1,224 @@
+//! `hysid identify cascade` and `hysid identify hysteresis`.
+
+use super::cascade::{fitted, plots, print_summary, report, rows, uncertainty};
+use crate::cli::{CascadeArgs, DataArgs, HysteresisArgs, InitialArg, OutputArgs};
+use crate::output::{ensure_dir, write_json};
+use crate::plot::{plot, Figure, Series, Style};
+use crate::progress::FitProgress;
+use crate::report::{print_table, Report, Row};
+use anyhow::{Context, Result};
+use hysid::data::{CsvSpec, IdData};
+use hysid::estimate::cascade::CascadeIdentification;
+use hysid::estimate::hysteresis::{HysteresisFit, HysteresisIdentification, InitialOutput};
+use hysid::fitted::FittedModel;
+use hysid::metrics;
+use hysid::model::ChForm;
+use serde_json::json;
+use std::path::Path;
+
+/// Reads the input and output columns of a CSV file.
+pub fn load(args: &DataArgs) -> Result<IdData> {
+    let spec = CsvSpec {
+        inputs: vec![args.input.clone()],
+        outputs: vec![args.output.clone()],
+        time: args.time.clone(),
+        ts: args.ts,
+    };
+    Ok(IdData::from_csv(&args.data, &spec)?)
+}
+
+/// `hysid identify cascade`.
+pub fn cascade(args: &CascadeArgs) -> Result<()> {
+    let form = ChForm::parse(&args.hysteresis)?;
+    let data = load(&args.data)?;
+    let mut id = CascadeIdentification::new(form, args.na, args.nb, args.delay);
+    id.uncertainty = uncertainty(args.uncertainty, args.replicates);
+    id.bootstrap_seed = args.seed;
+    let fit = {
+        let progress = FitProgress::new("identifying cascade");
+        let mut callback = progress.callback();
+        id.estimate(&data, &mut callback)?
+    };
+    let (x, y) = (data.experiment(0).input(0), data.experiment(0).output(0));
+    println!(
+        "Cascade {} + linear block (na = {}, nb = {}, k = {}) from {} ({} samples)",
+        form.short_name(),
+        args.na,
+        args.nb,
+        args.delay,
+        args.data.data.display(),
+        x.len()
+    );
+    print_table(&rows(&fit, None, None));
+    let extra =
+        json!({"data": args.data.data, "input": args.data.input, "output": args.data.output});
+    let report = report(&fit, y, id.uncertainty, extra);
+    print_summary(&fit, &report);
+    if let Some(dir) = &args.output.out {
+        let files = plots(dir, &fit, x, y, None)?;
+        println!("  plots: {} files in {}", files.len(), dir.display());
+    }
+    finish(&args.output, &report, &fitted(&fit))
+}
+
+/// `hysid identify hysteresis`.
+pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
+    let form = ChForm::parse(&args.hysteresis)?;
+    let data = load(&args.data)?;
+    let mut id = HysteresisIdentification::new(form);
+    id.initial = match args.initial_output {
+        InitialArg::Measured => InitialOutput::Measured,
+        InitialArg::Zero => InitialOutput::Zero,
+    };
+    let fit = {
+        let progress = FitProgress::new("identifying hysteresis");
+        let mut callback = progress.callback();
+        id.estimate(&data, &mut callback)?
+    };
+    println!(
+        "Coleman–Hodgdon hysteresis {} from {} ({} samples)",
+        form.short_name(),
+        args.data.data.display(),
+        data.n_samples()
+    );
+    let std = fit.std();
+    let rows: Vec<Row> = form
+        .parameter_names()
+        .iter()
+        .zip(fit.model.params())
+        .zip(&std)
+        .map(|((name, estimate), std)| Row {
+            name: name.to_string(),
+            truth: None,
+            initial: None,
+            estimate,
+            std: *std,
+        })
+        .collect();
+    print_table(&rows);
+    let report = hysteresis_report(&fit, &data, id.initial);
+    println!(
+        "  separated regression: d re-estimated {} times ({}); output-error fit: {} iterations, {}",
+        fit.separated.d_history.len().saturating_sub(1),
+        fit.separated.termination,
+        fit.output_error.report.iterations,
+        fit.output_error.report.termination
+    );
+    println!(
+        "  fit {:.2} %   RMSE {:.4e}   time {:.2} s",
+        report.fit_percent, report.rmse, report.elapsed_s
+    );
+    let adm = fit.model.admissibility();
+    if !adm.holds {
+        println!(
+            "  warning: the identified hysteresis is not admissible: {}",
+            adm.violations.join("; ")
+        );
+    }
+    if let Some(dir) = &args.output.out {
+        hysteresis_plots(dir, &fit, &data)?;
+        println!("  plots: {}", dir.display());
+    }
+    let fitted = FittedModel::Hysteresis {
+        model: fit.model.clone(),
+        initial: id.initial,
+        std,
+    };
+    finish(&args.output, &report, &fitted)
+}
+
+fn hysteresis_report(fit: &HysteresisFit, data: &IdData, initial: InitialOutput) -> Report {
+    let oe = &fit.output_error;
+    let y: Vec<f64> = data
+        .experiments()
+        .iter()
+        .flat_map(|e| e.output(0).iter().copied())
+        .collect();
+    let yhat: Vec<f64> = oe
+        .simulated
+        .iter()
+        .flat_map(|s| s[0].iter().copied())
+        .collect();
+    let fitted = FittedModel::Hysteresis {
+        model: fit.model.clone(),
+        initial,
+        std: fit.std(),
+    };
+    Report {
+        model: fitted.to_file(),
+        fit_percent: metrics::fit_percent(&y, &yhat),
+        rmse: metrics::rmse(&y, &yhat),
+        iterations: oe.report.iterations,
+        termination: oe.report.termination.to_string(),
+        termination_code: oe.report.termination.clone(),
+        elapsed_s: fit.elapsed_s,
+        samples: y.len(),
+        loss: oe.loss,
+        fpe: oe.fpe,
+        aic: oe.aic,
+        uncertainty: "asymptotic (threshold d: truncated normal)".into(),
+        details: json!({
+            "fit_percent_per_experiment": oe.fit_percent,
+            "admissibility": fit.model.admissibility(),
+            "threshold": fit.threshold,
+            "separated_regression": {
+                "d_history": fit.separated.d_history,
+                "termination": fit.separated.termination.to_string(),
+            },
+            "output_error_history": oe.report.history,
+        }),
+    }
+}
+
+fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()> {
+    ensure_dir(dir)?;
+    let mut loops = Figure::new(
+        "Hysteresis: measured and simulated output against input",
+        "x",
+        "y",
+    );
+    let labels: Vec<(String, String)> = (0..data.n_experiments())
+        .map(|e| {
+            (
+                format!("measured {}", e + 1),
+                format!("simulated {}", e + 1),
+            )
+        })
+        .collect();
+    for (e, exp) in data.experiments().iter().enumerate() {
+        loops = loops
+            .with(Series::points(&labels[e].0, exp.input(0), exp.output(0)))
+            .with(Series::dashed(
+                &labels[e].1,
+                exp.input(0),
+                &fit.output_error.simulated[e][0],
+            ));
+    }
+    plot(&dir.join("loops.svg"), &loops)?;
+    let exp = data.experiment(0);
+    let title = format!(
+        "Output: measured and simulated (fit {:.2} %)",
+        fit.output_error.fit_percent[0][0]
+    );
+    let output = Figure::new(&title, "sample", "y")
+        .with(Series::indexed("measured", exp.output(0), Style::Line))
+        .with(Series::indexed(
+            "simulated",
+            &fit.output_error.simulated[0][0],
+            Style::DashedLine,
+        ));
+    plot(&dir.join("output.svg"), &output)
+}
+
+/// Writes the report and the model file when asked for.
+fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<()> {
+    if let Some(path) = &output.json {
+        write_json(path, report).context("writing the JSON report")?;
+        println!("  report: {}", path.display());
+    }
+    if let Some(path) = &output.model {
+        write_json(path, &model.to_file()).context("writing the model file")?;
+        println!("  model: {}", path.display());
+    }
+    Ok(())
+}
