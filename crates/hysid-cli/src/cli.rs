@@ -24,6 +24,36 @@ pub enum Command {
     /// Simulate a saved model on the input of a CSV file (fit % and RMSE when the measured
     /// output is given).
     Simulate(SimulateArgs),
+    /// Write a built-in example's data as CSV (for benchmarks and for trying `identify`).
+    #[command(subcommand)]
+    Generate(Generate),
+}
+
+/// Data generators.
+#[derive(Debug, Subcommand)]
+pub enum Generate {
+    /// The cascade examples of MODELS.md §1.6 (columns t, x, y).
+    Voros(GenerateVorosArgs),
+}
+
+/// Options of `hysid generate voros`.
+#[derive(Debug, Args)]
+pub struct GenerateVorosArgs {
+    /// Which example: 1 or 2.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub example: u8,
+    /// Number of samples (the amplitude schedule repeats); default the example's own length.
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// Leave the output noise out.
+    #[arg(long)]
+    pub noise_free: bool,
+    /// Seed of the input disturbance and the output noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// The CSV file to write.
+    #[arg(long)]
+    pub out: PathBuf,
 }
 
 /// Built-in examples.

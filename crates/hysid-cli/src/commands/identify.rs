@@ -13,6 +13,7 @@ use hysid::estimate::hysteresis::{HysteresisFit, HysteresisIdentification, Initi
 use hysid::fitted::FittedModel;
 use hysid::metrics;
 use hysid::model::ChForm;
+use hysid::Error;
 use serde_json::json;
 use std::path::Path;
 
@@ -24,7 +25,11 @@ pub fn load(args: &DataArgs) -> Result<IdData> {
         time: args.time.clone(),
         ts: args.ts,
     };
-    Ok(IdData::from_csv(&args.data, &spec)?)
+    IdData::from_csv(&args.data, &spec).map_err(|e| match e {
+        // The data layer names channels, not files: say which file.
+        Error::NonFinite { .. } => anyhow::anyhow!("{}: {e}", args.data.display()),
+        other => other.into(),
+    })
 }
 
 /// `hysid identify cascade`.

@@ -2,10 +2,11 @@
 
 mod cascade;
 mod demo;
+mod generate;
 mod identify;
 mod simulate;
 
-use crate::cli::{Cli, Command, Demo, Identify};
+use crate::cli::{Cli, Command, Demo, Generate, Identify};
 use anyhow::Result;
 
 /// Runs the parsed command line.
@@ -15,5 +16,6 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Identify(Identify::Cascade(args)) => identify::cascade(&args),
         Command::Identify(Identify::Hysteresis(args)) => identify::hysteresis(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Generate(Generate::Voros(args)) => generate::voros(&args),
     }
 }

@@ -578,29 +578,11 @@ impl CascadeIdentification {
             uncertainty: Uncertainty::Asymptotic,
             ..self.clone()
         };
-        // The estimate itself is a feasible start for every replicate: a replicate whose global
-        // search ends above the local refit from it has failed, and the local refit stands.
-        let start = fit.parameters.values();
-        let scan = if data.n_samples() > self.window {
-            0
-        } else {
-            self.scan
-        };
         let refit = |replicate: &IdData| -> Result<Vec<f64>> {
-            let global = point.estimate(replicate, &mut |_| Control::Continue).ok();
-            let local = self
-                .fit(replicate, &start, scan, &mut |_| Control::Continue)
-                .ok();
-            let candidates = [
-                global.map(|g| (g.output_error.report.cost, g.model.params())),
-                local.map(|l| (l.fit.report.cost, l.fit.parameters.values())),
-            ];
-            candidates
-                .into_iter()
-                .flatten()
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, p)| p)
-                .ok_or_else(|| Error::Singular("bootstrap replicate could not be refitted".into()))
+            Ok(point
+                .estimate(replicate, &mut |_| Control::Continue)?
+                .model
+                .params())
         };
         let sigma = [fit.covariance.sigma2.sqrt()];
         parametric_bootstrap(
@@ -625,6 +607,7 @@ impl CascadeIdentification {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::estimate::switching::classify;
     use crate::examples::CascadeExample;
 
     /// Streamed sensitivities agree with central differences of the simulation (switching

@@ -1,0 +1,424 @@
+//! Command-line tests: the commands work end to end, and bad input gives one clear line on
+//! stderr, a non-zero exit, no panic and no output file.
+
+use assert_cmd::Command;
+use std::fs;
+use std::path::{Path, PathBuf};
+use tempfile::TempDir;
+
+fn hysid() -> Command {
+    Command::cargo_bin("hysid").unwrap()
+}
+
+/// Writes a CSV file with the given header and rows.
+fn csv(dir: &Path, name: &str, header: &str, rows: &[String]) -> PathBuf {
+    let path = dir.join(name);
+    let mut text = format!("{header}\n");
+    for r in rows {
+        text.push_str(r);
+        text.push('\n');
+    }
+    fs::write(&path, text).unwrap();
+    path
+}
+
+/// Example 1's data (noise-free) written by `hysid generate voros`.
+fn example_data(dir: &Path, noise_free: bool) -> PathBuf {
+    let path = dir.join("ex1.csv");
+    let mut cmd = hysid();
+    cmd.args(["generate", "voros", "--example", "1", "--out"])
+        .arg(&path);
+    if noise_free {
+        cmd.arg("--noise-free");
+    }
+    cmd.assert().success();
+    path
+}
+
+/// Runs `hysid identify cascade` on `data` expecting failure; returns stderr.
+fn identify_fails(data: &Path, json: &Path) -> String {
+    let out = hysid()
+        .args([
+            "identify",
+            "cascade",
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch4",
+        ])
+        .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
+        .arg(data)
+        .arg("--json")
+        .arg(json)
+        .assert()
+        .failure()
+        .get_output()
+        .clone();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one line, got: {stderr}");
+    assert!(lines[0].starts_with("error: "), "{stderr}");
+    assert!(!json.exists(), "a report was written despite the error");
+    stderr
+}
+
+fn rows(n: usize, f: impl Fn(usize) -> String) -> Vec<String> {
+    (0..n).map(f).collect()
+}
+
+#[test]
+fn demo_reports_every_parameter_and_writes_plots() {
+    let dir = TempDir::new().unwrap();
+    let json = dir.path().join("report.json");
+    let out = hysid()
+        .args([
+            "demo",
+            "voros",
+            "--example",
+            "1",
+            "--uncertainty",
+            "asymptotic",
+            "--out",
+        ])
+        .arg(dir.path())
+        .arg("--json")
+        .arg(&json)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let stdout = String::from_utf8(out).unwrap();
+    for name in [
+        "alpha",
+        "m1",
+        "c1",
+        "d",
+        "b2",
+        "a1",
+        "a2",
+        "fit",
+        "paper iteration",
+    ] {
+        assert!(stdout.contains(name), "missing {name} in:\n{stdout}");
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["model"]["kind"], "ch_cascade");
+    assert!(
+        report["model"]["parameters"]["alpha"]["value"]
+            .as_f64()
+            .unwrap()
+            > 0.29
+    );
+    assert!(
+        report["model"]["parameters"]["alpha"]["std"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    assert_eq!(report["model"]["parameters"]["b"][0]["value"], 1.0);
+    assert_eq!(
+        report["model"]["parameters"]["a"].as_array().unwrap().len(),
+        2
+    );
+    for key in [
+        "fit_percent",
+        "rmse",
+        "iterations",
+        "termination",
+        "elapsed_s",
+    ] {
+        assert!(!report[key].is_null(), "missing {key}");
+    }
+    assert!(report["fit_percent"].as_f64().unwrap() > 97.0);
+    for plot in [
+        "loops.svg",
+        "input.svg",
+        "output.svg",
+        "paper_iteration.svg",
+        "output_error_iterations.svg",
+    ] {
+        assert!(
+            dir.path().join("voros-example1").join(plot).exists(),
+            "{plot}"
+        );
+    }
+}
+
+#[test]
+fn identified_model_file_simulates_the_data() {
+    let dir = TempDir::new().unwrap();
+    let data = example_data(dir.path(), true);
+    let model = dir.path().join("model.json");
+    hysid()
+        .args([
+            "identify",
+            "cascade",
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch4",
+        ])
+        .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
+        .arg(&data)
+        .arg("--model")
+        .arg(&model)
+        .assert()
+        .success();
+    let report = dir.path().join("sim.json");
+    let sim = dir.path().join("sim.csv");
+    hysid()
+        .args(["simulate", "--input", "x", "--output", "y", "--model"])
+        .arg(&model)
+        .arg("--data")
+        .arg(&data)
+        .arg("--json")
+        .arg(&report)
+        .arg("--out")
+        .arg(&sim)
+        .assert()
+        .success();
+    let report: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(
+        report["fit_percent"].as_f64().unwrap() > 99.9999,
+        "{report}"
+    );
+    assert!(fs::read_to_string(&sim)
+        .unwrap()
+        .starts_with("x,simulated,y"));
+}
+
+#[test]
+fn hysteresis_alone_is_identified_from_a_csv_file() {
+    let dir = TempDir::new().unwrap();
+    // A hysteresis record: the examples' input through a known 6-parameter hysteresis.
+    let h = hysid::model::ColemanHodgdon::general(0.4, 1.2, 0.15, 0.6, 0.1, 2.0).unwrap();
+    let x = hysid::examples::CascadeExample::example2()
+        .generate(1, false)
+        .unwrap()
+        .x;
+    let y = h.simulate(&x, 0.0).unwrap();
+    let data = csv(
+        dir.path(),
+        "h.csv",
+        "u,v",
+        &rows(x.len(), |i| format!("{},{}", x[i], y[i])),
+    );
+    let json = dir.path().join("h.json");
+    hysid()
+        .args([
+            "identify",
+            "hysteresis",
+            "--input",
+            "u",
+            "--output",
+            "v",
+            "--hysteresis",
+            "ch6",
+            "--data",
+        ])
+        .arg(&data)
+        .arg("--json")
+        .arg(&json)
+        .assert()
+        .success();
+    let report: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["model"]["kind"], "coleman_hodgdon");
+    let d = report["model"]["parameters"]["d"]["value"]
+        .as_f64()
+        .unwrap();
+    assert!((d - 2.0).abs() < 1e-6, "{d}");
+}
+
+#[test]
+fn missing_column_is_a_one_line_error() {
+    let dir = TempDir::new().unwrap();
+    let data = csv(
+        dir.path(),
+        "a.csv",
+        "x,z",
+        &rows(100, |i| format!("{i},{i}")),
+    );
+    let err = identify_fails(&data, &dir.path().join("r.json"));
+    assert!(
+        err.contains("no column named 'y'") && err.contains("x, z"),
+        "{err}"
+    );
+}
+
+#[test]
+fn nan_is_a_one_line_error() {
+    let dir = TempDir::new().unwrap();
+    let data = csv(
+        dir.path(),
+        "a.csv",
+        "x,y",
+        &rows(100, |i| {
+            if i == 42 {
+                "nan,1".into()
+            } else {
+                format!("{i},{i}")
+            }
+        }),
+    );
+    let err = identify_fails(&data, &dir.path().join("r.json"));
+    assert!(err.contains("not finite") && err.contains("42"), "{err}");
+}
+
+#[test]
+fn non_numeric_cell_is_a_one_line_error() {
+    let dir = TempDir::new().unwrap();
+    let data = csv(
+        dir.path(),
+        "a.csv",
+        "x,y",
+        &rows(100, |i| {
+            if i == 7 {
+                "1,abc".into()
+            } else {
+                format!("{i},{i}")
+            }
+        }),
+    );
+    let err = identify_fails(&data, &dir.path().join("r.json"));
+    assert!(
+        err.contains("'abc' is not a number") && err.contains("line 9"),
+        "{err}"
+    );
+}
+
+#[test]
+fn empty_file_is_a_one_line_error() {
+    let dir = TempDir::new().unwrap();
+    let data = dir.path().join("empty.csv");
+    fs::write(&data, "").unwrap();
+    let err = identify_fails(&data, &dir.path().join("r.json"));
+    assert!(err.contains("empty"), "{err}");
+}
+
+#[test]
+fn fewer_samples_than_parameters_is_a_one_line_error() {
+    let dir = TempDir::new().unwrap();
+    let data = csv(
+        dir.path(),
+        "a.csv",
+        "x,y",
+        &rows(6, |i| format!("{},{}", i as f64 * 0.3, i)),
+    );
+    let err = identify_fails(&data, &dir.path().join("r.json"));
+    assert!(err.contains("too few samples"), "{err}");
+}
+
+#[test]
+fn constant_input_is_a_one_line_error() {
+    let dir = TempDir::new().unwrap();
+    let data = csv(
+        dir.path(),
+        "a.csv",
+        "x,y",
+        &rows(500, |i| format!("1.5,{}", (i as f64 * 0.1).sin())),
+    );
+    let err = identify_fails(&data, &dir.path().join("r.json"));
+    assert!(err.contains("does not excite"), "{err}");
+}
+
+#[test]
+fn input_too_fast_for_the_model_is_a_one_line_error() {
+    let dir = TempDir::new().unwrap();
+    let data = example_data(dir.path(), true);
+    let model = dir.path().join("model.json");
+    hysid()
+        .args([
+            "identify",
+            "cascade",
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch4",
+        ])
+        .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
+        .arg(&data)
+        .arg("--model")
+        .arg(&model)
+        .assert()
+        .success();
+    // Steps of 10 per sample: α·|Δx| = 3 with α = 0.3.
+    let fast = csv(
+        dir.path(),
+        "fast.csv",
+        "x",
+        &rows(50, |i| format!("{}", if i % 2 == 0 { -5.0 } else { 5.0 })),
+    );
+    let out_csv = dir.path().join("sim.csv");
+    let out = hysid()
+        .args(["simulate", "--input", "x", "--model"])
+        .arg(&model)
+        .arg("--data")
+        .arg(&fast)
+        .arg("--out")
+        .arg(&out_csv)
+        .assert()
+        .failure()
+        .get_output()
+        .stderr
+        .clone();
+    let err = String::from_utf8(out).unwrap();
+    assert!(
+        err.contains("too fast") && err.contains("sample 1"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1);
+    assert!(!out_csv.exists());
+}
+
+#[test]
+fn unknown_hysteresis_form_and_bad_model_file_are_one_line_errors() {
+    let dir = TempDir::new().unwrap();
+    let data = example_data(dir.path(), true);
+    let out = hysid()
+        .args([
+            "identify",
+            "cascade",
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch5",
+        ])
+        .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
+        .arg(&data)
+        .assert()
+        .failure()
+        .get_output()
+        .stderr
+        .clone();
+    assert!(String::from_utf8(out).unwrap().contains("use ch4"));
+    let bad = dir.path().join("bad.json");
+    fs::write(&bad, "{\"kind\": 3}").unwrap();
+    let out = hysid()
+        .args(["simulate", "--input", "x", "--model"])
+        .arg(&bad)
+        .arg("--data")
+        .arg(&data)
+        .assert()
+        .failure()
+        .get_output()
+        .stderr
+        .clone();
+    let err = String::from_utf8(out).unwrap();
+    assert!(
+        err.contains("not a hysid model file") && err.lines().count() == 1,
+        "{err}"
+    );
+}
