@@ -115,12 +115,13 @@ pub struct DataArgs {
     /// CSV file with a header row.
     #[arg(long)]
     pub data: PathBuf,
-    /// Input column (the hysteresis input x).
-    #[arg(long)]
-    pub input: String,
-    /// Output column.
-    #[arg(long)]
-    pub output: String,
+    /// Input column (the hysteresis input x). Repeat --input/--output pairs to fit several
+    /// experiments (e.g. loops measured separately) together.
+    #[arg(long, required = true)]
+    pub input: Vec<String>,
+    /// Output column (one per --input).
+    #[arg(long, required = true)]
+    pub output: Vec<String>,
     /// Sample time; otherwise from the time column, else 1.
     #[arg(long)]
     pub ts: Option<f64>,

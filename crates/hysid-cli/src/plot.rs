@@ -938,4 +938,4 @@ mod tests {
 }
 
 #[cfg(test)]
-mod tests;
+mod render_tests;

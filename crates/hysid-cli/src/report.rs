@@ -1,7 +1,8 @@
 //! The JSON report and the printed parameter table.
 
-use hysid::estimate::Termination;
+use hysid::estimate::{OutputErrorFit, Termination};
 use hysid::fitted::ModelFile;
+use hysid::metrics;
 use serde::Serialize;
 
 /// The JSON report every identification command writes with `--json`.
@@ -33,6 +34,35 @@ pub struct Report {
     pub uncertainty: String,
     /// Command-specific details.
     pub details: serde_json::Value,
+}
+
+impl Report {
+    /// The report of an output-error fit whose simulated output `yhat` is compared with the
+    /// measured `y`.
+    pub fn new(
+        model: ModelFile,
+        fit: &OutputErrorFit,
+        (y, yhat): (&[f64], &[f64]),
+        elapsed_s: f64,
+        uncertainty: String,
+        details: serde_json::Value,
+    ) -> Self {
+        Self {
+            model,
+            fit_percent: metrics::fit_percent(y, yhat),
+            rmse: metrics::rmse(y, yhat),
+            iterations: fit.report.iterations,
+            termination: fit.report.termination.to_string(),
+            termination_code: fit.report.termination.clone(),
+            elapsed_s,
+            samples: y.len(),
+            loss: fit.loss,
+            fpe: fit.fpe,
+            aic: fit.aic,
+            uncertainty,
+            details,
+        }
+    }
 }
 
 /// One row of the printed parameter table.

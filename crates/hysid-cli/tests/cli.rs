@@ -35,21 +35,27 @@ fn example_data(dir: &Path, noise_free: bool) -> PathBuf {
     path
 }
 
+/// `hysid identify cascade` on `data` with Example 1's structure.
+fn identify_cascade(data: &Path) -> Command {
+    let mut cmd = hysid();
+    cmd.args([
+        "identify",
+        "cascade",
+        "--input",
+        "x",
+        "--output",
+        "y",
+        "--hysteresis",
+        "ch4",
+    ])
+    .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
+    .arg(data);
+    cmd
+}
+
 /// Runs `hysid identify cascade` on `data` expecting failure; returns stderr.
 fn identify_fails(data: &Path, json: &Path) -> String {
-    let out = hysid()
-        .args([
-            "identify",
-            "cascade",
-            "--input",
-            "x",
-            "--output",
-            "y",
-            "--hysteresis",
-            "ch4",
-        ])
-        .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
-        .arg(data)
+    let out = identify_cascade(data)
         .arg("--json")
         .arg(json)
         .assert()
@@ -154,19 +160,7 @@ fn identified_model_file_simulates_the_data() {
     let dir = TempDir::new().unwrap();
     let data = example_data(dir.path(), true);
     let model = dir.path().join("model.json");
-    hysid()
-        .args([
-            "identify",
-            "cascade",
-            "--input",
-            "x",
-            "--output",
-            "y",
-            "--hysteresis",
-            "ch4",
-        ])
-        .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
-        .arg(&data)
+    identify_cascade(&data)
         .arg("--model")
         .arg(&model)
         .assert()
@@ -335,19 +329,7 @@ fn input_too_fast_for_the_model_is_a_one_line_error() {
     let dir = TempDir::new().unwrap();
     let data = example_data(dir.path(), true);
     let model = dir.path().join("model.json");
-    hysid()
-        .args([
-            "identify",
-            "cascade",
-            "--input",
-            "x",
-            "--output",
-            "y",
-            "--hysteresis",
-            "ch4",
-        ])
-        .args(["--na", "2", "--nb", "2", "--delay", "1", "--data"])
-        .arg(&data)
+    identify_cascade(&data)
         .arg("--model")
         .arg(&model)
         .assert()

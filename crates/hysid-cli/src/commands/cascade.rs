@@ -79,26 +79,20 @@ pub fn report(
     if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
         obj.extend(more);
     }
-    Report {
-        model: fitted(fit).to_file(),
-        fit_percent: metrics::fit_percent(y, yhat),
-        rmse: metrics::rmse(y, yhat),
-        iterations: oe.report.iterations,
-        termination: oe.report.termination.to_string(),
-        termination_code: oe.report.termination.clone(),
-        elapsed_s: fit.elapsed_s,
-        samples: y.len(),
-        loss: oe.loss,
-        fpe: oe.fpe,
-        aic: oe.aic,
-        uncertainty: match uncertainty {
-            Uncertainty::Asymptotic => "asymptotic".into(),
-            Uncertainty::Bootstrap(n) => {
-                format!("parametric bootstrap, {n} replicates (threshold d: truncated normal)")
-            }
-        },
+    let uncertainty = match uncertainty {
+        Uncertainty::Asymptotic => "asymptotic (threshold d: truncated normal)".into(),
+        Uncertainty::Bootstrap(n) => {
+            format!("parametric bootstrap, {n} replicates (threshold d: truncated normal)")
+        }
+    };
+    Report::new(
+        fitted(fit).to_file(),
+        oe,
+        (y, yhat),
+        fit.elapsed_s,
+        uncertainty,
         details,
-    }
+    )
 }
 
 /// Prints the lines under the table: the paper's iteration, the final fit, warnings.

@@ -7,29 +7,63 @@ use crate::plot::{plot, Figure, Series, Style};
 use crate::progress::FitProgress;
 use crate::report::{print_table, Report, Row};
 use anyhow::{Context, Result};
-use hysid::data::{CsvSpec, IdData};
+use hysid::data::{Channel, CsvSpec, Experiment, IdData};
 use hysid::estimate::cascade::CascadeIdentification;
 use hysid::estimate::hysteresis::{HysteresisFit, HysteresisIdentification, InitialOutput};
 use hysid::fitted::FittedModel;
-use hysid::metrics;
 use hysid::model::ChForm;
 use hysid::Error;
 use serde_json::json;
 use std::path::Path;
 
-/// Reads the input and output columns of a CSV file.
+/// Reads the input and output columns of a CSV file: one experiment per --input/--output
+/// pair.
 pub fn load(args: &DataArgs) -> Result<IdData> {
-    let spec = CsvSpec {
-        inputs: vec![args.input.clone()],
-        outputs: vec![args.output.clone()],
-        time: args.time.clone(),
-        ts: args.ts,
-    };
-    IdData::from_csv(&args.data, &spec).map_err(|e| match e {
-        // The data layer names channels, not files: say which file.
-        Error::NonFinite { .. } => anyhow::anyhow!("{}: {e}", args.data.display()),
-        other => other.into(),
-    })
+    anyhow::ensure!(
+        args.input.len() == args.output.len(),
+        "give one --output per --input ({} inputs, {} outputs)",
+        args.input.len(),
+        args.output.len()
+    );
+    let mut data: Option<IdData> = None;
+    for (k, (input, output)) in args.input.iter().zip(&args.output).enumerate() {
+        let spec = CsvSpec {
+            inputs: vec![input.clone()],
+            outputs: vec![output.clone()],
+            time: args.time.clone(),
+            ts: args.ts,
+        };
+        let experiment = IdData::from_csv(&args.data, &spec).map_err(|e| match e {
+            // The data layer names channels, not files: say which file.
+            Error::NonFinite { .. } => anyhow::anyhow!("{}: {e}", args.data.display()),
+            other => other.into(),
+        })?;
+        data = Some(match data {
+            None => experiment,
+            // Later pairs become further experiments under the first pair's channel names.
+            Some(d) => {
+                let renamed = rename(experiment, d.input_channels(), d.output_channels(), k)?;
+                d.merge(renamed)?
+            }
+        });
+    }
+    data.ok_or_else(|| anyhow::anyhow!("give at least one --input/--output pair"))
+}
+
+/// The experiment of `data` under the given channel names, named "experiment k+1".
+fn rename(data: IdData, inputs: &[Channel], outputs: &[Channel], k: usize) -> Result<IdData> {
+    let exp = data.experiment(0);
+    let experiment = Experiment::new(
+        format!("experiment {}", k + 1),
+        vec![exp.input(0).to_vec()],
+        vec![exp.output(0).to_vec()],
+    )?;
+    Ok(IdData::new(
+        data.ts(),
+        inputs.to_vec(),
+        outputs.to_vec(),
+        vec![experiment],
+    )?)
 }
 
 /// `hysid identify cascade`.
@@ -149,38 +183,34 @@ fn hysteresis_report(fit: &HysteresisFit, data: &IdData, initial: InitialOutput)
         initial,
         std: fit.std(),
     };
-    Report {
-        model: fitted.to_file(),
-        fit_percent: metrics::fit_percent(&y, &yhat),
-        rmse: metrics::rmse(&y, &yhat),
-        iterations: oe.report.iterations,
-        termination: oe.report.termination.to_string(),
-        termination_code: oe.report.termination.clone(),
-        elapsed_s: fit.elapsed_s,
-        samples: y.len(),
-        loss: oe.loss,
-        fpe: oe.fpe,
-        aic: oe.aic,
-        uncertainty: "asymptotic (threshold d: truncated normal)".into(),
-        details: json!({
-            "fit_percent_per_experiment": oe.fit_percent,
-            "admissibility": fit.model.admissibility(),
-            "threshold": fit.threshold,
-            "separated_regression": {
-                "d_history": fit.separated.d_history,
-                "termination": fit.separated.termination.to_string(),
-            },
-            "output_error_history": oe.report.history,
-        }),
-    }
+    let details = json!({
+        "fit_percent_per_experiment": oe.fit_percent,
+        "admissibility": fit.model.admissibility(),
+        "threshold": fit.threshold,
+        "separated_regression": {
+            "d_history": fit.separated.d_history,
+            "termination": fit.separated.termination.to_string(),
+        },
+        "output_error_history": oe.report.history,
+    });
+    Report::new(
+        fitted.to_file(),
+        oe,
+        (&y, &yhat),
+        fit.elapsed_s,
+        "asymptotic (threshold d: truncated normal)".into(),
+        details,
+    )
 }
 
 fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()> {
     ensure_dir(dir)?;
+    let x_name = data.input_channels()[0].to_string();
+    let y_name = data.output_channels()[0].to_string();
     let mut loops = Figure::new(
         "Hysteresis: measured and simulated output against input",
-        "x",
-        "y",
+        &x_name,
+        &y_name,
     );
     let labels: Vec<(String, String)> = (0..data.n_experiments())
         .map(|e| {
@@ -205,7 +235,7 @@ fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()
         "Output: measured and simulated (fit {:.2} %)",
         fit.output_error.fit_percent[0][0]
     );
-    let output = Figure::new(&title, "sample", "y")
+    let output = Figure::new(&title, "sample", &y_name)
         .with(Series::indexed("measured", exp.output(0), Style::Line))
         .with(Series::indexed(
             "simulated",

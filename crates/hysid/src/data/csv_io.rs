@@ -52,7 +52,7 @@ impl IdData {
     /// differ from it by more than 1 %. See the [module documentation](self) for errors.
     ///
     /// ```
-    /// use hysid_data::data::{CsvSpec, IdData};
+    /// use hysid::data::{CsvSpec, IdData};
     ///
     /// let dir = tempfile::tempdir()?;
     /// let path = dir.path().join("run.csv");

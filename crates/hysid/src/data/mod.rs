@@ -189,7 +189,7 @@ impl IdData {
     /// Single-input single-output data of one experiment.
     ///
     /// ```
-    /// use hysid_data::data::IdData;
+    /// use hysid::data::IdData;
     ///
     /// let data = IdData::siso(0.01, "u", vec![0.0, 1.0, 2.0], "y", vec![0.0, 0.5, 1.5])?;
     /// assert_eq!(data.ts(), 0.01);
@@ -198,7 +198,7 @@ impl IdData {
     ///
     /// // Validation: the channels must have the same length.
     /// assert!(IdData::siso(0.01, "u", vec![0.0, 1.0], "y", vec![0.0]).is_err());
-    /// # Ok::<(), hysid_data::Error>(())
+    /// # Ok::<(), hysid::Error>(())
     /// ```
     pub fn siso(
         ts: f64,

@@ -17,12 +17,9 @@
 //!
 //! With the estimate θ̂, its simulated outputs ŷ and the residual standard deviation σ̂ of each
 //! output, B replicate data sets y* = ŷ + e*, e* ~ N(0, σ̂²) white, are fitted again by the
-//! caller's refit procedure; the spread of each parameter over the replicates is reported as
-//! half the width of its central 68.3 % interval (the percentile standard error: for a normal
-//! distribution it is the standard deviation, and unlike the sample standard deviation it is
-//! not dominated by the odd replicate whose refit found a poor local minimum; Efron &
-//! Tibshirani, An Introduction to the Bootstrap, 1993, ch. 6 and 13). Replicates run in
-//! parallel, each with its own seeded stream.
+//! caller's refit procedure; the standard deviation of each parameter over the replicates is
+//! reported (Efron & Tibshirani, An Introduction to the Bootstrap, 1993, ch. 6). Replicates
+//! run in parallel, each with its own seeded stream.
 
 use crate::data::{Experiment, IdData};
 use crate::signal::gaussian_noise;
@@ -32,8 +29,7 @@ use rayon::prelude::*;
 /// The spread of an estimate over bootstrap replicates.
 #[derive(Clone, Debug)]
 pub struct Bootstrap {
-    /// Half the width of the central 68.3 % interval of every parameter over the successful
-    /// replicates (the percentile-bootstrap standard error).
+    /// Standard deviation of every parameter over the successful replicates.
     pub std: Vec<f64>,
     /// The replicate estimates.
     pub replicates: Vec<Vec<f64>>,
@@ -77,11 +73,11 @@ pub fn parametric_bootstrap(
         )));
     }
     let p = ok[0].len();
+    let n = ok.len() as f64;
     let std = (0..p)
         .map(|i| {
-            let mut column: Vec<f64> = ok.iter().map(|r| r[i]).collect();
-            column.sort_by(f64::total_cmp);
-            0.5 * (quantile(&column, 0.841_344_746) - quantile(&column, 0.158_655_254))
+            let mean = ok.iter().map(|r| r[i]).sum::<f64>() / n;
+            (ok.iter().map(|r| (r[i] - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
         })
         .collect();
     Ok(Bootstrap {
@@ -89,14 +85,6 @@ pub fn parametric_bootstrap(
         replicates: ok,
         failed,
     })
-}
-
-/// The q-quantile of sorted values, linearly interpolated between order statistics.
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    let pos = q * (sorted.len() - 1) as f64;
-    let lo = pos.floor() as usize;
-    let hi = (lo + 1).min(sorted.len() - 1);
-    sorted[lo] + (pos - lo as f64) * (sorted[hi] - sorted[lo])
 }
 
 /// One replicate: the simulated outputs plus fresh white Gaussian noise.

@@ -23,15 +23,16 @@
 use super::bootstrap::{parametric_bootstrap, Bootstrap};
 use super::global::{GlobalSearch, GridCandidate};
 use super::hysteresis::{
-    check_excitation, check_finite, hysteresis_sensitivities, max_abs_input, max_increment,
+    bounded_parameter, check_excitation, check_finite, hysteresis_sensitivities, max_increment,
     rate_error, simulate_switched,
 };
 use super::key_term::{KeyTermFit, KeyTermSeparation};
 use super::levenberg_marquardt::{Control, IterationRecord, LmConfig};
 use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel, SensitivitySink};
-use super::parameters::{Parameter, ParameterSet};
+use super::parameters::ParameterSet;
 use super::switching::{
-    fit_with_switching_updates, place_threshold, SwitchedFit, Switching, ThresholdPosterior,
+    fit_with_switching_updates, place_threshold, true_cost, SwitchedFit, Switching,
+    ThresholdPosterior,
 };
 use super::Uncertainty;
 use crate::data::{Experiment, IdData};
@@ -67,22 +68,14 @@ impl CascadeStructure {
         HysteresisCascade::from_params(self.form, self.na, self.nb, self.delay, theta)
     }
 
-    /// Parameters with values `theta`, α bounded by the rate limit 1/max|Δx| and d > 0.
+    /// Parameters with values `theta`, α and d bounded as the data require (see
+    /// [`bounded_parameter`]).
     pub fn parameter_set(&self, theta: &[f64], data: &IdData) -> ParameterSet {
-        let alpha_max = 1.0 / max_increment(data);
-        let d_min = 1e-9 * max_abs_input(data);
         let names = HysteresisCascade::parameter_names(self.form, self.na, self.nb);
         let params = names
             .iter()
             .zip(theta)
-            .map(|(name, &value)| {
-                let p = Parameter::new(name.clone(), value);
-                match name.as_str() {
-                    "alpha" => p.bounds(f64::MIN_POSITIVE, alpha_max),
-                    "d" => p.bounds(d_min, f64::INFINITY),
-                    _ => p,
-                }
-            })
+            .map(|(name, &value)| bounded_parameter(name, value, data))
             .collect();
         ParameterSet::new(params).expect("cascade parameter names are unique")
     }
@@ -296,8 +289,8 @@ pub struct CascadeFit {
 
 impl CascadeFit {
     /// The reported standard deviations ([`HysteresisCascade::params`] order): the
-    /// bootstrap's when it ran, else the asymptotic ones of the output-error fit; for d the
-    /// truncated-normal one of [`threshold_posterior`] in both cases.
+    /// bootstrap's when it ran, else the asymptotic ones, with the truncated-normal one of
+    /// [`ThresholdPosterior`] for d.
     pub fn std(&self) -> Vec<f64> {
         let mut std = self
             .bootstrap
@@ -578,11 +571,28 @@ impl CascadeIdentification {
             uncertainty: Uncertainty::Asymptotic,
             ..self.clone()
         };
+        // A refit that does worse on its replicate than the estimate it was generated from has
+        // failed (its global search ended in a poor minimum); the local refit from the
+        // estimate replaces it. A refit that does better stays, whichever minimum it found:
+        // that is how the bootstrap sees nearly equal minima.
+        let start = fit.parameters.values();
+        let scan = if data.n_samples() > self.window {
+            0
+        } else {
+            self.scan
+        };
         let refit = |replicate: &IdData| -> Result<Vec<f64>> {
-            Ok(point
-                .estimate(replicate, &mut |_| Control::Continue)?
-                .model
-                .params())
+            let reference = true_cost(&self.structure, replicate, &start)?;
+            if let Ok(global) = point.estimate(replicate, &mut |_| Control::Continue) {
+                if global.output_error.report.cost <= reference {
+                    return Ok(global.model.params());
+                }
+            }
+            Ok(self
+                .fit(replicate, &start, scan, &mut |_| Control::Continue)?
+                .fit
+                .parameters
+                .values())
         };
         let sigma = [fit.covariance.sigma2.sqrt()];
         parametric_bootstrap(

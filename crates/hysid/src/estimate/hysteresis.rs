@@ -87,12 +87,24 @@ impl HysteresisStructure {
 
 impl OutputErrorModel for HysteresisStructure {
     fn parameters(&self) -> ParameterSet {
-        positive_hysteresis_parameters(
-            self.form,
-            &vec![1.0; self.form.n_params()],
-            f64::INFINITY,
-            f64::MIN_POSITIVE,
-        )
+        let names: Vec<String> = self
+            .form
+            .parameter_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let params = names
+            .iter()
+            .map(|name| {
+                let p = Parameter::new(name.clone(), 1.0);
+                if name == "alpha" || name == "d" {
+                    p.bounds(f64::MIN_POSITIVE, f64::INFINITY)
+                } else {
+                    p
+                }
+            })
+            .collect();
+        ParameterSet::new(params).expect("names of a ChForm are unique")
     }
 
     fn n_outputs(&self) -> usize {
@@ -170,25 +182,32 @@ pub fn hysteresis_sensitivities(
     }
 }
 
-/// Parameters of a hysteresis with α in (alpha_min, alpha_max] and d > d_min.
-pub(crate) fn positive_hysteresis_parameters(
+/// The bounds the data put on a hysteresis parameter: α in (0, 1/max|Δx|] (the rate limit
+/// of (D)) and d in [10⁻⁹·max|x|, max|x|] (beyond the input range no sample ever switches, so
+/// the data say nothing about d); other parameters are free.
+pub(crate) fn bounded_parameter(name: &str, value: f64, data: &IdData) -> Parameter {
+    let p = Parameter::new(name, value);
+    match name {
+        "alpha" => p.bounds(f64::MIN_POSITIVE, 1.0 / max_increment(data)),
+        "d" => {
+            let max_x = max_abs_input(data);
+            p.bounds(1e-9 * max_x, max_x)
+        }
+        _ => p,
+    }
+}
+
+/// The hysteresis parameters `values` with the bounds of [`bounded_parameter`].
+pub(crate) fn bounded_hysteresis_parameters(
     form: ChForm,
     values: &[f64],
-    alpha_max: f64,
-    d_min: f64,
+    data: &IdData,
 ) -> ParameterSet {
     let params = form
         .parameter_names()
         .iter()
         .zip(values)
-        .map(|(&name, &value)| {
-            let p = Parameter::new(name, value);
-            match name {
-                "alpha" => p.bounds(f64::MIN_POSITIVE, alpha_max),
-                "d" => p.bounds(d_min, f64::INFINITY),
-                _ => p,
-            }
-        })
+        .map(|(&name, &value)| bounded_parameter(name, value, data))
         .collect();
     ParameterSet::new(params).expect("names of a ChForm are unique")
 }
@@ -309,12 +328,11 @@ impl HysteresisIdentification {
         let alpha_max = 1.0 / max_increment(data);
         let mut start = separated.model.params();
         start[0] = start[0].min(alpha_max);
-        let params = positive_hysteresis_parameters(
-            self.form,
-            &start,
-            alpha_max,
-            1e-9 * max_abs_input(data),
-        );
+        let mut params = bounded_hysteresis_parameters(self.form, &start, data);
+        for k in 0..params.len() {
+            let p = params.get_mut(k);
+            p.value = p.value.clamp(p.min, p.max);
+        }
         let estimator = OutputError {
             config: self.lm.clone(),
             ..OutputError::default()

@@ -681,48 +681,52 @@ mod tests {
         Decay { t, y }
     }
 
+    /// Fits the decay from `start` with free parameters `free` inside [lo, hi].
+    fn fit(
+        start: [f64; 2],
+        free: &[usize],
+        lo: [f64; 2],
+        hi: [f64; 2],
+        control: Control,
+    ) -> LmReport {
+        minimize(
+            &decay(),
+            &start,
+            free,
+            &lo,
+            &hi,
+            &LmConfig::default(),
+            &mut |_| control,
+        )
+        .unwrap()
+    }
+
+    const INF: f64 = f64::INFINITY;
+
     #[test]
     fn recovers_exact_parameters_from_far_start() {
-        let p = decay();
-        let inf = f64::INFINITY;
-        let report = minimize(
-            &p,
-            &[0.5, 4.0],
-            &[0, 1],
-            &[-inf, -inf],
-            &[inf, inf],
-            &LmConfig::default(),
-            &mut |_| Control::Continue,
-        )
-        .unwrap();
+        let report = fit([0.5, 4.0], &[0, 1], [-INF; 2], [INF; 2], Control::Continue);
         assert!((report.theta[0] - 2.5).abs() < 1e-9, "{:?}", report);
         assert!((report.theta[1] - 1.3).abs() < 1e-9);
     }
 
     #[test]
     fn respects_bounds_and_fixed_parameters() {
-        let p = decay();
-        let report = minimize(
-            &p,
-            &[1.0, 1.0],
+        let report = fit(
+            [1.0, 1.0],
             &[0, 1],
-            &[0.0, 0.0],
-            &[2.0, 10.0],
-            &LmConfig::default(),
-            &mut |_| Control::Continue,
-        )
-        .unwrap();
+            [0.0, 0.0],
+            [2.0, 10.0],
+            Control::Continue,
+        );
         assert_eq!(report.theta[0], 2.0);
-        let fixed = minimize(
-            &p,
-            &[2.5, 1.0],
+        let fixed = fit(
+            [2.5, 1.0],
             &[1],
-            &[0.0, 0.0],
-            &[10.0, 10.0],
-            &LmConfig::default(),
-            &mut |_| Control::Continue,
-        )
-        .unwrap();
+            [0.0, 0.0],
+            [10.0, 10.0],
+            Control::Continue,
+        );
         assert_eq!(fixed.theta[0], 2.5);
         assert!((fixed.theta[1] - 1.3).abs() < 1e-9);
         assert_eq!(fixed.covariance().std[0], 0.0);
@@ -730,19 +734,34 @@ mod tests {
 
     #[test]
     fn callback_can_stop() {
-        let p = decay();
-        let inf = f64::INFINITY;
-        let report = minimize(
-            &p,
-            &[0.5, 4.0],
-            &[0, 1],
-            &[-inf, -inf],
-            &[inf, inf],
-            &LmConfig::default(),
-            &mut |_| Control::Stop,
-        )
-        .unwrap();
+        let report = fit([0.5, 4.0], &[0, 1], [-INF; 2], [INF; 2], Control::Stop);
         assert_eq!(report.termination, Termination::Stopped);
         assert_eq!(report.iterations, 1);
+    }
+
+    /// A trial point where the model cannot be simulated is rejected, not fatal: the decay
+    /// refuses b < −5, and a start near that wall still converges.
+    #[test]
+    fn diverging_trials_are_rejected() {
+        let report = fit([8.0, -4.9], &[0, 1], [-INF; 2], [INF; 2], Control::Continue);
+        assert!(
+            report.rejected_trials > 0,
+            "no trial was rejected: {report:?}"
+        );
+        assert!((report.theta[1] - 1.3).abs() < 1e-9, "{report:?}");
+    }
+
+    #[test]
+    fn a_model_that_cannot_start_is_an_error() {
+        let err = minimize(
+            &decay(),
+            &[1.0, -6.0],
+            &[0, 1],
+            &[-INF; 2],
+            &[INF; 2],
+            &LmConfig::default(),
+            &mut |_| Control::Continue,
+        );
+        assert!(err.is_err());
     }
 }

@@ -82,7 +82,7 @@ pub fn least_squares(phi: &DMatrix<f64>, y: &[f64], names: &[&str]) -> Result<Ls
     let smax = svd.singular_values.max();
     let smin = svd.singular_values.min();
     let condition_number = smax / smin;
-    if !(condition_number < MAX_CONDITION) {
+    if condition_number.is_nan() || condition_number >= MAX_CONDITION {
         return Err(Error::Singular(format!(
             "regressors {} are (nearly) linearly dependent (condition number {condition_number:.3e}); \
              the data do not excite the model enough or it has too many parameters",

@@ -126,7 +126,7 @@ fn conditional_shift(report: &LmReport, fixed: usize, delta: f64) -> Vec<(usize,
 
 /// Mean and standard deviation of N(μ, s²) truncated to [a, b].
 fn truncated_normal(mu: f64, s: f64, a: f64, b: f64) -> (f64, f64) {
-    if !(s > 0.0) || !s.is_finite() {
+    if s.is_nan() || s <= 0.0 || !s.is_finite() {
         return (mu.clamp(a, b), 0.0);
     }
     if b.is_finite() {
@@ -384,14 +384,14 @@ fn fit_in_interval<M: OutputErrorModel>(
     d_index: usize,
 ) -> Option<OutputErrorFit> {
     let (lo, hi) = (edges[i - 1], edges[i] - edges[i].abs() * 1e-14);
-    if !(hi > lo) {
+    if hi.is_nan() || hi <= lo {
         return None;
     }
     let mut params = start.clone();
     let d = params.get_mut(d_index);
     d.min = lo.max(d.min);
     d.max = hi.min(d.max);
-    if !(d.min < d.max) {
+    if d.min.is_nan() || d.min >= d.max {
         return None;
     }
     d.value = d.value.clamp(d.min, d.max);
@@ -421,8 +421,8 @@ fn interval_of(edges: &[f64], d: f64) -> usize {
         .clamp(1, edges.len().saturating_sub(1).max(1))
 }
 
-/// The output-error sum of squares of `model` at `theta`, switching following d.
-fn true_cost(model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<f64> {
+/// The output-error sum of squares of `model` at `theta` over output 0 of every experiment.
+pub fn true_cost(model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<f64> {
     let mut total = 0.0;
     for (e, exp) in data.experiments().iter().enumerate() {
         let mut y = vec![vec![0.0; exp.len()]];
