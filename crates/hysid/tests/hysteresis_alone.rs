@@ -99,3 +99,66 @@ fn noisy_estimates_lie_within_their_standard_deviations() {
         "{inside}/{total} within 3 std"
     );
 }
+
+/// Real records vendored in `data/` (no published parameters exist for them): the
+/// identification runs and fits them at least as well as recorded in the README.
+#[test]
+fn real_piezo_and_ferrite_records_are_fitted() {
+    use hysid::data::CsvSpec;
+    use std::path::Path;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
+    let spec = |input: &str, output: &str| CsvSpec {
+        inputs: vec![input.into()],
+        outputs: vec![output.into()],
+        time: None,
+        ts: None,
+    };
+    let piezo = IdData::from_csv(
+        &root.join("piezo/piezo_150V_1Hz.csv"),
+        &spec("voltage_V", "displacement_um"),
+    )
+    .unwrap();
+    let fit = HysteresisIdentification::new(ChForm::General6)
+        .estimate(&piezo, &mut |_| Control::Continue)
+        .unwrap();
+    assert!(
+        fit.output_error.fit_percent[0][0] > 99.4,
+        "piezo fit {:?}",
+        fit.output_error.fit_percent
+    );
+
+    let file = root.join("ferrite/mnzn_ferrite_bh_loops.csv");
+    let mut loops: Option<IdData> = None;
+    for k in 1..=4 {
+        let one =
+            IdData::from_csv(&file, &spec(&format!("H{k}_A_per_m"), &format!("B{k}_T"))).unwrap();
+        let exp = one.experiment(0);
+        let renamed = IdData::new(
+            one.ts(),
+            vec![Channel::new("H")],
+            vec![Channel::new("B")],
+            vec![Experiment::new(
+                format!("loop {k}"),
+                vec![exp.input(0).to_vec()],
+                vec![exp.output(0).to_vec()],
+            )
+            .unwrap()],
+        )
+        .unwrap();
+        loops = Some(match loops {
+            None => renamed,
+            Some(l) => l.merge(renamed).unwrap(),
+        });
+    }
+    let loops = loops.unwrap();
+    let fit = HysteresisIdentification::new(ChForm::General6)
+        .estimate(&loops, &mut |_| Control::Continue)
+        .unwrap();
+    for f in &fit.output_error.fit_percent {
+        assert!(
+            f[0] > 92.0,
+            "ferrite fits {:?}",
+            fit.output_error.fit_percent
+        );
+    }
+}

@@ -70,6 +70,7 @@ pub fn report(
         "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
         "threshold": fit.threshold,
         "switching_consistent": fit.switching_consistent,
+        "fit_percent_per_experiment": oe.fit_percent,
         "key_term_iteration": key_term,
         "output_error_history": oe.report.history,
         "candidates": fit.candidates.iter().map(|c| json!({"origin": c.origin, "cost": c.cost, "start": c.start, "refined": c.refined})).collect::<Vec<_>>(),
@@ -127,7 +128,9 @@ pub fn print_summary(fit: &CascadeFit, report: &Report) {
         );
     }
     if !fit.switching_consistent {
-        println!("  note: the switching function did not settle; the best classification found is reported");
+        println!(
+            "  note: re-classifying the samples by the final d did not lower the criterion; the best classification is kept"
+        );
     }
 }
 

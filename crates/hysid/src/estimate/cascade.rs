@@ -347,23 +347,9 @@ impl CascadeIdentification {
             window.experiment(0).input(0),
             window.experiment(0).output(0),
         );
-        let dbg = std::env::var("HYSID_TIMING").is_ok();
         let grid = self.grid.search(x, y)?;
-        if dbg {
-            eprintln!("grid {:.3}", clock.elapsed().as_secs_f64());
-        }
         let key_term = self.run_key_term(&window, &grid)?;
-        if dbg {
-            eprintln!("kts {:.3}", clock.elapsed().as_secs_f64());
-        }
         let candidates = self.refine_candidates(&window, &grid, key_term.as_ref());
-        if dbg {
-            eprintln!(
-                "candidates {:.3} n={}",
-                clock.elapsed().as_secs_f64(),
-                candidates.len()
-            );
-        }
         let best = candidates
             .iter()
             .min_by(|a, b| a.cost.total_cmp(&b.cost))
@@ -385,17 +371,7 @@ impl CascadeIdentification {
         } else {
             best.refined.clone()
         };
-        if dbg {
-            eprintln!("window scan {:.3}", clock.elapsed().as_secs_f64());
-        }
         let switched = self.fit(data, &start, if long { 0 } else { self.scan }, callback)?;
-        if dbg {
-            eprintln!(
-                "final fit {:.3} fits {}",
-                clock.elapsed().as_secs_f64(),
-                switched.fits
-            );
-        }
         let d_index = self.structure.form.n_params() - 1;
         let (output_error, threshold) = place_threshold(&self.make(), data, switched.fit, d_index)?;
         let model = self.structure.cascade(&output_error.parameters.values())?;
