@@ -53,6 +53,18 @@ fn identify_cascade(data: &Path) -> Command {
     cmd
 }
 
+/// Example 1's noise-free data and the model file identified from it.
+fn identified_example(dir: &Path) -> (PathBuf, PathBuf) {
+    let data = example_data(dir, true);
+    let model = dir.join("model.json");
+    identify_cascade(&data)
+        .arg("--model")
+        .arg(&model)
+        .assert()
+        .success();
+    (data, model)
+}
+
 /// Runs `hysid identify cascade` on `data` expecting failure; returns stderr.
 fn identify_fails(data: &Path, json: &Path) -> String {
     let out = identify_cascade(data)
@@ -158,13 +170,7 @@ fn demo_reports_every_parameter_and_writes_plots() {
 #[test]
 fn identified_model_file_simulates_the_data() {
     let dir = TempDir::new().unwrap();
-    let data = example_data(dir.path(), true);
-    let model = dir.path().join("model.json");
-    identify_cascade(&data)
-        .arg("--model")
-        .arg(&model)
-        .assert()
-        .success();
+    let (data, model) = identified_example(dir.path());
     let report = dir.path().join("sim.json");
     let sim = dir.path().join("sim.csv");
     hysid()
@@ -232,16 +238,27 @@ fn hysteresis_alone_is_identified_from_a_csv_file() {
     assert!((d - 2.0).abs() < 1e-6, "{d}");
 }
 
+/// The one-line error of `hysid identify cascade` on a CSV file with `header` and `rows`.
+fn bad_input_error(header: &str, rows: Vec<String>) -> String {
+    let dir = TempDir::new().unwrap();
+    let data = csv(dir.path(), "a.csv", header, &rows);
+    identify_fails(&data, &dir.path().join("r.json"))
+}
+
+/// `n` rows "i,i", with row `bad` replaced by `text`.
+fn ramp_with(n: usize, bad: usize, text: &str) -> Vec<String> {
+    rows(n, |i| {
+        if i == bad {
+            text.to_string()
+        } else {
+            format!("{i},{i}")
+        }
+    })
+}
+
 #[test]
 fn missing_column_is_a_one_line_error() {
-    let dir = TempDir::new().unwrap();
-    let data = csv(
-        dir.path(),
-        "a.csv",
-        "x,z",
-        &rows(100, |i| format!("{i},{i}")),
-    );
-    let err = identify_fails(&data, &dir.path().join("r.json"));
+    let err = bad_input_error("x,z", ramp_with(100, usize::MAX, ""));
     assert!(
         err.contains("no column named 'y'") && err.contains("x, z"),
         "{err}"
@@ -250,39 +267,13 @@ fn missing_column_is_a_one_line_error() {
 
 #[test]
 fn nan_is_a_one_line_error() {
-    let dir = TempDir::new().unwrap();
-    let data = csv(
-        dir.path(),
-        "a.csv",
-        "x,y",
-        &rows(100, |i| {
-            if i == 42 {
-                "nan,1".into()
-            } else {
-                format!("{i},{i}")
-            }
-        }),
-    );
-    let err = identify_fails(&data, &dir.path().join("r.json"));
+    let err = bad_input_error("x,y", ramp_with(100, 42, "nan,1"));
     assert!(err.contains("not finite") && err.contains("42"), "{err}");
 }
 
 #[test]
 fn non_numeric_cell_is_a_one_line_error() {
-    let dir = TempDir::new().unwrap();
-    let data = csv(
-        dir.path(),
-        "a.csv",
-        "x,y",
-        &rows(100, |i| {
-            if i == 7 {
-                "1,abc".into()
-            } else {
-                format!("{i},{i}")
-            }
-        }),
-    );
-    let err = identify_fails(&data, &dir.path().join("r.json"));
+    let err = bad_input_error("x,y", ramp_with(100, 7, "1,abc"));
     assert!(
         err.contains("'abc' is not a number") && err.contains("line 9"),
         "{err}"
@@ -300,40 +291,23 @@ fn empty_file_is_a_one_line_error() {
 
 #[test]
 fn fewer_samples_than_parameters_is_a_one_line_error() {
-    let dir = TempDir::new().unwrap();
-    let data = csv(
-        dir.path(),
-        "a.csv",
-        "x,y",
-        &rows(6, |i| format!("{},{}", i as f64 * 0.3, i)),
-    );
-    let err = identify_fails(&data, &dir.path().join("r.json"));
+    let err = bad_input_error("x,y", rows(6, |i| format!("{},{}", i as f64 * 0.3, i)));
     assert!(err.contains("too few samples"), "{err}");
 }
 
 #[test]
 fn constant_input_is_a_one_line_error() {
-    let dir = TempDir::new().unwrap();
-    let data = csv(
-        dir.path(),
-        "a.csv",
+    let err = bad_input_error(
         "x,y",
-        &rows(500, |i| format!("1.5,{}", (i as f64 * 0.1).sin())),
+        rows(500, |i| format!("1.5,{}", (i as f64 * 0.1).sin())),
     );
-    let err = identify_fails(&data, &dir.path().join("r.json"));
     assert!(err.contains("does not excite"), "{err}");
 }
 
 #[test]
 fn input_too_fast_for_the_model_is_a_one_line_error() {
     let dir = TempDir::new().unwrap();
-    let data = example_data(dir.path(), true);
-    let model = dir.path().join("model.json");
-    identify_cascade(&data)
-        .arg("--model")
-        .arg(&model)
-        .assert()
-        .success();
+    let (data, model) = identified_example(dir.path());
     // Steps of 10 per sample: α·|Δx| = 3 with α = 0.3.
     let fast = csv(
         dir.path(),
