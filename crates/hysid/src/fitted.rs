@@ -12,7 +12,7 @@
 //! ```
 //!
 //! Kinds: `coleman_hodgdon` (the hysteresis alone; `initial_output` is `measured` or `zero`)
-//! and `ch_cascade` (hysteresis followed by a linear block; b[0] = 1 is fixed).
+//! and `ch_cascade` (hysteresis followed by a linear block; b₁ = 1 is fixed).
 
 use crate::estimate::hysteresis::{simulate_switched, InitialOutput};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};

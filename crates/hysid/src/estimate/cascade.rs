@@ -68,8 +68,8 @@ impl CascadeStructure {
         HysteresisCascade::from_params(self.form, self.na, self.nb, self.delay, theta)
     }
 
-    /// Parameters with values `theta`, α and d bounded as the data require (see
-    /// [`bounded_parameter`]).
+    /// Parameters with values `theta`, α and d bounded as the data require: α in
+    /// (0, 1/max|Δx|] (the rate limit of the recursion) and d in [10⁻⁹·max|x|, max|x|].
     pub fn parameter_set(&self, theta: &[f64], data: &IdData) -> ParameterSet {
         let names = HysteresisCascade::parameter_names(self.form, self.na, self.nb);
         let params = names

@@ -24,12 +24,12 @@
 //!
 //! | symbol | meaning | unit | constraint |
 //! | --- | --- | --- | --- |
-//! | α (`alpha`) | rate of approach to the anhysteretic curve f | 1/[x] | α > 0, α·\|Δx\| ≤ 1 |
-//! | m1 | slope of f in the central segment | [y]/[x] | m1 ≥ c1 |
-//! | m2 | slope of f outside the central segment (6-parameter form) | [y]/[x] | m2 ≥ c2 |
-//! | c1 | value of g in the central segment | [y]/[x] | see admissibility |
-//! | c2 | value of g outside (6-parameter form) | [y]/[x] | |
-//! | d | half-width of the central segment | [x] | d > 0 |
+//! | α (`alpha`) | rate of approach to the anhysteretic curve f | 1/unit(x) | α > 0, α·\|Δx\| ≤ 1 |
+//! | m1 | slope of f in the central segment | unit(y)/unit(x) | m1 ≥ c1 |
+//! | m2 | slope of f outside the central segment (6-parameter form) | unit(y)/unit(x) | m2 ≥ c2 |
+//! | c1 | value of g in the central segment | unit(y)/unit(x) | see admissibility |
+//! | c2 | value of g outside (6-parameter form) | unit(y)/unit(x) | |
+//! | d | half-width of the central segment | unit(x) | d > 0 |
 //!
 //! The **4-parameter saturated form** (`ch4`, Vörös 2015: "major loop saturation … 4
 //! parameters"; m2 = c2 = 0 is RECONSTRUCTED) fixes m2 = c2 = 0, so f saturates at ±m1·d.
