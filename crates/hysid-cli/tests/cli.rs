@@ -307,7 +307,7 @@ fn constant_input_is_a_one_line_error() {
 #[test]
 fn input_too_fast_for_the_model_is_a_one_line_error() {
     let dir = TempDir::new().unwrap();
-    let (data, model) = identified_example(dir.path());
+    let (_, model) = identified_example(dir.path());
     // Steps of 10 per sample: α·|Δx| = 3 with α = 0.3.
     let fast = csv(
         dir.path(),

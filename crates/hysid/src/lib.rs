@@ -11,9 +11,12 @@
 //!   a global (α, d) grid stage, recursive least squares with forgetting, and a general
 //!   output-error Levenberg–Marquardt engine with bounds, fixed parameters, several
 //!   experiments and standard deviations.
+//! * [`greybox`]: continuous-time grey-box models (Bouc–Wen oscillator, rigid body with
+//!   friction), their integrators and their output-error estimation.
 //! * [`data`]: the [`data::IdData`] container and CSV input/output.
 //! * [`signal`]: excitation signals and noise, all seeded.
 //! * [`metrics`]: fit %, RMSE and information criteria.
+//! * [`validate`]: residual analysis and the one-at-a-time sensitivity table.
 //! * [`examples`]: the project's numerical examples (MODELS.md §1.6).
 //! * [`fitted`]: fitted models and their JSON model files.
 //!
@@ -33,8 +36,10 @@ pub mod error;
 pub mod estimate;
 pub mod examples;
 pub mod fitted;
+pub mod greybox;
 pub mod metrics;
 pub mod model;
 pub mod signal;
+pub mod validate;
 
 pub use error::{Error, Result};

@@ -302,7 +302,17 @@ impl<'a> State<'a> {
         config: &'a LmConfig,
     ) -> Result<Self> {
         let mut residuals = vec![0.0; problem.n_residuals()];
-        problem.residuals(theta0, &mut residuals)?;
+        problem
+            .residuals(theta0, &mut residuals)
+            .map_err(|e| match e {
+                Error::Diverged { index, reason } => Error::Diverged {
+                    index,
+                    reason: format!(
+                        "the model cannot be simulated from its initial parameters ({reason})"
+                    ),
+                },
+                other => other,
+            })?;
         if let Some(i) = residuals.iter().position(|r| !r.is_finite()) {
             return Err(Error::Diverged {
                 index: i,

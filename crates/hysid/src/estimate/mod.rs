@@ -12,6 +12,7 @@
 //! * [`key_term`]: the iterative key-term-separation method of Vörös (2015) for the cascade.
 //! * [`global`]: the (α, d) grid stage that makes the cascade fit independent of the start.
 //! * [`cascade`]: the whole cascade pipeline (global stage, paper iteration, output error).
+//! * [`multistart`]: several starts inside the bounds, fitted in parallel, the best kept.
 //! * [`nelder_mead`]: a small simplex minimiser for the non-smooth (α, d) profile.
 //! * [`rls`]: recursive least squares with forgetting for online identification.
 //! * [`switching`]: the switching function h as an internal variable of output-error fits.
@@ -23,6 +24,7 @@ pub mod hysteresis;
 pub mod key_term;
 pub mod levenberg_marquardt;
 mod linear_ls;
+pub mod multistart;
 pub mod nelder_mead;
 pub mod output_error;
 mod parameters;
