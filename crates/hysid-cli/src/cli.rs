@@ -27,6 +27,206 @@ pub enum Command {
     /// Write a built-in example's data as CSV (for benchmarks and for trying `identify`).
     #[command(subcommand)]
     Generate(Generate),
+    /// Nonlinear grey-box models (MATLAB's idnlgrey/nlgreyest/present).
+    #[command(subcommand)]
+    Greybox(Greybox),
+    /// Public benchmarks.
+    #[command(subcommand)]
+    Benchmark(Benchmark),
+}
+
+/// Grey-box commands.
+#[derive(Debug, Subcommand)]
+pub enum Greybox {
+    /// Fit a built-in grey-box model by output error.
+    Fit(GreyboxFitArgs),
+}
+
+/// Options of `hysid greybox fit`.
+#[derive(Debug, Args)]
+pub struct GreyboxFitArgs {
+    /// The model: bouc-wen or rigid-body.
+    #[arg(long)]
+    pub model: String,
+    #[command(flatten)]
+    pub data: DataArgs,
+    /// Keep this parameter at its value (repeatable).
+    #[arg(long)]
+    pub fix: Vec<String>,
+    /// Estimate this parameter although the model fixes it by default (e.g. nu, gain).
+    #[arg(long)]
+    pub free: Vec<String>,
+    /// Initial value, NAME=VALUE (repeatable).
+    #[arg(long)]
+    pub init: Vec<String>,
+    /// Bounds, NAME=LO:HI (repeatable; inf allowed).
+    #[arg(long)]
+    pub bounds: Vec<String>,
+    /// Estimate the initial value of this state in every experiment (repeatable).
+    #[arg(long = "estimate-x0")]
+    pub estimate_x0: Vec<String>,
+    #[command(flatten)]
+    pub simulation: SimulationArgs,
+    #[command(flatten)]
+    pub search: SearchArgs,
+    /// Print and report the ±20 % one-at-a-time sensitivity table (Gunnar et al. 2006).
+    #[arg(long)]
+    pub sensitivity: bool,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write the fitted model here (loadable by `hysid simulate`).
+    #[arg(long = "model-out")]
+    pub model_out: Option<PathBuf>,
+    /// Directory for plots (SVG).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// How a grey-box model is simulated.
+#[derive(Debug, Args)]
+pub struct SimulationArgs {
+    /// Integrator.
+    #[arg(long, value_enum, default_value_t = IntegratorArg::Rk4)]
+    pub integrator: IntegratorArg,
+    /// Integration steps per sample.
+    #[arg(long, default_value_t = 10)]
+    pub substeps: usize,
+    /// Input between samples.
+    #[arg(long, value_enum, default_value_t = InterpolationArg::Zoh)]
+    pub interpolation: InterpolationArg,
+}
+
+/// Integrators.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum IntegratorArg {
+    /// Fixed-step fourth-order Runge–Kutta (analytic sensitivities).
+    Rk4,
+    /// Newmark average acceleration (second-order mechanical models).
+    Newmark,
+}
+
+/// Input interpolations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum InterpolationArg {
+    /// Zero-order hold.
+    Zoh,
+    /// Linear.
+    Linear,
+    /// Band-limited (periodic records).
+    BandLimited,
+}
+
+/// Search settings.
+#[derive(Debug, Args)]
+pub struct SearchArgs {
+    /// Number of starting points (drawn inside the bounds; the first is the given start).
+    #[arg(long, default_value_t = 1)]
+    pub starts: usize,
+    /// Seed of the random starts.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Maximum iterations of the final fit (Gunnar et al. 2006 use 30).
+    #[arg(long, default_value_t = 100)]
+    pub max_iterations: usize,
+    /// Stop when the expected relative improvement falls below this (Gunnar et al. 2006:
+    /// 1e-4, i.e. 0.01 %).
+    #[arg(long, default_value_t = 1e-10)]
+    pub tolerance: f64,
+}
+
+/// Benchmarks.
+#[derive(Debug, Subcommand)]
+pub enum Benchmark {
+    /// The Bouc–Wen hysteretic benchmark (Noël & Schoukens 2016).
+    BoucWen(BoucWenArgs),
+}
+
+/// Options of `hysid benchmark bouc-wen`.
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct BoucWenArgs {
+    /// Make test signals by the official recipe instead.
+    #[command(subcommand)]
+    pub generate: Option<BoucWenGenerate>,
+    /// Training record (columns t_s, u_N, y_m).
+    #[arg(long)]
+    pub train: Option<PathBuf>,
+    /// Test record(s), same columns, scored by e_RMS in simulation mode.
+    #[arg(long)]
+    pub test: Vec<PathBuf>,
+    /// Score test records after repeating their input twice and keeping the second pass
+    /// (steady state of a periodic test signal) instead of simulating from rest.
+    #[arg(long)]
+    pub steady_state: bool,
+    /// Start from the benchmark's nominal parameters times this factor.
+    #[arg(long, default_value_t = 1.0)]
+    pub start_factor: f64,
+    /// Initial value, NAME=VALUE (repeatable; overrides the nominal start).
+    #[arg(long)]
+    pub init: Vec<String>,
+    #[command(flatten)]
+    pub search: BenchmarkSearchArgs,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Directory for plots (SVG).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Search settings of the benchmark fit.
+#[derive(Debug, Args)]
+pub struct BenchmarkSearchArgs {
+    /// Number of starting points.
+    #[arg(long, default_value_t = 8)]
+    pub starts: usize,
+    /// Seed of the random starts.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// RK4 steps per sample (750 Hz × 4 = 3 kHz; the training record's residual is its noise
+    /// from 2 on).
+    #[arg(long, default_value_t = 4)]
+    pub substeps: usize,
+}
+
+/// Test-signal generation.
+#[derive(Debug, Subcommand)]
+pub enum BoucWenGenerate {
+    /// Simulate a test signal by the official recipe and write t_s, u_N, y_m.
+    Generate(BoucWenGenerateArgs),
+}
+
+/// Options of `hysid benchmark bouc-wen generate`.
+#[derive(Debug, Args)]
+pub struct BoucWenGenerateArgs {
+    /// multisine (8192 samples per period, 5–150 Hz, RMS 50 N) or sweep (40 sin(2π(18t + t²/12))).
+    #[arg(long, value_enum, default_value_t = SignalArg::Multisine)]
+    pub signal: SignalArg,
+    /// Multisine periods to simulate and write (from rest).
+    #[arg(long, default_value_t = 2)]
+    pub periods: usize,
+    /// Sweep samples.
+    #[arg(long, default_value_t = 153_000)]
+    pub samples: usize,
+    /// Seed of the multisine phases.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// RMS of white Gaussian output noise to add (the training records use 8e-6 m).
+    #[arg(long, default_value_t = 0.0)]
+    pub noise: f64,
+    /// The CSV file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Benchmark test signals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SignalArg {
+    /// Random-phase multisine.
+    Multisine,
+    /// Linear sine sweep.
+    Sweep,
 }
 
 /// Data generators.
@@ -201,18 +401,24 @@ pub enum InitialArg {
 /// Options of `hysid simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Model file written by `hysid identify … --model`.
+    /// Model file written by `hysid identify … --model` or `hysid greybox fit --model-out`.
     #[arg(long)]
     pub model: PathBuf,
     /// CSV file with a header row.
     #[arg(long)]
     pub data: PathBuf,
-    /// Input column.
-    #[arg(long)]
-    pub input: String,
+    /// Input column (repeat for models with several inputs).
+    #[arg(long, required = true)]
+    pub input: Vec<String>,
     /// Measured output column, for fit % and RMSE.
     #[arg(long)]
     pub output: Option<String>,
+    /// Sample time; otherwise from the time column, else 1.
+    #[arg(long)]
+    pub ts: Option<f64>,
+    /// Time column (default: a column named t, time, t_s or time_s, if any).
+    #[arg(long)]
+    pub time: Option<String>,
     /// Write the input and the simulated output (and the measured one) as CSV here.
     #[arg(long = "out")]
     pub out_csv: Option<PathBuf>,

@@ -378,3 +378,150 @@ fn unknown_hysteresis_form_and_bad_model_file_are_one_line_errors() {
         "{err}"
     );
 }
+
+/// The benchmark's training record, vendored in `data/`.
+fn bouc_wen_train() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/bouc-wen/train_multisine_5periods.csv")
+}
+
+#[test]
+fn benchmark_fits_the_training_record_and_scores_a_generated_test_set() {
+    let dir = TempDir::new().unwrap();
+    let test = dir.path().join("test.csv");
+    hysid()
+        .args([
+            "benchmark",
+            "bouc-wen",
+            "generate",
+            "--signal",
+            "multisine",
+            "--periods",
+            "1",
+            "--out",
+        ])
+        .arg(&test)
+        .assert()
+        .success();
+    let json = dir.path().join("bw.json");
+    hysid()
+        .args(["benchmark", "bouc-wen", "--start-factor", "2", "--train"])
+        .arg(bouc_wen_train())
+        .arg("--test")
+        .arg(&test)
+        .arg("--json")
+        .arg(&json)
+        .assert()
+        .success();
+    let report: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["model"]["kind"], "bouc_wen");
+    let alpha = report["model"]["parameters"]["alpha"]["value"]
+        .as_f64()
+        .unwrap();
+    assert!((alpha / 5e4 - 1.0).abs() < 0.01, "{alpha}");
+    let e_rms = report["details"]["tests"][0]["e_rms"].as_f64().unwrap();
+    assert!(e_rms < 1e-5, "{e_rms}");
+    for key in [
+        "fit_percent",
+        "rmse",
+        "iterations",
+        "termination",
+        "elapsed_s",
+    ] {
+        assert!(!report[key].is_null(), "missing {key}");
+    }
+}
+
+#[test]
+fn greybox_fit_writes_a_model_that_simulate_loads() {
+    let dir = TempDir::new().unwrap();
+    let model = dir.path().join("bw.json");
+    let out = hysid()
+        .args([
+            "greybox", "fit", "--model", "bouc-wen", "--input", "u_N", "--output", "y_m",
+        ])
+        .args([
+            "--interpolation",
+            "band-limited",
+            "--substeps",
+            "4",
+            "--sensitivity",
+            "--data",
+        ])
+        .arg(bouc_wen_train())
+        .arg("--model-out")
+        .arg(&model)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let stdout = String::from_utf8(out).unwrap();
+    assert!(
+        stdout.contains("change of fit %") && stdout.contains("beta_delta"),
+        "{stdout}"
+    );
+    let json = dir.path().join("sim.json");
+    hysid()
+        .args(["simulate", "--input", "u_N", "--output", "y_m", "--model"])
+        .arg(&model)
+        .arg("--data")
+        .arg(bouc_wen_train())
+        .arg("--json")
+        .arg(&json)
+        .assert()
+        .success();
+    let report: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    let rmse = report["rmse"].as_f64().unwrap();
+    assert!((rmse - 7.37e-6).abs() < 0.3e-6, "{rmse}");
+}
+
+/// `hysid greybox fit` expecting failure: the one line on stderr.
+fn greybox_fails(data: &Path, extra: &[&str]) -> String {
+    let out = hysid()
+        .args([
+            "greybox", "fit", "--model", "bouc-wen", "--input", "u_N", "--output", "y_m", "--data",
+        ])
+        .arg(data)
+        .args(extra)
+        .assert()
+        .failure()
+        .get_output()
+        .stderr
+        .clone();
+    let err = String::from_utf8(out).unwrap();
+    assert!(
+        !err.contains("panicked") && err.lines().count() == 1 && err.starts_with("error: "),
+        "{err}"
+    );
+    err
+}
+
+#[test]
+fn greybox_bad_input_and_numerical_trouble_are_one_line_errors() {
+    let dir = TempDir::new().unwrap();
+    let nan = csv(
+        dir.path(),
+        "nan.csv",
+        "t_s,u_N,y_m",
+        &rows(100, |i| {
+            if i == 5 {
+                "0.1,nan,0".into()
+            } else {
+                format!("{},{i},0", i as f64 / 750.0)
+            }
+        }),
+    );
+    assert!(greybox_fails(&nan, &[]).contains("not finite"));
+    let train = bouc_wen_train();
+    let err = greybox_fails(&train, &["--init", "cL=-5"]);
+    assert!(err.contains("cL") && err.contains("bounds"), "{err}");
+    let err = greybox_fails(&train, &["--init", "mL=1e-3", "--init", "kL=1e9"]);
+    assert!(
+        err.contains("cannot be simulated from its initial parameters"),
+        "{err}"
+    );
+    let err = greybox_fails(&train, &["--init", "mass=3"]);
+    assert!(err.contains("no parameter named 'mass'"), "{err}");
+}

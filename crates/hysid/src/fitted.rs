@@ -11,10 +11,22 @@
 //!  "delay": 1}
 //! ```
 //!
-//! Kinds: `coleman_hodgdon` (the hysteresis alone; `initial_output` is `measured` or `zero`)
-//! and `ch_cascade` (hysteresis followed by a linear block; b₁ = 1 is fixed).
+//! Kinds: `coleman_hodgdon` (the hysteresis alone; `initial_output` is `measured` or `zero`),
+//! `ch_cascade` (hysteresis followed by a linear block; b₁ = 1 is fixed), and the grey-box
+//! models `bouc_wen` and `rigid_body`, which add `simulation` (integrator, sub-steps, input
+//! interpolation) and `initial_state`:
+//!
+//! ```json
+//! {"kind": "bouc_wen",
+//!  "parameters": {"mL": {"value": 2.0005, "std": 0.00015, "unit": "kg"}, …},
+//!  "simulation": {"integrator": "rk4", "substeps": 4, "interpolation": "band_limited"},
+//!  "initial_state": [0.0, 0.0, 0.0]}
+//! ```
 
 use crate::estimate::hysteresis::{simulate_switched, InitialOutput};
+use crate::estimate::ParameterSet;
+use crate::greybox::simulate::{simulate as simulate_state_space, InputTrack};
+use crate::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -23,13 +35,16 @@ use std::path::Path;
 
 /// A parameter value with its standard deviation (0 when fixed, NaN written as null when
 /// unknown).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Estimate {
     /// The value.
     pub value: f64,
     /// One standard deviation.
     #[serde(default, with = "nullable")]
     pub std: f64,
+    /// The unit (grey-box models).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub unit: String,
 }
 
 /// A parameter entry: a scalar or a coefficient list.
@@ -45,10 +60,11 @@ pub enum ParameterEntry {
 /// The JSON model file (see the module docs).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModelFile {
-    /// `coleman_hodgdon` or `ch_cascade`.
+    /// `coleman_hodgdon`, `ch_cascade`, `bouc_wen` or `rigid_body`.
     pub kind: String,
-    /// `ch4` or `ch6`.
-    pub hysteresis: ChForm,
+    /// `ch4` or `ch6` (Coleman–Hodgdon kinds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hysteresis: Option<ChForm>,
     /// Parameters by name (MODELS.md symbols).
     pub parameters: BTreeMap<String, ParameterEntry>,
     /// Delay k of the linear block (cascade only).
@@ -57,6 +73,57 @@ pub struct ModelFile {
     /// Initial output of the hysteresis alone.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_output: Option<InitialOutput>,
+    /// How a grey-box model is simulated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<SimulationSpec>,
+    /// Initial state of a grey-box model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_state: Option<Vec<f64>>,
+}
+
+/// The simulation settings in a model file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SimulationSpec {
+    /// `rk4` or `newmark`.
+    pub integrator: String,
+    /// Sub-steps per sample.
+    pub substeps: usize,
+    /// Input interpolation.
+    pub interpolation: InputInterpolation,
+}
+
+impl SimulationSpec {
+    /// The spec of a simulation (adaptive integrators are saved as RK4 with 20 sub-steps).
+    pub fn of(sim: &Simulation) -> Self {
+        let (integrator, substeps) = match sim.integrator {
+            Integrator::Rk4 { substeps } => ("rk4", substeps),
+            Integrator::Newmark { substeps } => ("newmark", substeps),
+            Integrator::Adaptive { .. } => ("rk4", 20),
+        };
+        Self {
+            integrator: integrator.into(),
+            substeps,
+            interpolation: sim.interpolation,
+        }
+    }
+
+    /// The simulation settings.
+    pub fn simulation(&self) -> Result<Simulation> {
+        let substeps = self.substeps.max(1);
+        let integrator = match self.integrator.as_str() {
+            "rk4" => Integrator::Rk4 { substeps },
+            "newmark" => Integrator::Newmark { substeps },
+            other => {
+                return Err(Error::Config(format!(
+                    "unknown integrator '{other}'; use rk4 or newmark"
+                )))
+            }
+        };
+        Ok(Simulation {
+            integrator,
+            interpolation: self.interpolation,
+        })
+    }
 }
 
 /// A fitted model that can simulate.
@@ -78,14 +145,35 @@ pub enum FittedModel {
         /// Standard deviations in [`HysteresisCascade::params`] order.
         std: Vec<f64>,
     },
+    /// A built-in grey-box model.
+    GreyBox {
+        /// Its kind (`bouc_wen`, `rigid_body`).
+        kind: String,
+        /// Its parameters (values, units, bounds, fixed flags).
+        parameters: ParameterSet,
+        /// Their standard deviations.
+        std: Vec<f64>,
+        /// How it is simulated.
+        simulation: Simulation,
+        /// Its initial state.
+        initial_state: Vec<f64>,
+    },
 }
 
 impl FittedModel {
-    /// Simulates the model's output for the input `x`; `y0` is the measured initial output
-    /// (used by a hysteresis with [`InitialOutput::Measured`]). Errors when α·|Δx| > 1.
-    pub fn simulate(&self, x: &[f64], y0: Option<f64>) -> Result<Vec<f64>> {
+    /// Simulates the model's outputs for the input channels `inputs` sampled every `ts`;
+    /// `y0` is the measured initial output (used by a hysteresis with
+    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges.
+    pub fn simulate(&self, inputs: &[&[f64]], ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let first = || {
+            inputs
+                .first()
+                .copied()
+                .ok_or_else(|| Error::Config("no input channel given".into()))
+        };
         match self {
             FittedModel::Hysteresis { model, initial, .. } => {
+                let x = first()?;
                 model.check_rate(x)?;
                 let v0 = match initial {
                     InitialOutput::Measured => y0.ok_or_else(|| {
@@ -96,34 +184,75 @@ impl FittedModel {
                     })?,
                     InitialOutput::Zero => 0.0,
                 };
-                Ok(simulate_switched(model, x, v0, None))
+                Ok(vec![simulate_switched(model, x, v0, None)])
             }
-            FittedModel::Cascade { model, .. } => Ok(model.simulate(x)?.y),
+            FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::GreyBox {
+                kind,
+                parameters,
+                simulation,
+                initial_state,
+                ..
+            } => {
+                let model = models::by_kind(kind)?;
+                if inputs.len() != model.inputs().len() {
+                    return Err(Error::Config(format!(
+                        "the {kind} model has {} input(s), {} given",
+                        model.inputs().len(),
+                        inputs.len()
+                    )));
+                }
+                let track = InputTrack::new(inputs, simulation)?;
+                let theta = parameters.values();
+                let mut outputs = vec![Vec::with_capacity(track.len()); model.outputs().len()];
+                let (mut u, mut y) = (vec![0.0; inputs.len()], vec![0.0; outputs.len()]);
+                simulate_state_space(
+                    model.as_ref(),
+                    &theta,
+                    initial_state,
+                    &track,
+                    ts,
+                    simulation.integrator,
+                    |k, x| {
+                        track.at(k, 0.0, &mut u);
+                        model.output(x, &u, &theta, &mut y);
+                        for (o, v) in outputs.iter_mut().zip(&y) {
+                            o.push(*v);
+                        }
+                    },
+                )?;
+                Ok(outputs)
+            }
         }
     }
 
     /// The model file of this model.
     pub fn to_file(&self) -> ModelFile {
+        let empty = |kind: &str| ModelFile {
+            kind: kind.into(),
+            hysteresis: None,
+            parameters: BTreeMap::new(),
+            delay: None,
+            initial_output: None,
+            simulation: None,
+            initial_state: None,
+        };
         match self {
             FittedModel::Hysteresis {
                 model,
                 initial,
                 std,
             } => ModelFile {
-                kind: "coleman_hodgdon".into(),
-                hysteresis: model.form(),
+                hysteresis: Some(model.form()),
                 parameters: hysteresis_entries(model, std),
-                delay: None,
                 initial_output: Some(*initial),
+                ..empty("coleman_hodgdon")
             },
             FittedModel::Cascade { model, std } => {
                 let nh = model.hysteresis.form().n_params();
                 let mut parameters = hysteresis_entries(&model.hysteresis, &std[..nh]);
                 let nb = model.linear.nb();
-                let mut b = vec![Estimate {
-                    value: 1.0,
-                    std: 0.0,
-                }];
+                let mut b = vec![estimate((&1.0, &0.0))];
                 b.extend(
                     model.linear.b()[1..]
                         .iter()
@@ -140,56 +269,115 @@ impl FittedModel {
                 parameters.insert("b".into(), ParameterEntry::List(b));
                 parameters.insert("a".into(), ParameterEntry::List(a));
                 ModelFile {
-                    kind: "ch_cascade".into(),
-                    hysteresis: model.hysteresis.form(),
+                    hysteresis: Some(model.hysteresis.form()),
                     parameters,
                     delay: Some(model.linear.delay()),
-                    initial_output: None,
+                    ..empty("ch_cascade")
                 }
             }
+            FittedModel::GreyBox {
+                kind,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+            } => ModelFile {
+                parameters: parameters
+                    .iter()
+                    .zip(std)
+                    .map(|(p, s)| {
+                        let mut e = estimate((&p.value, s));
+                        e.unit = p.unit.clone();
+                        (p.name.clone(), ParameterEntry::Scalar(e))
+                    })
+                    .collect(),
+                simulation: Some(SimulationSpec::of(simulation)),
+                initial_state: Some(initial_state.clone()),
+                ..empty(kind)
+            },
         }
     }
 
     /// Rebuilds a fitted model from a model file.
     pub fn from_file(file: &ModelFile) -> Result<Self> {
-        let form = file.hysteresis;
-        let names = form.parameter_names();
+        match file.kind.as_str() {
+            "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
+            kind => Self::grey_box_from_file(kind, file),
+        }
+    }
+
+    fn coleman_hodgdon_from_file(file: &ModelFile) -> Result<Self> {
+        let form = file.hysteresis.ok_or_else(|| {
+            Error::Config(format!(
+                "a {} model needs \"hysteresis\": \"ch4\" or \"ch6\"",
+                file.kind
+            ))
+        })?;
         let mut values = Vec::new();
         let mut std = Vec::new();
-        for name in names {
-            let e = scalar(file, name)?;
+        for name in form.parameter_names() {
+            let e = scalar(file, name, &form.parameter_names().join(", "))?;
             values.push(e.value);
             std.push(e.std);
         }
         let hysteresis = ColemanHodgdon::from_params(form, &values)?;
-        match file.kind.as_str() {
-            "coleman_hodgdon" => Ok(FittedModel::Hysteresis {
+        if file.kind == "coleman_hodgdon" {
+            return Ok(FittedModel::Hysteresis {
                 model: hysteresis,
                 initial: file.initial_output.unwrap_or(InitialOutput::Measured),
                 std,
-            }),
-            "ch_cascade" => {
-                let a = list(file, "a")?;
-                let b = list(file, "b")?;
-                let delay = file
-                    .delay
-                    .ok_or_else(|| Error::Config("a ch_cascade model needs \"delay\"".into()))?;
-                let linear = LinearBlock::new(
-                    a.iter().map(|e| e.value).collect(),
-                    b.iter().map(|e| e.value).collect(),
-                    delay,
-                )?;
-                std.extend(b.iter().skip(1).map(|e| e.std));
-                std.extend(a.iter().map(|e| e.std));
-                Ok(FittedModel::Cascade {
-                    model: HysteresisCascade::new(hysteresis, linear)?,
-                    std,
-                })
-            }
-            other => Err(Error::Config(format!(
-                "unknown model kind '{other}'; this version knows coleman_hodgdon and ch_cascade"
-            ))),
+            });
         }
+        let a = list(file, "a")?;
+        let b = list(file, "b")?;
+        let delay = file
+            .delay
+            .ok_or_else(|| Error::Config("a ch_cascade model needs \"delay\"".into()))?;
+        let linear = LinearBlock::new(
+            a.iter().map(|e| e.value).collect(),
+            b.iter().map(|e| e.value).collect(),
+            delay,
+        )?;
+        std.extend(b.iter().skip(1).map(|e| e.std));
+        std.extend(a.iter().map(|e| e.std));
+        Ok(FittedModel::Cascade {
+            model: HysteresisCascade::new(hysteresis, linear)?,
+            std,
+        })
+    }
+
+    fn grey_box_from_file(kind: &str, file: &ModelFile) -> Result<Self> {
+        let model = models::by_kind(kind).map_err(|_| {
+            Error::Config(format!(
+                "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen and rigid_body"
+            ))
+        })?;
+        let mut parameters = model.parameters();
+        let names = parameters.names().join(", ");
+        let mut std = Vec::new();
+        for i in 0..parameters.len() {
+            let e = scalar(file, &parameters.get(i).name.clone(), &names)?;
+            parameters.get_mut(i).value = e.value;
+            std.push(e.std);
+        }
+        let n = model.states().len();
+        let initial_state = file.initial_state.clone().unwrap_or_else(|| vec![0.0; n]);
+        if initial_state.len() != n {
+            return Err(Error::Config(format!(
+                "\"initial_state\" needs {n} values for the {kind} model"
+            )));
+        }
+        let simulation = file
+            .simulation
+            .as_ref()
+            .map_or(Ok(Simulation::default()), SimulationSpec::simulation)?;
+        Ok(FittedModel::GreyBox {
+            kind: kind.to_string(),
+            parameters,
+            std,
+            simulation,
+            initial_state,
+        })
     }
 
     /// Reads a model file.
@@ -213,6 +401,7 @@ fn estimate((value, std): (&f64, &f64)) -> Estimate {
     Estimate {
         value: *value,
         std: *std,
+        unit: String::new(),
     }
 }
 
@@ -226,16 +415,15 @@ fn hysteresis_entries(model: &ColemanHodgdon, std: &[f64]) -> BTreeMap<String, P
         .collect()
 }
 
-fn scalar(file: &ModelFile, name: &str) -> Result<Estimate> {
+fn scalar(file: &ModelFile, name: &str, all: &str) -> Result<Estimate> {
     match file.parameters.get(name) {
-        Some(ParameterEntry::Scalar(e)) => Ok(*e),
+        Some(ParameterEntry::Scalar(e)) => Ok(e.clone()),
         Some(ParameterEntry::List(_)) => Err(Error::Config(format!(
             "parameter '{name}' must be a single value"
         ))),
         None => Err(Error::Config(format!(
-            "parameter '{name}' is missing (a {} model needs {})",
-            file.hysteresis.short_name(),
-            file.hysteresis.parameter_names().join(", ")
+            "parameter '{name}' is missing (a {} model needs {all})",
+            file.kind
         ))),
     }
 }
@@ -243,7 +431,7 @@ fn scalar(file: &ModelFile, name: &str) -> Result<Estimate> {
 fn list(file: &ModelFile, name: &str) -> Result<Vec<Estimate>> {
     match file.parameters.get(name) {
         Some(ParameterEntry::List(v)) => Ok(v.clone()),
-        Some(ParameterEntry::Scalar(e)) => Ok(vec![*e]),
+        Some(ParameterEntry::Scalar(e)) => Ok(vec![e.clone()]),
         None => Err(Error::Config(format!(
             "coefficient list '{name}' is missing"
         ))),

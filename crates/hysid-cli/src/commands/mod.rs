@@ -1,12 +1,15 @@
 //! One module per subcommand.
 
+mod benchmark;
 mod cascade;
 mod demo;
 mod generate;
+mod greybox;
 mod identify;
+mod present;
 mod simulate;
 
-use crate::cli::{Cli, Command, Demo, Generate, Identify};
+use crate::cli::{Benchmark, Cli, Command, Demo, Generate, Greybox, Identify};
 use anyhow::Result;
 
 /// Runs the parsed command line.
@@ -17,5 +20,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Identify(Identify::Hysteresis(args)) => identify::hysteresis(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Generate(Generate::Voros(args)) => generate::voros(&args),
+        Command::Greybox(Greybox::Fit(args)) => greybox::fit(&args),
+        Command::Benchmark(Benchmark::BoucWen(args)) => benchmark::bouc_wen(&args),
     }
 }

@@ -3,37 +3,47 @@
 use crate::cli::SimulateArgs;
 use crate::output::write_json;
 use anyhow::{Context, Result};
-use hysid::data::{read_columns, write_csv};
+use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::fitted::FittedModel;
 use hysid::metrics;
 use serde_json::json;
 
-/// Simulates the model on the input column; compares with the output column when given.
+/// Simulates the model on the input columns; compares with the output column when given.
 pub fn run(args: &SimulateArgs) -> Result<()> {
     let model = FittedModel::load(&args.model)?;
-    let mut names = vec![args.input.as_str()];
-    if let Some(out) = &args.output {
-        names.push(out.as_str());
-    }
-    let (_, columns) = read_columns(&args.data, &names)?;
-    let x = &columns[0];
-    let measured = columns.get(1);
-    let yhat = model
-        .simulate(x, measured.and_then(|y| y.first().copied()))
+    let spec = CsvSpec {
+        inputs: args.input.clone(),
+        outputs: args.output.iter().cloned().collect(),
+        time: args.time.clone(),
+        ts: args.ts,
+    };
+    let data = IdData::from_csv(&args.data, &spec)?;
+    let exp = data.experiment(0);
+    let inputs: Vec<&[f64]> = (0..args.input.len()).map(|c| exp.input(c)).collect();
+    let measured = args.output.as_ref().map(|_| exp.output(0));
+    let outputs = model
+        .simulate(
+            &inputs,
+            data.ts(),
+            measured.and_then(|y| y.first().copied()),
+        )
         .with_context(|| format!("simulating on {}", args.data.display()))?;
+    let yhat = &outputs[0];
     let kind = model.to_file().kind;
     println!(
         "Simulated {kind} on {} ({} samples)",
         args.data.display(),
-        x.len()
+        exp.len()
     );
-    let scores = measured.map(|y| (metrics::fit_percent(y, &yhat), metrics::rmse(y, &yhat)));
+    let scores = measured.map(|y| (metrics::fit_percent(y, yhat), metrics::rmse(y, yhat)));
     if let Some((fit, rmse)) = scores {
         println!("  fit {fit:.2} %   RMSE {rmse:.4e}");
     }
     if let Some(path) = &args.out_csv {
-        let mut headers = vec![args.input.as_str(), "simulated"];
-        let mut cols: Vec<&[f64]> = vec![x, &yhat];
+        let mut headers: Vec<&str> = args.input.iter().map(String::as_str).collect();
+        headers.push("simulated");
+        let mut cols: Vec<&[f64]> = inputs.clone();
+        cols.push(yhat);
         if let (Some(name), Some(y)) = (&args.output, measured) {
             headers.push(name.as_str());
             cols.push(y);
@@ -44,7 +54,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if let Some(path) = &args.json {
         let report = json!({
             "model": model.to_file(),
-            "samples": x.len(),
+            "samples": exp.len(),
             "fit_percent": scores.map(|s| s.0),
             "rmse": scores.map(|s| s.1),
         });

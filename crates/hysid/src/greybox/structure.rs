@@ -140,7 +140,13 @@ impl OutputErrorModel for GreyBox {
         self.model.outputs().len()
     }
 
-    fn simulate(&self, theta: &[f64], _data: &IdData, exp: usize, y: &mut [Vec<f64>]) -> Result<()> {
+    fn simulate(
+        &self,
+        theta: &[f64],
+        _data: &IdData,
+        exp: usize,
+        y: &mut [Vec<f64>],
+    ) -> Result<()> {
         let p = self.n_model_params();
         let (model_theta, x0) = (&theta[..p], self.initial_state(theta, exp));
         let track = &self.tracks[exp];

@@ -1,0 +1,269 @@
+//! `hysid greybox fit`: output-error estimation of a built-in grey-box model.
+
+use super::present::{print_fit, print_residuals, print_sensitivity, report};
+use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
+use crate::commands::identify::load;
+use crate::output::{ensure_dir, write_json};
+use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
+use crate::progress::FitProgress;
+use anyhow::{bail, Context, Result};
+use hysid::data::IdData;
+use hysid::estimate::{LmConfig, ParameterSet};
+use hysid::fitted::FittedModel;
+use hysid::greybox::{
+    models, GreyBoxEstimation, GreyBoxFit, InitialStates, InputInterpolation, Integrator,
+    Simulation, StateSpaceModel,
+};
+use hysid::validate::{sensitivity_table, ResidualAnalysis};
+use serde_json::json;
+use std::path::Path;
+use std::sync::Arc;
+
+/// Runs `hysid greybox fit`.
+pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
+    let model: Arc<dyn StateSpaceModel> = Arc::from(models::by_kind(&args.model)?);
+    let data = load(&args.data)?;
+    let params = configure(
+        model.parameters(),
+        &args.fix,
+        &args.free,
+        &args.init,
+        &args.bounds,
+    )?;
+    let initial = initial_states(model.as_ref(), &data, &args.estimate_x0)?;
+    let estimation = GreyBoxEstimation {
+        simulation: simulation(&args.simulation),
+        lm: LmConfig {
+            max_iterations: args.search.max_iterations,
+            improvement_tolerance: args.search.tolerance,
+            ..LmConfig::default()
+        },
+        starts: args.search.starts.max(1),
+        seed: args.search.seed,
+        ..GreyBoxEstimation::default()
+    };
+    let fit = {
+        let progress = FitProgress::new("fitting");
+        let mut callback = progress.callback();
+        estimation.estimate(model.clone(), &data, &params, initial, &mut callback)?
+    };
+    print_fit(
+        &format!(
+            "{} fitted to {} ({} samples)",
+            model.kind(),
+            args.data.data.display(),
+            data.n_samples()
+        ),
+        &fit,
+    );
+    let residuals = print_residuals(&fit, &data);
+    let sensitivity = if args.sensitivity {
+        let structure = hysid::greybox::GreyBox::new(
+            model.clone(),
+            &data,
+            estimation.simulation,
+            initial_from(&fit, model.as_ref(), &data),
+        )?;
+        let rows = sensitivity_table(&structure, &data, &fit.fit.parameters, 0.2)?;
+        print_sensitivity(&rows);
+        Some(rows)
+    } else {
+        None
+    };
+    let fitted = fitted_model(model.as_ref(), &fit, estimation.simulation);
+    if let Some(dir) = &args.out {
+        plots(dir, &fit, &data, &residuals)?;
+        println!("  plots: {}", dir.display());
+    }
+    let extra =
+        json!({"data": args.data.data, "residual_analysis": residuals, "sensitivity": sensitivity});
+    let report = report(&fit, &data, fitted.to_file(), extra);
+    if let Some(path) = &args.json {
+        write_json(path, &report).context("writing the JSON report")?;
+        println!("  report: {}", path.display());
+    }
+    if let Some(path) = &args.model_out {
+        write_json(path, &fitted.to_file()).context("writing the model file")?;
+        println!("  model: {}", path.display());
+    }
+    Ok(())
+}
+
+/// `params` with the command line's fixes, frees, initial values and bounds applied.
+pub fn configure(
+    mut params: ParameterSet,
+    fix: &[String],
+    free: &[String],
+    init: &[String],
+    bounds: &[String],
+) -> Result<ParameterSet> {
+    for name in fix {
+        params.by_name_mut(name)?.fixed = true;
+    }
+    for name in free {
+        params.by_name_mut(name)?.fixed = false;
+    }
+    for spec in init {
+        let (name, value) = spec
+            .split_once('=')
+            .with_context(|| format!("--init {spec}: write NAME=VALUE"))?;
+        params.by_name_mut(name.trim())?.value = number(value, "--init", spec)?;
+    }
+    for spec in bounds {
+        let (name, range) = spec
+            .split_once('=')
+            .with_context(|| format!("--bounds {spec}: write NAME=LO:HI"))?;
+        let (lo, hi) = range
+            .split_once(':')
+            .with_context(|| format!("--bounds {spec}: write NAME=LO:HI"))?;
+        let p = params.by_name_mut(name.trim())?;
+        p.min = number(lo, "--bounds", spec)?;
+        p.max = number(hi, "--bounds", spec)?;
+    }
+    Ok(params)
+}
+
+fn number(text: &str, option: &str, spec: &str) -> Result<f64> {
+    match text.trim() {
+        "inf" | "+inf" => Ok(f64::INFINITY),
+        "-inf" => Ok(f64::NEG_INFINITY),
+        t => t
+            .parse()
+            .with_context(|| format!("{option} {spec}: '{t}' is not a number")),
+    }
+}
+
+/// Initial states at rest, with the named ones estimated.
+fn initial_states(
+    model: &dyn StateSpaceModel,
+    data: &IdData,
+    estimate: &[String],
+) -> Result<InitialStates> {
+    let states = model.states();
+    let mut initial = InitialStates::at_rest(states.len(), data.n_experiments());
+    for name in estimate {
+        let Some(i) = states.iter().position(|s| &s.name == name) else {
+            let names: Vec<&str> = states.iter().map(|s| s.name.as_str()).collect();
+            bail!(
+                "--estimate-x0 {name}: the {} model's states are {}",
+                model.kind(),
+                names.join(", ")
+            );
+        };
+        initial.estimated[i] = true;
+    }
+    Ok(initial)
+}
+
+/// The fitted initial states, fixed (for re-simulation).
+fn initial_from(fit: &GreyBoxFit, model: &dyn StateSpaceModel, data: &IdData) -> InitialStates {
+    let n = model.states().len();
+    let p = model.parameters().len();
+    let v = fit.fit.parameters.values();
+    InitialStates {
+        values: (0..data.n_experiments())
+            .map(|e| v[p + e * n..p + (e + 1) * n].to_vec())
+            .collect(),
+        estimated: vec![false; n],
+    }
+}
+
+/// The command line's simulation settings.
+pub fn simulation(args: &SimulationArgs) -> Simulation {
+    let substeps = args.substeps.max(1);
+    Simulation {
+        integrator: match args.integrator {
+            IntegratorArg::Rk4 => Integrator::Rk4 { substeps },
+            IntegratorArg::Newmark => Integrator::Newmark { substeps },
+        },
+        interpolation: match args.interpolation {
+            InterpolationArg::Zoh => InputInterpolation::ZeroOrderHold,
+            InterpolationArg::Linear => InputInterpolation::Linear,
+            InterpolationArg::BandLimited => InputInterpolation::BandLimited,
+        },
+    }
+}
+
+/// The model file content: the model's own parameters, their std, and the first
+/// experiment's initial state.
+pub fn fitted_model(
+    model: &dyn StateSpaceModel,
+    fit: &GreyBoxFit,
+    simulation: Simulation,
+) -> FittedModel {
+    let p = model.parameters().len();
+    let n = model.states().len();
+    let all = &fit.fit.parameters;
+    let parameters =
+        ParameterSet::new(all.iter().take(p).cloned().collect()).expect("names are unique");
+    let values = all.values();
+    FittedModel::GreyBox {
+        kind: model.kind().to_string(),
+        parameters,
+        std: fit.fit.std()[..p].to_vec(),
+        simulation,
+        initial_state: values[p..p + n].to_vec(),
+    }
+}
+
+/// Measured against simulated output, residual correlations, convergence.
+pub fn plots(
+    dir: &Path,
+    fit: &GreyBoxFit,
+    data: &IdData,
+    residuals: &[ResidualAnalysis],
+) -> Result<()> {
+    ensure_dir(dir)?;
+    let exp = data.experiment(0);
+    let t: Vec<f64> = (0..exp.len()).map(|k| k as f64 * data.ts()).collect();
+    let y_name = data.output_channels()[0].to_string();
+    let title = format!(
+        "Output: measured and simulated (fit {:.2} %)",
+        fit.fit.fit_percent[0][0]
+    );
+    let output = Figure::new(&title, "t [s]", &y_name)
+        .with(Series::line("measured", &t, exp.output(0)))
+        .with(Series::dashed("simulated", &t, &fit.fit.simulated[0][0]));
+    plot(&dir.join("output.svg"), &output)?;
+    let a = &residuals[0];
+    let lags: Vec<f64> = (0..=a.max_lag).map(|l| l as f64).collect();
+    let cross_lags: Vec<f64> = (-(a.max_lag as i64)..=a.max_lag as i64)
+        .map(|l| l as f64)
+        .collect();
+    let auto = Figure::new("Residual auto-correlation", "lag", "r")
+        .with(Series::new(
+            "r_e",
+            lags.as_slice(),
+            a.autocorrelation.as_slice(),
+            Style::Points,
+        ))
+        .with(hline("99 %", (0.0, a.max_lag as f64), a.band))
+        .with(hline("-99 %", (0.0, a.max_lag as f64), -a.band));
+    let cross = Figure::new("Input-residual cross-correlation", "lag", "r")
+        .with(Series::new(
+            "r_eu",
+            cross_lags.as_slice(),
+            a.cross_correlation[0].as_slice(),
+            Style::Points,
+        ))
+        .with(hline(
+            "99 %",
+            (-(a.max_lag as f64), a.max_lag as f64),
+            a.band,
+        ))
+        .with(hline(
+            "-99 %",
+            (-(a.max_lag as f64), a.max_lag as f64),
+            -a.band,
+        ));
+    plot_panels(
+        &dir.join("residuals.svg"),
+        "Residual analysis (experiment 1)",
+        &[auto, cross],
+        2,
+    )?;
+    let cost: Vec<f64> = fit.fit.report.history.iter().map(|r| r.cost).collect();
+    let convergence = Figure::new("Criterion per iteration", "iteration", "sum of squares")
+        .with(Series::indexed("S", &cost, Style::Line));
+    plot(&dir.join("convergence.svg"), &convergence)
+}

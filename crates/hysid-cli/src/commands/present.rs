@@ -1,0 +1,166 @@
+//! The `present`-like report of a grey-box fit: parameters with standard deviations, units,
+//! bounds and fixed flags; strong correlations; fit per experiment; loss, FPE, AIC; why the
+//! search stopped; residual analysis; optional sensitivity table.
+
+use crate::report::Report;
+use hysid::data::IdData;
+use hysid::greybox::GreyBoxFit;
+use hysid::validate::{residual_analysis, ResidualAnalysis, SensitivityRow};
+use serde_json::json;
+
+/// Prints the parameter table and the fit statistics.
+pub fn print_fit(title: &str, fit: &GreyBoxFit) {
+    let oe = &fit.fit;
+    println!("{title}");
+    println!(
+        "  {:<14}{:>16}   {:<10} {:<10} {:>24}",
+        "parameter", "value", "± std", "unit", "bounds"
+    );
+    let std = oe.std();
+    for (i, p) in oe.parameters.iter().enumerate() {
+        if p.fixed && p.name.starts_with("x0.") && p.value == 0.0 {
+            continue;
+        }
+        let std = if p.fixed {
+            "(fixed)".to_string()
+        } else if std[i].is_finite() {
+            format!("{:.3e}", std[i])
+        } else {
+            "n/a".into()
+        };
+        let bounds = if p.min.is_finite() || p.max.is_finite() {
+            format!("[{:.3e}, {:.3e}]", p.min, p.max)
+        } else {
+            String::new()
+        };
+        println!(
+            "  {:<14}{:>16.8e}   {:<10} {:<10} {:>24}",
+            p.name, p.value, std, p.unit, bounds
+        );
+    }
+    for (a, b, r) in strong_correlations(fit, 0.95) {
+        println!("  note: {a} and {b} are correlated (r = {r:+.3})");
+    }
+    let fits: Vec<String> = oe
+        .fit_percent
+        .iter()
+        .map(|f| format!("{:.2} %", f[0]))
+        .collect();
+    println!("  fit per experiment: {}", fits.join(", "));
+    println!(
+        "  loss {:.4e}   FPE {:.4e}   AIC {:.1}   {} iterations, {} function evaluations, {} rejected trials",
+        oe.loss, oe.fpe, oe.aic, oe.report.iterations, oe.report.function_evaluations, oe.report.rejected_trials
+    );
+    println!(
+        "  stopped: {}   time {:.2} s",
+        oe.report.termination, fit.elapsed_s
+    );
+    if fit.starts.len() > 1 {
+        let good = fit
+            .starts
+            .iter()
+            .map(|s| s.cost)
+            .fold(f64::INFINITY, f64::min);
+        let near = fit.starts.iter().filter(|s| s.cost <= 1.01 * good).count();
+        println!(
+            "  multi-start: {} starts screened, {near} reached the best screened criterion",
+            fit.starts.len()
+        );
+    }
+}
+
+/// Pairs of free parameters with |correlation| above `limit`.
+pub fn strong_correlations(fit: &GreyBoxFit, limit: f64) -> Vec<(String, String, f64)> {
+    let oe = &fit.fit;
+    let free = &oe.report.free;
+    let c = &oe.covariance.correlation;
+    let mut out = Vec::new();
+    for (a, &i) in free.iter().enumerate() {
+        for &j in &free[a + 1..] {
+            if c[(i, j)].abs() > limit {
+                out.push((
+                    oe.parameters.get(i).name.clone(),
+                    oe.parameters.get(j).name.clone(),
+                    c[(i, j)],
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// Residual analysis of every experiment's first output, printed in one line each.
+pub fn print_residuals(fit: &GreyBoxFit, data: &IdData) -> Vec<ResidualAnalysis> {
+    (0..data.n_experiments())
+        .map(|e| {
+            let a = residual_analysis(data, e, 0, &fit.fit.simulated[e][0], 25);
+            println!(
+                "  residuals, experiment {}: {} of {} auto-correlations and {} of {} input cross-correlations outside the 99 % band ±{:.3}",
+                e + 1,
+                a.auto_outside,
+                a.max_lag,
+                a.cross_outside.iter().sum::<usize>(),
+                a.cross_correlation.iter().map(|c| c.len()).sum::<usize>(),
+                a.band
+            );
+            a
+        })
+        .collect()
+}
+
+/// Prints the sensitivity table.
+pub fn print_sensitivity(rows: &[SensitivityRow]) {
+    println!("  change of fit % for ±20 % of each parameter (one at a time), per experiment:");
+    for r in rows {
+        let cells: Vec<String> =
+            r.up.iter()
+                .zip(&r.down)
+                .map(|(u, d)| format!("{u:+8.3} / {d:+8.3}"))
+                .collect();
+        println!("    {:<12} {}", r.name, cells.join("   "));
+    }
+}
+
+/// The JSON report of a grey-box fit.
+pub fn report(
+    fit: &GreyBoxFit,
+    data: &IdData,
+    model_file: hysid::fitted::ModelFile,
+    extra: serde_json::Value,
+) -> Report {
+    let oe = &fit.fit;
+    let y: Vec<f64> = data
+        .experiments()
+        .iter()
+        .flat_map(|e| e.output(0).iter().copied())
+        .collect();
+    let yhat: Vec<f64> = oe
+        .simulated
+        .iter()
+        .flat_map(|s| s[0].iter().copied())
+        .collect();
+    let n = oe.parameters.len();
+    let correlation: Vec<Vec<f64>> = (0..n)
+        .map(|i| (0..n).map(|j| oe.covariance.correlation[(i, j)]).collect())
+        .collect();
+    let mut details = json!({
+        "fit_percent_per_experiment": oe.fit_percent,
+        "mse_per_experiment": oe.mse,
+        "function_evaluations": oe.report.function_evaluations,
+        "rejected_trials": oe.report.rejected_trials,
+        "correlation": correlation,
+        "history": oe.report.history,
+        "starts": fit.starts,
+    });
+    if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
+        obj.extend(more);
+    }
+    Report::new(
+        model_file,
+        oe,
+        (&y, &yhat),
+        fit.elapsed_s,
+        "asymptotic".into(),
+        details,
+    )
+}
