@@ -82,7 +82,7 @@ pub trait StateSpaceModel: Sync + Send {
     }
 
     /// For second-order mechanical models, the number of degrees of freedom n: the first n
-    /// states are positions, the next n their velocities (ẋ[i] = x[n + i]). Newmark
+    /// states are positions, the next n their velocities (ẋᵢ = x_{n+i}). Newmark
     /// integration needs this layout.
     fn mechanical_dofs(&self) -> Option<usize> {
         None
