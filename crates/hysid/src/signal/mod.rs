@@ -1,5 +1,11 @@
-//! Excitation signals and noise. Every random generator takes a seed and uses the portable
-//! xoshiro256++ generator, so a seed gives the same signal on every machine and version.
+//! Excitation signals, noise and preprocessing. Every random generator takes a seed and uses
+//! the portable xoshiro256++ generator, so a seed gives the same signal on every machine and
+//! version. The MATLAB-compatible preprocessing (`butter`, `filter`, `filtfilt`, `gradient`)
+//! functions are re-exported here from the `filter` submodule.
+
+mod filter;
+
+pub use filter::{butter, filter, filtfilt, gradient, remove_mean, steady_state_initial_conditions, TransferFunction};
 
 use crate::{Error, Result};
 use rand::rngs::Xoshiro256PlusPlus;
