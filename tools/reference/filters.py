@@ -32,8 +32,28 @@ for order, wn in [(4, 0.2), (2, 0.05), (6, 0.45)]:
     y = signal.filtfilt(b, a, x, padtype="odd", padlen=3 * (max(len(a), len(b)) - 1))
     cases.append({"order": order, "wn": wn, "b": b.tolist(), "a": a.tolist(), "x": x.tolist(), "filtfilt": y.tolist()})
 
+cheby = []
+for order, rp, wn in [(8, 0.05, 0.08), (8, 0.05, 0.4), (5, 0.5, 0.3)]:
+    b, a = signal.cheby1(order, rp, wn)
+    cheby.append({"order": order, "ripple_db": rp, "wn": wn, "b": b.tolist(), "a": a.tolist()})
+
+
+def matlab_decimate(x, r):
+    """MATLAB decimate(x, r): cheby1(8, 0.05, 0.8/r), filtfilt with MATLAB's padding, and
+    every r-th sample aligned so that the last one is kept (nbeg = r - (r*nout - nd))."""
+    b, a = signal.cheby1(8, 0.05, 0.8 / r)
+    y = signal.filtfilt(b, a, x, padtype="odd", padlen=3 * (max(len(a), len(b)) - 1))
+    nd = len(x)
+    nout = -(-nd // r)
+    nbeg = r - (r * nout - nd)
+    return y[nbeg - 1 :: r]
+
+
+xd = test_signal(1003)
 x = test_signal(50)
 out = {
+    "cheby1": cheby,
+    "decimate": {"r": 10, "x": xd.tolist(), "y": matlab_decimate(xd, 10).tolist()},
     "generator": "tools/reference/filters.py",
     "numpy": np.__version__,
     "scipy": scipy.__version__,

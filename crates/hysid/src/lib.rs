@@ -13,6 +13,8 @@
 //!   experiments and standard deviations.
 //! * [`greybox`]: continuous-time grey-box models (Bouc–Wen oscillator, rigid body with
 //!   friction), their integrators and their output-error estimation.
+//! * [`actuator`]: the linear actuator of Gunnar et al. (2006): loops, virtual rig and the
+//!   three-step identification.
 //! * [`data`]: the [`data::IdData`] container and CSV input/output.
 //! * [`signal`]: excitation signals and noise, all seeded.
 //! * [`metrics`]: fit %, RMSE and information criteria.
@@ -31,6 +33,7 @@
 //! * J. Gunnar, E. Wernholt, G. Hovland, T. Brogårdh, "Nonlinear Grey-Box Identification of
 //!   Linear Actuators Containing Hysteresis", ICRA 2006.
 
+pub mod actuator;
 pub mod data;
 pub mod error;
 pub mod estimate;

@@ -18,7 +18,7 @@ use hysid::greybox::{
     GreyBoxEstimation, InitialStates, InputInterpolation, Integrator, Simulation, StateSpaceModel,
 };
 use hysid::metrics;
-use hysid::signal::{decimate, gaussian_noise, multisine, sine_sweep};
+use hysid::signal::{decimate_fir, gaussian_noise, multisine, sine_sweep};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -221,7 +221,7 @@ fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
     let y_fine = model
         .simulate(&[input.experiment(0).input(0)], input.ts(), None)?
         .remove(0);
-    let mut y = decimate(&y_fine, UP);
+    let mut y = decimate_fir(&y_fine, UP);
     y.truncate(u.len());
     if args.noise > 0.0 {
         let noise = gaussian_noise(y.len(), args.noise, args.seed.wrapping_add(7))?;

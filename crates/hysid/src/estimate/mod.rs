@@ -9,6 +9,7 @@
 //!   [`OutputErrorModel`].
 //! * [`bootstrap`]: parametric bootstrap standard deviations where the curvature misleads.
 //! * [`hysteresis`]: the Coleman–Hodgdon hysteresis alone, from measured input and output.
+//! * [`inverse_dynamics`]: rigid-body least squares with friction (IDIM, step 1 of paper 2).
 //! * [`key_term`]: the iterative key-term-separation method of Vörös (2015) for the cascade.
 //! * [`global`]: the (α, d) grid stage that makes the cascade fit independent of the start.
 //! * [`cascade`]: the whole cascade pipeline (global stage, paper iteration, output error).
@@ -21,6 +22,7 @@ pub mod bootstrap;
 pub mod cascade;
 pub mod global;
 pub mod hysteresis;
+pub mod inverse_dynamics;
 pub mod key_term;
 pub mod levenberg_marquardt;
 mod linear_ls;

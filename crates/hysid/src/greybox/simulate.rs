@@ -758,3 +758,34 @@ mod integrator_tests {
         }
     }
 }
+
+/// One RK4 step of length `h` from (t, x) with the input held at `u`: the building block of
+/// closed-loop simulations, where the input of the next interval depends on the state.
+pub fn rk4_step(
+    model: &dyn StateSpaceModel,
+    theta: &[f64],
+    t: f64,
+    x: &mut [f64],
+    u: &[f64],
+    h: f64,
+) {
+    let n = x.len();
+    let mut k: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; n]);
+    let mut stage = x.to_vec();
+    model.rhs(t, x, u, theta, &mut k[0]);
+    for i in 0..n {
+        stage[i] = x[i] + 0.5 * h * k[0][i];
+    }
+    model.rhs(t + 0.5 * h, &stage, u, theta, &mut k[1]);
+    for i in 0..n {
+        stage[i] = x[i] + 0.5 * h * k[1][i];
+    }
+    model.rhs(t + 0.5 * h, &stage, u, theta, &mut k[2]);
+    for i in 0..n {
+        stage[i] = x[i] + h * k[2][i];
+    }
+    model.rhs(t + h, &stage, u, theta, &mut k[3]);
+    for i in 0..n {
+        x[i] += h / 6.0 * (k[0][i] + 2.0 * k[1][i] + 2.0 * k[2][i] + k[3][i]);
+    }
+}

@@ -8,6 +8,8 @@
 //!   extended at both ends by odd reflection of 3·(nfilt − 1) samples, and each pass starts
 //!   from the filter's steady-state initial conditions scaled by the first sample.
 //! * [`gradient`]: MATLAB's `gradient`: central differences inside, one-sided at the ends.
+//! * [`cheby1`], [`decimate`]: MATLAB's `cheby1` and `decimate(x, r)` with its default
+//!   8th-order Chebyshev type I filter.
 //!
 //! The reference values of the tests come from SciPy (`scipy.signal.butter`, `filtfilt` with
 //! `padtype='odd', padlen=3*(max(len(a), len(b))-1)`, `numpy.gradient`), which implement the
@@ -35,29 +37,79 @@ pub struct TransferFunction {
 /// assert!((dc - 1.0).abs() < 1e-12);
 /// ```
 pub fn butter(order: usize, wn: f64) -> Result<TransferFunction> {
-    if order == 0 || !(wn > 0.0 && wn < 1.0) {
-        return Err(Error::Config(format!(
-            "butter needs an order >= 1 and a cut-off strictly between 0 and 1 (relative to Nyquist), got order {order}, cut-off {wn}"
-        )));
-    }
-    // Prewarped analog cut-off for the bilinear transform s = (z − 1)/(z + 1).
-    let warped = (std::f64::consts::FRAC_PI_2 * wn).tan();
+    check_design(order, wn, "butter")?;
     let n = order as f64;
     let poles: Vec<Complex<f64>> = (0..order)
         .map(|k| {
             let angle = std::f64::consts::PI * (2.0 * k as f64 + n + 1.0) / (2.0 * n);
-            Complex::new(angle.cos(), angle.sin()) * warped
+            Complex::new(angle.cos(), angle.sin())
         })
         .collect();
-    // Bilinear: z = (1 + s)/(1 − s); zeros of the low-pass at z = −1.
-    let z_poles: Vec<Complex<f64>> = poles.iter().map(|p| (Complex::new(1.0, 0.0) + p) / (Complex::new(1.0, 0.0) - p)).collect();
+    Ok(bilinear_lowpass(&poles, 1.0, wn))
+}
+
+/// The `order`-th order Chebyshev type I low-pass with `ripple_db` decibels of pass-band
+/// ripple and pass-band edge `wn` relative to Nyquist, as MATLAB's `cheby1(order, rp, wn)`.
+pub fn cheby1(order: usize, ripple_db: f64, wn: f64) -> Result<TransferFunction> {
+    check_design(order, wn, "cheby1")?;
+    if !(ripple_db > 0.0) {
+        return Err(Error::Config(format!(
+            "cheby1 needs a positive ripple in dB, got {ripple_db}"
+        )));
+    }
+    let n = order as f64;
+    let eps = (10f64.powf(ripple_db / 10.0) - 1.0).sqrt();
+    let mu = (1.0 / eps).asinh() / n;
+    let poles: Vec<Complex<f64>> = (1..=order)
+        .map(|k| {
+            let theta = std::f64::consts::PI * (2.0 * k as f64 - 1.0) / (2.0 * n);
+            Complex::new(-mu.sinh() * theta.sin(), mu.cosh() * theta.cos())
+        })
+        .collect();
+    // Unit gain at DC for odd orders, the ripple floor 1/√(1 + ε²) for even ones.
+    let prototype_gain = poles
+        .iter()
+        .fold(Complex::new(1.0, 0.0), |g, p| g * (-p))
+        .re;
+    let gain = if order % 2 == 0 {
+        prototype_gain / (1.0 + eps * eps).sqrt()
+    } else {
+        prototype_gain
+    };
+    Ok(bilinear_lowpass(&poles, gain, wn))
+}
+
+fn check_design(order: usize, wn: f64, name: &str) -> Result<()> {
+    if order == 0 || !(wn > 0.0 && wn < 1.0) {
+        return Err(Error::Config(format!(
+            "{name} needs an order >= 1 and a cut-off strictly between 0 and 1 (relative to Nyquist), got order {order}, cut-off {wn}"
+        )));
+    }
+    Ok(())
+}
+
+/// The digital low-pass of an all-pole analog prototype with unit cut-off (poles, gain):
+/// frequency-scaled to the prewarped cut-off, then the bilinear transform z = (1 + s)/(1 − s),
+/// which puts every zero at z = −1.
+fn bilinear_lowpass(prototype: &[Complex<f64>], prototype_gain: f64, wn: f64) -> TransferFunction {
+    let order = prototype.len();
+    let warped = (std::f64::consts::FRAC_PI_2 * wn).tan();
+    let one = Complex::new(1.0, 0.0);
+    let poles: Vec<Complex<f64>> = prototype.iter().map(|p| p * warped).collect();
+    let z_poles: Vec<Complex<f64>> = poles.iter().map(|p| (one + p) / (one - p)).collect();
     let gain = poles
         .iter()
-        .fold(Complex::new(warped.powi(order as i32), 0.0), |g, p| g / (Complex::new(1.0, 0.0) - p))
+        .fold(
+            Complex::new(prototype_gain * warped.powi(order as i32), 0.0),
+            |g, p| g / (one - p),
+        )
         .re;
     let a = real_polynomial(&z_poles);
-    let b: Vec<f64> = real_polynomial(&vec![Complex::new(-1.0, 0.0); order]).iter().map(|c| c * gain).collect();
-    Ok(TransferFunction { b, a })
+    let b = real_polynomial(&vec![-one; order])
+        .iter()
+        .map(|c| c * gain)
+        .collect();
+    TransferFunction { b, a }
 }
 
 /// Coefficients of Π(z − rᵢ) in descending powers (roots in conjugate pairs or real).
@@ -86,7 +138,8 @@ pub fn filter(tf: &TransferFunction, x: &[f64], zi: &[f64]) -> Vec<f64> {
             let y = coef(&tf.b, 0) * xi + z.first().copied().unwrap_or(0.0);
             for i in 0..n - 1 {
                 let next = z.get(i + 1).copied().unwrap_or(0.0);
-                z[i] = coef(&tf.b, i + 1) * xi + if i + 1 < n - 1 { next } else { 0.0 } - coef(&tf.a, i + 1) * y;
+                z[i] = coef(&tf.b, i + 1) * xi + if i + 1 < n - 1 { next } else { 0.0 }
+                    - coef(&tf.a, i + 1) * y;
             }
             y
         })
@@ -111,8 +164,13 @@ pub fn steady_state_initial_conditions(tf: &TransferFunction) -> Vec<f64> {
             lhs[(i, i + 1)] -= 1.0;
         }
     }
-    let rhs = DVector::from_fn(m, |i, _| coef(&tf.b, i + 1) - coef(&tf.a, i + 1) * coef(&tf.b, 0));
-    lhs.lu().solve(&rhs).map(|v| v.iter().copied().collect()).unwrap_or_else(|| vec![0.0; m])
+    let rhs = DVector::from_fn(m, |i, _| {
+        coef(&tf.b, i + 1) - coef(&tf.a, i + 1) * coef(&tf.b, 0)
+    });
+    lhs.lu()
+        .solve(&rhs)
+        .map(|v| v.iter().copied().collect())
+        .unwrap_or_else(|| vec![0.0; m])
 }
 
 /// Zero-phase filtering as MATLAB's `filtfilt` (see the module docs). Errors when the record
@@ -137,6 +195,20 @@ pub fn filtfilt(tf: &TransferFunction, x: &[f64]) -> Result<Vec<f64>> {
     let reversed: Vec<f64> = forward.iter().rev().copied().collect();
     let backward = filter(tf, &reversed, &scaled(reversed[0]));
     Ok(backward.iter().rev().skip(nfact).take(n).copied().collect())
+}
+
+/// MATLAB's `decimate(x, r)` with its default filter: an 8th-order Chebyshev type I
+/// low-pass (0.05 dB ripple, edge 0.8/r of Nyquist) applied by [`filtfilt`], then every r-th
+/// sample, aligned so that the last sample is kept (MATLAB's `nbeg`).
+pub fn decimate(x: &[f64], r: usize) -> Result<Vec<f64>> {
+    if r <= 1 {
+        return Ok(x.to_vec());
+    }
+    let tf = cheby1(8, 0.05, 0.8 / r as f64)?;
+    let filtered = filtfilt(&tf, x)?;
+    let n_out = x.len().div_ceil(r);
+    let first = x.len() + r - 1 - r * n_out;
+    Ok(filtered.iter().skip(first).step_by(r).copied().collect())
 }
 
 /// MATLAB's `gradient(x, h)`: central differences inside, one-sided differences at the ends.

@@ -5,7 +5,10 @@
 
 mod filter;
 
-pub use filter::{butter, filter, filtfilt, gradient, remove_mean, steady_state_initial_conditions, TransferFunction};
+pub use filter::{
+    butter, cheby1, decimate, filter, filtfilt, gradient, remove_mean,
+    steady_state_initial_conditions, TransferFunction,
+};
 
 use crate::{Error, Result};
 use rand::rngs::Xoshiro256PlusPlus;
@@ -128,7 +131,7 @@ pub fn sine_sweep(n: usize, fs: f64, amplitude: f64, f0: f64, rate: f64) -> Vec<
 /// its cut-off at the new Nyquist frequency, 20·factor + 1 taps, applied centred, the record
 /// extended by its end values) followed by keeping every `factor`-th sample, starting with
 /// the first. Like MATLAB's `decimate(…, 'fir')`, up to its filter details.
-pub fn decimate(x: &[f64], factor: usize) -> Vec<f64> {
+pub fn decimate_fir(x: &[f64], factor: usize) -> Vec<f64> {
     if factor <= 1 || x.is_empty() {
         return x.to_vec();
     }
@@ -230,7 +233,7 @@ mod tests {
             .map(|k| (std::f64::consts::TAU * 0.2 * k as f64).sin())
             .collect();
         let mixed: Vec<f64> = slow.iter().zip(&fast).map(|(a, b)| a + b).collect();
-        let d = decimate(&mixed, 10);
+        let d = decimate_fir(&mixed, 10);
         for (k, v) in d.iter().enumerate().skip(30).take(1900) {
             assert!(
                 (v - slow[10 * k]).abs() < 2e-3,

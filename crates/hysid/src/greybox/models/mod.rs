@@ -3,30 +3,37 @@
 //! * [`BoucWen`]: the single-degree-of-freedom Bouc–Wen oscillator of the hysteretic
 //!   benchmark (Noël & Schoukens 2016), in identifiable parameters.
 //! * [`RigidBody`]: a rigid body with viscous and Coulomb friction and a force offset.
+//! * [`ActuatorFixed`], [`ActuatorFree`]: the linear actuator with a Dhaouadi hysteresis of
+//!   Gunnar et al. (2006), saddle fixed and free.
 
+mod actuator;
 mod bouc_wen;
 mod rigid_body;
 
+pub use actuator::{ActuatorFixed, ActuatorFree};
 pub use bouc_wen::BoucWen;
 pub use rigid_body::RigidBody;
 
 use super::StateSpaceModel;
 use crate::{Error, Result};
 
-/// The built-in model called `kind` (`bouc_wen`, `rigid_body`).
+/// The built-in model called `kind` (`bouc_wen`, `rigid_body`, `actuator_fixed`,
+/// `actuator_free`; dashes allowed for underscores).
 pub fn by_kind(kind: &str) -> Result<Box<dyn StateSpaceModel>> {
     match kind.trim().to_ascii_lowercase().replace('-', "_").as_str() {
         "bouc_wen" => Ok(Box::new(BoucWen)),
         "rigid_body" => Ok(Box::new(RigidBody)),
+        "actuator_fixed" => Ok(Box::new(ActuatorFixed)),
+        "actuator_free" => Ok(Box::new(ActuatorFree)),
         other => Err(Error::Config(format!(
-            "unknown grey-box model '{other}'; the built-in ones are bouc-wen and rigid-body"
+            "unknown grey-box model '{other}'; the built-in ones are bouc-wen, rigid-body, actuator-fixed and actuator-free"
         ))),
     }
 }
 
-/// sgn with sgn(0) = 0.
+/// sgn with sgn(0) = 0 (friction and hysteresis laws use it).
 #[inline]
-pub(crate) fn sign0(v: f64) -> f64 {
+pub fn sign0(v: f64) -> f64 {
     if v > 0.0 {
         1.0
     } else if v < 0.0 {
@@ -103,6 +110,28 @@ mod tests {
         let mut theta = BoucWen.parameters().values();
         theta[6] = 1.3;
         check_jacobians(&BoucWen, &points, &theta);
+    }
+
+    #[test]
+    fn actuator_jacobians_agree_with_differences() {
+        let fixed_points = vec![
+            (vec![0.03, 0.4, 0.2], vec![0.8]),
+            (vec![-0.05, -1.2, -0.3], vec![-0.2]),
+        ];
+        check_jacobians(
+            &ActuatorFixed,
+            &fixed_points,
+            &ActuatorFixed.parameters().values(),
+        );
+        let free_points = vec![
+            (vec![0.03, 0.4, 2e-4, 0.2], vec![0.8]),
+            (vec![-0.05, -1.2, -1e-3, -0.3], vec![-0.2]),
+        ];
+        check_jacobians(
+            &ActuatorFree,
+            &free_points,
+            &ActuatorFree.parameters().values(),
+        );
     }
 
     #[test]

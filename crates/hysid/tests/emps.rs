@@ -1,0 +1,40 @@
+//! Step 1 on real data: the EMPS positioning system's inverse-dynamics least squares with the
+//! published preprocessing reproduces the published reference model (MODELS.md §3.2).
+
+use hysid::data::{CsvSpec, IdData};
+use hysid::estimate::inverse_dynamics::RigidBodyLs;
+use std::path::Path;
+
+#[test]
+fn emps_reference_model_is_reproduced() {
+    let spec = CsvSpec {
+        inputs: vec!["vir_V".into()],
+        outputs: vec!["qm_m".into()],
+        time: Some("t_s".into()),
+        ts: None,
+    };
+    let data = IdData::from_csv(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/emps/DATA_EMPS.csv"),
+        &spec,
+    )
+    .unwrap();
+    let exp = data.experiment(0);
+    let est = RigidBodyLs::emps()
+        .estimate(exp.output(0), exp.input(0), data.ts())
+        .unwrap();
+    let published = [
+        (95.1089, 0.005),
+        (203.5034, 0.005),
+        (20.3935, 0.005),
+        (-3.1648, 0.02),
+    ];
+    for ((name, got), (want, tol)) in est.names.iter().zip(&est.values).zip(published) {
+        assert!(((got - want) / want).abs() < tol, "{name}: {got} vs {want}");
+    }
+    assert!(
+        (est.relative_error_percent - 4.0834).abs() < 0.2,
+        "{}",
+        est.relative_error_percent
+    );
+    eprintln!("{est:?}");
+}
