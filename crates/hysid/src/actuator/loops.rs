@@ -65,7 +65,6 @@ mod tests {
         for period in 0..3 {
             for k in 0..n {
                 let t = k as f64 * dt;
-                let x1 = q * t.sin();
                 let v = q * (t + 0.5 * dt).cos();
                 // Exact solution of ẋ4 over one small step with constant ẋ1.
                 let (decay, target) = ((-alpha * v.abs() * dt).exp(), a * v.signum() / alpha);

@@ -191,7 +191,8 @@ impl Rig {
                 "the rig needs 7 finite true parameters (J, Fv, Fc, k1, k2, alpha, A)".into(),
             ));
         }
-        if !(self.fs > 0.0)
+        if self.fs.is_nan()
+            || self.fs <= 0.0
             || self.substeps == 0
             || self.backlash < 0.0
             || self.angle_noise < 0.0

@@ -52,7 +52,7 @@ pub fn butter(order: usize, wn: f64) -> Result<TransferFunction> {
 /// ripple and pass-band edge `wn` relative to Nyquist, as MATLAB's `cheby1(order, rp, wn)`.
 pub fn cheby1(order: usize, ripple_db: f64, wn: f64) -> Result<TransferFunction> {
     check_design(order, wn, "cheby1")?;
-    if !(ripple_db > 0.0) {
+    if ripple_db.is_nan() || ripple_db <= 0.0 {
         return Err(Error::Config(format!(
             "cheby1 needs a positive ripple in dB, got {ripple_db}"
         )));
