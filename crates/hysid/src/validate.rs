@@ -145,15 +145,22 @@ pub fn sensitivity_table(
 
 /// fit % of the first output of every experiment for the parameter vector θ.
 pub fn fits(model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<Vec<f64>> {
-    data.experiments()
-        .iter()
-        .enumerate()
-        .map(|(e, exp)| {
-            let mut y = vec![vec![0.0; exp.len()]; model.n_outputs()];
-            model.simulate(theta, data, e, &mut y)?;
-            Ok(metrics::fit_percent(exp.output(0), &y[0]))
-        })
+    (0..data.n_experiments())
+        .map(|e| experiment_fit(model, data, e, theta))
         .collect()
+}
+
+/// fit % of the first output of experiment `e` for the parameter vector θ.
+pub fn experiment_fit(
+    model: &dyn OutputErrorModel,
+    data: &IdData,
+    e: usize,
+    theta: &[f64],
+) -> Result<f64> {
+    let exp = &data.experiments()[e];
+    let mut y = vec![vec![0.0; exp.len()]; model.n_outputs()];
+    model.simulate(theta, data, e, &mut y)?;
+    Ok(metrics::fit_percent(exp.output(0), &y[0]))
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 
 use hysid::data::{CsvSpec, IdData};
 use hysid::estimate::{Control, OutputErrorModel, ParameterSet};
-use hysid::greybox::models::{BoucWen, RigidBody};
+use hysid::greybox::models::{ActuatorFixed, BoucWen, RigidBody};
 use hysid::greybox::{
     GreyBox, GreyBoxEstimation, InitialStates, InputInterpolation, Integrator, Simulation,
     StateSpaceModel,
@@ -74,16 +74,45 @@ fn train_record() -> IdData {
 }
 
 /// Streamed sensitivities of the grey-box structure (forward sensitivity equations through
-/// RK4) agree with central differences of its simulation, initial states included.
+/// RK4) agree with central differences of its simulation, initial states included — also
+/// through the stick–slip events of Coulomb friction (the rigid body reverses, the actuator
+/// sticks and breaks away).
 #[test]
 fn sensitivities_match_finite_differences() {
-    let models: Vec<(Arc<dyn StateSpaceModel>, Vec<f64>)> = vec![
-        (Arc::new(BoucWen), vec![1e-4, 0.01, 3.0]),
-        (Arc::new(RigidBody), vec![0.01, 0.2]),
+    let fast = multisine(512, 1, 750.0, 5.0, 150.0, 50.0, 3).unwrap();
+    // The actuator's motor sticks at every reversal of this slow torque.
+    let slow: Vec<f64> = (0..512)
+        .map(|k| 1.4 * (std::f64::consts::TAU * 4.0 * k as f64 / 1000.0).sin())
+        .collect();
+    // (model, initial state, sample time, input, relative step of the central differences:
+    // the initial speed of the actuator matters only until the motor first stops, so its
+    // differences need a larger step to rise above rounding).
+    type Case = (Arc<dyn StateSpaceModel>, Vec<f64>, f64, Vec<f64>, f64);
+    let models: Vec<Case> = vec![
+        (
+            Arc::new(BoucWen),
+            vec![1e-4, 0.01, 3.0],
+            1.0 / 750.0,
+            fast.clone(),
+            1e-6,
+        ),
+        (
+            Arc::new(RigidBody),
+            vec![0.01, 0.2],
+            1.0 / 750.0,
+            fast,
+            1e-6,
+        ),
+        (
+            Arc::new(ActuatorFixed),
+            vec![0.01, 0.05, 0.1],
+            1e-3,
+            slow,
+            1e-4,
+        ),
     ];
-    for (model, x0) in models {
-        let u = multisine(512, 1, 750.0, 5.0, 150.0, 50.0, 3).unwrap();
-        let data = IdData::siso(1.0 / 750.0, "u", u, "y", vec![0.0; 512]).unwrap();
+    for (model, x0, ts, u, step) in models {
+        let data = IdData::siso(ts, "u", u, "y", vec![0.0; 512]).unwrap();
         let initial = InitialStates {
             values: vec![x0.clone()],
             estimated: vec![true; x0.len()],
@@ -102,13 +131,15 @@ fn sensitivities_match_finite_differences() {
             .filter(|&i| !params.get(i).fixed || i >= model.parameters().len())
             .collect();
         let mut analytic = vec![vec![0.0; free.len()]; 512];
-        gb.simulate_sensitivities(&theta, &data, 0, &free, &mut |t, _, dy| {
+        let mut y = vec![0.0; 512];
+        gb.simulate_sensitivities(&theta, &data, 0, &free, &mut |t, yt, dy| {
+            y[t] = yt[0];
             analytic[t].copy_from_slice(dy)
         })
         .expect("analytic sensitivities")
         .unwrap();
         for (c, &i) in free.iter().enumerate() {
-            let h = 1e-6 * theta[i].abs().max(1e-4);
+            let h = step * theta[i].abs().max(1e-4);
             let (mut hi, mut lo) = (theta.clone(), theta.clone());
             hi[i] += h;
             lo[i] -= h;
@@ -116,6 +147,14 @@ fn sensitivities_match_finite_differences() {
             gb.simulate(&hi, &data, 0, &mut yh).unwrap();
             gb.simulate(&lo, &data, 0, &mut yl).unwrap();
             let scale = analytic.iter().map(|r| r[c].abs()).fold(0.0, f64::max);
+            if model.kind() == "actuator_fixed" {
+                // At rest the torsion does not change from one sample to the next.
+                let stuck = y.windows(2).filter(|w| w[0] == w[1]).count();
+                assert!(
+                    stuck > 20,
+                    "the motor should stick: {stuck} samples at rest"
+                );
+            }
             for t in 0..512 {
                 let fd = (yh[0][t] - yl[0][t]) / (2.0 * h);
                 assert!(

@@ -3,6 +3,8 @@
 //!
 //! * [`loops`]: the steady-state loop formula of step 2 (corrected).
 //! * [`rig`]: the virtual test rig reproducing the paper's eight experiments.
+//! * [`identify`]: the three steps and the paper's tables.
 
+pub mod identify;
 pub mod loops;
 pub mod rig;

@@ -6,11 +6,18 @@
 //! | 1 | free | PI speed control to 210 sin(2π·1·t) rad/s, 10 s | same |
 //! | 2–5 | fixed | PI angle control to Q sin(0.5t), max flexibility torque 0.9–1.6 N·m, one steady-state period | Q for 0.9, 1.13, 1.37, 1.6 N·m; one period of warm-up, then 12.6 s (a full 12.57 s period; the paper's 12.3 s is a little short of it) |
 //! | 6 | fixed | torque 1.4 sin(2t) N·m | 2 periods (6.3 s) from rest |
-//! | 7, 8 | fixed | multisine torque 1–30 Hz, 5 s, two amplitude/phase sets (8 smaller) | RMS 0.5 and 0.25 N·m, seeds 7 and 8 |
+//! | 7, 8 | fixed | multisine torque 1–30 Hz, 5 s, two amplitude/phase sets (8 smaller) | RMS 0.5 and 0.4 N·m, seeds 7 and 8 |
 //!
-//! The plant is integrated by RK4 with 10 steps per sample, the torque held between samples.
-//! The controllers act on the true signals; the logged motor angle and torque carry white
-//! Gaussian noise of the given standard deviations (defaults 2·10⁻⁵ rad, 5·10⁻³ N·m).
+//! The plant is integrated by RK4 with 10 steps per sample (stick–slip aware, see
+//! [`crate::greybox::stick_slip`]), the torque held between samples. The controllers act on
+//! the true signals.
+//!
+//! **Measurement noise** (PROJECT levels): the logged angle and torque carry white Gaussian
+//! noise with the standard deviation of a rounding to 16-bit numbers — one count of a
+//! 16-bit-per-revolution encoder, 2π/2¹⁶/√12 = 2.77·10⁻⁵ rad, and one count of a 16-bit torque
+//! log over ±5 N·m, 10/2¹⁶/√12 = 4.40·10⁻⁵ N·m. Larger torque noise makes the output-error
+//! step biased (errors in the input variable, amplified by the stick–slip of the friction):
+//! the README reports what it costs.
 //!
 //! **Backlash** (optional, unmodelled by the identification, as on the real actuator): the
 //! spring sees the deflection d of a play of width b on the torsion x1 (d follows x1 only
@@ -21,13 +28,23 @@
 //! Without backlash and noise, the saddle-fixed sets are exactly what the identification
 //! model [`ActuatorFixed`] simulates with the same integrator.
 
-use crate::greybox::models::{ActuatorFixed, ActuatorFree};
+use crate::greybox::models::{coulomb_direction, ActuatorFixed, ActuatorFree};
 use crate::greybox::simulate::rk4_step;
+use crate::greybox::stick_slip::Rk4;
 use crate::greybox::StateSpaceModel;
 use crate::signal::{gaussian_noise, multisine};
 use crate::{Error, Result};
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
+
+/// One count of a 16-bit-per-revolution motor encoder [rad].
+pub const ANGLE_QUANTUM: f64 = TAU / 65_536.0;
+
+/// One count of a 16-bit torque log over ±5 N·m [N·m].
+pub const TORQUE_QUANTUM: f64 = 10.0 / 65_536.0;
+
+/// √12: a uniform rounding error of one count q has standard deviation q/√12.
+const SQRT_12: f64 = 3.464_101_615_137_754_6;
 
 /// Settings of the virtual rig.
 #[derive(Clone, Debug)]
@@ -48,6 +65,9 @@ pub struct Rig {
     pub torque_noise: f64,
     /// Play width b of the backlash in the flexibility [rad]; 0 for none.
     pub backlash: f64,
+    /// RMS torque of the multisines of data sets 7 and 8 [N·m] (8 the smaller, as in the
+    /// paper).
+    pub multisine_rms: [f64; 2],
     /// Seed of the noise.
     pub seed: u64,
 }
@@ -60,9 +80,10 @@ impl Default for Rig {
             m: 1.2,
             fs: 1000.0,
             substeps: 10,
-            angle_noise: 2e-5,
-            torque_noise: 5e-3,
+            angle_noise: ANGLE_QUANTUM / SQRT_12,
+            torque_noise: TORQUE_QUANTUM / SQRT_12,
             backlash: 0.0,
+            multisine_rms: [0.5, 0.4],
             seed: 1,
         }
     }
@@ -155,7 +176,7 @@ impl Rig {
                 )
             }
             7 | 8 => {
-                let rms = if set == 7 { 0.5 } else { 0.25 };
+                let rms = self.multisine_rms[set - 7];
                 let n = (5.0 * fs).round() as usize;
                 (
                     Excitation::Torque(multisine(n, 1, fs, 1.0, 30.0, rms, set as u64)?),
@@ -343,19 +364,18 @@ impl Plant {
         let g = th[3] * d + th[4] * d.powi(3) + x4;
         let (j, fv, fc) = (th[0], th[1], th[2]);
         let (r, m, free) = (self.r, self.m, self.saddle_free);
-        let rhs = |s: &[f64; 4]| -> [f64; 4] {
-            let acc = (-fv * s[1] - fc * crate::greybox::models::sign0(s[1]) - g + tau) / j;
-            let saddle = if free { g / (r * m) } else { 0.0 };
-            [s[1], acc, if free { s[3] } else { 0.0 }, saddle]
+        // (θ, θ̇, z, ż) with the spring torque g held over the step.
+        let mut rate = |_: f64, s: &[f64], held: Option<f64>, ds: &mut [f64]| {
+            let applied = tau - g - fv * s[1];
+            let direction = held.or_else(|| coulomb_direction(s[1], applied, fc));
+            ds[0] = s[1];
+            ds[1] = direction.map_or(0.0, |dir| (applied - fc * dir) / j);
+            ds[2] = if free { s[3] } else { 0.0 };
+            ds[3] = if free { g / (r * m) } else { 0.0 };
         };
-        let s0 = [x[0], x[1], x[2], x[3]];
-        let k1 = rhs(&s0);
-        let k2 = rhs(&std::array::from_fn(|i| s0[i] + 0.5 * h * k1[i]));
-        let k3 = rhs(&std::array::from_fn(|i| s0[i] + 0.5 * h * k2[i]));
-        let k4 = rhs(&std::array::from_fn(|i| s0[i] + h * k3[i]));
-        for i in 0..4 {
-            x[i] = s0[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
+        let mut s = [x[0], x[1], x[2], x[3]];
+        Rk4::new(4).step(&mut rate, &mut s, h, Some(1), None);
+        x[..4].copy_from_slice(&s);
         let x1 = x[0] - x[2] / r;
         let half = 0.5 * self.backlash;
         let new_d = d.clamp(x1 - half, x1 + half);
@@ -395,6 +415,13 @@ impl StateSpaceModel for FreeWithPosition {
     }
     fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
         ActuatorFree.output(x, u, theta, y);
+    }
+    fn stick_slip_velocity(&self) -> Option<usize> {
+        ActuatorFree.stick_slip_velocity()
+    }
+    fn rhs_sliding(&self, t: f64, x: &[f64], u: &[f64], th: &[f64], d: f64, dx: &mut [f64]) {
+        ActuatorFree.rhs_sliding(t, &x[..4], u, th, d, &mut dx[..4]);
+        dx[4] = x[2];
     }
 }
 

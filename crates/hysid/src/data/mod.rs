@@ -336,6 +336,31 @@ impl IdData {
         Ok((head, tail))
     }
 
+    /// The experiments at `indices`, in that order (MATLAB's `getexp`).
+    ///
+    /// Fails with [`Error::InvalidData`] on an empty selection or an index out of range.
+    pub fn select(&self, indices: &[usize]) -> Result<Self> {
+        if indices.is_empty() {
+            return Err(invalid("select at least one experiment".to_string()));
+        }
+        let mut experiments = Vec::with_capacity(indices.len());
+        for &i in indices {
+            let e = self.experiments.get(i).ok_or_else(|| {
+                invalid(format!(
+                    "there is no experiment {i}: the data hold {}",
+                    self.experiments.len()
+                ))
+            })?;
+            experiments.push(e.clone());
+        }
+        Ok(Self {
+            ts: self.ts,
+            inputs: self.inputs.clone(),
+            outputs: self.outputs.clone(),
+            experiments,
+        })
+    }
+
     /// Appends the experiments of `other` to those of `self`.
     ///
     /// Fails with [`Error::InvalidData`] naming what differs if the two data sets do not

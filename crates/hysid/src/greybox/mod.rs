@@ -15,6 +15,7 @@
 //!
 //! * [`simulate`]: integrators (RK4 with sub-steps, Newmark, adaptive Dormand–Prince) and the
 //!   input interpolation between samples.
+//! * [`stick_slip`]: RK4 steps that integrate Coulomb friction as stick–slip.
 //! * [`structure`]: a model, its simulation settings and its initial states per experiment
 //!   as an [`OutputErrorModel`](crate::estimate::OutputErrorModel).
 //! * [`estimate`]: output-error estimation with multi-start (MATLAB's `nlgreyest`).
@@ -23,6 +24,7 @@
 pub mod estimate;
 pub mod models;
 pub mod simulate;
+pub mod stick_slip;
 pub mod structure;
 
 pub use estimate::{GreyBoxEstimation, GreyBoxFit};
@@ -86,5 +88,48 @@ pub trait StateSpaceModel: Sync + Send {
     /// integration needs this layout.
     fn mechanical_dofs(&self) -> Option<usize> {
         None
+    }
+
+    /// For models with Coulomb friction: the index of the velocity state whose sign the
+    /// friction follows. RK4 then integrates stick–slip ([`stick_slip`]): a step that starts
+    /// sliding holds the friction direction ([`rhs_sliding`](Self::rhs_sliding)) and is cut
+    /// where the velocity reaches zero; at exactly zero velocity [`rhs`](Self::rhs) decides
+    /// between sticking and breaking away, so `rhs` must implement friction at rest as the
+    /// force that holds the body, clamp(applied, −Fc, Fc) ([`models::coulomb_direction`]).
+    /// None (the default) for smooth models.
+    fn stick_slip_velocity(&self) -> Option<usize> {
+        None
+    }
+
+    /// [`rhs`](Self::rhs) with the Coulomb friction held in `direction` (±1) whatever the sign
+    /// of the velocity, so that no stage of a sliding step sees the friction flip. Models that
+    /// name a [`stick_slip_velocity`](Self::stick_slip_velocity) must implement it; the
+    /// default is `rhs`.
+    fn rhs_sliding(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        _direction: f64,
+        dx: &mut [f64],
+    ) {
+        self.rhs(t, x, u, theta, dx);
+    }
+
+    /// [`rhs_jacobians`](Self::rhs_jacobians) with the Coulomb friction held in `direction`
+    /// (see [`rhs_sliding`](Self::rhs_sliding)); the default is `rhs_jacobians`.
+    #[allow(clippy::too_many_arguments)]
+    fn rhs_jacobians_sliding(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        _direction: f64,
+        fx: &mut [f64],
+        ftheta: &mut [f64],
+    ) -> bool {
+        self.rhs_jacobians(t, x, u, theta, fx, ftheta)
     }
 }

@@ -30,6 +30,7 @@
 //! * [`Integrator::Adaptive`]: Dormand–Prince 5(4) with error control, restarted at every
 //!   sample (the input may jump there); the reference the tests compare the others with.
 
+use super::stick_slip::{Rk4, Sensitivities};
 use super::StateSpaceModel;
 use crate::{Error, Result};
 use rustfft::num_complex::Complex;
@@ -256,8 +257,8 @@ struct Stepper<'a> {
     ts: f64,
     integrator: Integrator,
     u: Vec<f64>,
+    rk4: Rk4,
     k: [Vec<f64>; 7],
-    tmp: Vec<f64>,
 }
 
 impl<'a> Stepper<'a> {
@@ -268,6 +269,12 @@ impl<'a> Stepper<'a> {
         ts: f64,
         integrator: Integrator,
     ) -> Result<Self> {
+        if model.stick_slip_velocity().is_some() && !matches!(integrator, Integrator::Rk4 { .. }) {
+            return Err(Error::Config(format!(
+                "{} has Coulomb friction, and only RK4 integrates its stick phases; use the RK4 integrator",
+                model.kind()
+            )));
+        }
         if let Integrator::Newmark { .. } = integrator {
             if model.mechanical_dofs().is_none() {
                 return Err(Error::Config(format!(
@@ -284,8 +291,8 @@ impl<'a> Stepper<'a> {
             ts,
             integrator,
             u: vec![0.0; input.n_channels()],
+            rk4: Rk4::new(n),
             k: std::array::from_fn(|_| vec![0.0; n]),
-            tmp: vec![0.0; n],
         })
     }
 
@@ -326,28 +333,22 @@ impl<'a> Stepper<'a> {
         );
     }
 
-    /// One RK4 step of fraction `dtau` of the sample interval from τ.
+    /// One RK4 step of fraction `dtau` of the sample interval from τ (stick–slip aware,
+    /// see [`super::stick_slip`]).
     fn rk4_step(&mut self, k: usize, tau: f64, dtau: f64, x: &mut [f64]) {
-        let h = dtau * self.ts;
         let (model, theta, input, ts) = (self.model, self.theta, self.input, self.ts);
-        let [k1, k2, k3, k4, ..] = &mut self.k;
-        let (u, tmp) = (&mut self.u, &mut self.tmp);
-        rate(model, theta, input, ts, u, k, tau, x, k1);
-        for i in 0..x.len() {
-            tmp[i] = x[i] + 0.5 * h * k1[i];
-        }
-        rate(model, theta, input, ts, u, k, tau + 0.5 * dtau, tmp, k2);
-        for i in 0..x.len() {
-            tmp[i] = x[i] + 0.5 * h * k2[i];
-        }
-        rate(model, theta, input, ts, u, k, tau + 0.5 * dtau, tmp, k3);
-        for i in 0..x.len() {
-            tmp[i] = x[i] + h * k3[i];
-        }
-        rate(model, theta, input, ts, u, k, tau + dtau, tmp, k4);
-        for i in 0..x.len() {
-            x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
+        let u = &mut self.u;
+        let mut f = |dt: f64, x: &[f64], held: Option<f64>, out: &mut [f64]| {
+            let tau = tau + dt / ts;
+            input.at(k, tau, u);
+            let t = (k as f64 + tau) * ts;
+            match held {
+                Some(d) => model.rhs_sliding(t, x, u, theta, d, out),
+                None => model.rhs(t, x, u, theta, out),
+            }
+        };
+        let velocity = model.stick_slip_velocity();
+        self.rk4.step(&mut f, x, dtau * ts, velocity, None);
     }
 
     /// One Newmark step (see the module docs) of fraction `dtau` from τ.
@@ -576,15 +577,25 @@ pub fn simulate_sensitivities(
     for (c, &i) in initial.iter().enumerate() {
         z[n + i * q + params.len() + c] = 1.0;
     }
-    let mut ks: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; dim]);
-    let mut stage = vec![0.0; dim];
     let m = substeps.max(1);
     let h = ts / m as f64;
-    let mut rate = |kk: usize, tau: f64, zs: &[f64], out: &mut [f64]| {
+    let mut rk4 = Rk4::new(dim);
+    let velocity = model.stick_slip_velocity();
+    let layout = Some(Sensitivities { n, q });
+    let mut rate = |kk: usize, tau: f64, zs: &[f64], held: Option<f64>, out: &mut [f64]| {
         input.at(kk, tau, &mut u);
         let t = (kk as f64 + tau) * ts;
-        model.rhs(t, &zs[..n], &u, theta, &mut out[..n]);
-        model.rhs_jacobians(t, &zs[..n], &u, theta, &mut fx, &mut ft);
+        let x = &zs[..n];
+        match held {
+            Some(d) => {
+                model.rhs_sliding(t, x, &u, theta, d, &mut out[..n]);
+                model.rhs_jacobians_sliding(t, x, &u, theta, d, &mut fx, &mut ft);
+            }
+            None => {
+                model.rhs(t, x, &u, theta, &mut out[..n]);
+                model.rhs_jacobians(t, x, &u, theta, &mut fx, &mut ft);
+            }
+        }
         // Ṡ = fx·S + fθ[:, params] (initial-state columns have no direct term).
         for r in 0..n {
             for c in 0..q {
@@ -610,23 +621,10 @@ pub fn simulate_sensitivities(
         }
         for j in 0..m {
             let tau = j as f64 / m as f64;
-            let dtau = 1.0 / m as f64;
-            rate(k, tau, &z, &mut ks[0]);
-            for i in 0..dim {
-                stage[i] = z[i] + 0.5 * h * ks[0][i];
-            }
-            rate(k, tau + 0.5 * dtau, &stage, &mut ks[1]);
-            for i in 0..dim {
-                stage[i] = z[i] + 0.5 * h * ks[1][i];
-            }
-            rate(k, tau + 0.5 * dtau, &stage, &mut ks[2]);
-            for i in 0..dim {
-                stage[i] = z[i] + h * ks[2][i];
-            }
-            rate(k, tau + dtau, &stage, &mut ks[3]);
-            for i in 0..dim {
-                z[i] += h / 6.0 * (ks[0][i] + 2.0 * ks[1][i] + 2.0 * ks[2][i] + ks[3][i]);
-            }
+            let mut f = |dt: f64, zs: &[f64], held: Option<f64>, out: &mut [f64]| {
+                rate(k, tau + dt / ts, zs, held, out)
+            };
+            rk4.step(&mut f, &mut z, h, velocity, layout);
         }
     }
     Ok(true)
@@ -759,8 +757,9 @@ mod integrator_tests {
     }
 }
 
-/// One RK4 step of length `h` from (t, x) with the input held at `u`: the building block of
-/// closed-loop simulations, where the input of the next interval depends on the state.
+/// One RK4 step of length `h` from (t, x) with the input held at `u` (stick–slip aware, see
+/// [`super::stick_slip`]): the building block of closed-loop simulations, where the input of
+/// the next interval depends on the state.
 pub fn rk4_step(
     model: &dyn StateSpaceModel,
     theta: &[f64],
@@ -769,23 +768,10 @@ pub fn rk4_step(
     u: &[f64],
     h: f64,
 ) {
-    let n = x.len();
-    let mut k: [Vec<f64>; 4] = std::array::from_fn(|_| vec![0.0; n]);
-    let mut stage = x.to_vec();
-    model.rhs(t, x, u, theta, &mut k[0]);
-    for i in 0..n {
-        stage[i] = x[i] + 0.5 * h * k[0][i];
-    }
-    model.rhs(t + 0.5 * h, &stage, u, theta, &mut k[1]);
-    for i in 0..n {
-        stage[i] = x[i] + 0.5 * h * k[1][i];
-    }
-    model.rhs(t + 0.5 * h, &stage, u, theta, &mut k[2]);
-    for i in 0..n {
-        stage[i] = x[i] + h * k[2][i];
-    }
-    model.rhs(t + h, &stage, u, theta, &mut k[3]);
-    for i in 0..n {
-        x[i] += h / 6.0 * (k[0][i] + 2.0 * k[1][i] + 2.0 * k[2][i] + k[3][i]);
-    }
+    let mut f = |dt: f64, x: &[f64], held: Option<f64>, out: &mut [f64]| match held {
+        Some(d) => model.rhs_sliding(t + dt, x, u, theta, d, out),
+        None => model.rhs(t + dt, x, u, theta, out),
+    };
+    let velocity = model.stick_slip_velocity();
+    Rk4::new(x.len()).step(&mut f, x, h, velocity, None);
 }

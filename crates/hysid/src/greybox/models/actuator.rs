@@ -14,6 +14,10 @@
 //! g(x) = k1 x1 + k2 x1³ + x4
 //! ```
 //!
+//! Coulomb friction at rest holds the motor while |τ − g| ≤ Fc (stick–slip, integrated by
+//! [`crate::greybox::stick_slip`]; sgn(0) is otherwise undefined and a plain integrator
+//! chatters there).
+//!
 //! With the saddle fixed (x3 = 0; steps 2 and 3 of the paper) the states are (x1, x2, x4):
 //! ẋ1 = x2, ẋ2 = (−Fv x2 − Fc sgn(x2) − g + τ)/J, ẋ4 = −α|x2|x4 + A x2.
 //!
@@ -29,7 +33,7 @@
 //! | r | `r` | gear ratio (saddle free; known, fixed) | m/rad | 1.867·10⁻³ |
 //! | m | `m` | saddle mass (saddle free; known, fixed) | kg | 1.2 |
 
-use super::sign0;
+use super::{coulomb_direction, sign0};
 use crate::data::Channel;
 use crate::estimate::{Parameter, ParameterSet};
 use crate::greybox::StateSpaceModel;
@@ -73,6 +77,22 @@ fn actuator_parameters() -> Vec<Parameter> {
     ]
 }
 
+/// (ẋ2, friction direction) at motor speed x2, flexibility torque g and input τ, or None
+/// while Coulomb friction holds the motor at rest; `held` forces the friction direction
+/// (inside a sliding RK4 step, see [`crate::greybox::stick_slip`]).
+#[inline]
+fn motor_acceleration(
+    th: &[f64],
+    x2: f64,
+    g: f64,
+    tau: f64,
+    held: Option<f64>,
+) -> Option<(f64, f64)> {
+    let applied = tau - g - th[FV] * x2;
+    held.or_else(|| coulomb_direction(x2, applied, th[FC]))
+        .map(|s| ((applied - th[FC] * s) / th[J], s))
+}
+
 /// The flexibility torque g = k1 x1 + k2 x1³ + x4 and its derivative ∂g/∂x1.
 #[inline]
 fn flexibility(th: &[f64], x1: f64, x4: f64) -> (f64, f64) {
@@ -108,11 +128,11 @@ impl StateSpaceModel for ActuatorFixed {
     }
 
     fn rhs(&self, _t: f64, x: &[f64], u: &[f64], th: &[f64], dx: &mut [f64]) {
-        let (x1, x2, x4) = (x[0], x[1], x[2]);
-        let (g, _) = flexibility(th, x1, x4);
-        dx[0] = x2;
-        dx[1] = (-th[FV] * x2 - th[FC] * sign0(x2) - g + u[0]) / th[J];
-        dx[2] = -th[ALPHA] * x2.abs() * x4 + th[A] * x2;
+        fixed_rhs(x, u, th, None, dx);
+    }
+
+    fn rhs_sliding(&self, _t: f64, x: &[f64], u: &[f64], th: &[f64], d: f64, dx: &mut [f64]) {
+        fixed_rhs(x, u, th, Some(d), dx);
     }
 
     fn output(&self, x: &[f64], _u: &[f64], _theta: &[f64], y: &mut [f64]) {
@@ -128,26 +148,21 @@ impl StateSpaceModel for ActuatorFixed {
         fx: &mut [f64],
         ft: &mut [f64],
     ) -> bool {
-        let (x1, x2, x4) = (x[0], x[1], x[2]);
-        let (g, dg) = flexibility(th, x1, x4);
-        let j = th[J];
-        let p = th.len();
-        fx.fill(0.0);
-        ft.fill(0.0);
-        fx[1] = 1.0;
-        fx[3] = -dg / j;
-        fx[4] = -th[FV] / j;
-        fx[5] = -1.0 / j;
-        fx[7] = -th[ALPHA] * sign0(x2) * x4 + th[A];
-        fx[8] = -th[ALPHA] * x2.abs();
-        let acc = (-th[FV] * x2 - th[FC] * sign0(x2) - g + u[0]) / j;
-        ft[p + J] = -acc / j;
-        ft[p + FV] = -x2 / j;
-        ft[p + FC] = -sign0(x2) / j;
-        ft[p + K1] = -x1 / j;
-        ft[p + K2] = -x1.powi(3) / j;
-        ft[2 * p + ALPHA] = -x2.abs() * x4;
-        ft[2 * p + A] = x2;
+        fixed_jacobians(x, u, th, None, fx, ft);
+        true
+    }
+
+    fn rhs_jacobians_sliding(
+        &self,
+        _t: f64,
+        x: &[f64],
+        u: &[f64],
+        th: &[f64],
+        d: f64,
+        fx: &mut [f64],
+        ft: &mut [f64],
+    ) -> bool {
+        fixed_jacobians(x, u, th, Some(d), fx, ft);
         true
     }
 
@@ -168,6 +183,56 @@ impl StateSpaceModel for ActuatorFixed {
     fn mechanical_dofs(&self) -> Option<usize> {
         Some(1)
     }
+
+    fn stick_slip_velocity(&self) -> Option<usize> {
+        Some(1)
+    }
+}
+
+/// The saddle-fixed right-hand side; with `held` = Some(d) the motion is taken to be in
+/// direction d (friction and |x2| of the hysteresis on that branch).
+fn fixed_rhs(x: &[f64], u: &[f64], th: &[f64], held: Option<f64>, dx: &mut [f64]) {
+    let (x1, x2, x4) = (x[0], x[1], x[2]);
+    let (g, _) = flexibility(th, x1, x4);
+    let speed = held.map_or(x2.abs(), |d| d * x2);
+    dx[0] = x2;
+    dx[1] = motor_acceleration(th, x2, g, u[0], held).map_or(0.0, |(acc, _)| acc);
+    dx[2] = -th[ALPHA] * speed * x4 + th[A] * x2;
+}
+
+/// ∂f/∂x and ∂f/∂θ of [`fixed_rhs`].
+fn fixed_jacobians(
+    x: &[f64],
+    u: &[f64],
+    th: &[f64],
+    held: Option<f64>,
+    fx: &mut [f64],
+    ft: &mut [f64],
+) {
+    let (x1, x2, x4) = (x[0], x[1], x[2]);
+    let (g, dg) = flexibility(th, x1, x4);
+    let j = th[J];
+    let p = th.len();
+    let direction = held.unwrap_or(sign0(x2));
+    let speed = direction * x2;
+    fx.fill(0.0);
+    ft.fill(0.0);
+    fx[1] = 1.0;
+    fx[7] = -th[ALPHA] * direction * x4 + th[A];
+    fx[8] = -th[ALPHA] * speed;
+    // While the motor sticks ẋ2 is identically zero: row 1 stays zero.
+    if let Some((acc, s)) = motor_acceleration(th, x2, g, u[0], held) {
+        fx[3] = -dg / j;
+        fx[4] = -th[FV] / j;
+        fx[5] = -1.0 / j;
+        ft[p + J] = -acc / j;
+        ft[p + FV] = -x2 / j;
+        ft[p + FC] = -s / j;
+        ft[p + K1] = -x1 / j;
+        ft[p + K2] = -x1.powi(3) / j;
+    }
+    ft[2 * p + ALPHA] = -speed * x4;
+    ft[2 * p + A] = x2;
 }
 
 impl StateSpaceModel for ActuatorFree {
@@ -210,13 +275,11 @@ impl StateSpaceModel for ActuatorFree {
     }
 
     fn rhs(&self, _t: f64, x: &[f64], u: &[f64], th: &[f64], dx: &mut [f64]) {
-        let (x1, x2, x3, x4) = (x[0], x[1], x[2], x[3]);
-        let (g, _) = flexibility(th, x1, x4);
-        let w = x2 - x3 / th[R];
-        dx[0] = w;
-        dx[1] = (-th[FV] * x2 - th[FC] * sign0(x2) - g + u[0]) / th[J];
-        dx[2] = g / (th[R] * th[M]);
-        dx[3] = -th[ALPHA] * w.abs() * x4 + th[A] * w;
+        free_rhs(x, u, th, None, dx);
+    }
+
+    fn rhs_sliding(&self, _t: f64, x: &[f64], u: &[f64], th: &[f64], d: f64, dx: &mut [f64]) {
+        free_rhs(x, u, th, Some(d), dx);
     }
 
     fn output(&self, x: &[f64], _u: &[f64], _theta: &[f64], y: &mut [f64]) {
@@ -232,42 +295,21 @@ impl StateSpaceModel for ActuatorFree {
         fx: &mut [f64],
         ft: &mut [f64],
     ) -> bool {
-        let (x1, x2, x3, x4) = (x[0], x[1], x[2], x[3]);
-        let (g, dg) = flexibility(th, x1, x4);
-        let (j, r, m) = (th[J], th[R], th[M]);
-        let w = x2 - x3 / r;
-        let dw = -th[ALPHA] * sign0(w) * x4 + th[A]; // ∂ẋ4/∂w
-        let p = th.len();
-        fx.fill(0.0);
-        ft.fill(0.0);
-        // Row 0: ẋ1 = x2 − x3/r.
-        fx[1] = 1.0;
-        fx[2] = -1.0 / r;
-        ft[R] = x3 / (r * r);
-        // Row 1: ẋ2.
-        fx[4] = -dg / j;
-        fx[5] = -th[FV] / j;
-        fx[7] = -1.0 / j;
-        let acc = (-th[FV] * x2 - th[FC] * sign0(x2) - g + u[0]) / j;
-        ft[p + J] = -acc / j;
-        ft[p + FV] = -x2 / j;
-        ft[p + FC] = -sign0(x2) / j;
-        ft[p + K1] = -x1 / j;
-        ft[p + K2] = -x1.powi(3) / j;
-        // Row 2: ẋ3 = g/(r m).
-        fx[8] = dg / (r * m);
-        fx[11] = 1.0 / (r * m);
-        ft[2 * p + K1] = x1 / (r * m);
-        ft[2 * p + K2] = x1.powi(3) / (r * m);
-        ft[2 * p + R] = -g / (r * r * m);
-        ft[2 * p + M] = -g / (r * m * m);
-        // Row 3: ẋ4 = −α|w|x4 + A w.
-        fx[13] = dw;
-        fx[14] = -dw / r;
-        fx[15] = -th[ALPHA] * w.abs();
-        ft[3 * p + ALPHA] = -w.abs() * x4;
-        ft[3 * p + A] = w;
-        ft[3 * p + R] = dw * x3 / (r * r);
+        free_jacobians(x, u, th, None, fx, ft);
+        true
+    }
+
+    fn rhs_jacobians_sliding(
+        &self,
+        _t: f64,
+        x: &[f64],
+        u: &[f64],
+        th: &[f64],
+        d: f64,
+        fx: &mut [f64],
+        ft: &mut [f64],
+    ) -> bool {
+        free_jacobians(x, u, th, Some(d), fx, ft);
         true
     }
 
@@ -284,4 +326,68 @@ impl StateSpaceModel for ActuatorFree {
         hx[0] = 1.0;
         true
     }
+
+    fn stick_slip_velocity(&self) -> Option<usize> {
+        Some(1)
+    }
+}
+
+/// The saddle-free right-hand side; `held` as in [`fixed_rhs`] (the hysteresis follows the
+/// torsion rate w = x2 − x3/r, which the friction direction does not hold).
+fn free_rhs(x: &[f64], u: &[f64], th: &[f64], held: Option<f64>, dx: &mut [f64]) {
+    let (x1, x2, x3, x4) = (x[0], x[1], x[2], x[3]);
+    let (g, _) = flexibility(th, x1, x4);
+    let w = x2 - x3 / th[R];
+    dx[0] = w;
+    dx[1] = motor_acceleration(th, x2, g, u[0], held).map_or(0.0, |(acc, _)| acc);
+    dx[2] = g / (th[R] * th[M]);
+    dx[3] = -th[ALPHA] * w.abs() * x4 + th[A] * w;
+}
+
+/// ∂f/∂x and ∂f/∂θ of [`free_rhs`].
+fn free_jacobians(
+    x: &[f64],
+    u: &[f64],
+    th: &[f64],
+    held: Option<f64>,
+    fx: &mut [f64],
+    ft: &mut [f64],
+) {
+    let (x1, x2, x3, x4) = (x[0], x[1], x[2], x[3]);
+    let (g, dg) = flexibility(th, x1, x4);
+    let (j, r, m) = (th[J], th[R], th[M]);
+    let w = x2 - x3 / r;
+    let dw = -th[ALPHA] * sign0(w) * x4 + th[A]; // ∂ẋ4/∂w
+    let p = th.len();
+    fx.fill(0.0);
+    ft.fill(0.0);
+    // Row 0: ẋ1 = x2 − x3/r.
+    fx[1] = 1.0;
+    fx[2] = -1.0 / r;
+    ft[R] = x3 / (r * r);
+    // Row 1: ẋ2 (identically zero while the motor sticks).
+    if let Some((acc, s)) = motor_acceleration(th, x2, g, u[0], held) {
+        fx[4] = -dg / j;
+        fx[5] = -th[FV] / j;
+        fx[7] = -1.0 / j;
+        ft[p + J] = -acc / j;
+        ft[p + FV] = -x2 / j;
+        ft[p + FC] = -s / j;
+        ft[p + K1] = -x1 / j;
+        ft[p + K2] = -x1.powi(3) / j;
+    }
+    // Row 2: ẋ3 = g/(r m).
+    fx[8] = dg / (r * m);
+    fx[11] = 1.0 / (r * m);
+    ft[2 * p + K1] = x1 / (r * m);
+    ft[2 * p + K2] = x1.powi(3) / (r * m);
+    ft[2 * p + R] = -g / (r * r * m);
+    ft[2 * p + M] = -g / (r * m * m);
+    // Row 3: ẋ4 = −α|w|x4 + A w.
+    fx[13] = dw;
+    fx[14] = -dw / r;
+    fx[15] = -th[ALPHA] * w.abs();
+    ft[3 * p + ALPHA] = -w.abs() * x4;
+    ft[3 * p + A] = w;
+    ft[3 * p + R] = dw * x3 / (r * r);
 }

@@ -43,6 +43,23 @@ pub fn sign0(v: f64) -> f64 {
     }
 }
 
+/// The direction s of Coulomb friction Fc·s at velocity `v` under the `applied` force (all
+/// other forces on the body): sgn(v) while sliding; at rest, sgn(applied) when the applied
+/// force breaks the body away (|applied| > Fc), and None while friction holds it
+/// (|applied| ≤ Fc: the friction force is then −applied and the acceleration zero). Models
+/// that use it name their velocity in
+/// [`StateSpaceModel::stick_slip_velocity`] so that RK4 stops at v = 0.
+#[inline]
+pub fn coulomb_direction(v: f64, applied: f64, fc: f64) -> Option<f64> {
+    if v != 0.0 {
+        Some(sign0(v))
+    } else if applied.abs() > fc {
+        Some(sign0(applied))
+    } else {
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,6 +6,9 @@
 //! M q̈ + Fv q̇ + Fc sgn(q̇) + offset = g·u
 //! ```
 //!
+//! At rest, friction holds the body while |g·u − offset| ≤ Fc (stick–slip, integrated by
+//! [`crate::greybox::stick_slip`]).
+//!
 //! States x = (q, q̇), input u (drive signal), output q (position). g converts the drive
 //! signal into force (1 when u is already a force; 35.15 N/V for the EMPS positioning system).
 //! The same structure, Jt θ̈ + Fv θ̇ + Fc sgn(θ̇) = τ, is the rigid-body step of Gunnar et al.
@@ -23,7 +26,7 @@
 //! parameters of serial robots", IEEE Trans. Robotics and Automation 6(3), 1990 (the friction
 //! model); A. Janot, M. Gautier, M. Brunot, "Data set and reference models of EMPS", 2019.
 
-use super::sign0;
+use super::coulomb_direction;
 use crate::data::Channel;
 use crate::estimate::{Parameter, ParameterSet};
 use crate::greybox::StateSpaceModel;
@@ -74,7 +77,12 @@ impl StateSpaceModel for RigidBody {
     fn rhs(&self, _t: f64, x: &[f64], u: &[f64], th: &[f64], dx: &mut [f64]) {
         let v = x[1];
         dx[0] = v;
-        dx[1] = (th[GAIN] * u[0] - th[FV] * v - th[FC] * sign0(v) - th[OFFSET]) / th[M];
+        dx[1] = acceleration(v, u[0], th, None).map_or(0.0, |(acc, _)| acc);
+    }
+
+    fn rhs_sliding(&self, _t: f64, x: &[f64], u: &[f64], th: &[f64], d: f64, dx: &mut [f64]) {
+        dx[0] = x[1];
+        dx[1] = acceleration(x[1], u[0], th, Some(d)).map_or(0.0, |(acc, _)| acc);
     }
 
     fn output(&self, x: &[f64], _u: &[f64], _theta: &[f64], y: &mut [f64]) {
@@ -90,19 +98,21 @@ impl StateSpaceModel for RigidBody {
         fx: &mut [f64],
         ft: &mut [f64],
     ) -> bool {
-        let v = x[1];
-        let m = th[M];
-        let p = th.len();
-        fx.fill(0.0);
-        ft.fill(0.0);
-        fx[1] = 1.0;
-        fx[3] = -th[FV] / m;
-        let acc = (th[GAIN] * u[0] - th[FV] * v - th[FC] * sign0(v) - th[OFFSET]) / m;
-        ft[p + M] = -acc / m;
-        ft[p + FV] = -v / m;
-        ft[p + FC] = -sign0(v) / m;
-        ft[p + OFFSET] = -1.0 / m;
-        ft[p + GAIN] = u[0] / m;
+        jacobians(x, u, th, None, fx, ft);
+        true
+    }
+
+    fn rhs_jacobians_sliding(
+        &self,
+        _t: f64,
+        x: &[f64],
+        u: &[f64],
+        th: &[f64],
+        d: f64,
+        fx: &mut [f64],
+        ft: &mut [f64],
+    ) -> bool {
+        jacobians(x, u, th, Some(d), fx, ft);
         true
     }
 
@@ -122,5 +132,37 @@ impl StateSpaceModel for RigidBody {
 
     fn mechanical_dofs(&self) -> Option<usize> {
         Some(1)
+    }
+
+    fn stick_slip_velocity(&self) -> Option<usize> {
+        Some(1)
+    }
+}
+
+/// (q̈, friction direction) at velocity v and input u, or None while friction holds the body
+/// at rest; `held` forces the friction direction (inside a sliding RK4 step, see
+/// [`crate::greybox::stick_slip`]).
+#[inline]
+fn acceleration(v: f64, u: f64, th: &[f64], held: Option<f64>) -> Option<(f64, f64)> {
+    let applied = th[GAIN] * u - th[FV] * v - th[OFFSET];
+    held.or_else(|| coulomb_direction(v, applied, th[FC]))
+        .map(|s| ((applied - th[FC] * s) / th[M], s))
+}
+
+/// ∂f/∂x and ∂f/∂θ; while the body sticks its acceleration is identically zero (row 1 zero).
+fn jacobians(x: &[f64], u: &[f64], th: &[f64], held: Option<f64>, fx: &mut [f64], ft: &mut [f64]) {
+    let v = x[1];
+    let m = th[M];
+    let p = th.len();
+    fx.fill(0.0);
+    ft.fill(0.0);
+    fx[1] = 1.0;
+    if let Some((acc, s)) = acceleration(v, u[0], th, held) {
+        fx[3] = -th[FV] / m;
+        ft[p + M] = -acc / m;
+        ft[p + FV] = -v / m;
+        ft[p + FC] = -s / m;
+        ft[p + OFFSET] = -1.0 / m;
+        ft[p + GAIN] = u[0] / m;
     }
 }
