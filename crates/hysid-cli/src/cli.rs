@@ -33,6 +33,132 @@ pub enum Command {
     /// Public benchmarks.
     #[command(subcommand)]
     Benchmark(Benchmark),
+    /// The linear actuator with hysteresis of Gunnar et al. (2006): virtual test rig and the
+    /// three-step identification.
+    #[command(subcommand)]
+    Actuator(Actuator),
+    /// Rigid bodies with friction: inverse-dynamics least squares.
+    #[command(subcommand, name = "rigid-body")]
+    RigidBody(RigidBody),
+}
+
+/// Actuator commands.
+#[derive(Debug, Subcommand)]
+pub enum Actuator {
+    /// Simulate the paper's eight experiments on the virtual rig and write them as
+    /// DIR/dataset1.csv … dataset8.csv (columns t_s, tau_Nm, theta_rad) and DIR/rig.json.
+    Rig(RigArgs),
+    /// The three steps on data sets 1–8 of a directory: tables I–III, figures 2 and 4.
+    Identify(ActuatorIdentifyArgs),
+}
+
+/// Settings of the virtual rig.
+#[derive(Debug, Args)]
+pub struct RigSettings {
+    /// Play width of an unmodelled backlash in the flexibility [rad] (0: none; the real
+    /// actuator has one, e.g. 0.003).
+    #[arg(long, default_value_t = 0.0)]
+    pub backlash: f64,
+    /// Measurement noise as a multiple of the documented levels (one 16-bit count:
+    /// 2.77e-5 rad on the angle, 4.40e-5 N·m on the torque); 0 for none.
+    #[arg(long, default_value_t = 1.0)]
+    pub noise: f64,
+    /// Seed of the noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// A true parameter, NAME=VALUE (repeatable; J, Fv, Fc, k1, k2, alpha, A; default
+    /// Table I's m67).
+    #[arg(long)]
+    pub truth: Vec<String>,
+}
+
+/// Options of `hysid actuator rig`.
+#[derive(Debug, Args)]
+pub struct RigArgs {
+    /// Directory for the data sets (created if needed).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub rig: RigSettings,
+}
+
+/// Settings of the three steps.
+#[derive(Debug, Args)]
+pub struct ThreeStepArgs {
+    /// Remove the sample mean of every signal before filtering.
+    #[arg(long)]
+    pub remove_mean: bool,
+    /// Maximum iterations of each step-3 fit (the paper: 30).
+    #[arg(long, default_value_t = 30)]
+    pub max_iterations: usize,
+    /// Stop a step-3 fit when the expected relative improvement falls below this (the
+    /// paper: 0.01 %).
+    #[arg(long, default_value_t = 1e-4)]
+    pub tolerance: f64,
+}
+
+/// Options of `hysid actuator identify`.
+#[derive(Debug, Args)]
+pub struct ActuatorIdentifyArgs {
+    /// Directory holding dataset1.csv … dataset8.csv (columns t_s, tau_Nm, theta_rad); a
+    /// rig.json beside them adds the true parameters to the tables.
+    #[arg(long)]
+    pub data: PathBuf,
+    #[command(flatten)]
+    pub steps: ThreeStepArgs,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Directory for the tables (Markdown) and the plots (SVG).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Rigid-body commands.
+#[derive(Debug, Subcommand)]
+pub enum RigidBody {
+    /// Inverse-dynamics least squares of M q̈ + Fv q̇ + Fc sgn(q̇) [+ offset] = g·u (step 1 of
+    /// Gunnar et al. 2006; the EMPS reference method).
+    Ls(RigidBodyLsArgs),
+}
+
+/// Options of `hysid rigid-body ls`.
+#[derive(Debug, Args)]
+pub struct RigidBodyLsArgs {
+    /// Estimation record (CSV with a time column t_s, t, time or time_s).
+    #[arg(long)]
+    pub data: PathBuf,
+    /// Column of the measured position.
+    #[arg(long)]
+    pub position: String,
+    /// Column of the drive signal u (force = gain·u).
+    #[arg(long)]
+    pub input: String,
+    /// Drive gain g [force per unit of u] (EMPS: 35.15065188 N/V).
+    #[arg(long, default_value_t = 1.0)]
+    pub gain: f64,
+    /// Estimate a constant force offset.
+    #[arg(long)]
+    pub offset: bool,
+    /// Validation record(s) with the same columns (repeatable): relative error of the
+    /// estimate on each.
+    #[arg(long)]
+    pub validate: Vec<PathBuf>,
+    /// Cut-off of the zero-phase Butterworth position filter [Hz].
+    #[arg(long, default_value_t = 100.0)]
+    pub cutoff: f64,
+    /// Order of the Butterworth filter.
+    #[arg(long, default_value_t = 4)]
+    pub order: usize,
+    /// Decimation factor of the regression ("parallel decimation"; 1 for none).
+    #[arg(long, default_value_t = 10)]
+    pub decimate: usize,
+    /// Samples dropped at each end (filter transients), at the original rate.
+    #[arg(long, default_value_t = 50)]
+    pub border: usize,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
 }
 
 /// Grey-box commands.
@@ -45,7 +171,7 @@ pub enum Greybox {
 /// Options of `hysid greybox fit`.
 #[derive(Debug, Args)]
 pub struct GreyboxFitArgs {
-    /// The model: bouc-wen or rigid-body.
+    /// The model: bouc-wen, rigid-body, actuator-fixed or actuator-free.
     #[arg(long)]
     pub model: String,
     #[command(flatten)]
@@ -262,6 +388,24 @@ pub enum Demo {
     /// Vörös (2015): Coleman–Hodgdon hysteresis followed by a linear block, the project's
     /// Example 1 or 2 (MODELS.md §1.6).
     Voros(VorosArgs),
+    /// Gunnar et al. (2006): the virtual actuator rig and the three steps, with the paper's
+    /// tables and figures.
+    Actuator(DemoActuatorArgs),
+}
+
+/// Options of `hysid demo actuator`.
+#[derive(Debug, Args)]
+pub struct DemoActuatorArgs {
+    #[command(flatten)]
+    pub rig: RigSettings,
+    #[command(flatten)]
+    pub steps: ThreeStepArgs,
+    /// Directory for the data sets, tables and plots.
+    #[arg(long, default_value = "hysid-out")]
+    pub out: PathBuf,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
 }
 
 /// Options of `hysid demo voros`.

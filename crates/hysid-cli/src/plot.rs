@@ -194,6 +194,38 @@ pub fn plot_panels_sized(
     write_atomic(path, &svg)
 }
 
+/// One panel per parameter: its value per iteration, and the true value when known.
+pub fn convergence(
+    path: &Path,
+    title: &str,
+    names: &[String],
+    history: &[Vec<f64>],
+    truth: Option<&[f64]>,
+) -> anyhow::Result<()> {
+    let iterations: Vec<f64> = (0..history.len()).map(|i| i as f64).collect();
+    let columns: Vec<Vec<f64>> = (0..names.len())
+        .map(|j| history.iter().map(|h| h[j]).collect())
+        .collect();
+    let range = (0.0, (history.len().max(2) - 1) as f64);
+    let panels: Vec<Figure> = names
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let mut fig = Figure::new(name, "iteration", name).with(Series::new(
+                "estimate",
+                iterations.as_slice(),
+                columns[j].as_slice(),
+                Style::Line,
+            ));
+            if let Some(t) = truth {
+                fig = fig.with(hline("true", range, t[j]));
+            }
+            fig
+        })
+        .collect();
+    plot_panels(path, title, &panels, 2)
+}
+
 // ---------------------------------------------------------------------------
 // Rendering plumbing
 // ---------------------------------------------------------------------------

@@ -36,5 +36,20 @@ fn emps_reference_model_is_reproduced() {
         "{}",
         est.relative_error_percent
     );
-    eprintln!("{est:?}");
+    // Published relative standard deviations [%] and condition number.
+    for (got, want) in est
+        .relative_std_percent
+        .iter()
+        .zip([0.1141, 0.5631, 0.4964, 1.4021])
+    {
+        assert!(
+            (got / want - 1.0).abs() < 0.05,
+            "relative std {got} vs {want}"
+        );
+    }
+    assert!(
+        (est.condition_number_unscaled / 25.99 - 1.0).abs() < 0.01,
+        "{}",
+        est.condition_number_unscaled
+    );
 }

@@ -3,7 +3,7 @@
 
 use crate::cli::UncertaintyArg;
 use crate::output::ensure_dir;
-use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
+use crate::plot::{convergence, plot, Figure, Series, Style};
 use crate::report::{Report, Row};
 use anyhow::Result;
 use hysid::estimate::cascade::CascadeFit;
@@ -193,38 +193,6 @@ pub fn plots(
         })?);
     }
     Ok(files)
-}
-
-/// One panel per parameter: its value per iteration, and the true value when known.
-fn convergence(
-    path: &Path,
-    title: &str,
-    names: &[String],
-    history: &[Vec<f64>],
-    truth: Option<&[f64]>,
-) -> Result<()> {
-    let iterations: Vec<f64> = (0..history.len()).map(|i| i as f64).collect();
-    let columns: Vec<Vec<f64>> = (0..names.len())
-        .map(|j| history.iter().map(|h| h[j]).collect())
-        .collect();
-    let range = (0.0, (history.len().max(2) - 1) as f64);
-    let panels: Vec<Figure> = names
-        .iter()
-        .enumerate()
-        .map(|(j, name)| {
-            let mut fig = Figure::new(name, "iteration", name).with(Series::new(
-                "estimate",
-                iterations.as_slice(),
-                columns[j].as_slice(),
-                Style::Line,
-            ));
-            if let Some(t) = truth {
-                fig = fig.with(hline("true", range, t[j]));
-            }
-            fig
-        })
-        .collect();
-    plot_panels(path, title, &panels, 2)
 }
 
 fn save(dir: &Path, name: &str, draw: impl FnOnce(&Path) -> Result<()>) -> Result<PathBuf> {

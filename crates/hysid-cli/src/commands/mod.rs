@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+mod actuator;
 mod benchmark;
 mod cascade;
 mod demo;
@@ -7,9 +8,10 @@ mod generate;
 mod greybox;
 mod identify;
 mod present;
+mod rigid_body;
 mod simulate;
 
-use crate::cli::{Benchmark, Cli, Command, Demo, Generate, Greybox, Identify};
+use crate::cli::{Actuator, Benchmark, Cli, Command, Demo, Generate, Greybox, Identify, RigidBody};
 use anyhow::Result;
 
 /// Runs the parsed command line.
@@ -22,5 +24,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Generate(Generate::Voros(args)) => generate::voros(&args),
         Command::Greybox(Greybox::Fit(args)) => greybox::fit(&args),
         Command::Benchmark(Benchmark::BoucWen(args)) => benchmark::bouc_wen(&args),
+        Command::Demo(Demo::Actuator(args)) => actuator::demo(&args),
+        Command::Actuator(Actuator::Rig(args)) => actuator::rig(&args),
+        Command::Actuator(Actuator::Identify(args)) => actuator::identify(&args),
+        Command::RigidBody(RigidBody::Ls(args)) => rigid_body::ls(&args),
     }
 }

@@ -18,30 +18,79 @@
 //! every signal; optional mean removal; velocities by `gradient`.
 
 use super::loops::{ascending, branch_samples, descending, turning_points};
-use crate::data::{Channel, Experiment, IdData};
+use crate::data::{Channel, CsvSpec, Experiment, IdData};
 use crate::estimate::inverse_dynamics::{RigidBodyEstimate, RigidBodyLs};
+use crate::estimate::OutputErrorModel;
 use crate::estimate::{least_squares, Control, LmConfig, ParameterSet};
 use crate::greybox::models::ActuatorFixed;
 use crate::greybox::{
     GreyBox, GreyBoxEstimation, GreyBoxFit, InitialStates, InputInterpolation, Integrator,
     Simulation, StateSpaceModel,
 };
+use crate::metrics::fit_percent;
 use crate::signal::{butter, filtfilt, gradient, remove_mean};
-use crate::validate::{experiment_fit, sensitivity_table, SensitivityRow};
+use crate::validate::{sensitivity_table, SensitivityRow};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// The columns of a data-set file: time \[s\], motor torque [N·m], motor angle \[rad\].
+pub const COLUMNS: [&str; 3] = ["t_s", "tau_Nm", "theta_rad"];
+
+/// The file of data set `set` in a data directory: `datasetK.csv`.
+pub fn data_set_path(dir: &Path, set: usize) -> PathBuf {
+    dir.join(format!("dataset{set}.csv"))
+}
+
+/// Reads data sets 1–8 from `dir` (`dataset1.csv` … `dataset8.csv`, columns [`COLUMNS`]).
+///
+/// Fails with [`Error::InvalidData`] naming every missing file.
+pub fn read_data_sets(dir: &Path) -> Result<BTreeMap<usize, Record>> {
+    let missing: Vec<String> = (1..=8)
+        .map(|s| data_set_path(dir, s))
+        .filter(|p| !p.is_file())
+        .map(|p| p.display().to_string())
+        .collect();
+    if !missing.is_empty() {
+        return Err(Error::InvalidData(format!(
+            "missing {} (the procedure needs dataset1.csv to dataset8.csv, columns {})",
+            missing.join(", "),
+            COLUMNS.join(", ")
+        )));
+    }
+    let spec = CsvSpec {
+        inputs: vec![COLUMNS[1].into()],
+        outputs: vec![COLUMNS[2].into()],
+        time: Some(COLUMNS[0].into()),
+        ts: None,
+    };
+    (1..=8)
+        .map(|set| {
+            let data = IdData::from_csv(&data_set_path(dir, set), &spec)?;
+            let exp = data.experiment(0);
+            Ok((
+                set,
+                Record {
+                    ts: data.ts(),
+                    torque: exp.input(0).to_vec(),
+                    angle: exp.output(0).to_vec(),
+                },
+            ))
+        })
+        .collect()
+}
 
 /// One measured data set: motor torque and motor angle.
 #[derive(Clone, Debug)]
 pub struct Record {
-    /// Sample time [s].
+    /// Sample time \[s\].
     pub ts: f64,
     /// Motor torque τ [N·m].
     pub torque: Vec<f64>,
-    /// Motor angle θ [rad].
+    /// Motor angle θ \[rad\].
     pub angle: Vec<f64>,
 }
 
@@ -50,9 +99,9 @@ pub struct Record {
 pub struct ThreeSteps {
     /// Gear ratio r [m/rad] (known).
     pub r: f64,
-    /// Saddle mass m [kg] (known).
+    /// Saddle mass m \[kg\] (known).
     pub m: f64,
-    /// Cut-off of the zero-phase Butterworth pre-filter [Hz].
+    /// Cut-off of the zero-phase Butterworth pre-filter \[Hz\].
     pub cutoff_hz: f64,
     /// Remove the sample mean of every signal before filtering.
     pub remove_mean: bool,
@@ -108,11 +157,11 @@ pub struct Loop {
     pub set: usize,
     /// Amplitude Q of the torsion.
     pub q: f64,
-    /// Torsion x1 over one period.
+    /// Torsion x1 on the samples step 2 uses (away from the reversals).
     pub x1: Vec<f64>,
-    /// τn = τ − Fc sgn(x2) over the same samples.
+    /// τn = τ − Fv ẋ1 − Fc·(direction of the motion) on the same samples.
     pub tau_n: Vec<f64>,
-    /// True where x1 rises.
+    /// True on the ascending branch.
     pub ascending: Vec<bool>,
 }
 
@@ -129,8 +178,11 @@ pub struct ActuatorIdentification {
     pub m0: Vec<f64>,
     /// Step 3 fits by name (m67, m68, m67f, m68f).
     pub step3: BTreeMap<String, GreyBoxFit>,
-    /// fit % of every model (m0 and step 3) on data sets 6, 7, 8.
+    /// fit % of every model (m0 and step 3) on data sets 6, 7, 8 (NaN where a model cannot
+    /// be simulated on a set).
     pub fit_table: BTreeMap<String, Vec<f64>>,
+    /// The simulated torsion of every model on data sets 6, 7, 8 (empty where it diverges).
+    pub simulated: BTreeMap<String, Vec<Vec<f64>>>,
     /// ±20 % sensitivity of m67 on data sets 6, 7, 8.
     pub sensitivity: Vec<SensitivityRow>,
     /// The filtered estimation data of sets 6, 7, 8 (for plots).
@@ -143,6 +195,15 @@ pub const PARAMETERS: [&str; 7] = ["J", "Fv", "Fc", "k1", "k2", "alpha", "A"];
 impl ThreeSteps {
     /// Runs the three steps on data sets 1–8 (`records[&k]` is set k).
     pub fn run(&self, records: &BTreeMap<usize, Record>) -> Result<ActuatorIdentification> {
+        self.run_reporting(records, &mut |_| {})
+    }
+
+    /// [`run`](Self::run), telling `progress` what it starts (for long runs).
+    pub fn run_reporting(
+        &self,
+        records: &BTreeMap<usize, Record>,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<ActuatorIdentification> {
         for set in 1..=8 {
             if !records.contains_key(&set) {
                 return Err(Error::InvalidData(format!(
@@ -150,9 +211,11 @@ impl ThreeSteps {
                 )));
             }
         }
+        progress("step 1: rigid-body least squares on data set 1");
         let step1 = self.step1(&records[&1])?;
         let (jt, fv, fc) = (step1.values[0], step1.values[1], step1.values[2]);
         let j = jt - self.r * self.r * self.m;
+        progress("step 2: steady-state loops of data sets 2-5");
         let step2 = self.step2(&[2, 3, 4, 5].map(|s| (s, &records[&s])), fv, fc)?;
         let m0 = vec![
             j,
@@ -164,8 +227,9 @@ impl ThreeSteps {
             step2.values[3],
         ];
         let validation = self.estimation_data(&[6, 7, 8].map(|s| &records[&s]))?;
-        let step3 = self.step3(&validation, &m0)?;
-        let fit_table = self.fit_table(&validation, &m0, &step3)?;
+        let step3 = self.step3(&validation, &m0, progress)?;
+        progress("tables: fit on data sets 6-8 and the ±20 % sensitivity of m67");
+        let (fit_table, simulated) = self.fit_table(&validation, &m0, &step3)?;
         let m67 = &step3["m67"];
         let structure = self.structure(&validation)?;
         let nominal = structure.parameter_set(&model_parameters(&m67.fit.parameters));
@@ -177,6 +241,7 @@ impl ThreeSteps {
             m0,
             step3,
             fit_table,
+            simulated,
             sensitivity,
             validation,
         })
@@ -272,6 +337,13 @@ impl ThreeSteps {
     /// Sets 6, 7, 8 filtered, as three experiments of (τ → x1).
     fn estimation_data(&self, records: &[&Record; 3]) -> Result<IdData> {
         let ts = records[0].ts;
+        if let Some(k) = records.iter().position(|r| (r.ts / ts - 1.0).abs() > 1e-6) {
+            return Err(Error::InvalidData(format!(
+                "data sets 6, 7 and 8 must share one sample time; set {} has {} s, set 6 {ts} s",
+                k + 6,
+                records[k].ts
+            )));
+        }
         let experiments = records
             .iter()
             .zip([6, 7, 8])
@@ -301,7 +373,12 @@ impl ThreeSteps {
     }
 
     /// Step 3: the four output-error fits.
-    fn step3(&self, validation: &IdData, m0: &[f64]) -> Result<BTreeMap<String, GreyBoxFit>> {
+    fn step3(
+        &self,
+        validation: &IdData,
+        m0: &[f64],
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<BTreeMap<String, GreyBoxFit>> {
         let variants = [
             ("m67", 1, false),
             ("m68", 2, false),
@@ -310,6 +387,11 @@ impl ThreeSteps {
         ];
         let mut out = BTreeMap::new();
         for (name, second, fixed) in variants {
+            progress(&format!(
+                "step 3: {name}, output error on data sets 6 and {}{}",
+                second + 6,
+                if fixed { " (J, Fv, Fc fixed)" } else { "" }
+            ));
             let data = validation.select(&[0, second])?;
             let mut params = ActuatorFixed.parameters();
             params.set_values(m0);
@@ -333,14 +415,15 @@ impl ThreeSteps {
         Ok(out)
     }
 
-    /// fit % of m0 and the step-3 models on sets 6, 7, 8 (simulated from rest); NaN where a
-    /// model cannot be simulated on a set (it diverges there).
+    /// fit % of m0 and the step-3 models on sets 6, 7, 8 (simulated from rest), NaN where a
+    /// model cannot be simulated on a set (it diverges there); and the simulations.
+    #[allow(clippy::type_complexity)]
     fn fit_table(
         &self,
         validation: &IdData,
         m0: &[f64],
         step3: &BTreeMap<String, GreyBoxFit>,
-    ) -> Result<BTreeMap<String, Vec<f64>>> {
+    ) -> Result<(BTreeMap<String, Vec<f64>>, BTreeMap<String, Vec<Vec<f64>>>)> {
         let structure = self.structure(validation)?;
         let mut models = vec![("m0".to_string(), m0.to_vec())];
         for (name, fit) in step3 {
@@ -349,23 +432,30 @@ impl ThreeSteps {
                 fit.fit.parameters.values()[..PARAMETERS.len()].to_vec(),
             ));
         }
-        let mut table = BTreeMap::new();
+        let (mut table, mut simulated) = (BTreeMap::new(), BTreeMap::new());
         for (name, values) in models {
             let mut params = ActuatorFixed.parameters();
             params.set_values(&values);
             let theta = structure.parameter_set(&params).values();
-            let row = (0..validation.n_experiments())
-                .map(
-                    |e| match experiment_fit(&structure, validation, e, &theta) {
-                        Ok(fit) => Ok(fit),
-                        Err(Error::Diverged { .. }) => Ok(f64::NAN),
-                        Err(other) => Err(other),
-                    },
-                )
-                .collect::<Result<Vec<f64>>>()?;
-            table.insert(name, row);
+            let (mut fits, mut outputs) = (Vec::new(), Vec::new());
+            for (e, exp) in validation.experiments().iter().enumerate() {
+                let mut y = vec![vec![0.0; exp.len()]];
+                match structure.simulate(&theta, validation, e, &mut y) {
+                    Ok(()) => {
+                        fits.push(fit_percent(exp.output(0), &y[0]));
+                        outputs.push(y.swap_remove(0));
+                    }
+                    Err(Error::Diverged { .. }) => {
+                        fits.push(f64::NAN);
+                        outputs.push(Vec::new());
+                    }
+                    Err(other) => return Err(other),
+                }
+            }
+            table.insert(name.clone(), fits);
+            simulated.insert(name, outputs);
         }
-        Ok(table)
+        Ok((table, simulated))
     }
 }
 

@@ -3,8 +3,10 @@
 //!
 //! * [`loops`]: the steady-state loop formula of step 2 (corrected).
 //! * [`rig`]: the virtual test rig reproducing the paper's eight experiments.
-//! * [`identify`]: the three steps and the paper's tables.
+//! * [`identify`]: the three steps.
+//! * [`tables`]: the paper's Tables I–III regenerated, as Markdown and JSON.
 
 pub mod identify;
 pub mod loops;
 pub mod rig;
+pub mod tables;

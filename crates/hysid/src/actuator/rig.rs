@@ -28,6 +28,8 @@
 //! Without backlash and noise, the saddle-fixed sets are exactly what the identification
 //! model [`ActuatorFixed`] simulates with the same integrator.
 
+use super::identify::{data_set_path, COLUMNS};
+use crate::data::write_csv;
 use crate::greybox::models::{coulomb_direction, ActuatorFixed, ActuatorFree};
 use crate::greybox::simulate::rk4_step;
 use crate::greybox::stick_slip::Rk4;
@@ -36,8 +38,9 @@ use crate::signal::{gaussian_noise, multisine};
 use crate::{Error, Result};
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
+use std::path::{Path, PathBuf};
 
-/// One count of a 16-bit-per-revolution motor encoder [rad].
+/// One count of a 16-bit-per-revolution motor encoder \[rad\].
 pub const ANGLE_QUANTUM: f64 = TAU / 65_536.0;
 
 /// One count of a 16-bit torque log over ±5 N·m [N·m].
@@ -53,17 +56,17 @@ pub struct Rig {
     pub truth: Vec<f64>,
     /// Gear ratio r [m/rad].
     pub r: f64,
-    /// Saddle mass m [kg].
+    /// Saddle mass m \[kg\].
     pub m: f64,
-    /// Sampling frequency [Hz].
+    /// Sampling frequency \[Hz\].
     pub fs: f64,
     /// RK4 steps per sample.
     pub substeps: usize,
-    /// Standard deviation of the logged angle noise [rad].
+    /// Standard deviation of the logged angle noise \[rad\].
     pub angle_noise: f64,
     /// Standard deviation of the logged torque noise [N·m].
     pub torque_noise: f64,
-    /// Play width b of the backlash in the flexibility [rad]; 0 for none.
+    /// Play width b of the backlash in the flexibility \[rad\]; 0 for none.
     pub backlash: f64,
     /// RMS torque of the multisines of data sets 7 and 8 [N·m] (8 the smaller, as in the
     /// paper).
@@ -96,12 +99,23 @@ pub struct RigRecord {
     pub set: usize,
     /// True when the saddle moved (set 1).
     pub saddle_free: bool,
-    /// Sample time [s].
+    /// Sample time \[s\].
     pub ts: f64,
     /// Logged motor torque [N·m].
     pub torque: Vec<f64>,
-    /// Logged motor angle [rad].
+    /// Logged motor angle \[rad\].
     pub angle: Vec<f64>,
+}
+
+impl RigRecord {
+    /// Writes the record as `datasetK.csv` in `dir` (columns t_s, tau_Nm, theta_rad; written
+    /// through a temporary file, never half-written); returns the path.
+    pub fn write(&self, dir: &Path) -> Result<PathBuf> {
+        let path = data_set_path(dir, self.set);
+        let t: Vec<f64> = (0..self.torque.len()).map(|k| k as f64 * self.ts).collect();
+        write_csv(&path, &COLUMNS, &[&t, &self.torque, &self.angle])?;
+        Ok(path)
+    }
 }
 
 /// How a data set is excited.

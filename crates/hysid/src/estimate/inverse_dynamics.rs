@@ -38,7 +38,7 @@ pub struct RigidBodyLs {
     pub gain: f64,
     /// Estimate a constant force offset.
     pub offset: bool,
-    /// Cut-off of the position filter [Hz].
+    /// Cut-off of the position filter \[Hz\].
     pub cutoff_hz: f64,
     /// Order of the Butterworth position filter.
     pub filter_order: usize,
@@ -76,8 +76,12 @@ pub struct RigidBodyEstimate {
     pub relative_std_percent: Vec<f64>,
     /// ‖g·u − Wθ̂‖/‖g·u‖ on the estimation record [%].
     pub relative_error_percent: f64,
-    /// Condition number of the (column-scaled) regressor matrix.
+    /// Condition number of the column-scaled regressor matrix (columns of unit norm): what
+    /// the estimate's accuracy depends on.
     pub condition_number: f64,
+    /// Condition number of the regressor matrix as it is, in physical units (the figure the
+    /// EMPS reference reports, 25.99).
+    pub condition_number_unscaled: f64,
     /// Equations in the regression.
     pub equations: usize,
 }
@@ -113,6 +117,7 @@ impl RigidBodyLs {
                 .collect(),
             relative_error_percent: relative_error(&w, &force, &values),
             condition_number: ls.condition_number,
+            condition_number_unscaled: condition_number(&w),
             equations: force.len(),
             names,
             values,
@@ -209,6 +214,15 @@ impl RigidBodyLs {
 }
 
 /// 100·‖f − Wθ‖/‖f‖.
+/// σmax/σmin of `w`.
+fn condition_number(w: &DMatrix<f64>) -> f64 {
+    let sv = w.singular_values();
+    let (max, min) = sv
+        .iter()
+        .fold((0.0f64, f64::INFINITY), |(a, b), s| (a.max(*s), b.min(*s)));
+    max / min
+}
+
 fn relative_error(w: &DMatrix<f64>, force: &[f64], theta: &[f64]) -> f64 {
     let fitted = w * nalgebra::DVector::from_column_slice(theta);
     let err: f64 = force

@@ -18,7 +18,7 @@
 use crate::{Error, Result};
 use nalgebra::{Complex, DMatrix, DVector};
 
-/// A digital filter's transfer-function coefficients, b(z)/a(z) with a[0] = 1.
+/// A digital filter's transfer-function coefficients, b(z)/a(z) with a₀ = 1.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TransferFunction {
     /// Numerator coefficients b0, b1, ….

@@ -1,0 +1,408 @@
+//! `hysid actuator rig|identify` and `hysid demo actuator`: the linear actuator of Gunnar et
+//! al. (2006), its virtual test rig and the three-step identification with the paper's tables
+//! and figures.
+
+use crate::cli::{ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs};
+use crate::output::{ensure_dir, write_atomic, write_json};
+use crate::plot::{convergence, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
+use anyhow::{bail, Context, Result};
+use hysid::actuator::identify::{
+    read_data_sets, ActuatorIdentification, Record, ThreeSteps, PARAMETERS,
+};
+use hysid::actuator::loops::{ascending, descending};
+use hysid::actuator::rig::Rig;
+use hysid::estimate::LmConfig;
+use serde_json::json;
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Writes the eight data sets of the virtual rig.
+pub fn rig(args: &RigArgs) -> Result<()> {
+    let rig = rig_from(&args.rig)?;
+    let files = write_rig(&rig, &args.out)?;
+    println!(
+        "virtual actuator rig (Gunnar et al. 2006): {} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
+        files.len(),
+        args.out.display(),
+        rig.backlash,
+        rig.angle_noise,
+        rig.torque_noise,
+        rig.seed
+    );
+    Ok(())
+}
+
+/// The three steps on a data directory.
+pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
+    let records = read_data_sets(&args.data)?;
+    let truth = rig_truth(&args.data)?;
+    let clock = Instant::now();
+    let id = run(&three_steps(&args.steps), &records)?;
+    publish(
+        &id,
+        truth.as_deref(),
+        &records,
+        args.out.as_deref(),
+        args.json.as_deref(),
+        json!({ "data": args.data, "elapsed_s": clock.elapsed().as_secs_f64() }),
+    )
+}
+
+/// The rig and the three steps on the default settings.
+pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
+    let clock = Instant::now();
+    let rig = rig_from(&args.rig)?;
+    let data_dir = args.out.join("actuator-data");
+    write_rig(&rig, &data_dir)?;
+    let records = read_data_sets(&data_dir)?;
+    println!(
+        "Virtual actuator rig (Gunnar et al. 2006): backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {}; data in {}",
+        rig.backlash,
+        rig.angle_noise,
+        rig.torque_noise,
+        rig.seed,
+        data_dir.display()
+    );
+    let id = run(&three_steps(&args.steps), &records)?;
+    publish(
+        &id,
+        Some(&rig.truth),
+        &records,
+        Some(&args.out.join("actuator")),
+        args.json.as_deref(),
+        json!({ "data": data_dir, "rig": rig_json(&rig) }),
+    )?;
+    println!("  total time {:.1} s", clock.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// The three steps, naming each stage on stderr when it is a terminal (so that an error
+/// stays the only line there otherwise).
+fn run(steps: &ThreeSteps, records: &BTreeMap<usize, Record>) -> Result<ActuatorIdentification> {
+    let terminal = std::io::stderr().is_terminal();
+    let id = steps.run_reporting(records, &mut |stage| {
+        if terminal {
+            eprintln!("  {stage}");
+        }
+    })?;
+    Ok(id)
+}
+
+/// Prints the tables; writes Markdown, plots and JSON.
+fn publish(
+    id: &ActuatorIdentification,
+    truth: Option<&[f64]>,
+    records: &BTreeMap<usize, Record>,
+    out: Option<&Path>,
+    json_path: Option<&Path>,
+    details: serde_json::Value,
+) -> Result<()> {
+    let markdown = id.markdown(truth);
+    println!("\n{markdown}");
+    for (name, fit) in &id.step3 {
+        println!(
+            "  {name}: {} iterations, stopped: {}, {:.2} s",
+            fit.fit.report.iterations, fit.fit.report.termination, fit.elapsed_s
+        );
+    }
+    if let Some(dir) = out {
+        ensure_dir(dir)?;
+        write_atomic(&dir.join("tables.md"), markdown.as_bytes())?;
+        let files = figures(dir, id, truth, records)?;
+        println!("  tables and {} plots in {}", files.len(), dir.display());
+    }
+    if let Some(path) = json_path {
+        let mut report = serde_json::to_value(id.report(truth))?;
+        report["details"] = details;
+        write_json(path, &report)?;
+        println!("  report: {}", path.display());
+    }
+    Ok(())
+}
+
+fn three_steps(args: &ThreeStepArgs) -> ThreeSteps {
+    let defaults = ThreeSteps::default();
+    ThreeSteps {
+        remove_mean: args.remove_mean,
+        lm: LmConfig {
+            max_iterations: args.max_iterations,
+            improvement_tolerance: args.tolerance,
+            ..defaults.lm.clone()
+        },
+        ..defaults
+    }
+}
+
+fn rig_from(settings: &RigSettings) -> Result<Rig> {
+    if !(settings.noise.is_finite() && settings.noise >= 0.0) {
+        bail!(
+            "--noise {}: give a non-negative multiple of the documented noise levels",
+            settings.noise
+        );
+    }
+    if !(settings.backlash.is_finite() && settings.backlash >= 0.0) {
+        bail!(
+            "--backlash {}: give a non-negative play width in rad",
+            settings.backlash
+        );
+    }
+    let defaults = Rig::default();
+    let mut truth = defaults.truth.clone();
+    for spec in &settings.truth {
+        let (name, value) = spec
+            .split_once('=')
+            .with_context(|| format!("--truth {spec}: write NAME=VALUE"))?;
+        let i = PARAMETERS
+            .iter()
+            .position(|p| *p == name.trim())
+            .with_context(|| {
+                format!(
+                    "--truth {spec}: the parameters are {}",
+                    PARAMETERS.join(", ")
+                )
+            })?;
+        truth[i] = value
+            .trim()
+            .parse()
+            .with_context(|| format!("--truth {spec}: '{value}' is not a number"))?;
+    }
+    Ok(Rig {
+        truth,
+        backlash: settings.backlash,
+        angle_noise: defaults.angle_noise * settings.noise,
+        torque_noise: defaults.torque_noise * settings.noise,
+        seed: settings.seed,
+        ..defaults
+    })
+}
+
+/// Simulates and writes the data sets and rig.json; returns the data-set files.
+fn write_rig(rig: &Rig, dir: &Path) -> Result<Vec<PathBuf>> {
+    ensure_dir(dir)?;
+    let records = rig.records()?;
+    let files = records
+        .iter()
+        .map(|r| r.write(dir))
+        .collect::<hysid::Result<Vec<_>>>()?;
+    write_json(&dir.join("rig.json"), &rig_json(rig))?;
+    Ok(files)
+}
+
+fn rig_json(rig: &Rig) -> serde_json::Value {
+    let truth: BTreeMap<&str, f64> = PARAMETERS
+        .iter()
+        .copied()
+        .zip(rig.truth.iter().copied())
+        .collect();
+    json!({
+        "truth": truth,
+        "r": rig.r,
+        "m": rig.m,
+        "fs_hz": rig.fs,
+        "backlash_rad": rig.backlash,
+        "angle_noise_rad": rig.angle_noise,
+        "torque_noise_Nm": rig.torque_noise,
+        "multisine_rms_Nm": rig.multisine_rms,
+        "seed": rig.seed,
+    })
+}
+
+/// The true parameters from DIR/rig.json, when the data came from the rig.
+fn rig_truth(dir: &Path) -> Result<Option<Vec<f64>>> {
+    let path = dir.join("rig.json");
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{} is not valid JSON", path.display()))?;
+    PARAMETERS
+        .iter()
+        .map(|p| {
+            value["truth"][p].as_f64().with_context(|| {
+                format!("{}: truth.{p} is missing (remove the file or rewrite it with `hysid actuator rig`)", path.display())
+            })
+        })
+        .collect::<Result<Vec<f64>>>()
+        .map(Some)
+}
+
+/// Figure 2 (the loops of step 2), figure 4 (torque against torsion, measured and simulated
+/// by m67), the compare plots of sets 6–8 and the convergence of m67.
+fn figures(
+    dir: &Path,
+    id: &ActuatorIdentification,
+    truth: Option<&[f64]>,
+    records: &BTreeMap<usize, Record>,
+) -> Result<Vec<PathBuf>> {
+    let mut files = vec![dir.join("fig2_loops.svg")];
+    loops_figure(&files[0], id)?;
+    let path = dir.join("fig4_torque_torsion.svg");
+    torque_torsion_figure(&path, id)?;
+    files.push(path);
+    let path = dir.join("compare.svg");
+    compare_figure(&path, id, records)?;
+    files.push(path);
+    let m67 = &id.step3["m67"].fit.report.history;
+    if !m67.is_empty() {
+        let path = dir.join("m67_convergence.svg");
+        let names: Vec<String> = PARAMETERS.iter().map(|p| p.to_string()).collect();
+        let mut history: Vec<Vec<f64>> = vec![id.m0.clone()];
+        history.extend(m67.iter().map(|r| r.theta[..PARAMETERS.len()].to_vec()));
+        convergence(
+            &path,
+            "m67: estimates per iteration (0 = m0)",
+            &names,
+            &history,
+            truth,
+        )?;
+        files.push(path);
+    }
+    Ok(files)
+}
+
+fn loops_figure(path: &Path, id: &ActuatorIdentification) -> Result<()> {
+    let [k1, k2, alpha, a] = id.step2.values;
+    let labels: Vec<String> = id
+        .step2
+        .loops
+        .iter()
+        .map(|l| format!("set {} (Q = {:.3} rad)", l.set, l.q))
+        .collect();
+    let curves: Vec<(Vec<f64>, Vec<f64>)> = id
+        .step2
+        .loops
+        .iter()
+        .map(|l| {
+            let n = 200;
+            let up = (0..=n).map(|i| -l.q + 2.0 * l.q * i as f64 / n as f64);
+            let down = (0..=n).map(|i| l.q - 2.0 * l.q * i as f64 / n as f64);
+            let x: Vec<f64> = up.clone().chain(down.clone()).collect();
+            let y: Vec<f64> = up
+                .map(|x| k1 * x + k2 * x.powi(3) + ascending(a, alpha, l.q, x))
+                .chain(down.map(|x| k1 * x + k2 * x.powi(3) + descending(a, alpha, l.q, x)))
+                .collect();
+            (x, y)
+        })
+        .collect();
+    let mut fig = Figure::new(
+        "Figure 2: steady-state loops (points) and the step-2 model (lines)",
+        "torsion x1 [rad]",
+        "τn [N·m]",
+    );
+    for ((l, label), (x, y)) in id.step2.loops.iter().zip(&labels).zip(&curves) {
+        fig = fig
+            .with(Series::new(
+                label.as_str(),
+                thin(&l.x1, 400),
+                thin(&l.tau_n, 400),
+                Style::Points,
+            ))
+            .with(Series::new("", x.as_slice(), y.as_slice(), Style::Line));
+    }
+    plot(path, &fig)
+}
+
+fn torque_torsion_figure(path: &Path, id: &ActuatorIdentification) -> Result<()> {
+    let titles = ["data set 6", "data set 7", "data set 8"];
+    let panels: Vec<Figure> = id
+        .validation
+        .experiments()
+        .iter()
+        .zip(&id.simulated["m67"])
+        .zip(titles)
+        .map(|((exp, sim), title)| {
+            let tau = thin(exp.input(0), PLOT_POINTS);
+            let fig = Figure::new(title, "torsion x1 [rad]", "torque τ [N·m]").with(Series::new(
+                "measured",
+                thin(exp.output(0), PLOT_POINTS),
+                tau.clone(),
+                Style::Line,
+            ));
+            if sim.is_empty() {
+                fig
+            } else {
+                fig.with(Series::new(
+                    "simulated (m67)",
+                    thin(sim, PLOT_POINTS),
+                    tau,
+                    Style::DashedLine,
+                ))
+            }
+        })
+        .collect();
+    plot_panels(
+        path,
+        "Figure 4: torque against torsion, measured and simulated",
+        &panels,
+        3,
+    )
+}
+
+fn compare_figure(
+    path: &Path,
+    id: &ActuatorIdentification,
+    records: &BTreeMap<usize, Record>,
+) -> Result<()> {
+    let ts = records[&6].ts;
+    let titles: Vec<String> = (6..=8)
+        .map(|set| {
+            let f = &id.fit_table;
+            format!(
+                "data set {set}: fit m0 {:.1} %, m67 {:.1} %",
+                f["m0"][set - 6],
+                f["m67"][set - 6]
+            )
+        })
+        .collect();
+    let times: Vec<Vec<f64>> = id
+        .validation
+        .experiments()
+        .iter()
+        .map(|e| (0..e.len()).map(|k| k as f64 * ts).collect())
+        .collect();
+    let panels: Vec<Figure> = (0..3)
+        .map(|e| {
+            let exp = &id.validation.experiments()[e];
+            let t = thin(&times[e], PLOT_POINTS);
+            let mut fig = Figure::new(&titles[e], "t [s]", "torsion x1 [rad]").with(Series::new(
+                "measured",
+                t.clone(),
+                thin(exp.output(0), PLOT_POINTS),
+                Style::Line,
+            ));
+            for name in ["m0", "m67"] {
+                let sim = &id.simulated[name][e];
+                if !sim.is_empty() {
+                    fig = fig.with(Series::new(
+                        name,
+                        t.clone(),
+                        thin(sim, PLOT_POINTS),
+                        Style::DashedLine,
+                    ));
+                }
+            }
+            fig
+        })
+        .collect();
+    plot_panels_sized(
+        path,
+        "Measured and simulated torsion (MATLAB compare)",
+        &panels,
+        1,
+        (1400, 1050),
+    )
+}
+
+/// Points per plotted series: enough for the eye at 1 kHz records, and SVG files of a few
+/// hundred kilobytes.
+const PLOT_POINTS: usize = 2500;
+
+/// Every k-th sample, k chosen to keep at most `max` of them.
+fn thin(x: &[f64], max: usize) -> Vec<f64> {
+    let step = x.len().div_ceil(max.max(1)).max(1);
+    x.iter().step_by(step).copied().collect()
+}

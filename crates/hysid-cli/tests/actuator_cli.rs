@@ -1,0 +1,258 @@
+//! `hysid actuator`, `hysid demo actuator` and `hysid rigid-body ls` end to end, and their
+//! one-line errors.
+
+use assert_cmd::Command;
+use std::fs;
+use std::path::{Path, PathBuf};
+use tempfile::TempDir;
+
+fn hysid() -> Command {
+    Command::cargo_bin("hysid").unwrap()
+}
+
+/// Runs `cmd` expecting failure: one line on stderr, no panic; returns it.
+fn one_line_error(cmd: &mut Command) -> String {
+    let out = cmd.assert().failure().get_output().stderr.clone();
+    let err = String::from_utf8(out).unwrap();
+    assert!(
+        !err.contains("panicked") && err.lines().count() == 1 && err.starts_with("error: "),
+        "{err}"
+    );
+    err
+}
+
+fn rig(dir: &Path, extra: &[&str]) -> PathBuf {
+    let data = dir.join("rig");
+    hysid()
+        .args(["actuator", "rig", "--out"])
+        .arg(&data)
+        .args(extra)
+        .assert()
+        .success();
+    data
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn emps() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/emps/DATA_EMPS.csv")
+}
+
+/// The rig writes eight data sets; identify recovers the noise-free truth (m67 within
+/// 0.1 %) and writes the tables, the figures and the JSON report.
+#[test]
+fn rig_and_identify_regenerate_the_tables() {
+    let dir = TempDir::new().unwrap();
+    let data = rig(dir.path(), &["--noise", "0"]);
+    for set in 1..=8 {
+        let text = fs::read_to_string(data.join(format!("dataset{set}.csv"))).unwrap();
+        assert!(text.starts_with("t_s,tau_Nm,theta_rad\n"), "{set}");
+    }
+    let out = dir.path().join("out");
+    let report = dir.path().join("report.json");
+    let stdout = hysid()
+        .args(["actuator", "identify", "--data"])
+        .arg(&data)
+        .arg("--out")
+        .arg(&out)
+        .arg("--json")
+        .arg(&report)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let stdout = String::from_utf8(stdout).unwrap();
+    for heading in ["Table I", "Table II", "Table III", "truth (rig)", "m68f"] {
+        assert!(stdout.contains(heading), "{heading}: {stdout}");
+    }
+    for file in [
+        "tables.md",
+        "fig2_loops.svg",
+        "fig4_torque_torsion.svg",
+        "compare.svg",
+        "m67_convergence.svg",
+    ] {
+        assert!(out.join(file).is_file(), "{file}");
+    }
+    let r = json(&report);
+    let truth = &r["truth"];
+    for name in ["J", "Fv", "Fc", "k1", "k2", "alpha", "A"] {
+        let estimate = r["models"]["m67"]["parameters"][name]["value"]
+            .as_f64()
+            .unwrap();
+        let t = truth[name].as_f64().unwrap();
+        assert!(
+            ((estimate - t) / t).abs() < 1e-3,
+            "{name}: {estimate} vs {t}"
+        );
+        assert!(r["models"]["m67f"]["parameters"]["J"]["fixed"]
+            .as_bool()
+            .unwrap());
+    }
+    assert_eq!(
+        r["models"]["m68"]["estimated_on"],
+        serde_json::json!([6, 8])
+    );
+    assert_eq!(r["sensitivity"].as_array().unwrap().len(), 7);
+}
+
+#[test]
+fn demo_runs_the_rig_and_all_three_steps() {
+    let dir = TempDir::new().unwrap();
+    let report = dir.path().join("demo.json");
+    let stdout = hysid()
+        .args(["demo", "actuator", "--out"])
+        .arg(dir.path())
+        .arg("--json")
+        .arg(&report)
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let stdout = String::from_utf8(stdout).unwrap();
+    assert!(
+        stdout.contains("Table II") && stdout.contains("total time"),
+        "{stdout}"
+    );
+    let r = json(&report);
+    for m in ["m0", "m67", "m68", "m67f", "m68f"] {
+        let fits = r["models"][m]["fit_percent"].as_array().unwrap();
+        assert!(
+            fits.iter().all(|f| f.as_f64().unwrap() > 95.0),
+            "{m}: {fits:?}"
+        );
+    }
+    assert!(dir.path().join("actuator/fig2_loops.svg").is_file());
+}
+
+#[test]
+fn missing_data_sets_are_named_in_one_line() {
+    let dir = TempDir::new().unwrap();
+    let data = rig(dir.path(), &[]);
+    fs::remove_file(data.join("dataset3.csv")).unwrap();
+    fs::remove_file(data.join("dataset7.csv")).unwrap();
+    let report = dir.path().join("r.json");
+    let err = one_line_error(
+        hysid()
+            .args(["actuator", "identify", "--data"])
+            .arg(&data)
+            .arg("--json")
+            .arg(&report),
+    );
+    assert!(
+        err.contains("dataset3.csv") && err.contains("dataset7.csv"),
+        "{err}"
+    );
+    assert!(!report.exists());
+}
+
+#[test]
+fn a_loop_record_without_a_full_period_is_one_line() {
+    let dir = TempDir::new().unwrap();
+    let data = rig(dir.path(), &[]);
+    let path = data.join("dataset4.csv");
+    let text = fs::read_to_string(&path).unwrap();
+    let short: Vec<&str> = text.lines().take(3000).collect();
+    fs::write(&path, short.join("\n")).unwrap();
+    let err = one_line_error(hysid().args(["actuator", "identify", "--data"]).arg(&data));
+    assert!(
+        err.contains("data set 4") && err.contains("full loop period"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_rig_settings_are_one_line() {
+    let dir = TempDir::new().unwrap();
+    let err = one_line_error(
+        hysid()
+            .args(["actuator", "rig", "--noise=-1", "--out"])
+            .arg(dir.path().join("x")),
+    );
+    assert!(err.contains("--noise"), "{err}");
+    let err = one_line_error(
+        hysid()
+            .args(["actuator", "rig", "--truth", "beta=3", "--out"])
+            .arg(dir.path().join("x")),
+    );
+    assert!(err.contains("alpha"), "{err}");
+}
+
+/// EMPS: the published inverse-dynamics estimates (MODELS.md §3.2).
+#[test]
+fn rigid_body_ls_reproduces_the_emps_reference() {
+    let dir = TempDir::new().unwrap();
+    let report = dir.path().join("emps.json");
+    hysid()
+        .args(["rigid-body", "ls", "--data"])
+        .arg(emps())
+        .args([
+            "--position",
+            "qm_m",
+            "--input",
+            "vir_V",
+            "--gain",
+            "35.15065188",
+            "--offset",
+        ])
+        .arg("--validate")
+        .arg(emps())
+        .arg("--json")
+        .arg(&report)
+        .assert()
+        .success();
+    let r = json(&report);
+    let p = &r["parameters"];
+    for (name, published, tol) in [
+        ("M", 95.1089, 0.005),
+        ("Fv", 203.5034, 0.005),
+        ("Fc", 20.3935, 0.005),
+        ("offset", -3.1648, 0.02),
+    ] {
+        let v = p[name]["value"].as_f64().unwrap();
+        assert!(((v - published) / published).abs() < tol, "{name}: {v}");
+        assert!(p[name]["relative_std_percent"].as_f64().unwrap() > 0.0);
+    }
+    let records = r["records"].as_array().unwrap();
+    assert_eq!(records.len(), 2);
+    for rec in records {
+        let e = rec["relative_error_percent"].as_f64().unwrap();
+        assert!((e - 4.0834).abs() < 0.2, "{e}");
+    }
+}
+
+#[test]
+fn rigid_body_ls_bad_input_is_one_line() {
+    let dir = TempDir::new().unwrap();
+    let err = one_line_error(
+        hysid()
+            .args(["rigid-body", "ls", "--data"])
+            .arg(emps())
+            .args(["--position", "q_missing", "--input", "vir_V"]),
+    );
+    assert!(err.contains("q_missing"), "{err}");
+    // A position that only ever increases: Coulomb friction cannot be told from an offset.
+    let path = dir.path().join("oneway.csv");
+    let rows: Vec<String> = (0..3000)
+        .map(|k| {
+            format!(
+                "{},{},{}",
+                k as f64 * 1e-3,
+                1e-3 * k as f64 * k as f64 * 1e-3,
+                1.0
+            )
+        })
+        .collect();
+    fs::write(&path, format!("t_s,q,u\n{}\n", rows.join("\n"))).unwrap();
+    let err = one_line_error(
+        hysid()
+            .args(["rigid-body", "ls", "--data"])
+            .arg(&path)
+            .args(["--position", "q", "--input", "u"]),
+    );
+    assert!(err.contains("never changes sign"), "{err}");
+}
