@@ -14,20 +14,7 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn records(rig: &Rig) -> BTreeMap<usize, Record> {
-    rig.records()
-        .unwrap()
-        .into_iter()
-        .map(|r| {
-            (
-                r.set,
-                Record {
-                    ts: r.ts,
-                    torque: r.torque,
-                    angle: r.angle,
-                },
-            )
-        })
-        .collect()
+    rig.data_sets().unwrap()
 }
 
 fn bench(c: &mut Criterion) {

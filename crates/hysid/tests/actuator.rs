@@ -8,20 +8,7 @@ use hysid::Error;
 use std::collections::BTreeMap;
 
 fn records(rig: &Rig) -> BTreeMap<usize, Record> {
-    rig.records()
-        .unwrap()
-        .into_iter()
-        .map(|r| {
-            (
-                r.set,
-                Record {
-                    ts: r.ts,
-                    torque: r.torque,
-                    angle: r.angle,
-                },
-            )
-        })
-        .collect()
+    rig.data_sets().unwrap()
 }
 
 fn identify(rig: &Rig) -> ActuatorIdentification {

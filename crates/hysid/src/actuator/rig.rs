@@ -28,7 +28,8 @@
 //! Without backlash and noise, the saddle-fixed sets are exactly what the identification
 //! model [`ActuatorFixed`] simulates with the same integrator.
 
-use super::identify::{data_set_path, COLUMNS};
+use super::identify::{data_set_path, Record, COLUMNS};
+use std::collections::BTreeMap;
 use crate::data::write_csv;
 use crate::greybox::models::{coulomb_direction, ActuatorFixed, ActuatorFree};
 use crate::greybox::simulate::rk4_step;
@@ -154,6 +155,22 @@ impl Rig {
             .into_par_iter()
             .map(|set| self.record(set))
             .collect()
+    }
+
+    /// All eight data sets as the identification reads them (`[&k]` is set k).
+    pub fn data_sets(&self) -> Result<BTreeMap<usize, Record>> {
+        Ok(self
+            .records()?
+            .into_iter()
+            .map(|r| {
+                let record = Record {
+                    ts: r.ts,
+                    torque: r.torque,
+                    angle: r.angle,
+                };
+                (r.set, record)
+            })
+            .collect())
     }
 
     /// Data set `set` (1–8).
