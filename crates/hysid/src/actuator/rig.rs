@@ -29,7 +29,6 @@
 //! model [`ActuatorFixed`] simulates with the same integrator.
 
 use super::identify::{data_set_path, Record, COLUMNS};
-use std::collections::BTreeMap;
 use crate::data::write_csv;
 use crate::greybox::models::{coulomb_direction, ActuatorFixed, ActuatorFree};
 use crate::greybox::simulate::rk4_step;
@@ -38,6 +37,7 @@ use crate::greybox::StateSpaceModel;
 use crate::signal::{gaussian_noise, multisine};
 use crate::{Error, Result};
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 

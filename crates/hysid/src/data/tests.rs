@@ -269,6 +269,20 @@ fn split_rejects_points_that_leave_a_part_empty() {
 }
 
 #[test]
+fn select_picks_experiments_in_the_given_order() {
+    let data = miso(3).merge(miso(5)).unwrap().merge(miso(2)).unwrap();
+    let picked = data.select(&[2, 0]).unwrap();
+    assert_eq!(picked.n_experiments(), 2);
+    assert_eq!(picked.n_samples(), 2 + 3);
+    assert_eq!(picked.output(0, 0), data.output(2, 0));
+    assert_eq!(picked.output(1, 0), data.output(0, 0));
+    assert_eq!(picked.input_channels(), data.input_channels());
+    assert_eq!(picked.ts(), data.ts());
+    assert!(invalid_message(data.select(&[])).contains("at least one"));
+    assert!(invalid_message(data.select(&[3])).contains("no experiment 3"));
+}
+
+#[test]
 fn merge_appends_experiments() {
     let merged = miso(3).merge(miso(5)).unwrap().merge(miso(2)).unwrap();
     assert_eq!(merged.n_experiments(), 3);

@@ -64,20 +64,43 @@ pub fn coulomb_direction(v: f64, applied: f64, fc: f64) -> Option<f64> {
 mod tests {
     use super::*;
 
-    /// ∂f/∂x and ∂f/∂θ of a model against central differences of f at a few points.
+    /// ∂f/∂x and ∂f/∂θ of a model against central differences of f at a few points; for a
+    /// model with Coulomb friction also with the friction held in either direction.
     fn check_jacobians(
         model: &dyn StateSpaceModel,
         points: &[(Vec<f64>, Vec<f64>)],
         theta: &[f64],
     ) {
+        let mut modes = vec![None];
+        if model.stick_slip_velocity().is_some() {
+            modes.extend([Some(1.0), Some(-1.0)]);
+        }
+        for held in modes {
+            check_jacobians_held(model, points, theta, held);
+        }
+    }
+
+    fn check_jacobians_held(
+        model: &dyn StateSpaceModel,
+        points: &[(Vec<f64>, Vec<f64>)],
+        theta: &[f64],
+        held: Option<f64>,
+    ) {
         let n = model.states().len();
         let p = theta.len();
         for (x, u) in points {
             let (mut fx, mut ft) = (vec![0.0; n * n], vec![0.0; n * p]);
-            assert!(model.rhs_jacobians(0.0, x, u, theta, &mut fx, &mut ft));
+            let provided = match held {
+                None => model.rhs_jacobians(0.0, x, u, theta, &mut fx, &mut ft),
+                Some(d) => model.rhs_jacobians_sliding(0.0, x, u, theta, d, &mut fx, &mut ft),
+            };
+            assert!(provided);
             let f = |x: &[f64], th: &[f64]| {
                 let mut dx = vec![0.0; n];
-                model.rhs(0.0, x, u, th, &mut dx);
+                match held {
+                    None => model.rhs(0.0, x, u, th, &mut dx),
+                    Some(d) => model.rhs_sliding(0.0, x, u, th, d, &mut dx),
+                }
                 dx
             };
             for j in 0..n {
@@ -91,7 +114,7 @@ mod tests {
                     let an = fx[i * n + j];
                     assert!(
                         (fd - an).abs() <= 1e-6 * an.abs().max(1.0),
-                        "{} ∂f{i}/∂x{j} at {x:?}: {fd} vs {an}",
+                        "{} ({held:?}) ∂f{i}/∂x{j} at {x:?}: {fd} vs {an}",
                         model.kind()
                     );
                 }
@@ -107,7 +130,7 @@ mod tests {
                     let an = ft[i * p + j];
                     assert!(
                         (fd - an).abs() <= 1e-6 * an.abs().max(1.0),
-                        "{} ∂f{i}/∂θ{j} at {x:?}: {fd} vs {an}",
+                        "{} ({held:?}) ∂f{i}/∂θ{j} at {x:?}: {fd} vs {an}",
                         model.kind()
                     );
                 }
