@@ -72,12 +72,25 @@ pub struct RigSettings {
     pub truth: Vec<String>,
 }
 
+/// The actuator's known constants.
+#[derive(Debug, Args)]
+pub struct ActuatorConstants {
+    /// Gear ratio r of the screw [m/rad] (known; the paper's actuator: 1.867e-3).
+    #[arg(long, default_value_t = 1.867e-3)]
+    pub gear_ratio: f64,
+    /// Saddle mass m [kg] (known; the paper's actuator: 1.2).
+    #[arg(long, default_value_t = 1.2)]
+    pub saddle_mass: f64,
+}
+
 /// Options of `hysid actuator rig`.
 #[derive(Debug, Args)]
 pub struct RigArgs {
     /// Directory for the data sets (created if needed).
     #[arg(long)]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub constants: ActuatorConstants,
     #[command(flatten)]
     pub rig: RigSettings,
 }
@@ -88,6 +101,13 @@ pub struct ThreeStepArgs {
     /// Remove the sample mean of every signal before filtering.
     #[arg(long)]
     pub remove_mean: bool,
+    /// Cut-off of the zero-phase 4th-order Butterworth pre-filter [Hz] (the paper: 100).
+    #[arg(long, default_value_t = 100.0)]
+    pub cutoff: f64,
+    /// Step 2 leaves out samples within this fraction of a loop's peak-to-peak torsion from
+    /// a reversal, where the motor sticks and the friction torque is unknown.
+    #[arg(long, default_value_t = 0.05)]
+    pub reversal_margin: f64,
     /// Maximum iterations of each step-3 fit (the paper: 30).
     #[arg(long, default_value_t = 30)]
     pub max_iterations: usize,
@@ -104,6 +124,8 @@ pub struct ActuatorIdentifyArgs {
     /// rig.json beside them adds the true parameters to the tables.
     #[arg(long)]
     pub data: PathBuf,
+    #[command(flatten)]
+    pub constants: ActuatorConstants,
     #[command(flatten)]
     pub steps: ThreeStepArgs,
     /// Write the JSON report here.
@@ -396,6 +418,8 @@ pub enum Demo {
 /// Options of `hysid demo actuator`.
 #[derive(Debug, Args)]
 pub struct DemoActuatorArgs {
+    #[command(flatten)]
+    pub constants: ActuatorConstants,
     #[command(flatten)]
     pub rig: RigSettings,
     #[command(flatten)]

@@ -256,3 +256,59 @@ fn rigid_body_ls_bad_input_is_one_line() {
     );
     assert!(err.contains("never changes sign"), "{err}");
 }
+
+#[test]
+fn bad_three_step_settings_are_one_line() {
+    let dir = TempDir::new().unwrap();
+    let data = rig(dir.path(), &[]);
+    let identify = |extra: &[&str]| {
+        one_line_error(
+            hysid()
+                .args(["actuator", "identify", "--data"])
+                .arg(&data)
+                .args(extra),
+        )
+    };
+    let err = identify(&["--gear-ratio", "0"]);
+    assert!(err.contains("gear ratio"), "{err}");
+    let err = identify(&["--saddle-mass=-1"]);
+    assert!(err.contains("saddle mass"), "{err}");
+    let err = identify(&["--cutoff", "800"]);
+    assert!(err.contains("Nyquist"), "{err}");
+    let err = identify(&["--reversal-margin", "0.5"]);
+    assert!(err.contains("reversal_margin"), "{err}");
+}
+
+#[test]
+fn rig_and_identify_take_the_actuator_constants() {
+    let dir = TempDir::new().unwrap();
+    let err = one_line_error(
+        hysid()
+            .args(["actuator", "rig", "--gear-ratio", "0", "--out"])
+            .arg(dir.path().join("x")),
+    );
+    assert!(err.contains("gear ratio"), "{err}");
+    // A heavier saddle on the rig (r²m = 2 % of J): step 1 measures Jt = J + r²m on the
+    // saddle-free data set 1, so m0's J is right only when identify is told the same mass.
+    let data = rig(dir.path(), &["--noise", "0", "--saddle-mass", "3"]);
+    let m0_j = |mass: &str| {
+        let report = dir.path().join(format!("r{mass}.json"));
+        hysid()
+            .args(["actuator", "identify", "--saddle-mass", mass, "--data"])
+            .arg(&data)
+            .arg("--json")
+            .arg(&report)
+            .assert()
+            .success();
+        let r = json(&report);
+        let truth = r["truth"]["J"].as_f64().unwrap();
+        let j = r["models"]["m0"]["parameters"]["J"]["value"]
+            .as_f64()
+            .unwrap();
+        (j - truth) / truth
+    };
+    let told = m0_j("3");
+    let not_told = m0_j("1.2");
+    assert!(told.abs() < 0.006, "{told}");
+    assert!(not_told > 0.01, "{not_told}");
+}

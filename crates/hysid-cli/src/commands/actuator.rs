@@ -2,7 +2,9 @@
 //! al. (2006), its virtual test rig and the three-step identification with the paper's tables
 //! and figures.
 
-use crate::cli::{ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs};
+use crate::cli::{
+    ActuatorConstants, ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs,
+};
 use crate::output::{ensure_dir, write_atomic, write_json};
 use crate::plot::{convergence, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
 use anyhow::{bail, Context, Result};
@@ -20,7 +22,7 @@ use std::time::Instant;
 
 /// Writes the eight data sets of the virtual rig.
 pub fn rig(args: &RigArgs) -> Result<()> {
-    let rig = rig_from(&args.rig)?;
+    let rig = rig_from(&args.rig, &args.constants)?;
     let files = write_rig(&rig, &args.out)?;
     println!(
         "virtual actuator rig (Gunnar et al. 2006): {} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
@@ -39,7 +41,7 @@ pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
     let records = read_data_sets(&args.data)?;
     let truth = rig_truth(&args.data)?;
     let clock = Instant::now();
-    let id = run(&three_steps(&args.steps), &records)?;
+    let id = run(&three_steps(&args.steps, &args.constants), &records)?;
     publish(
         &id,
         truth.as_deref(),
@@ -53,7 +55,7 @@ pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
 /// The rig and the three steps on the default settings.
 pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     let clock = Instant::now();
-    let rig = rig_from(&args.rig)?;
+    let rig = rig_from(&args.rig, &args.constants)?;
     let data_dir = args.out.join("actuator-data");
     write_rig(&rig, &data_dir)?;
     let records = read_data_sets(&data_dir)?;
@@ -65,7 +67,7 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
         rig.seed,
         data_dir.display()
     );
-    let id = run(&three_steps(&args.steps), &records)?;
+    let id = run(&three_steps(&args.steps, &args.constants), &records)?;
     publish(
         &id,
         Some(&rig.truth),
@@ -122,10 +124,14 @@ fn publish(
     Ok(())
 }
 
-fn three_steps(args: &ThreeStepArgs) -> ThreeSteps {
+fn three_steps(args: &ThreeStepArgs, constants: &ActuatorConstants) -> ThreeSteps {
     let defaults = ThreeSteps::default();
     ThreeSteps {
+        r: constants.gear_ratio,
+        m: constants.saddle_mass,
+        cutoff_hz: args.cutoff,
         remove_mean: args.remove_mean,
+        reversal_margin: args.reversal_margin,
         lm: LmConfig {
             max_iterations: args.max_iterations,
             improvement_tolerance: args.tolerance,
@@ -135,7 +141,7 @@ fn three_steps(args: &ThreeStepArgs) -> ThreeSteps {
     }
 }
 
-fn rig_from(settings: &RigSettings) -> Result<Rig> {
+fn rig_from(settings: &RigSettings, constants: &ActuatorConstants) -> Result<Rig> {
     if !(settings.noise.is_finite() && settings.noise >= 0.0) {
         bail!(
             "--noise {}: give a non-negative multiple of the documented noise levels",
@@ -174,6 +180,8 @@ fn rig_from(settings: &RigSettings) -> Result<Rig> {
         angle_noise: defaults.angle_noise * settings.noise,
         torque_noise: defaults.torque_noise * settings.noise,
         seed: settings.seed,
+        r: constants.gear_ratio,
+        m: constants.saddle_mass,
         ..defaults
     })
 }

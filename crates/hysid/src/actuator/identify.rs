@@ -204,6 +204,7 @@ impl ThreeSteps {
         records: &BTreeMap<usize, Record>,
         progress: &mut dyn FnMut(&str),
     ) -> Result<ActuatorIdentification> {
+        self.check()?;
         for set in 1..=8 {
             if !records.contains_key(&set) {
                 return Err(Error::InvalidData(format!(
@@ -247,8 +248,48 @@ impl ThreeSteps {
         })
     }
 
+    /// Refuses settings no actuator has: a non-positive gear ratio or cut-off, a negative
+    /// saddle mass, a reversal margin that would leave no branch samples.
+    fn check(&self) -> Result<()> {
+        let bad = |name: &str, value: f64, reason: &str| {
+            Err(Error::InvalidParameter {
+                name: name.into(),
+                value,
+                reason: reason.into(),
+            })
+        };
+        if !(self.r.is_finite() && self.r > 0.0) {
+            return bad("r", self.r, "the gear ratio must be positive (m/rad)");
+        }
+        if !(self.m.is_finite() && self.m >= 0.0) {
+            return bad("m", self.m, "the saddle mass must be zero or positive (kg)");
+        }
+        if !(self.cutoff_hz.is_finite() && self.cutoff_hz > 0.0) {
+            return bad(
+                "cutoff",
+                self.cutoff_hz,
+                "the pre-filter cut-off must be positive (Hz)",
+            );
+        }
+        if !(0.0..0.25).contains(&self.reversal_margin) {
+            return bad(
+                "reversal_margin",
+                self.reversal_margin,
+                "must lie in [0, 0.25) of the loop's peak-to-peak torsion",
+            );
+        }
+        Ok(())
+    }
+
     /// The zero-phase Butterworth pre-filter (with optional mean removal).
     fn prefilter(&self, x: &[f64], ts: f64) -> Result<Vec<f64>> {
+        let nyquist = 0.5 / ts;
+        if self.cutoff_hz >= nyquist {
+            return Err(Error::Config(format!(
+                "the pre-filter cut-off {} Hz is not below the data's Nyquist frequency {nyquist} Hz; choose a lower cut-off",
+                self.cutoff_hz
+            )));
+        }
         let tf = butter(4, self.cutoff_hz * 2.0 * ts)?;
         let x = if self.remove_mean {
             remove_mean(x)

@@ -254,6 +254,12 @@ impl Rig {
                 "the rig needs fs > 0, substeps >= 1 and non-negative backlash and noise".into(),
             ));
         }
+        if !(self.r.is_finite() && self.r > 0.0 && self.m.is_finite() && self.m >= 0.0) {
+            return Err(Error::Config(format!(
+                "the rig needs a positive gear ratio and a non-negative saddle mass, got r = {} m/rad, m = {} kg",
+                self.r, self.m
+            )));
+        }
         Ok(())
     }
 
