@@ -108,6 +108,10 @@ pub struct ThreeStepArgs {
     /// a reversal, where the motor sticks and the friction torque is unknown.
     #[arg(long, default_value_t = 0.05)]
     pub reversal_margin: f64,
+    /// Fit step 3 (and score Table II) on the unfiltered records; the paper pre-filters
+    /// them, which biases a nonlinear model slightly (see the README).
+    #[arg(long)]
+    pub unfiltered_step3: bool,
     /// Maximum iterations of each step-3 fit (the paper: 30).
     #[arg(long, default_value_t = 30)]
     pub max_iterations: usize,

@@ -132,6 +132,7 @@ fn three_steps(args: &ThreeStepArgs, constants: &ActuatorConstants) -> ThreeStep
         cutoff_hz: args.cutoff,
         remove_mean: args.remove_mean,
         reversal_margin: args.reversal_margin,
+        prefilter_step3: !args.unfiltered_step3,
         lm: LmConfig {
             max_iterations: args.max_iterations,
             improvement_tolerance: args.tolerance,
