@@ -40,3 +40,32 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 pub fn ensure_dir(dir: &Path) -> Result<()> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create directory {}", dir.display()))
 }
+
+/// Checks, before any work, that every result file can be written where asked (its
+/// directory exists and the path is not a directory) and creates the plot directories, so
+/// that a long fit never ends in "cannot write".
+pub fn preflight(files: &[Option<&Path>], dirs: &[Option<&Path>]) -> Result<()> {
+    for path in files.iter().flatten() {
+        if path.is_dir() {
+            anyhow::bail!(
+                "cannot write {}: it is a directory; give a file name",
+                path.display()
+            );
+        }
+        let dir = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        if !dir.is_dir() {
+            anyhow::bail!(
+                "cannot write {}: directory {} does not exist; create it or choose another path",
+                path.display(),
+                dir.display()
+            );
+        }
+    }
+    for dir in dirs.iter().flatten() {
+        ensure_dir(dir)?;
+    }
+    Ok(())
+}

@@ -525,3 +525,53 @@ fn greybox_bad_input_and_numerical_trouble_are_one_line_errors() {
     let err = greybox_fails(&train, &["--init", "mass=3"]);
     assert!(err.contains("no parameter named 'mass'"), "{err}");
 }
+
+/// A report, model or CSV destination that cannot be written is refused before any work
+/// (one line naming it, nothing written), not after a long fit.
+#[test]
+fn unwritable_destinations_are_refused_before_the_work() {
+    let dir = TempDir::new().unwrap();
+    let data = example_data(dir.path(), true);
+    let nowhere = dir.path().join("no-such-dir");
+    let check = |cmd: &mut Command, what: &Path| {
+        let out = cmd.assert().failure().get_output().clone();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert!(
+            stderr.lines().count() == 1
+                && stderr.contains(&what.display().to_string())
+                && !stderr.contains("panicked"),
+            "{stderr}"
+        );
+        // Refused at once: nothing was printed on stdout.
+        assert!(
+            out.stdout.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+    };
+    let json = nowhere.join("r.json");
+    check(identify_cascade(&data).arg("--json").arg(&json), &json);
+    let model = nowhere.join("m.json");
+    check(identify_cascade(&data).arg("--model").arg(&model), &model);
+    // A directory where a file is expected.
+    check(
+        identify_cascade(&data).arg("--json").arg(dir.path()),
+        dir.path(),
+    );
+    let csv_out = nowhere.join("x.csv");
+    check(
+        hysid()
+            .args(["generate", "voros", "--example", "1", "--out"])
+            .arg(&csv_out),
+        &csv_out,
+    );
+    check(
+        hysid()
+            .args(["demo", "actuator", "--json"])
+            .arg(&json)
+            .arg("--out")
+            .arg(dir.path().join("demo")),
+        &json,
+    );
+    assert!(!nowhere.exists());
+}

@@ -5,7 +5,7 @@
 use crate::cli::{
     ActuatorConstants, ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs,
 };
-use crate::output::{ensure_dir, write_atomic, write_json};
+use crate::output::{ensure_dir, preflight, write_atomic, write_json};
 use crate::plot::{convergence, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
 use anyhow::{bail, Context, Result};
 use hysid::actuator::identify::{
@@ -23,6 +23,7 @@ use std::time::Instant;
 /// Writes the eight data sets of the virtual rig.
 pub fn rig(args: &RigArgs) -> Result<()> {
     let rig = rig_from(&args.rig, &args.constants)?;
+    preflight(&[], &[Some(&args.out)])?;
     let files = write_rig(&rig, &args.out)?;
     println!(
         "virtual actuator rig (Gunnar et al. 2006): {} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
@@ -38,6 +39,7 @@ pub fn rig(args: &RigArgs) -> Result<()> {
 
 /// The three steps on a data directory.
 pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
+    preflight(&[args.json.as_deref()], &[args.out.as_deref()])?;
     let records = read_data_sets(&args.data)?;
     let truth = rig_truth(&args.data)?;
     let clock = Instant::now();
@@ -56,6 +58,7 @@ pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
 pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     let clock = Instant::now();
     let rig = rig_from(&args.rig, &args.constants)?;
+    preflight(&[args.json.as_deref()], &[Some(&args.out)])?;
     let data_dir = args.out.join("actuator-data");
     write_rig(&rig, &data_dir)?;
     let records = read_data_sets(&data_dir)?;

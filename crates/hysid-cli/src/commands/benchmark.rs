@@ -6,7 +6,7 @@
 use super::greybox::{configure, fitted_model, plots};
 use super::present::{print_fit, print_residuals, report};
 use crate::cli::{BoucWenArgs, BoucWenGenerate, BoucWenGenerateArgs, SignalArg};
-use crate::output::{ensure_dir, write_json};
+use crate::output::{ensure_dir, preflight, write_json};
 use crate::plot::{plot, Figure, Series};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
@@ -37,6 +37,7 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
     if let Some(BoucWenGenerate::Generate(g)) = &args.generate {
         return generate(g);
     }
+    preflight(&[args.json.as_deref()], &[args.out.as_deref()])?;
     let Some(train) = &args.train else {
         bail!(
             "give the training record with --train FILE (columns t_s, u_N, y_m), or use `generate`"
@@ -193,6 +194,7 @@ const UP: usize = 20;
 /// Simulates a test signal by the official recipe: the input at 15 kHz, Newmark (γ = ½,
 /// β = ¼) at 15 kHz, low-pass filtering and decimation back to 750 Hz.
 fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
+    preflight(&[Some(&args.out)], &[])?;
     let (u, u_fine) = match args.signal {
         SignalArg::Multisine => {
             anyhow::ensure!(args.periods >= 1, "--periods must be at least 1");

@@ -2,7 +2,7 @@
 
 use super::cascade::{plots, print_summary, report, rows, uncertainty};
 use crate::cli::{UncertaintyArg, VorosArgs};
-use crate::output::write_json;
+use crate::output::{preflight, write_json};
 use crate::progress::FitProgress;
 use crate::report::print_table;
 use anyhow::Result;
@@ -13,6 +13,7 @@ use serde_json::json;
 /// Generates Example 1 or 2, identifies it and reports against the truth.
 pub fn voros(args: &VorosArgs) -> Result<()> {
     let ex = CascadeExample::number(args.example)?;
+    preflight(&[args.json.as_deref()], &[Some(&args.out)])?;
     let generated = ex.generate(args.seed, !args.noise_free)?;
     let data = generated.id_data()?;
     let truth = &ex.truth;

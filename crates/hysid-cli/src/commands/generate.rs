@@ -1,6 +1,7 @@
 //! `hysid generate voros`: the examples' data as CSV.
 
 use crate::cli::GenerateVorosArgs;
+use crate::output::preflight;
 use anyhow::Result;
 use hysid::data::write_csv;
 use hysid::examples::CascadeExample;
@@ -8,6 +9,7 @@ use hysid::examples::CascadeExample;
 /// Writes columns t, x, y of Example 1 or 2 (optionally extended to `--samples`).
 pub fn voros(args: &GenerateVorosArgs) -> Result<()> {
     let mut ex = CascadeExample::number(args.example)?;
+    preflight(&[Some(&args.out)], &[])?;
     if let Some(n) = args.samples {
         anyhow::ensure!(n >= 2, "--samples must be at least 2, got {n}");
         ex = ex.extended(n);

@@ -3,7 +3,7 @@
 use super::present::{print_fit, print_residuals, print_sensitivity, report};
 use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
 use crate::commands::identify::load;
-use crate::output::{ensure_dir, write_json};
+use crate::output::{ensure_dir, preflight, write_json};
 use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
@@ -22,6 +22,10 @@ use std::sync::Arc;
 /// Runs `hysid greybox fit`.
 pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     let model: Arc<dyn StateSpaceModel> = Arc::from(models::by_kind(&args.model)?);
+    preflight(
+        &[args.json.as_deref(), args.model_out.as_deref()],
+        &[args.out.as_deref()],
+    )?;
     let data = load(&args.data)?;
     let params = configure(
         model.parameters(),

@@ -69,6 +69,7 @@ fn rename(data: IdData, inputs: &[Channel], outputs: &[Channel], k: usize) -> Re
 /// `hysid identify cascade`.
 pub fn cascade(args: &CascadeArgs) -> Result<()> {
     let form = ChForm::parse(&args.hysteresis)?;
+    preflight_outputs(&args.output)?;
     let data = load(&args.data)?;
     let mut id = CascadeIdentification::new(form, args.na, args.nb, args.delay);
     id.uncertainty = uncertainty(args.uncertainty, args.replicates);
@@ -103,6 +104,7 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
 /// `hysid identify hysteresis`.
 pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
     let form = ChForm::parse(&args.hysteresis)?;
+    preflight_outputs(&args.output)?;
     let data = load(&args.data)?;
     let mut id = HysteresisIdentification::new(form);
     id.initial = match args.initial_output {
@@ -256,4 +258,12 @@ fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<(
         println!("  model: {}", path.display());
     }
     Ok(())
+}
+
+/// Checks the report, model and plot destinations before the fit.
+fn preflight_outputs(output: &OutputArgs) -> Result<()> {
+    crate::output::preflight(
+        &[output.json.as_deref(), output.model.as_deref()],
+        &[output.out.as_deref()],
+    )
 }

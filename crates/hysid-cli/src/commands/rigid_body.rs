@@ -2,7 +2,7 @@
 //! 1 of Gunnar et al. 2006; the reference method of the EMPS benchmark, Janot et al. 2019).
 
 use crate::cli::RigidBodyLsArgs;
-use crate::output::write_json;
+use crate::output::{preflight, write_json};
 use anyhow::{Context, Result};
 use hysid::data::{CsvSpec, IdData};
 use hysid::estimate::inverse_dynamics::RigidBodyLs;
@@ -11,6 +11,7 @@ use std::path::Path;
 
 /// Estimates on one record; relative errors on every validation record.
 pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
+    preflight(&[args.json.as_deref()], &[])?;
     let ls = RigidBodyLs {
         inertia_name: "M".into(),
         gain: args.gain,

@@ -1,7 +1,7 @@
 //! `hysid simulate`: run a saved model on new input data.
 
 use crate::cli::SimulateArgs;
-use crate::output::write_json;
+use crate::output::{preflight, write_json};
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::fitted::FittedModel;
@@ -11,6 +11,7 @@ use serde_json::json;
 /// Simulates the model on the input columns; compares with the output column when given.
 pub fn run(args: &SimulateArgs) -> Result<()> {
     let model = FittedModel::load(&args.model)?;
+    preflight(&[args.out_csv.as_deref(), args.json.as_deref()], &[])?;
     let spec = CsvSpec {
         inputs: args.input.clone(),
         outputs: args.output.iter().cloned().collect(),
