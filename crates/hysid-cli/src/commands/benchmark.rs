@@ -15,7 +15,8 @@ use hysid::fitted::FittedModel;
 use hysid::greybox::models::BoucWen;
 use hysid::greybox::simulate::band_limited_upsample;
 use hysid::greybox::{
-    GreyBoxEstimation, InitialStates, InputInterpolation, Integrator, Simulation, StateSpaceModel,
+    GreyBoxEstimation, GreyBoxFit, InitialStates, InputInterpolation, Integrator, Simulation,
+    StateSpaceModel,
 };
 use hysid::metrics;
 use hysid::signal::{decimate_fir, gaussian_noise, multisine, sine_sweep};
@@ -44,6 +45,49 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
         );
     };
     let data = record(train)?;
+    let (fit, simulation) = fit_training(args, &data)?;
+    print_fit(
+        &format!(
+            "Bouc–Wen benchmark: fitted to {} ({} samples)",
+            train.display(),
+            data.n_samples()
+        ),
+        &fit,
+    );
+    let residuals = print_residuals(&fit, &data);
+    println!(
+        "  training e_RMS {:.4e} m (the record's noise is 7.4e-6 m)",
+        fit.fit.mse[0][0].sqrt()
+    );
+    let fitted = fitted_model(&BoucWen, &fit, simulation);
+    let tests = args
+        .test
+        .iter()
+        .map(|path| score(&fitted, path, args.steady_state))
+        .collect::<Result<Vec<_>>>()?;
+    print_tests(&tests);
+    if let Some(dir) = &args.out {
+        plots(dir, &fit, &data, &residuals)?;
+        test_plots(dir, &tests)?;
+        println!("  plots: {}", dir.display());
+    }
+    if let Some(path) = &args.json {
+        let extra = json!({
+            "train": train,
+            "training_e_rms": fit.fit.mse[0][0].sqrt(),
+            "tests": tests.iter().map(|t| json!({"file": t.file, "e_rms": t.e_rms, "fit_percent": t.fit_percent, "samples": t.y.len()})).collect::<Vec<_>>(),
+            "published_multisine_e_rms": PUBLISHED.iter().map(|(who, e)| json!({"method": who, "e_rms": e})).collect::<Vec<_>>(),
+            "residual_analysis": residuals,
+        });
+        write_json(path, &report(&fit, &data, fitted.to_file(), extra))?;
+        println!("  report: {}", path.display());
+    }
+    Ok(())
+}
+
+/// The output-error fit of the training record from the nominal start times
+/// `--start-factor` (and `--init`), with the benchmark's integrator settings.
+fn fit_training(args: &BoucWenArgs, data: &IdData) -> Result<(GreyBoxFit, Simulation)> {
     let mut params = BoucWen.parameters();
     for i in params.free_indices() {
         params.get_mut(i).value *= args.start_factor;
@@ -66,32 +110,18 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
         let mut callback = progress.callback();
         estimation.estimate(
             Arc::new(BoucWen),
-            &data,
+            data,
             &params,
             InitialStates::at_rest(3, 1),
             &mut callback,
         )?
     };
-    print_fit(
-        &format!(
-            "Bouc–Wen benchmark: fitted to {} ({} samples)",
-            train.display(),
-            data.n_samples()
-        ),
-        &fit,
-    );
-    let residuals = print_residuals(&fit, &data);
-    println!(
-        "  training e_RMS {:.4e} m (the record's noise is 7.4e-6 m)",
-        fit.fit.mse[0][0].sqrt()
-    );
-    let fitted = fitted_model(&BoucWen, &fit, simulation);
-    let tests = args
-        .test
-        .iter()
-        .map(|path| score(&fitted, path, args.steady_state))
-        .collect::<Result<Vec<_>>>()?;
-    for t in &tests {
+    Ok((fit, simulation))
+}
+
+/// e_RMS per test record, and the published figures for comparison.
+fn print_tests(tests: &[TestScore]) {
+    for t in tests {
         println!(
             "  test {}: e_RMS {:.4e} m, fit {:.2} % ({} samples)",
             t.file.display(),
@@ -110,23 +140,6 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
             published.join("; ")
         );
     }
-    if let Some(dir) = &args.out {
-        plots(dir, &fit, &data, &residuals)?;
-        test_plots(dir, &tests)?;
-        println!("  plots: {}", dir.display());
-    }
-    if let Some(path) = &args.json {
-        let extra = json!({
-            "train": train,
-            "training_e_rms": fit.fit.mse[0][0].sqrt(),
-            "tests": tests.iter().map(|t| json!({"file": t.file, "e_rms": t.e_rms, "fit_percent": t.fit_percent, "samples": t.y.len()})).collect::<Vec<_>>(),
-            "published_multisine_e_rms": PUBLISHED.iter().map(|(who, e)| json!({"method": who, "e_rms": e})).collect::<Vec<_>>(),
-            "residual_analysis": residuals,
-        });
-        write_json(path, &report(&fit, &data, fitted.to_file(), extra))?;
-        println!("  report: {}", path.display());
-    }
-    Ok(())
 }
 
 /// A benchmark record: columns t_s, u_N, y_m.

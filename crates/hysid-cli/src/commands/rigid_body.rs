@@ -5,7 +5,7 @@ use crate::cli::RigidBodyLsArgs;
 use crate::output::{preflight, write_json};
 use anyhow::{Context, Result};
 use hysid::data::{CsvSpec, IdData};
-use hysid::estimate::inverse_dynamics::RigidBodyLs;
+use hysid::estimate::inverse_dynamics::{RigidBodyEstimate, RigidBodyLs};
 use serde_json::json;
 use std::path::Path;
 
@@ -25,6 +25,33 @@ pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
     let estimate = ls
         .estimate(&q, &u, ts)
         .with_context(|| args.data.display().to_string())?;
+    print_estimate(&estimate, args);
+    let mut records = vec![json!({
+        "file": args.data,
+        "role": "estimation",
+        "relative_error_percent": estimate.relative_error_percent,
+    })];
+    for path in &args.validate {
+        let (q, u, ts) = record(path, args)?;
+        let error = ls
+            .relative_error(&estimate, &q, &u, ts)
+            .with_context(|| path.display().to_string())?;
+        println!("  relative error {error:.4} % on {}", path.display());
+        records.push(json!({
+            "file": path,
+            "role": "validation",
+            "relative_error_percent": error,
+        }));
+    }
+    if let Some(path) = &args.json {
+        write_json(path, &report(&estimate, records, args))?;
+        println!("  report: {}", path.display());
+    }
+    Ok(())
+}
+
+/// The settings, the estimates with their standard deviations, the fit and the condition.
+fn print_estimate(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) {
     println!(
         "Rigid body g·u = M q̈ + Fv q̇ + Fc sgn(q̇){}: inverse-dynamics least squares on {}",
         if args.offset { " + offset" } else { "" },
@@ -53,53 +80,39 @@ pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
         estimate.condition_number_unscaled,
         estimate.condition_number
     );
-    let mut records = vec![json!({
-        "file": args.data,
-        "role": "estimation",
-        "relative_error_percent": estimate.relative_error_percent,
-    })];
-    for path in &args.validate {
-        let (q, u, ts) = record(path, args)?;
-        let error = ls
-            .relative_error(&estimate, &q, &u, ts)
-            .with_context(|| path.display().to_string())?;
-        println!("  relative error {error:.4} % on {}", path.display());
-        records.push(json!({
-            "file": path,
-            "role": "validation",
-            "relative_error_percent": error,
-        }));
-    }
-    if let Some(path) = &args.json {
-        let parameters: serde_json::Map<String, serde_json::Value> = (0..estimate.names.len())
-            .map(|i| {
-                (
-                    estimate.names[i].clone(),
-                    json!({
-                        "value": estimate.values[i],
-                        "std": estimate.std[i],
-                        "relative_std_percent": estimate.relative_std_percent[i],
-                    }),
-                )
-            })
-            .collect();
-        let report = json!({
-            "model": "rigid_body",
-            "parameters": parameters,
-            "records": records,
-            "condition_number": estimate.condition_number_unscaled,
-            "condition_number_scaled": estimate.condition_number,
-            "equations": estimate.equations,
-            "settings": {
-                "gain": args.gain, "offset": args.offset, "cutoff_hz": args.cutoff,
-                "filter_order": args.order, "decimation": args.decimate, "border": args.border,
-                "position": args.position, "input": args.input,
-            },
-        });
-        write_json(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    Ok(())
+}
+
+/// The JSON report: parameters by name, a relative error per record, the settings.
+fn report(
+    estimate: &RigidBodyEstimate,
+    records: Vec<serde_json::Value>,
+    args: &RigidBodyLsArgs,
+) -> serde_json::Value {
+    let parameters: serde_json::Map<String, serde_json::Value> = (0..estimate.names.len())
+        .map(|i| {
+            (
+                estimate.names[i].clone(),
+                json!({
+                    "value": estimate.values[i],
+                    "std": estimate.std[i],
+                    "relative_std_percent": estimate.relative_std_percent[i],
+                }),
+            )
+        })
+        .collect();
+    json!({
+        "model": "rigid_body",
+        "parameters": parameters,
+        "records": records,
+        "condition_number": estimate.condition_number_unscaled,
+        "condition_number_scaled": estimate.condition_number,
+        "equations": estimate.equations,
+        "settings": {
+            "gain": args.gain, "offset": args.offset, "cutoff_hz": args.cutoff,
+            "filter_order": args.order, "decimation": args.decimate, "border": args.border,
+            "position": args.position, "input": args.input,
+        },
+    })
 }
 
 /// Position, drive signal and sample time of a record.
