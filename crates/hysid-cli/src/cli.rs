@@ -18,10 +18,10 @@ pub enum Command {
     /// Run a built-in example end to end: generate data, identify, report, plot.
     #[command(subcommand)]
     Demo(Demo),
-    /// Identify a model from a CSV file.
+    /// Identify a model from a CSV or MAT file.
     #[command(subcommand)]
     Identify(Identify),
-    /// Simulate a saved model on the input of a CSV file (fit % and RMSE when the measured
+    /// Simulate a saved model on the input of a CSV or MAT file (fit % and RMSE when the measured
     /// output is given).
     Simulate(SimulateArgs),
     /// Write a built-in example's data as CSV (for benchmarks and for trying `identify`).
@@ -151,7 +151,8 @@ pub enum RigidBody {
 /// Options of `hysid rigid-body ls`.
 #[derive(Debug, Args)]
 pub struct RigidBodyLsArgs {
-    /// Estimation record (CSV with a time column t_s, t, time or time_s).
+    /// Estimation record: CSV with a time column t_s, t, time or time_s, or a MATLAB .mat
+    /// file with such a time variable (columns are then variable names or name(:,k)).
     #[arg(long)]
     pub data: PathBuf,
     /// Column of the measured position.
@@ -301,7 +302,7 @@ pub struct BoucWenArgs {
     /// Make test signals by the official recipe instead.
     #[command(subcommand)]
     pub generate: Option<BoucWenGenerate>,
-    /// Training record (columns t_s, u_N, y_m).
+    /// Training record (columns t_s, u_N, y_m; CSV or MATLAB .mat).
     #[arg(long)]
     pub train: Option<PathBuf>,
     /// Test record(s), same columns, scored by e_RMS in simulation mode.
@@ -484,7 +485,8 @@ pub enum Identify {
 /// Where the data come from.
 #[derive(Debug, Args)]
 pub struct DataArgs {
-    /// CSV file with a header row.
+    /// CSV file with a header row, or a MATLAB .mat file (-v7 or older; columns are then
+    /// variable names, or name(:,k) for column k of a matrix).
     #[arg(long)]
     pub data: PathBuf,
     /// Input column (the hysteresis input x). Repeat --input/--output pairs to fit several
@@ -576,7 +578,8 @@ pub struct SimulateArgs {
     /// Model file written by `hysid identify … --model` or `hysid greybox fit --model-out`.
     #[arg(long)]
     pub model: PathBuf,
-    /// CSV file with a header row.
+    /// CSV file with a header row, or a MATLAB .mat file (-v7 or older; columns are then
+    /// variable names, or name(:,k) for column k of a matrix).
     #[arg(long)]
     pub data: PathBuf,
     /// Input column (repeat for models with several inputs).

@@ -575,3 +575,57 @@ fn unwritable_destinations_are_refused_before_the_work() {
     );
     assert!(!nowhere.exists());
 }
+
+/// A MATLAB .mat file (the piezo record, written by tools/reference/mat_fixture.py) gives
+/// the same identification as the CSV record it was made from — a matrix column picked as
+/// record(:,3) included; a bad variable is one line naming the file.
+#[test]
+fn mat_files_identify_like_the_csv_record() {
+    let dir = TempDir::new().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let identify = |data: PathBuf, output: &str, json: &Path| {
+        hysid()
+            .args(["identify", "hysteresis", "--input", "voltage_V", "--output"])
+            .arg(output)
+            .args(["--hysteresis", "ch6", "--data"])
+            .arg(data)
+            .arg("--json")
+            .arg(json)
+            .assert()
+            .success();
+        let text = fs::read_to_string(json).unwrap();
+        serde_json::from_str::<serde_json::Value>(&text).unwrap()
+    };
+    let mat = root.join("crates/hysid/tests/data/piezo_150V_1Hz.mat");
+    let from_mat = identify(mat.clone(), "record(:,3)", &dir.path().join("m.json"));
+    let from_csv = identify(
+        root.join("data/piezo/piezo_150V_1Hz.csv"),
+        "displacement_um",
+        &dir.path().join("c.json"),
+    );
+    assert_eq!(
+        from_mat["model"]["parameters"],
+        from_csv["model"]["parameters"]
+    );
+    assert!(from_mat["fit_percent"].as_f64().unwrap() > 99.0);
+    let out = hysid()
+        .args([
+            "identify",
+            "hysteresis",
+            "--input",
+            "volts",
+            "--output",
+            "z",
+        ])
+        .args(["--hysteresis", "ch6", "--data"])
+        .arg(&mat)
+        .assert()
+        .failure()
+        .get_output()
+        .clone();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.lines().count() == 1 && stderr.contains("no numeric variable named 'volts'"),
+        "{stderr}"
+    );
+}

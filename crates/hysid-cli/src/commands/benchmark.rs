@@ -150,7 +150,7 @@ fn record(path: &Path) -> Result<IdData> {
         time: Some("t_s".into()),
         ts: None,
     };
-    IdData::from_csv(path, &spec)
+    IdData::from_file(path, &spec)
         .with_context(|| "benchmark records need the columns t_s, u_N, y_m".to_string())
 }
 

@@ -33,7 +33,7 @@ pub fn load(args: &DataArgs) -> Result<IdData> {
             time: args.time.clone(),
             ts: args.ts,
         };
-        let experiment = IdData::from_csv(&args.data, &spec).map_err(|e| match e {
+        let experiment = IdData::from_file(&args.data, &spec).map_err(|e| match e {
             // The data layer names channels, not files: say which file.
             Error::NonFinite { .. } => anyhow::anyhow!("{}: {e}", args.data.display()),
             other => other.into(),

@@ -123,7 +123,7 @@ fn record(path: &Path, args: &RigidBodyLsArgs) -> Result<(Vec<f64>, Vec<f64>, f6
         time: None,
         ts: None,
     };
-    let data = IdData::from_csv(path, &spec)?;
+    let data = IdData::from_file(path, &spec)?;
     let exp = data.experiment(0);
     Ok((exp.output(0).to_vec(), exp.input(0).to_vec(), data.ts()))
 }

@@ -18,7 +18,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         time: args.time.clone(),
         ts: args.ts,
     };
-    let data = IdData::from_csv(&args.data, &spec)?;
+    let data = IdData::from_file(&args.data, &spec)?;
     let exp = data.experiment(0);
     let inputs: Vec<&[f64]> = (0..args.input.len()).map(|c| exp.input(c)).collect();
     let measured = args.output.as_ref().map(|_| exp.output(0));

@@ -22,7 +22,7 @@ use super::{one_line, Channel, Experiment, IdData};
 use crate::error::{Error, Result};
 
 /// Names (compared case-insensitively) recognised as a time column when the spec names none.
-const TIME_COLUMN_NAMES: [&str; 4] = ["t", "time", "t_s", "time_s"];
+pub(super) const TIME_COLUMN_NAMES: [&str; 4] = ["t", "time", "t_s", "time_s"];
 
 /// Largest relative deviation of a time step from the mean step that is still "uniform".
 const TIME_STEP_RTOL: f64 = 0.01;
@@ -314,19 +314,21 @@ impl Table {
 /// The mean step of a strictly increasing, uniform time column.
 fn sample_time(path: &Path, column: &str, time: &[f64]) -> Result<f64> {
     let column = one_line(column);
-    let fail = |row: usize, problem: String| {
+    uniform_step(time).map_err(|(row, problem)| {
         Error::InvalidData(format!(
             "{}: line {}: time column '{column}' {problem}; resample the data to a uniform \
              grid, or pass --ts to set the sample time and ignore the time column",
             path.display(),
             line_of_row(path, row)
         ))
-    };
+    })
+}
+
+/// The mean step of a strictly increasing, uniform time vector; else the zero-based index
+/// of the first offending sample and what is wrong there.
+pub(super) fn uniform_step(time: &[f64]) -> std::result::Result<f64, (usize, String)> {
     if time.len() < 2 {
-        return Err(fail(
-            0,
-            "has a single row, which gives no sample time".into(),
-        ));
+        return Err((0, "has a single value, which gives no sample time".into()));
     }
     // Monotonicity first: a step back would otherwise show up as a misleading "bad step".
     if let Some(k) = time.windows(2).position(|pair| pair[1] <= pair[0]) {
@@ -335,14 +337,16 @@ fn sample_time(path: &Path, column: &str, time: &[f64]) -> Result<f64> {
             time[k + 1],
             time[k]
         );
-        return Err(fail(k + 1, problem));
+        return Err((k + 1, problem));
     }
     let ts = (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64;
     let off = |pair: &[f64]| (pair[1] - pair[0] - ts).abs() > TIME_STEP_RTOL * ts;
     if let Some(k) = time.windows(2).position(off) {
         let step = time[k + 1] - time[k];
-        let problem = format!("has a step of {step}, more than 1 % off the mean step {ts}");
-        return Err(fail(k + 1, problem));
+        return Err((
+            k + 1,
+            format!("has a step of {step}, more than 1 % off the mean step {ts}"),
+        ));
     }
     Ok(ts)
 }

@@ -15,8 +15,10 @@ use std::ops::Range;
 use crate::error::{Error, Result};
 
 pub mod csv_io;
+pub mod mat_io;
 
 pub use csv_io::{read_columns, write_csv, CsvSpec};
+pub use mat_io::is_mat;
 
 /// Sample times of two data sets that differ by less than this relative amount are taken
 /// as equal by [`IdData::merge`]: sample times derived from time columns may differ in

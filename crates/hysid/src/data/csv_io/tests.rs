@@ -330,7 +330,7 @@ fn from_csv_needs_two_rows_to_derive_ts() {
     let f = fixture("t,u\n0,1\n");
     let message = invalid_message(IdData::from_csv(&f.path, &spec(&["u"], &[])));
     assert!(
-        message.contains("line 2: time column 't' has a single row"),
+        message.contains("line 2: time column 't' has a single value"),
         "{message}"
     );
     let data = IdData::from_csv(
