@@ -312,3 +312,29 @@ fn rig_and_identify_take_the_actuator_constants() {
     assert!(told.abs() < 0.006, "{told}");
     assert!(not_told > 0.01, "{not_told}");
 }
+
+/// The official EMPS file written by MATLAB (level 5, PCWIN64) gives exactly the estimates of
+/// the CSV copy of the same record.
+#[test]
+fn rigid_body_ls_reads_the_official_matlab_file() {
+    let dir = TempDir::new().unwrap();
+    let run = |data: PathBuf, position: &str, input: &str, report: &Path| {
+        hysid()
+            .args(["rigid-body", "ls", "--data"])
+            .arg(data)
+            .args(["--position", position, "--input", input])
+            .args(["--gain", "35.15065188", "--offset", "--json"])
+            .arg(report)
+            .assert()
+            .success();
+        json(report)
+    };
+    let mat = emps().with_extension("mat");
+    let from_mat = run(mat, "qm", "vir", &dir.path().join("m.json"));
+    let from_csv = run(emps(), "qm_m", "vir_V", &dir.path().join("c.json"));
+    assert_eq!(from_mat["parameters"], from_csv["parameters"]);
+    assert_eq!(
+        from_mat["records"][0]["relative_error_percent"],
+        from_csv["records"][0]["relative_error_percent"]
+    );
+}
