@@ -255,6 +255,19 @@ fn rigid_body_ls_bad_input_is_one_line() {
             .args(["--position", "q", "--input", "u"]),
     );
     assert!(err.contains("never changes sign"), "{err}");
+    // A drive signal that is zero everywhere: nothing to explain (was NaN estimates).
+    let path = dir.path().join("unforced.csv");
+    let rows: Vec<String> = (0..3000)
+        .map(|k| format!("{},{},0", k as f64 * 1e-3, (6.0 * k as f64 * 1e-3).sin()))
+        .collect();
+    fs::write(&path, format!("t_s,q,u\n{}\n", rows.join("\n"))).unwrap();
+    let err = one_line_error(
+        hysid()
+            .args(["rigid-body", "ls", "--data"])
+            .arg(&path)
+            .args(["--position", "q", "--input", "u"]),
+    );
+    assert!(err.contains("force is zero everywhere"), "{err}");
 }
 
 #[test]

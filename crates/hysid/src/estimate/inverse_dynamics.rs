@@ -184,6 +184,15 @@ impl RigidBodyLs {
             columns.push(vec![1.0; q.len()]);
         }
         let force: Vec<f64> = u.iter().map(|v| self.gain * v).collect();
+        if force.iter().all(|f| *f == 0.0) {
+            return Err(Error::NotExciting {
+                channel: "g·u".into(),
+                reason: format!(
+                    "the force is zero everywhere (gain {}), there is nothing to explain; check the input column and the gain",
+                    self.gain
+                ),
+            });
+        }
         let r = self.decimation.max(1);
         let decimated: Vec<Vec<f64>> = columns
             .iter()
@@ -213,7 +222,6 @@ impl RigidBodyLs {
     }
 }
 
-/// 100·‖f − Wθ‖/‖f‖.
 /// σmax/σmin of `w`.
 fn condition_number(w: &DMatrix<f64>) -> f64 {
     let sv = w.singular_values();
@@ -223,6 +231,7 @@ fn condition_number(w: &DMatrix<f64>) -> f64 {
     max / min
 }
 
+/// 100·‖f − Wθ‖/‖f‖.
 fn relative_error(w: &DMatrix<f64>, force: &[f64], theta: &[f64]) -> f64 {
     let fitted = w * nalgebra::DVector::from_column_slice(theta);
     let err: f64 = force
