@@ -524,6 +524,17 @@ fn greybox_bad_input_and_numerical_trouble_are_one_line_errors() {
     );
     let err = greybox_fails(&train, &["--init", "mass=3"]);
     assert!(err.contains("no parameter named 'mass'"), "{err}");
+    // A measured output that never moves: nothing to fit (was an "exact fit" or -inf %).
+    let flat = csv(
+        dir.path(),
+        "flat.csv",
+        "t_s,u_N,y_m",
+        &rows(2000, |i| {
+            format!("{},{},0", i as f64 / 750.0, (i as f64 * 0.05).sin())
+        }),
+    );
+    let err = greybox_fails(&flat, &[]);
+    assert!(err.contains("output 'y_m' is constant"), "{err}");
 }
 
 /// A report, model or CSV destination that cannot be written is refused before any work

@@ -155,6 +155,7 @@ impl OutputError {
         callback: &mut dyn FnMut(&IterationRecord) -> Control,
     ) -> Result<OutputErrorFit> {
         params.validate()?;
+        check_outputs_vary(data)?;
         let problem =
             OutputErrorProblem::new(model, data, self.weights(model.n_outputs())?, self.skip)?;
         let free = params.free_indices();
@@ -442,4 +443,24 @@ impl Accumulator {
             cost: self.cost,
         }
     }
+}
+
+/// A measured output that never changes carries nothing to fit and leaves fit % undefined
+/// (its variance is zero): refused rather than reported as an "exact fit".
+fn check_outputs_vary(data: &IdData) -> Result<()> {
+    for experiment in data.experiments() {
+        for (o, channel) in data.output_channels().iter().enumerate() {
+            let y = experiment.output(o);
+            if let Some(&first) = y.first() {
+                if y.iter().all(|v| *v == first) {
+                    return Err(Error::InvalidData(format!(
+                        "output '{}' is constant ({first}) in experiment '{}': there is nothing to fit and fit % is undefined; check the output column",
+                        channel.name,
+                        experiment.name()
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
 }
