@@ -13,17 +13,7 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
 
 /// Writes `bytes` to `path` through a temporary file in the same directory.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        anyhow::bail!(
-            "cannot write {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
+    let dir = writable_file(path)?;
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -46,26 +36,33 @@ pub fn ensure_dir(dir: &Path) -> Result<()> {
 /// that a long fit never ends in "cannot write".
 pub fn preflight(files: &[Option<&Path>], dirs: &[Option<&Path>]) -> Result<()> {
     for path in files.iter().flatten() {
-        if path.is_dir() {
-            anyhow::bail!(
-                "cannot write {}: it is a directory; give a file name",
-                path.display()
-            );
-        }
-        let dir = path
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        if !dir.is_dir() {
-            anyhow::bail!(
-                "cannot write {}: directory {} does not exist; create it or choose another path",
-                path.display(),
-                dir.display()
-            );
-        }
+        writable_file(path)?;
     }
     for dir in dirs.iter().flatten() {
         ensure_dir(dir)?;
     }
     Ok(())
+}
+
+/// The directory `path` would be written into, when it exists and `path` is not itself a
+/// directory.
+fn writable_file(path: &Path) -> Result<&Path> {
+    if path.is_dir() {
+        anyhow::bail!(
+            "cannot write {}: it is a directory; give a file name",
+            path.display()
+        );
+    }
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "cannot write {}: directory {} does not exist; create it or choose another path",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(dir)
 }

@@ -1,5 +1,6 @@
 //! The JSON report and the printed parameter table.
 
+use hysid::data::IdData;
 use hysid::estimate::{OutputErrorFit, Termination};
 use hysid::fitted::ModelFile;
 use hysid::metrics;
@@ -62,6 +63,29 @@ impl Report {
             uncertainty,
             details,
         }
+    }
+
+    /// [`Report::new`] over every experiment of `data`: output 0 of each, measured and
+    /// simulated, stacked.
+    pub fn stacked(
+        model: ModelFile,
+        fit: &OutputErrorFit,
+        data: &IdData,
+        elapsed_s: f64,
+        uncertainty: String,
+        details: serde_json::Value,
+    ) -> Self {
+        let y: Vec<f64> = data
+            .experiments()
+            .iter()
+            .flat_map(|e| e.output(0).iter().copied())
+            .collect();
+        let yhat: Vec<f64> = fit
+            .simulated
+            .iter()
+            .flat_map(|s| s[0].iter().copied())
+            .collect();
+        Self::new(model, fit, (&y, &yhat), elapsed_s, uncertainty, details)
     }
 }
 

@@ -235,38 +235,29 @@ fn rigid_body_ls_bad_input_is_one_line() {
             .args(["--position", "q_missing", "--input", "vir_V"]),
     );
     assert!(err.contains("q_missing"), "{err}");
+    // 3 s at 1 kHz of (q, u) from `sample(t)`, through `rigid-body ls`.
+    let ls_error = |name: &str, sample: &dyn Fn(f64) -> (f64, f64)| {
+        let path = dir.path().join(name);
+        let rows: Vec<String> = (0..3000)
+            .map(|k| {
+                let t = k as f64 * 1e-3;
+                let (q, u) = sample(t);
+                format!("{t},{q},{u}")
+            })
+            .collect();
+        fs::write(&path, format!("t_s,q,u\n{}\n", rows.join("\n"))).unwrap();
+        one_line_error(
+            hysid()
+                .args(["rigid-body", "ls", "--data"])
+                .arg(&path)
+                .args(["--position", "q", "--input", "u"]),
+        )
+    };
     // A position that only ever increases: Coulomb friction cannot be told from an offset.
-    let path = dir.path().join("oneway.csv");
-    let rows: Vec<String> = (0..3000)
-        .map(|k| {
-            format!(
-                "{},{},{}",
-                k as f64 * 1e-3,
-                1e-3 * k as f64 * k as f64 * 1e-3,
-                1.0
-            )
-        })
-        .collect();
-    fs::write(&path, format!("t_s,q,u\n{}\n", rows.join("\n"))).unwrap();
-    let err = one_line_error(
-        hysid()
-            .args(["rigid-body", "ls", "--data"])
-            .arg(&path)
-            .args(["--position", "q", "--input", "u"]),
-    );
+    let err = ls_error("oneway.csv", &|t| (t * t, 1.0));
     assert!(err.contains("never changes sign"), "{err}");
     // A drive signal that is zero everywhere: nothing to explain (was NaN estimates).
-    let path = dir.path().join("unforced.csv");
-    let rows: Vec<String> = (0..3000)
-        .map(|k| format!("{},{},0", k as f64 * 1e-3, (6.0 * k as f64 * 1e-3).sin()))
-        .collect();
-    fs::write(&path, format!("t_s,q,u\n{}\n", rows.join("\n"))).unwrap();
-    let err = one_line_error(
-        hysid()
-            .args(["rigid-body", "ls", "--data"])
-            .arg(&path)
-            .args(["--position", "q", "--input", "u"]),
-    );
+    let err = ls_error("unforced.csv", &|t| ((6.0 * t).sin(), 0.0));
     assert!(err.contains("force is zero everywhere"), "{err}");
 }
 

@@ -170,16 +170,6 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
 
 fn hysteresis_report(fit: &HysteresisFit, data: &IdData, initial: InitialOutput) -> Report {
     let oe = &fit.output_error;
-    let y: Vec<f64> = data
-        .experiments()
-        .iter()
-        .flat_map(|e| e.output(0).iter().copied())
-        .collect();
-    let yhat: Vec<f64> = oe
-        .simulated
-        .iter()
-        .flat_map(|s| s[0].iter().copied())
-        .collect();
     let fitted = FittedModel::Hysteresis {
         model: fit.model.clone(),
         initial,
@@ -195,10 +185,10 @@ fn hysteresis_report(fit: &HysteresisFit, data: &IdData, initial: InitialOutput)
         },
         "output_error_history": oe.report.history,
     });
-    Report::new(
+    Report::stacked(
         fitted.to_file(),
         oe,
-        (&y, &yhat),
+        data,
         fit.elapsed_s,
         "asymptotic (threshold d: truncated normal)".into(),
         details,

@@ -129,16 +129,6 @@ pub fn report(
     extra: serde_json::Value,
 ) -> Report {
     let oe = &fit.fit;
-    let y: Vec<f64> = data
-        .experiments()
-        .iter()
-        .flat_map(|e| e.output(0).iter().copied())
-        .collect();
-    let yhat: Vec<f64> = oe
-        .simulated
-        .iter()
-        .flat_map(|s| s[0].iter().copied())
-        .collect();
     let n = oe.parameters.len();
     let correlation: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| oe.covariance.correlation[(i, j)]).collect())
@@ -155,10 +145,10 @@ pub fn report(
     if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
         obj.extend(more);
     }
-    Report::new(
+    Report::stacked(
         model_file,
         oe,
-        (&y, &yhat),
+        data,
         fit.elapsed_s,
         "asymptotic".into(),
         details,

@@ -287,6 +287,16 @@ impl ThreeSteps {
         Ok(())
     }
 
+    /// A signal as step 3 fits it: pre-filtered as in the paper, or raw (mean removal
+    /// applies either way).
+    fn step3_signal(&self, x: &[f64], ts: f64) -> Result<Vec<f64>> {
+        match (self.prefilter_step3, self.remove_mean) {
+            (true, _) => self.prefilter(x, ts),
+            (false, true) => Ok(remove_mean(x)),
+            (false, false) => Ok(x.to_vec()),
+        }
+    }
+
     /// The zero-phase Butterworth pre-filter (with optional mean removal).
     fn prefilter(&self, x: &[f64], ts: f64) -> Result<Vec<f64>> {
         let nyquist = 0.5 / ts;
@@ -395,16 +405,8 @@ impl ThreeSteps {
             .iter()
             .zip([6, 7, 8])
             .map(|(r, set)| {
-                let (torque, angle) = if self.prefilter_step3 {
-                    (
-                        self.prefilter(&r.torque, r.ts)?,
-                        self.prefilter(&r.angle, r.ts)?,
-                    )
-                } else if self.remove_mean {
-                    (remove_mean(&r.torque), remove_mean(&r.angle))
-                } else {
-                    (r.torque.clone(), r.angle.clone())
-                };
+                let torque = self.step3_signal(&r.torque, r.ts)?;
+                let angle = self.step3_signal(&r.angle, r.ts)?;
                 Experiment::new(format!("data set {set}"), vec![torque], vec![angle])
             })
             .collect::<Result<Vec<_>>>()?;

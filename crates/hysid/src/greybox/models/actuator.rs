@@ -93,6 +93,31 @@ fn motor_acceleration(
         .map(|s| ((applied - th[FC] * s) / th[J], s))
 }
 
+/// Row ẋ2 = (τ − Fv x2 − Fc s − g)/J of ∂f/∂x (`fx_row`; `columns` are the places of x1,
+/// x2 and x4 in the state) and of ∂f/∂θ (`ft_row`), for the motion (ẋ2, s) of
+/// [`motor_acceleration`].
+#[allow(clippy::too_many_arguments)]
+fn motor_row(
+    th: &[f64],
+    x1: f64,
+    x2: f64,
+    dg: f64,
+    (acc, s): (f64, f64),
+    [c1, c2, c4]: [usize; 3],
+    fx_row: &mut [f64],
+    ft_row: &mut [f64],
+) {
+    let j = th[J];
+    fx_row[c1] = -dg / j;
+    fx_row[c2] = -th[FV] / j;
+    fx_row[c4] = -1.0 / j;
+    ft_row[J] = -acc / j;
+    ft_row[FV] = -x2 / j;
+    ft_row[FC] = -s / j;
+    ft_row[K1] = -x1 / j;
+    ft_row[K2] = -x1.powi(3) / j;
+}
+
 /// The flexibility torque g = k1 x1 + k2 x1³ + x4 and its derivative ∂g/∂x1.
 #[inline]
 fn flexibility(th: &[f64], x1: f64, x4: f64) -> (f64, f64) {
@@ -211,7 +236,6 @@ fn fixed_jacobians(
 ) {
     let (x1, x2, x4) = (x[0], x[1], x[2]);
     let (g, dg) = flexibility(th, x1, x4);
-    let j = th[J];
     let p = th.len();
     let direction = held.unwrap_or(sign0(x2));
     let speed = direction * x2;
@@ -221,15 +245,17 @@ fn fixed_jacobians(
     fx[7] = -th[ALPHA] * direction * x4 + th[A];
     fx[8] = -th[ALPHA] * speed;
     // While the motor sticks ẋ2 is identically zero: row 1 stays zero.
-    if let Some((acc, s)) = motor_acceleration(th, x2, g, u[0], held) {
-        fx[3] = -dg / j;
-        fx[4] = -th[FV] / j;
-        fx[5] = -1.0 / j;
-        ft[p + J] = -acc / j;
-        ft[p + FV] = -x2 / j;
-        ft[p + FC] = -s / j;
-        ft[p + K1] = -x1 / j;
-        ft[p + K2] = -x1.powi(3) / j;
+    if let Some(motion) = motor_acceleration(th, x2, g, u[0], held) {
+        motor_row(
+            th,
+            x1,
+            x2,
+            dg,
+            motion,
+            [0, 1, 2],
+            &mut fx[3..6],
+            &mut ft[p..2 * p],
+        );
     }
     ft[2 * p + ALPHA] = -speed * x4;
     ft[2 * p + A] = x2;
@@ -355,7 +381,7 @@ fn free_jacobians(
 ) {
     let (x1, x2, x3, x4) = (x[0], x[1], x[2], x[3]);
     let (g, dg) = flexibility(th, x1, x4);
-    let (j, r, m) = (th[J], th[R], th[M]);
+    let (r, m) = (th[R], th[M]);
     let w = x2 - x3 / r;
     let dw = -th[ALPHA] * sign0(w) * x4 + th[A]; // ∂ẋ4/∂w
     let p = th.len();
@@ -366,15 +392,17 @@ fn free_jacobians(
     fx[2] = -1.0 / r;
     ft[R] = x3 / (r * r);
     // Row 1: ẋ2 (identically zero while the motor sticks).
-    if let Some((acc, s)) = motor_acceleration(th, x2, g, u[0], held) {
-        fx[4] = -dg / j;
-        fx[5] = -th[FV] / j;
-        fx[7] = -1.0 / j;
-        ft[p + J] = -acc / j;
-        ft[p + FV] = -x2 / j;
-        ft[p + FC] = -s / j;
-        ft[p + K1] = -x1 / j;
-        ft[p + K2] = -x1.powi(3) / j;
+    if let Some(motion) = motor_acceleration(th, x2, g, u[0], held) {
+        motor_row(
+            th,
+            x1,
+            x2,
+            dg,
+            motion,
+            [0, 1, 3],
+            &mut fx[4..8],
+            &mut ft[p..2 * p],
+        );
     }
     // Row 2: ẋ3 = g/(r m).
     fx[8] = dg / (r * m);
