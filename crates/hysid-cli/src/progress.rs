@@ -1,6 +1,6 @@
 //! Progress of long fits on stderr (hidden when stderr is not a terminal).
 
-use hysid::estimate::{Control, IterationRecord};
+use hysid::numerics::{Control, IterationRecord};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::time::Duration;
 

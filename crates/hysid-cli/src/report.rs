@@ -1,9 +1,10 @@
 //! The JSON report and the printed parameter table.
 
 use hysid::data::IdData;
-use hysid::estimate::{OutputErrorFit, Termination};
-use hysid::fitted::ModelFile;
-use hysid::metrics;
+use hysid::identify::OutputErrorFit;
+use hysid::model::saved::ModelFile;
+use hysid::numerics::metrics;
+use hysid::numerics::Termination;
 use serde::Serialize;
 
 /// The JSON report every identification command writes with `--json`.

@@ -200,7 +200,7 @@ fn hysteresis_alone_is_identified_from_a_csv_file() {
     let dir = TempDir::new().unwrap();
     // A hysteresis record: the examples' input through a known 6-parameter hysteresis.
     let h = hysid::model::ColemanHodgdon::general(0.4, 1.2, 0.15, 0.6, 0.1, 2.0).unwrap();
-    let x = hysid::examples::CascadeExample::example2()
+    let x = hysid::experiments::voros::CascadeExample::example2()
         .generate(1, false)
         .unwrap()
         .x;

@@ -5,10 +5,10 @@
 //! Run with `cargo bench -p hysid --bench actuator`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use hysid::actuator::identify::{Record, ThreeSteps};
-use hysid::actuator::rig::Rig;
 use hysid::data::{CsvSpec, IdData};
-use hysid::estimate::inverse_dynamics::RigidBodyLs;
+use hysid::experiments::actuator_rig::Rig;
+use hysid::identify::actuator::{Record, ThreeSteps};
+use hysid::identify::rigid_body::RigidBodyLs;
 use std::collections::BTreeMap;
 use std::hint::black_box;
 use std::path::Path;

@@ -4,11 +4,11 @@
 //! Run with `cargo bench -p hysid --bench cascade`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use hysid::estimate::cascade::{CascadeIdentification, CascadeStructure};
-use hysid::estimate::levenberg_marquardt::LeastSquaresProblem;
-use hysid::estimate::output_error::OutputErrorProblem;
-use hysid::estimate::Control;
-use hysid::examples::CascadeExample;
+use hysid::experiments::voros::CascadeExample;
+use hysid::identify::cascade::{CascadeIdentification, CascadeStructure};
+use hysid::identify::output_error::OutputErrorProblem;
+use hysid::numerics::levenberg_marquardt::LeastSquaresProblem;
+use hysid::numerics::Control;
 use std::hint::black_box;
 
 fn simulation(c: &mut Criterion) {

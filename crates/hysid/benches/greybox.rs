@@ -6,14 +6,13 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::data::{CsvSpec, IdData};
-use hysid::estimate::levenberg_marquardt::LeastSquaresProblem;
-use hysid::estimate::output_error::OutputErrorProblem;
-use hysid::estimate::{Control, OutputErrorModel};
-use hysid::greybox::models::BoucWen;
-use hysid::greybox::{
-    GreyBox, GreyBoxEstimation, InitialStates, InputInterpolation, Integrator, Simulation,
-    StateSpaceModel,
-};
+use hysid::identify::greybox::{GreyBox, GreyBoxEstimation, InitialStates};
+use hysid::identify::output_error::OutputErrorProblem;
+use hysid::identify::OutputErrorModel;
+use hysid::model::greybox::models::BoucWen;
+use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::numerics::levenberg_marquardt::LeastSquaresProblem;
+use hysid::numerics::Control;
 use std::hint::black_box;
 use std::path::Path;
 use std::sync::Arc;

@@ -8,15 +8,15 @@
 //!
 //! Run with `cargo run --release -p hysid --example actuator_three_steps`.
 
-use hysid::actuator::identify::ThreeSteps;
-use hysid::actuator::rig::Rig;
+use hysid::experiments::actuator_rig::Rig;
+use hysid::identify::actuator::ThreeSteps;
 
 fn main() -> hysid::Result<()> {
     let rig = Rig {
         backlash: 3e-3,
         ..Rig::default()
     };
-    // Your own records: `hysid::actuator::identify::read_data_sets(dir)` reads
+    // Your own records: `hysid::identify::actuator::read_data_sets(dir)` reads
     // dataset1.csv … dataset8.csv (columns t_s, tau_Nm, theta_rad).
     let records = rig.data_sets()?;
     let steps = ThreeSteps {

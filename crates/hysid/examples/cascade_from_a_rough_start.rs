@@ -9,10 +9,10 @@
 //!
 //! Run with `cargo run --release -p hysid --example cascade_from_a_rough_start`.
 
-use hysid::estimate::cascade::CascadeIdentification;
-use hysid::estimate::Control;
-use hysid::examples::CascadeExample;
+use hysid::experiments::voros::CascadeExample;
+use hysid::identify::cascade::CascadeIdentification;
 use hysid::model::HysteresisCascade;
+use hysid::numerics::Control;
 
 fn main() -> hysid::Result<()> {
     let example = CascadeExample::example1();

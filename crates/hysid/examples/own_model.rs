@@ -20,9 +20,12 @@
 //! Run with `cargo run --release -p hysid --example own_model`.
 
 use hysid::data::{Channel, IdData};
-use hysid::estimate::{Control, OutputErrorModel, Parameter, ParameterSet};
-use hysid::greybox::{GreyBox, GreyBoxEstimation, InitialStates, Simulation, StateSpaceModel};
-use hysid::signal::{gaussian_noise, multisine};
+use hysid::identify::greybox::{GreyBox, GreyBoxEstimation, InitialStates};
+use hysid::identify::OutputErrorModel;
+use hysid::model::greybox::{Simulation, StateSpaceModel};
+use hysid::model::{Parameter, ParameterSet};
+use hysid::numerics::signal::{gaussian_noise, multisine};
+use hysid::numerics::Control;
 use std::sync::Arc;
 
 /// The piezo stage (see the crate docs above). States x = (position, velocity, h).

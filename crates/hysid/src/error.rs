@@ -3,7 +3,7 @@
 //! Every message is a single line that says what is wrong, where (file, line, channel, sample,
 //! parameter) and, where there is one, what to do about it. Numerical non-convergence of an
 //! iterative estimator is *not* an error: it is reported in the estimator's report
-//! (see [`crate::estimate::Termination`]).
+//! (see [`crate::numerics::Termination`]).
 
 use std::path::PathBuf;
 

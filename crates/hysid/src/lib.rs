@@ -3,24 +3,21 @@
 //! hysid identifies models of systems that contain hysteresis from measured input/output data:
 //! a piezo stage, a harmonic drive, a lead-screw actuator, a magnetic core.
 //!
-//! * [`model`]: the model structures — the discrete Coleman–Hodgdon hysteresis with
-//!   piecewise-linear material functions, linear blocks with delay, and their cascade
-//!   (Vörös 2015).
-//! * [`estimate`]: the estimators — linear least squares with covariance, the separated
-//!   regression of the hysteresis, the iterative key-term-separation method of Vörös (2015),
-//!   a global (α, d) grid stage, recursive least squares with forgetting, and a general
-//!   output-error Levenberg–Marquardt engine with bounds, fixed parameters, several
-//!   experiments and standard deviations.
-//! * [`greybox`]: continuous-time grey-box models (Bouc–Wen oscillator, rigid body with
-//!   friction), their integrators and their output-error estimation.
-//! * [`actuator`]: the linear actuator of Gunnar et al. (2006): loops, virtual rig and the
-//!   three-step identification.
-//! * [`data`]: the [`data::IdData`] container and CSV input/output.
-//! * [`signal`]: excitation signals and noise, all seeded.
-//! * [`metrics`]: fit %, RMSE and information criteria.
-//! * [`validate`]: residual analysis and the one-at-a-time sensitivity table.
-//! * [`examples`]: the project's numerical examples (MODELS.md §1.6).
-//! * [`fitted`]: fitted models and their JSON model files.
+//! The library reads top-down in layers; each depends only on the layers below it
+//! (`docs/architecture.md` draws them and says where new code goes):
+//!
+//! 1. [`numerics`] — the Levenberg–Marquardt engine, least squares, a simplex minimiser,
+//!    filters and excitation signals, fit metrics; knows nothing of hysteresis. [`data`] —
+//!    the validated identification data set ([`data::IdData`]), CSV and .mat input.
+//! 2. [`model`] — parameters and every model (Coleman–Hodgdon hysteresis, linear blocks,
+//!    cascades, continuous-time grey-box models), each able to simulate itself, and the
+//!    saved-model file. No model imports an estimator.
+//! 3. [`experiments`] — virtual experiments built from the models (the project's examples,
+//!    the actuator rig).
+//! 4. [`identify`] — the recipes: cascade pipeline and paper iteration, hysteresis alone,
+//!    grey-box output error with multi-start, the three-step actuator procedure, rigid-body
+//!    least squares, bootstrap, recursive least squares, residual analysis.
+//! 5. [`report`] — the one report schema every command writes (`hysid.report/1`).
 //!
 //! Results that do not converge are reported in the estimator's report, never hidden;
 //! bad input is an [`Error`] with a one-line message.
@@ -33,16 +30,12 @@
 //! * J. Gunnar, E. Wernholt, G. Hovland, T. Brogårdh, "Nonlinear Grey-Box Identification of
 //!   Linear Actuators Containing Hysteresis", ICRA 2006.
 
-pub mod actuator;
 pub mod data;
 pub mod error;
-pub mod estimate;
-pub mod examples;
-pub mod fitted;
-pub mod greybox;
-pub mod metrics;
+pub mod experiments;
+pub mod identify;
 pub mod model;
-pub mod signal;
-pub mod validate;
+pub mod numerics;
+pub mod report;
 
 pub use error::{Error, Result};

@@ -2,8 +2,8 @@
 //! with known parameters (noise-free, noisy), the backlash pattern of the paper's tables,
 //! and bad input.
 
-use hysid::actuator::identify::{ActuatorIdentification, Record, ThreeSteps, PARAMETERS};
-use hysid::actuator::rig::Rig;
+use hysid::experiments::actuator_rig::Rig;
+use hysid::identify::actuator::{ActuatorIdentification, Record, ThreeSteps, PARAMETERS};
 use hysid::Error;
 use std::collections::BTreeMap;
 

@@ -2,10 +2,10 @@
 //! (MODELS.md §1.6): exact recovery without noise from the documented initial values and from
 //! random rough starts.
 
-use hysid::estimate::cascade::{CascadeFit, CascadeIdentification};
-use hysid::estimate::Control;
-use hysid::examples::CascadeExample;
+use hysid::experiments::voros::CascadeExample;
+use hysid::identify::cascade::{CascadeFit, CascadeIdentification};
 use hysid::model::ColemanHodgdon;
+use hysid::numerics::Control;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 

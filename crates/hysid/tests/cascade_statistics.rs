@@ -9,9 +9,10 @@
 //!
 //! This is the slowest test of the suite (a few minutes on two cores).
 
-use hysid::estimate::cascade::CascadeIdentification;
-use hysid::estimate::{Control, Uncertainty};
-use hysid::examples::CascadeExample;
+use hysid::experiments::voros::CascadeExample;
+use hysid::identify::cascade::CascadeIdentification;
+use hysid::identify::Uncertainty;
+use hysid::numerics::Control;
 
 const SEEDS: u64 = 20;
 const REPLICATES: usize = 30;

@@ -2,7 +2,7 @@
 //! published preprocessing reproduces the published reference model (MODELS.md §3.2).
 
 use hysid::data::{CsvSpec, IdData};
-use hysid::estimate::inverse_dynamics::RigidBodyLs;
+use hysid::identify::rigid_body::RigidBodyLs;
 use std::path::Path;
 
 #[test]

@@ -2,13 +2,13 @@
 //! trips, the benchmark's training record, multi-start and numerical trouble.
 
 use hysid::data::{CsvSpec, IdData};
-use hysid::estimate::{Control, OutputErrorModel, ParameterSet};
-use hysid::greybox::models::{ActuatorFixed, BoucWen, RigidBody};
-use hysid::greybox::{
-    GreyBox, GreyBoxEstimation, InitialStates, InputInterpolation, Integrator, Simulation,
-    StateSpaceModel,
-};
-use hysid::signal::{gaussian_noise, multisine};
+use hysid::identify::greybox::{GreyBox, GreyBoxEstimation, InitialStates};
+use hysid::identify::OutputErrorModel;
+use hysid::model::greybox::models::{ActuatorFixed, BoucWen, RigidBody};
+use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::ParameterSet;
+use hysid::numerics::signal::{gaussian_noise, multisine};
+use hysid::numerics::Control;
 use hysid::Error;
 use std::path::Path;
 use std::sync::Arc;
@@ -266,7 +266,7 @@ fn training_record_residual_with_the_true_parameters_is_the_noise() {
         let gb = GreyBox::new(Arc::new(BoucWen), &data, sim, InitialStates::at_rest(3, 1)).unwrap();
         let mut y = vec![vec![0.0; data.n_samples()]];
         gb.simulate(&theta, &data, 0, &mut y).unwrap();
-        hysid::metrics::rmse(data.experiment(0).output(0), &y[0])
+        hysid::numerics::metrics::rmse(data.experiment(0).output(0), &y[0])
     };
     let band_limited = rms(InputInterpolation::BandLimited);
     assert!(

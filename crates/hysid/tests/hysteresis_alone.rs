@@ -1,11 +1,11 @@
 //! The Coleman–Hodgdon hysteresis identified from its measured input and output.
 
 use hysid::data::{Channel, Experiment, IdData};
-use hysid::estimate::hysteresis::HysteresisIdentification;
-use hysid::estimate::Control;
-use hysid::examples::CascadeExample;
+use hysid::experiments::voros::CascadeExample;
+use hysid::identify::hysteresis::HysteresisIdentification;
 use hysid::model::{ChForm, ColemanHodgdon};
-use hysid::signal::add_noise_snr;
+use hysid::numerics::signal::add_noise_snr;
+use hysid::numerics::Control;
 
 fn truth(form: ChForm) -> ColemanHodgdon {
     match form {

@@ -2,7 +2,7 @@
 //! `tools/reference/filters.py` (SciPy/NumPy, which implement MATLAB's butter, filtfilt and
 //! gradient), to 1e-10.
 
-use hysid::signal::{butter, filtfilt, gradient};
+use hysid::numerics::signal::{butter, filtfilt, gradient};
 use serde_json::Value;
 
 fn reference() -> Value {
@@ -81,7 +81,7 @@ fn cheby1_and_decimate_match_the_reference() {
             case["ripple_db"].as_f64().unwrap(),
             case["wn"].as_f64().unwrap(),
         );
-        let tf = hysid::signal::cheby1(order, rp, wn).unwrap();
+        let tf = hysid::numerics::signal::cheby1(order, rp, wn).unwrap();
         assert_close(
             &tf.b,
             &floats(&case["b"]),
@@ -100,6 +100,8 @@ fn cheby1_and_decimate_match_the_reference() {
     // I − A nearly singular) amplify rounding, so two correct implementations agree to about
     // 1e-8 here, not 1e-10 — with SciPy's own coefficients as much as with ours.
     let d = &r["decimate"];
-    let got = hysid::signal::decimate(&floats(&d["x"]), d["r"].as_u64().unwrap() as usize).unwrap();
+    let got =
+        hysid::numerics::signal::decimate(&floats(&d["x"]), d["r"].as_u64().unwrap() as usize)
+            .unwrap();
     assert_close(&got, &floats(&d["y"]), 1e-7, "decimate");
 }

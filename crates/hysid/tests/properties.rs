@@ -4,12 +4,12 @@
 //! the actuator's hysteresis torque, the zero phase of `filtfilt`, the Butterworth design,
 //! `gradient` and the multisine generator.
 
-use hysid::actuator::loops::{ascending, descending};
-use hysid::greybox::models::ActuatorFixed;
-use hysid::greybox::simulate::{simulate, InputTrack};
-use hysid::greybox::{Simulation, StateSpaceModel};
+use hysid::identify::actuator::loops::{ascending, descending};
+use hysid::model::greybox::models::ActuatorFixed;
+use hysid::model::greybox::simulate::{simulate, InputTrack};
+use hysid::model::greybox::{Simulation, StateSpaceModel};
 use hysid::model::ColemanHodgdon;
-use hysid::signal::{butter, filtfilt, gradient, multisine, TransferFunction};
+use hysid::numerics::signal::{butter, filtfilt, gradient, multisine, TransferFunction};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use std::f64::consts::PI;

@@ -8,12 +8,12 @@ use crate::cli::{
 use crate::output::{ensure_dir, preflight, write_atomic, write_json};
 use crate::plot::{convergence, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
 use anyhow::{bail, Context, Result};
-use hysid::actuator::identify::{
+use hysid::experiments::actuator_rig::Rig;
+use hysid::identify::actuator::loops::{ascending, descending};
+use hysid::identify::actuator::{
     read_data_sets, ActuatorIdentification, Record, ThreeSteps, PARAMETERS,
 };
-use hysid::actuator::loops::{ascending, descending};
-use hysid::actuator::rig::Rig;
-use hysid::estimate::LmConfig;
+use hysid::numerics::LmConfig;
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;

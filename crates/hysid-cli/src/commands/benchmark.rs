@@ -11,15 +11,13 @@ use crate::plot::{plot, Figure, Series};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
-use hysid::fitted::FittedModel;
-use hysid::greybox::models::BoucWen;
-use hysid::greybox::simulate::band_limited_upsample;
-use hysid::greybox::{
-    GreyBoxEstimation, GreyBoxFit, InitialStates, InputInterpolation, Integrator, Simulation,
-    StateSpaceModel,
-};
-use hysid::metrics;
-use hysid::signal::{decimate_fir, gaussian_noise, multisine, sine_sweep};
+use hysid::identify::greybox::{GreyBoxEstimation, GreyBoxFit, InitialStates};
+use hysid::model::greybox::models::BoucWen;
+use hysid::model::greybox::simulate::band_limited_upsample;
+use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::saved::FittedModel;
+use hysid::numerics::metrics;
+use hysid::numerics::signal::{decimate_fir, gaussian_noise, multisine, sine_sweep};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

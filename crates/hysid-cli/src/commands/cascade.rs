@@ -6,11 +6,11 @@ use crate::output::ensure_dir;
 use crate::plot::{convergence, plot, Figure, Series, Style};
 use crate::report::{Report, Row};
 use anyhow::Result;
-use hysid::estimate::cascade::CascadeFit;
-use hysid::estimate::Uncertainty;
-use hysid::fitted::FittedModel;
-use hysid::metrics;
+use hysid::identify::cascade::CascadeFit;
+use hysid::identify::Uncertainty;
+use hysid::model::saved::FittedModel;
 use hysid::model::HysteresisCascade;
+use hysid::numerics::metrics;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 

@@ -6,8 +6,8 @@ use crate::output::{preflight, write_json};
 use crate::progress::FitProgress;
 use crate::report::print_table;
 use anyhow::Result;
-use hysid::estimate::cascade::CascadeIdentification;
-use hysid::examples::{CascadeExample, EXAMPLE_SNR};
+use hysid::experiments::voros::{CascadeExample, EXAMPLE_SNR};
+use hysid::identify::cascade::CascadeIdentification;
 use serde_json::json;
 
 /// Generates Example 1 or 2, identifies it and reports against the truth.

@@ -4,7 +4,7 @@ use crate::cli::GenerateVorosArgs;
 use crate::output::preflight;
 use anyhow::Result;
 use hysid::data::write_csv;
-use hysid::examples::CascadeExample;
+use hysid::experiments::voros::CascadeExample;
 
 /// Writes columns t, x, y of Example 1 or 2 (optionally extended to `--samples`).
 pub fn voros(args: &GenerateVorosArgs) -> Result<()> {

@@ -8,13 +8,12 @@ use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
 use hysid::data::IdData;
-use hysid::estimate::{LmConfig, ParameterSet};
-use hysid::fitted::FittedModel;
-use hysid::greybox::{
-    models, GreyBoxEstimation, GreyBoxFit, InitialStates, InputInterpolation, Integrator,
-    Simulation, StateSpaceModel,
-};
-use hysid::validate::{sensitivity_table, ResidualAnalysis};
+use hysid::identify::greybox::{GreyBoxEstimation, GreyBoxFit, InitialStates};
+use hysid::identify::validate::{sensitivity_table, ResidualAnalysis};
+use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::saved::FittedModel;
+use hysid::model::ParameterSet;
+use hysid::numerics::LmConfig;
 use serde_json::json;
 use std::path::Path;
 use std::sync::Arc;
@@ -62,7 +61,7 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     );
     let residuals = print_residuals(&fit, &data);
     let sensitivity = if args.sensitivity {
-        let structure = hysid::greybox::GreyBox::new(
+        let structure = hysid::identify::greybox::GreyBox::new(
             model.clone(),
             &data,
             estimation.simulation,

@@ -4,8 +4,8 @@
 
 use crate::report::Report;
 use hysid::data::IdData;
-use hysid::greybox::GreyBoxFit;
-use hysid::validate::{residual_analysis, ResidualAnalysis, SensitivityRow};
+use hysid::identify::greybox::GreyBoxFit;
+use hysid::identify::validate::{residual_analysis, ResidualAnalysis, SensitivityRow};
 use serde_json::json;
 
 /// Prints the parameter table and the fit statistics.
@@ -125,7 +125,7 @@ pub fn print_sensitivity(rows: &[SensitivityRow]) {
 pub fn report(
     fit: &GreyBoxFit,
     data: &IdData,
-    model_file: hysid::fitted::ModelFile,
+    model_file: hysid::model::saved::ModelFile,
     extra: serde_json::Value,
 ) -> Report {
     let oe = &fit.fit;

@@ -5,7 +5,7 @@ use crate::cli::RigidBodyLsArgs;
 use crate::output::{preflight, write_json};
 use anyhow::{Context, Result};
 use hysid::data::{CsvSpec, IdData};
-use hysid::estimate::inverse_dynamics::{RigidBodyEstimate, RigidBodyLs};
+use hysid::identify::rigid_body::{RigidBodyEstimate, RigidBodyLs};
 use serde_json::json;
 use std::path::Path;
 

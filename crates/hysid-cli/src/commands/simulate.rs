@@ -4,8 +4,8 @@ use crate::cli::SimulateArgs;
 use crate::output::{preflight, write_json};
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
-use hysid::fitted::FittedModel;
-use hysid::metrics;
+use hysid::model::saved::FittedModel;
+use hysid::numerics::metrics;
 use serde_json::json;
 
 /// Simulates the model on the input columns; compares with the output column when given.

@@ -59,7 +59,7 @@ use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
 /// Which parameterisation of the material functions is used.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
 pub enum ChForm {
     /// 4-parameter saturated form (α, m1, c1, d), with m2 = c2 = 0.
     #[serde(rename = "ch4")]
@@ -510,6 +510,33 @@ fn invalid(name: &str, value: f64, reason: &str) -> Error {
         value,
         reason: reason.to_string(),
     }
+}
+
+/// Where a hysteresis simulation starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialOutput {
+    /// v(0) = the measured y(0) of each experiment (default for measured hysteresis).
+    Measured,
+    /// v(0) = 0 (a demagnetised / virgin start).
+    Zero,
+}
+
+/// Runs (D) from v(0) = `v0`, with the switching `h` when given, else h(t) = (|x(t)| > d).
+pub fn simulate_switched(ch: &ColemanHodgdon, x: &[f64], v0: f64, h: Option<&[bool]>) -> Vec<f64> {
+    let Some(h) = h else {
+        return ch.simulate_unchecked(x, v0);
+    };
+    let mut v = Vec::with_capacity(x.len());
+    if x.is_empty() {
+        return v;
+    }
+    v.push(v0);
+    for t in 1..x.len() {
+        let next = ch.step_in(v[t - 1], x[t - 1], x[t], h[t]);
+        v.push(next);
+    }
+    v
 }
 
 #[cfg(test)]

@@ -1,14 +1,25 @@
-//! Model structures.
+//! Every model hysid identifies, each able to simulate itself. No model imports an
+//! estimator: the identify layer sits above this one.
 //!
+//! * [`Parameter`], [`ParameterSet`]: named parameters with value, unit, bounds and a fixed
+//!   flag (MATLAB's `idnlgrey` vocabulary).
 //! * [`ColemanHodgdon`]: discrete Coleman–Hodgdon hysteresis, piecewise-linear material
 //!   functions, 4- and 6-parameter forms.
 //! * [`LinearBlock`]: A(q⁻¹) y = B(q⁻¹) v with delay.
 //! * [`HysteresisCascade`]: the two in series (Vörös 2015).
+//! * [`greybox`]: continuous-time state-space models ([`greybox::StateSpaceModel`]), the
+//!   built-in ones (Bouc–Wen oscillator, rigid body, the actuator of Gunnar et al. 2006),
+//!   their integrators and forward sensitivities.
+//! * [`saved`]: fitted models and the saved-model file.
 
 mod cascade;
 pub mod coleman_hodgdon;
+pub mod greybox;
 mod linear;
+mod parameters;
+pub mod saved;
 
 pub use cascade::{CascadeOutput, HysteresisCascade};
 pub use coleman_hodgdon::{Admissibility, ChForm, ColemanHodgdon};
 pub use linear::LinearBlock;
+pub use parameters::{Parameter, ParameterSet};

@@ -1,0 +1,147 @@
+//! Output-error estimation of a grey-box model (MATLAB's `nlgreyest`), with multi-start.
+//!
+//! With several starts, each is first fitted for a few iterations on a leading part of the
+//! records (screening); the best screened start is then fitted on all the data. Screening
+//! keeps a multi-start affordable: most poor starts are recognisable after a few iterations.
+
+use super::structure::{GreyBox, InitialStates};
+use crate::data::IdData;
+use crate::identify::multistart::{best_of, draw_starts, StartOutcome};
+use crate::identify::{OutputError, OutputErrorFit};
+use crate::model::greybox::{Simulation, StateSpaceModel};
+use crate::model::ParameterSet;
+use crate::numerics::{Control, IterationRecord, LmConfig};
+use crate::{Error, Result};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Settings of a grey-box estimation.
+#[derive(Clone, Debug)]
+pub struct GreyBoxEstimation {
+    /// Integrator and input interpolation.
+    pub simulation: Simulation,
+    /// Levenberg–Marquardt settings of the final fit.
+    pub lm: LmConfig,
+    /// Weight per output (default 1).
+    pub output_weights: Option<Vec<f64>>,
+    /// Number of starts (1: the given start only).
+    pub starts: usize,
+    /// Seed of the random starts.
+    pub seed: u64,
+    /// Iterations of each screening fit.
+    pub screening_iterations: usize,
+    /// Leading samples of each experiment used for screening (None: all).
+    pub screening_samples: Option<usize>,
+}
+
+impl Default for GreyBoxEstimation {
+    fn default() -> Self {
+        Self {
+            simulation: Simulation::default(),
+            lm: LmConfig::default(),
+            output_weights: None,
+            starts: 1,
+            seed: 0,
+            screening_iterations: 10,
+            screening_samples: Some(16_384),
+        }
+    }
+}
+
+/// A fitted grey-box model.
+#[derive(Clone, Debug)]
+pub struct GreyBoxFit {
+    /// The final output-error fit (parameters with initial states, std, fit %, report).
+    pub fit: OutputErrorFit,
+    /// The screening outcome of every start (empty for a single start).
+    pub starts: Vec<StartOutcome>,
+    /// Wall-clock time of the whole estimation.
+    pub elapsed_s: f64,
+}
+
+impl GreyBoxEstimation {
+    /// Fits `model` to `data` from the parameters `model_params` (values, bounds, fixed flags
+    /// of the model's own parameters) and the initial states `initial`.
+    pub fn estimate(
+        &self,
+        model: Arc<dyn StateSpaceModel>,
+        data: &IdData,
+        model_params: &ParameterSet,
+        initial: InitialStates,
+        callback: &mut dyn FnMut(&IterationRecord) -> Control,
+    ) -> Result<GreyBoxFit> {
+        let clock = Instant::now();
+        check_names(model.as_ref(), model_params)?;
+        let structure = GreyBox::new(model.clone(), data, self.simulation, initial.clone())?;
+        let params = structure.parameter_set(model_params);
+        params.validate()?;
+        let (start, starts) = if self.starts > 1 {
+            self.screen(model, data, &params, initial)?
+        } else {
+            (params, Vec::new())
+        };
+        let estimator = OutputError {
+            config: self.lm.clone(),
+            output_weights: self.output_weights.clone(),
+            skip: 0,
+        };
+        let fit = estimator.estimate(&structure, data, &start, callback)?;
+        Ok(GreyBoxFit {
+            fit,
+            starts,
+            elapsed_s: clock.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Short fits from every start on the leading samples; the best start, moved to where its
+    /// screening fit ended, and every outcome.
+    fn screen(
+        &self,
+        model: Arc<dyn StateSpaceModel>,
+        data: &IdData,
+        params: &ParameterSet,
+        initial: InitialStates,
+    ) -> Result<(ParameterSet, Vec<StartOutcome>)> {
+        let shortest = data
+            .experiments()
+            .iter()
+            .map(|e| e.len())
+            .min()
+            .unwrap_or(0);
+        let leading = self.screening_samples.map_or(shortest, |n| n.min(shortest));
+        let screen_data = if leading < shortest {
+            data.slice(0..leading)?
+        } else {
+            data.clone()
+        };
+        let structure = GreyBox::new(model, &screen_data, self.simulation, initial)?;
+        let estimator = OutputError {
+            config: LmConfig {
+                max_iterations: self.screening_iterations,
+                ..self.lm.clone()
+            },
+            output_weights: self.output_weights.clone(),
+            skip: 0,
+        };
+        let starts = draw_starts(params, self.starts, self.seed);
+        let fit = |p: &ParameterSet| {
+            estimator.estimate(&structure, &screen_data, p, &mut |_| Control::Continue)
+        };
+        let (best, outcomes) = best_of(&starts, &fit)?;
+        Ok((best.parameters, outcomes))
+    }
+}
+
+/// The given parameters must be the model's, in its order.
+fn check_names(model: &dyn StateSpaceModel, params: &ParameterSet) -> Result<()> {
+    let expected = model.parameters().names();
+    if params.names() != expected {
+        return Err(Error::Config(format!(
+            "the {} model's parameters are {}, got {}",
+            model.kind(),
+            expected.join(", "),
+            params.names().join(", ")
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,12 @@
+//! Output-error estimation of continuous-time grey-box models (MATLAB's `nlgreyest`).
+//!
+//! * [`structure`]: a model ([`crate::model::greybox::StateSpaceModel`]), its simulation
+//!   settings and its initial states per experiment, bound to data as an
+//!   [`OutputErrorModel`](crate::identify::OutputErrorModel).
+//! * [`estimate`]: output-error estimation with multi-start.
+
+pub mod estimate;
+pub mod structure;
+
+pub use estimate::{GreyBoxEstimation, GreyBoxFit};
+pub use structure::{GreyBox, InitialStates};

@@ -1,0 +1,259 @@
+//! A grey-box model bound to data: the model, its simulation settings and its initial states
+//! per experiment, as an [`OutputErrorModel`].
+//!
+//! # Parameter vector
+//!
+//! `[model parameters…, initial states…]`: after the model's own parameters come the initial
+//! states of every experiment, named `x0.<state>.e<k>` (k = 1…E), fixed unless asked to be
+//! estimated (MATLAB's `InitialStates(i).Fixed`).
+
+use crate::data::IdData;
+use crate::identify::output_error::{OutputErrorModel, SensitivitySink};
+use crate::model::greybox::simulate::{
+    simulate, simulate_sensitivities, InputTrack, Integrator, Simulation,
+};
+use crate::model::greybox::StateSpaceModel;
+use crate::model::{Parameter, ParameterSet};
+use crate::{Error, Result};
+use std::sync::Arc;
+
+/// Initial states of every experiment and which of them are estimated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialStates {
+    /// x(t₀) per experiment.
+    pub values: Vec<Vec<f64>>,
+    /// Per state: estimated (true) or fixed at its value (false), the same in every
+    /// experiment.
+    pub estimated: Vec<bool>,
+}
+
+impl InitialStates {
+    /// All states start at zero, fixed (a system at rest).
+    pub fn at_rest(n_states: usize, n_experiments: usize) -> Self {
+        Self {
+            values: vec![vec![0.0; n_states]; n_experiments],
+            estimated: vec![false; n_states],
+        }
+    }
+}
+
+/// A model bound to data (see the module docs).
+pub struct GreyBox {
+    model: Arc<dyn StateSpaceModel>,
+    sim: Simulation,
+    initial: InitialStates,
+    tracks: Vec<InputTrack>,
+    ts: f64,
+}
+
+impl GreyBox {
+    /// Binds `model` to the experiments of `data` (its input and output channels must match
+    /// the model's in number), preparing the inputs for `sim`.
+    pub fn new(
+        model: Arc<dyn StateSpaceModel>,
+        data: &IdData,
+        sim: Simulation,
+        initial: InitialStates,
+    ) -> Result<Self> {
+        let (nu, ny, nx) = (
+            model.inputs().len(),
+            model.outputs().len(),
+            model.states().len(),
+        );
+        if data.input_channels().len() != nu || data.output_channels().len() != ny {
+            return Err(Error::Config(format!(
+                "the {} model has {nu} input(s) and {ny} output(s); the data have {} and {}",
+                model.kind(),
+                data.input_channels().len(),
+                data.output_channels().len()
+            )));
+        }
+        if initial.values.len() != data.n_experiments()
+            || initial.values.iter().any(|v| v.len() != nx)
+            || initial.estimated.len() != nx
+        {
+            return Err(Error::Config(format!(
+                "initial states: need {nx} values for each of the {} experiments",
+                data.n_experiments()
+            )));
+        }
+        let tracks = data
+            .experiments()
+            .iter()
+            .map(|e| {
+                let channels: Vec<&[f64]> = (0..nu).map(|c| e.input(c)).collect();
+                InputTrack::new(&channels, &sim)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            model,
+            sim,
+            initial,
+            tracks,
+            ts: data.ts(),
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &dyn StateSpaceModel {
+        self.model.as_ref()
+    }
+
+    /// The simulation settings.
+    pub fn simulation(&self) -> Simulation {
+        self.sim
+    }
+
+    /// The full parameter set: the model's parameters (`model_params`, e.g. with the user's
+    /// initial values and bounds) followed by the initial states.
+    pub fn parameter_set(&self, model_params: &ParameterSet) -> ParameterSet {
+        let states = self.model.states();
+        let mut params: Vec<Parameter> = model_params.iter().cloned().collect();
+        for (e, x0) in self.initial.values.iter().enumerate() {
+            for (i, state) in states.iter().enumerate() {
+                params.push(
+                    Parameter::new(format!("x0.{}.e{}", state.name, e + 1), x0[i])
+                        .unit(state.unit.clone())
+                        .fixed(!self.initial.estimated[i]),
+                );
+            }
+        }
+        ParameterSet::new(params).expect("state and parameter names do not clash")
+    }
+
+    fn n_model_params(&self) -> usize {
+        self.model.parameters().len()
+    }
+
+    /// x(t₀) of experiment `exp` from the full parameter vector.
+    fn initial_state<'t>(&self, theta: &'t [f64], exp: usize) -> &'t [f64] {
+        let n = self.model.states().len();
+        let start = self.n_model_params() + exp * n;
+        &theta[start..start + n]
+    }
+}
+
+impl OutputErrorModel for GreyBox {
+    fn parameters(&self) -> ParameterSet {
+        self.parameter_set(&self.model.parameters())
+    }
+
+    fn n_outputs(&self) -> usize {
+        self.model.outputs().len()
+    }
+
+    fn simulate(
+        &self,
+        theta: &[f64],
+        _data: &IdData,
+        exp: usize,
+        y: &mut [Vec<f64>],
+    ) -> Result<()> {
+        let p = self.n_model_params();
+        let (model_theta, x0) = (&theta[..p], self.initial_state(theta, exp));
+        let track = &self.tracks[exp];
+        let mut u = vec![0.0; track.n_channels()];
+        let mut out = vec![0.0; y.len()];
+        simulate(
+            self.model.as_ref(),
+            model_theta,
+            x0,
+            track,
+            self.ts,
+            self.sim.integrator,
+            |k, x| {
+                track.at(k, 0.0, &mut u);
+                self.model.output(x, &u, model_theta, &mut out);
+                for (channel, v) in y.iter_mut().zip(&out) {
+                    channel[k] = *v;
+                }
+            },
+        )
+    }
+
+    fn simulate_sensitivities(
+        &self,
+        theta: &[f64],
+        _data: &IdData,
+        exp: usize,
+        free: &[usize],
+        sink: &mut SensitivitySink<'_>,
+    ) -> Option<Result<()>> {
+        let Integrator::Rk4 { substeps } = self.sim.integrator else {
+            return None;
+        };
+        let p = self.n_model_params();
+        let nx = self.model.states().len();
+        let ny = self.model.outputs().len();
+        let (model_theta, x0) = (&theta[..p], self.initial_state(theta, exp));
+        // Columns of S: the free model parameters, then this experiment's free initial states.
+        let params: Vec<usize> = free.iter().copied().filter(|&i| i < p).collect();
+        let own = p + exp * nx..p + (exp + 1) * nx;
+        let initial: Vec<usize> = free
+            .iter()
+            .filter(|i| own.contains(i))
+            .map(|&i| i - own.start)
+            .collect();
+        let q = params.len() + initial.len();
+        // Where each free index's sensitivity comes from: a column of S (None: it belongs to
+        // another experiment's initial state and has no effect here).
+        let column: Vec<Option<usize>> = free
+            .iter()
+            .map(|&i| {
+                if i < p {
+                    params.iter().position(|&j| j == i)
+                } else if own.contains(&i) {
+                    initial
+                        .iter()
+                        .position(|&j| j == i - own.start)
+                        .map(|c| params.len() + c)
+                } else {
+                    None
+                }
+            })
+            .collect();
+        let track = &self.tracks[exp];
+        let mut u = vec![0.0; track.n_channels()];
+        let (mut y, mut hx, mut ht) = (vec![0.0; ny], vec![0.0; ny * nx], vec![0.0; ny * p]);
+        let mut row = vec![0.0; ny * free.len()];
+        let model = self.model.as_ref();
+        let mut has_output_jacobian = true;
+        let outcome = simulate_sensitivities(
+            model,
+            model_theta,
+            x0,
+            track,
+            self.ts,
+            substeps,
+            &params,
+            &initial,
+            |k, x, s| {
+                track.at(k, 0.0, &mut u);
+                model.output(x, &u, model_theta, &mut y);
+                has_output_jacobian &= model.output_jacobians(x, &u, model_theta, &mut hx, &mut ht);
+                // ∂y/∂p = h_x S + h_θ (the direct term only for model parameters).
+                for o in 0..ny {
+                    for (f, col) in column.iter().enumerate() {
+                        row[o * free.len() + f] = match col {
+                            None => 0.0,
+                            Some(c) => {
+                                let mut acc: f64 =
+                                    (0..nx).map(|j| hx[o * nx + j] * s[j * q + c]).sum();
+                                if *c < params.len() {
+                                    acc += ht[o * p + params[*c]];
+                                }
+                                acc
+                            }
+                        };
+                    }
+                }
+                sink(k, &y, &row);
+            },
+        );
+        match outcome {
+            Ok(true) if has_output_jacobian => Some(Ok(())),
+            Ok(_) => None,
+            Err(e) => Some(Err(e)),
+        }
+    }
+}

@@ -1,0 +1,548 @@
+//! The Coleman–Hodgdon hysteresis alone, identified from its measured input and output.
+//!
+//! # Method
+//!
+//! 1. **Profile over d.** For a fixed threshold d the switching function h is known and the
+//!    separated model (MODELS.md §1.2) is linear in α·m1, α·m2, α, c1, c2 once θ3 is tied to
+//!    d, θ3 = (θ1 − θ2)·d:
+//!
+//!    ```text
+//!    Δy = αm1·|Δx|(x(1−h) + d·sgn(x)h) + αm2·|Δx|(x·h − d·sgn(x)h) − α·|Δx|y(t−1) + c1(1−h)Δx + c2·hΔx
+//!    ```
+//!
+//!    (ch4: drop the m2 and c2 terms). A grid over d refined by golden-section search picks the
+//!    d with the smallest equation error: no starting value is needed.
+//! 2. **Separated regression with the switching function re-estimated** (Vörös 2015): least
+//!    squares on the free 6- (or 4-) parameter separated form with h from the current d̂,
+//!    then d̂ = θ3/(θ1 − θ2) (ch4: θ2/θ1), repeated until d̂ settles.
+//! 3. **Output-error refinement**: Levenberg–Marquardt on the simulated hysteresis output.
+//!    The regression uses the *measured* y(t−1) as a regressor, so noise on y biases it
+//!    (errors in variables); the output-error fit does not, and gives standard deviations.
+//!
+//! Several experiments (e.g. loops measured separately) are stacked; each starts from its own
+//! measured y(0).
+
+use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel, SensitivitySink};
+use super::switching::{
+    fit_with_switching_updates, place_threshold, Switching, ThresholdPosterior,
+};
+use crate::data::IdData;
+use crate::model::coleman_hodgdon::switching;
+pub use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
+use crate::model::{ChForm, ColemanHodgdon};
+use crate::model::{Parameter, ParameterSet};
+use crate::numerics::least_squares::{least_squares, LsSolution};
+use crate::numerics::levenberg_marquardt::{Control, IterationRecord, LmConfig};
+use crate::numerics::Termination;
+use crate::{Error, Result};
+use nalgebra::DMatrix;
+
+/// The hysteresis alone as an output-error model: input channel 0 is x, output channel 0 is y.
+#[derive(Clone, Debug)]
+pub struct HysteresisStructure {
+    /// 4- or 6-parameter form.
+    pub form: ChForm,
+    /// The initial output of every experiment.
+    pub initial: InitialOutput,
+    /// When set, the switching h(t) of every experiment is held at these values instead of
+    /// following d (see [`fit_with_switching_updates`]).
+    pub switching: Option<Switching>,
+}
+
+impl HysteresisStructure {
+    fn initial_output(&self, data: &IdData, exp: usize) -> f64 {
+        match self.initial {
+            InitialOutput::Measured => data.experiment(exp).output(0)[0],
+            InitialOutput::Zero => 0.0,
+        }
+    }
+}
+
+impl OutputErrorModel for HysteresisStructure {
+    fn parameters(&self) -> ParameterSet {
+        let names: Vec<String> = self
+            .form
+            .parameter_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let params = names
+            .iter()
+            .map(|name| {
+                let p = Parameter::new(name.clone(), 1.0);
+                if name == "alpha" || name == "d" {
+                    p.bounds(f64::MIN_POSITIVE, f64::INFINITY)
+                } else {
+                    p
+                }
+            })
+            .collect();
+        ParameterSet::new(params).expect("names of a ChForm are unique")
+    }
+
+    fn n_outputs(&self) -> usize {
+        1
+    }
+
+    fn simulate(&self, theta: &[f64], data: &IdData, exp: usize, y: &mut [Vec<f64>]) -> Result<()> {
+        let ch = ColemanHodgdon::from_params(self.form, theta)?;
+        let x = data.experiment(exp).input(0);
+        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
+        y[0] = simulate_switched(&ch, x, self.initial_output(data, exp), h);
+        check_finite(&y[0])
+    }
+
+    fn simulate_sensitivities(
+        &self,
+        theta: &[f64],
+        data: &IdData,
+        exp: usize,
+        free: &[usize],
+        sink: &mut SensitivitySink<'_>,
+    ) -> Option<Result<()>> {
+        let ch = match ColemanHodgdon::from_params(self.form, theta) {
+            Ok(ch) => ch,
+            Err(e) => return Some(Err(e)),
+        };
+        let x = data.experiment(exp).input(0);
+        let mut row = vec![0.0; free.len()];
+        let mut failed = None;
+        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
+        hysteresis_sensitivities(&ch, x, self.initial_output(data, exp), h, |t, v, s| {
+            if !v.is_finite() && failed.is_none() {
+                failed = Some(t);
+            }
+            for (r, &i) in row.iter_mut().zip(free) {
+                *r = s[i];
+            }
+            sink(t, &[v], &row);
+        });
+        Some(match failed {
+            None => Ok(()),
+            Some(index) => Err(diverged(index)),
+        })
+    }
+}
+
+/// Runs the hysteresis recursion and its parameter sensitivities s(t) = ∂v(t)/∂θ together,
+/// calling `on_sample(t, v(t), s(t))` for every sample. s(0) = 0 (v(0) does not depend on θ).
+///
+/// s(t) = (1 − α|Δx|)·s(t−1) + ∂(D)/∂θ with the switching held fixed inside each piece
+/// (see [`ColemanHodgdon::step_partials`]); `h` holds the switching fixed when given.
+pub fn hysteresis_sensitivities(
+    ch: &ColemanHodgdon,
+    x: &[f64],
+    v0: f64,
+    h: Option<&[bool]>,
+    mut on_sample: impl FnMut(usize, f64, &[f64]),
+) {
+    let nh = ch.form().n_params();
+    let mut s = vec![0.0; nh];
+    let mut partial = vec![0.0; nh];
+    let mut v = v0;
+    if x.is_empty() {
+        return;
+    }
+    on_sample(0, v, &s);
+    for t in 1..x.len() {
+        let outside = h.map_or(x[t].abs() > ch.d(), |h| h[t]);
+        let factor = ch.step_partials_in(v, x[t - 1], x[t], outside, &mut partial);
+        v = ch.step_in(v, x[t - 1], x[t], outside);
+        for (sk, pk) in s.iter_mut().zip(&partial) {
+            *sk = factor * *sk + pk;
+        }
+        on_sample(t, v, &s);
+    }
+}
+
+/// The bounds the data put on a hysteresis parameter: α in (0, 1/max|Δx|] (the rate limit
+/// of (D)) and d in [10⁻⁹·max|x|, max|x|] (beyond the input range no sample ever switches, so
+/// the data say nothing about d); other parameters are free.
+pub(crate) fn bounded_parameter(name: &str, value: f64, data: &IdData) -> Parameter {
+    let p = Parameter::new(name, value);
+    match name {
+        "alpha" => p.bounds(f64::MIN_POSITIVE, 1.0 / max_increment(data)),
+        "d" => {
+            let max_x = max_abs_input(data);
+            p.bounds(1e-9 * max_x, max_x)
+        }
+        _ => p,
+    }
+}
+
+/// The hysteresis parameters `values` with the bounds of [`bounded_parameter`].
+pub(crate) fn bounded_hysteresis_parameters(
+    form: ChForm,
+    values: &[f64],
+    data: &IdData,
+) -> ParameterSet {
+    let params = form
+        .parameter_names()
+        .iter()
+        .zip(values)
+        .map(|(&name, &value)| bounded_parameter(name, value, data))
+        .collect();
+    ParameterSet::new(params).expect("names of a ChForm are unique")
+}
+
+pub(crate) fn check_finite(y: &[f64]) -> Result<()> {
+    match y.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(index) => Err(diverged(index)),
+    }
+}
+
+fn diverged(index: usize) -> Error {
+    Error::Diverged {
+        index,
+        reason: "the simulated output is not finite".into(),
+    }
+}
+
+/// Largest |Δx| over all experiments' input channel 0.
+pub(crate) fn max_increment(data: &IdData) -> f64 {
+    data.experiments()
+        .iter()
+        .flat_map(|e| e.input(0).windows(2).map(|w| (w[1] - w[0]).abs()))
+        .fold(0.0, f64::max)
+}
+
+/// Largest |x| over all experiments' input channel 0.
+pub(crate) fn max_abs_input(data: &IdData) -> f64 {
+    data.experiments()
+        .iter()
+        .flat_map(|e| e.input(0).iter().map(|v| v.abs()))
+        .fold(0.0, f64::max)
+}
+
+/// Result of the separated regression.
+#[derive(Clone, Debug)]
+pub struct SeparatedFit {
+    /// The hysteresis recovered from the separated parameters.
+    pub model: ColemanHodgdon,
+    /// The last least-squares solution (separated parameters, their covariance).
+    pub ls: LsSolution,
+    /// d̂ after each re-estimation of the switching function (the first is the profile's).
+    pub d_history: Vec<f64>,
+    /// Why the switching re-estimation stopped.
+    pub termination: Termination,
+}
+
+/// The complete hysteresis-alone identification.
+#[derive(Clone, Debug)]
+pub struct HysteresisFit {
+    /// Steps 1–2: profile and separated regression.
+    pub separated: SeparatedFit,
+    /// Step 3: the output-error refinement (estimate, standard deviations, report).
+    pub output_error: OutputErrorFit,
+    /// What the data say about the threshold d; the reported d is its mean.
+    pub threshold: ThresholdPosterior,
+    /// The final model.
+    pub model: ColemanHodgdon,
+    /// Wall-clock time.
+    pub elapsed_s: f64,
+}
+
+impl HysteresisFit {
+    /// Reported standard deviations ([`ChForm::parameter_names`] order): asymptotic, with
+    /// the truncated-normal one for d (see [`super::switching`]).
+    pub fn std(&self) -> Vec<f64> {
+        let mut std = self.output_error.std().to_vec();
+        let d = std.len() - 1;
+        std[d] = self.threshold.std;
+        std
+    }
+}
+
+/// Settings of the hysteresis-alone identification.
+#[derive(Clone, Debug)]
+pub struct HysteresisIdentification {
+    /// 4- or 6-parameter form.
+    pub form: ChForm,
+    /// The initial output of the simulated hysteresis.
+    pub initial: InitialOutput,
+    /// Grid points of the d profile.
+    pub profile_points: usize,
+    /// Maximum re-estimations of the switching function.
+    pub max_switching_iterations: usize,
+    /// Intervals of d tried on each side of d̂ (see [`switching`](super::switching)).
+    pub scan: usize,
+    /// Output-error settings.
+    pub lm: LmConfig,
+}
+
+impl HysteresisIdentification {
+    /// Defaults: 60-point d profile, 50 switching iterations, tight LM tolerances.
+    pub fn new(form: ChForm) -> Self {
+        Self {
+            form,
+            initial: InitialOutput::Measured,
+            profile_points: 60,
+            max_switching_iterations: 50,
+            scan: 6,
+            lm: LmConfig::default(),
+        }
+    }
+
+    /// Identifies the hysteresis from input channel 0 (x) and output channel 0 (y) of `data`.
+    pub fn estimate(
+        &self,
+        data: &IdData,
+        callback: &mut dyn FnMut(&IterationRecord) -> Control,
+    ) -> Result<HysteresisFit> {
+        let clock = std::time::Instant::now();
+        check_excitation(data, self.form.n_params())?;
+        let separated = self.separated_regression(data)?;
+        let structure = |switching| HysteresisStructure {
+            form: self.form,
+            initial: self.initial,
+            switching,
+        };
+        let alpha_max = 1.0 / max_increment(data);
+        let mut start = separated.model.params();
+        start[0] = start[0].min(alpha_max);
+        let mut params = bounded_hysteresis_parameters(self.form, &start, data);
+        for k in 0..params.len() {
+            let p = params.get_mut(k);
+            p.value = p.value.clamp(p.min, p.max);
+        }
+        let estimator = OutputError {
+            config: self.lm.clone(),
+            ..OutputError::default()
+        };
+        let switched =
+            fit_with_switching_updates(&structure, data, &params, &estimator, self.scan, callback)?;
+        let d_index = self.form.n_params() - 1;
+        let (output_error, threshold) = place_threshold(&structure, data, switched.fit, d_index)?;
+        let model = ColemanHodgdon::from_params(self.form, &output_error.parameters.values())?;
+        if model.alpha() >= alpha_max * (1.0 - 1e-9) {
+            return Err(rate_error(data, model.alpha()));
+        }
+        Ok(HysteresisFit {
+            separated,
+            output_error,
+            threshold,
+            model,
+            elapsed_s: clock.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Steps 1–2: the d profile, then the separated regression with the switching function
+    /// re-estimated until d̂ settles.
+    pub fn separated_regression(&self, data: &IdData) -> Result<SeparatedFit> {
+        let d0 = self.profile_d(data)?;
+        let mut d = d0;
+        let mut d_history = vec![d0];
+        let mut best: Option<(ColemanHodgdon, LsSolution)> = None;
+        let mut termination = Termination::MaxIterations;
+        let d_max = max_abs_input(data);
+        for _ in 0..self.max_switching_iterations {
+            let (phi, dy) = separated_rows(data, self.form, d);
+            let ls = least_squares(&phi, &dy, self.form_regressor_names())?;
+            let theta: Vec<f64> = ls.theta.iter().copied().collect();
+            let model = match ColemanHodgdon::from_separated(self.form, &theta) {
+                Ok(m) if m.d() < d_max => m,
+                Ok(m) => {
+                    termination = Termination::Diverged {
+                        reason: format!("d = {} left the input range (max |x| = {d_max})", m.d()),
+                    };
+                    break;
+                }
+                Err(e) => {
+                    termination = Termination::Diverged {
+                        reason: e.to_string(),
+                    };
+                    break;
+                }
+            };
+            let change = (model.d() - d).abs() / d;
+            d = model.d();
+            d_history.push(d);
+            best = Some((model, ls));
+            if change < 1e-10 || same_switching(data, d, d_history[d_history.len() - 2]) {
+                termination = Termination::Converged { change };
+                break;
+            }
+        }
+        let (model, ls) = match best {
+            Some(b) if termination.converged() => b,
+            // The re-estimation wandered off: keep the profile's constrained solution.
+            _ => constrained_fit(data, self.form, d0)?,
+        };
+        Ok(SeparatedFit {
+            model,
+            ls,
+            d_history,
+            termination,
+        })
+    }
+
+    fn form_regressor_names(&self) -> &'static [&'static str] {
+        match self.form {
+            ChForm::Saturated4 => &["|dx|x(1-h)", "|dx|sgn(x)h", "-|dx|y", "(1-h)dx"],
+            ChForm::General6 => &[
+                "|dx|x(1-h)",
+                "|dx|x h",
+                "|dx|sgn(x)h",
+                "-|dx|y",
+                "(1-h)dx",
+                "h dx",
+            ],
+        }
+    }
+
+    /// The d with the smallest equation error of the constrained regression: a grid over
+    /// (0, max|x|) refined by golden-section search around the best grid point.
+    fn profile_d(&self, data: &IdData) -> Result<f64> {
+        let d_max = max_abs_input(data);
+        let cost = |d: f64| {
+            constrained_fit(data, self.form, d).map_or(f64::INFINITY, |(_, ls)| ls.residual_ss)
+        };
+        let n = self.profile_points.max(5);
+        let grid: Vec<f64> = (1..=n).map(|i| d_max * i as f64 / (n + 1) as f64).collect();
+        let costs: Vec<f64> = grid.iter().map(|&d| cost(d)).collect();
+        let (best, &best_cost) = costs
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .expect("grid is not empty");
+        if !best_cost.is_finite() {
+            return Err(Error::Singular(
+                "no threshold d gives a solvable regression; the input does not excite the hysteresis".into(),
+            ));
+        }
+        let step = d_max / (n + 1) as f64;
+        Ok(golden_section(
+            cost,
+            grid[best] - step,
+            grid[best] + step,
+            40,
+        ))
+    }
+}
+
+/// Errors unless every experiment's input moves and the data hold enough samples.
+pub(crate) fn check_excitation(data: &IdData, n_params: usize) -> Result<()> {
+    let name = data
+        .input_channels()
+        .first()
+        .map_or("x".to_string(), |c| c.name.clone());
+    if max_increment(data) == 0.0 {
+        return Err(Error::NotExciting {
+            channel: name,
+            reason: "it is constant, so the hysteresis never moves; drive it with periodic signals of several amplitudes".into(),
+        });
+    }
+    let needed = 3 * n_params + 10;
+    if data.n_samples() < needed {
+        return Err(Error::TooFewSamples {
+            samples: data.n_samples(),
+            parameters: n_params,
+            needed,
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn rate_error(data: &IdData, alpha: f64) -> Error {
+    let (index, dx) = data.experiments()[0]
+        .input(0)
+        .windows(2)
+        .enumerate()
+        .map(|(t, w)| (t + 1, w[1] - w[0]))
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .unwrap_or((0, 0.0));
+    Error::RateLimit {
+        index,
+        alpha,
+        dx,
+        product: alpha * dx.abs(),
+    }
+}
+
+/// True when thresholds `a` and `b` give the same switching function on every sample.
+fn same_switching(data: &IdData, a: f64, b: f64) -> bool {
+    data.experiments().iter().all(|e| {
+        e.input(0)
+            .iter()
+            .all(|&x| switching(x, a) == switching(x, b))
+    })
+}
+
+/// Rows of the free separated regression Δy(t) = φ_h(t)ᵀθ_h for threshold `d`.
+fn separated_rows(data: &IdData, form: ChForm, d: f64) -> (DMatrix<f64>, Vec<f64>) {
+    let p = form.n_params();
+    let rows = data.experiments().iter().map(|e| e.len() - 1).sum();
+    let mut phi = DMatrix::zeros(rows, p);
+    let mut dy = Vec::with_capacity(rows);
+    let mut buf = vec![0.0; p];
+    for e in data.experiments() {
+        let (x, y) = (e.input(0), e.output(0));
+        for t in 1..x.len() {
+            ColemanHodgdon::separated_regressor(form, d, x[t - 1], x[t], y[t - 1], &mut buf);
+            let r = dy.len();
+            for (k, v) in buf.iter().enumerate() {
+                phi[(r, k)] = *v;
+            }
+            dy.push(y[t] - y[t - 1]);
+        }
+    }
+    (phi, dy)
+}
+
+/// The regression with θ3 tied to d (see the module docs); returns the model and the fit.
+fn constrained_fit(data: &IdData, form: ChForm, d: f64) -> Result<(ColemanHodgdon, LsSolution)> {
+    let (full, dy) = separated_rows(data, form, d);
+    // Column combinations that tie θ3 = (θ1 − θ2)·d (ch6) or θ2 = θ1·d (ch4).
+    let phi = match form {
+        ChForm::General6 => DMatrix::from_fn(full.nrows(), 5, |r, c| match c {
+            0 => full[(r, 0)] + d * full[(r, 2)],
+            1 => full[(r, 1)] - d * full[(r, 2)],
+            k => full[(r, k + 1)],
+        }),
+        ChForm::Saturated4 => DMatrix::from_fn(full.nrows(), 3, |r, c| match c {
+            0 => full[(r, 0)] + d * full[(r, 1)],
+            k => full[(r, k + 1)],
+        }),
+    };
+    let ls = least_squares(&phi, &dy, &[])?;
+    let t = &ls.theta;
+    let model = match form {
+        ChForm::General6 => ColemanHodgdon::general(t[2], t[0] / t[2], t[1] / t[2], t[3], t[4], d)?,
+        ChForm::Saturated4 => ColemanHodgdon::saturated(t[1], t[0] / t[1], t[2], d)?,
+    };
+    Ok((model, ls))
+}
+
+/// Golden-section search for a minimum of `f` on [a, b] (`iterations` shrinkings).
+pub(crate) fn golden_section(
+    f: impl Fn(f64) -> f64,
+    mut a: f64,
+    mut b: f64,
+    iterations: usize,
+) -> f64 {
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    let mut c = b - r * (b - a);
+    let mut d = a + r * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..iterations {
+        if fc <= fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - r * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + r * (b - a);
+            fd = f(d);
+        }
+    }
+    if fc <= fd {
+        c
+    } else {
+        d
+    }
+}

@@ -1,0 +1,460 @@
+//! The switching function h as an internal variable of output-error fits.
+//!
+//! # Why
+//!
+//! In the discrete Coleman–Hodgdon recursion the material function g takes the value c1 or c2
+//! according to h(t) = (|x(t)| > d). The simulated output therefore jumps whenever d crosses a
+//! sample's |x(t)|: the output-error criterion is a fine staircase in d, smooth only inside
+//! each interval between consecutive sample magnitudes. A Gauss–Newton step judged on jumps
+//! its linear model cannot see stalls. Two measures make the fit reach the true minimum:
+//!
+//! 1. **Fixed point on h** (the internal-variable idea of Vörös 2015 applied to the output
+//!    error): hold h fixed, which makes the criterion smooth (d still moves the outer segment
+//!    of f), fit, re-classify the samples with the new d̂, repeat until the classification
+//!    no longer changes. A cycle, or a re-classification that does not lower the true
+//!    criterion, ends the loop with the best classification by the true criterion.
+//! 2. **Interval scan**: the criterion restricted to one interval of d is smooth and equals
+//!    the frozen-h criterion there, so fitting with d bounded to each of a set of intervals
+//!    around d̂ (a coarse pass over d̂ ± 3s, then every neighbour of the best) and keeping the
+//!    best minimises the true, discontinuous criterion locally. On
+//!    noise-free data only the true interval fits exactly, which is what recovers every
+//!    parameter to working precision.
+
+use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel};
+use crate::data::IdData;
+use crate::model::ParameterSet;
+use crate::numerics::levenberg_marquardt::{Control, IterationRecord, LmReport};
+use crate::Result;
+use nalgebra::{DMatrix, DVector};
+
+/// The switching h(t) = (|x(t)| > d) of every experiment, held fixed during a fit.
+pub type Switching = Vec<Vec<bool>>;
+
+/// The switching of every experiment's input channel 0 for threshold `d`.
+pub fn classify(data: &IdData, d: f64) -> Switching {
+    data.experiments()
+        .iter()
+        .map(|e| e.input(0).iter().map(|x| x.abs() > d).collect())
+        .collect()
+}
+
+/// What the data say about the threshold d (see the module docs).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ThresholdPosterior {
+    /// Lower end of the switching interval that contains d̂ (the largest sample magnitude ≤ d̂).
+    pub lower: f64,
+    /// Upper end (the smallest sample magnitude > d̂; +∞ above all samples).
+    pub upper: f64,
+    /// The asymptotic standard deviation s of the smooth part.
+    pub smooth_std: f64,
+    /// Mean of N(d̂, s²) truncated to [lower, upper).
+    pub mean: f64,
+    /// Standard deviation of that truncated normal.
+    pub std: f64,
+}
+
+/// The truncated-normal description of d (see the module docs) for the estimate `d_hat` with
+/// smooth standard deviation `smooth_std`.
+pub fn threshold_posterior(data: &IdData, d_hat: f64, smooth_std: f64) -> ThresholdPosterior {
+    // The neighbouring magnitudes by one pass (no sort: records can be long).
+    let (mut lower, mut upper) = (0.0f64, f64::INFINITY);
+    for e in data.experiments() {
+        for m in e.input(0).iter().skip(1).map(|x| x.abs()) {
+            if m <= d_hat {
+                lower = lower.max(m);
+            } else {
+                upper = upper.min(m);
+            }
+        }
+    }
+    let (mean, std) = truncated_normal(d_hat, smooth_std, lower, upper);
+    ThresholdPosterior {
+        lower,
+        upper,
+        smooth_std,
+        mean,
+        std,
+    }
+}
+
+/// Moves d to the mean of its [`threshold_posterior`] and the other free parameters to their
+/// conditional optimum for that d (−H_oo⁻¹H_od·Δd with H = JᵀJ, exact for the locally
+/// quadratic smooth part); one simulation refreshes the fit statistics, the covariance is kept.
+/// `d_index` is the position of d in the parameter vector.
+pub fn place_threshold<M: OutputErrorModel>(
+    make: &dyn Fn(Option<Switching>) -> M,
+    data: &IdData,
+    fit: OutputErrorFit,
+    d_index: usize,
+) -> Result<(OutputErrorFit, ThresholdPosterior)> {
+    let d_hat = fit.parameters.get(d_index).value;
+    let threshold = threshold_posterior(data, d_hat, fit.std()[d_index]);
+    if threshold.mean == d_hat {
+        return Ok((fit, threshold));
+    }
+    let mut theta = fit.parameters.values();
+    for (i, delta) in conditional_shift(&fit.report, d_index, threshold.mean - d_hat) {
+        theta[i] += delta;
+    }
+    theta[d_index] = threshold.mean;
+    let moved = fit.at(&make(Some(classify(data, threshold.mean))), data, &theta)?;
+    Ok((moved, threshold))
+}
+
+/// The change of the other free parameters that keeps the quadratic model of the criterion
+/// at its conditional minimum when parameter `fixed` moves by `delta`: −H_oo⁻¹H_od·delta.
+fn conditional_shift(report: &LmReport, fixed: usize, delta: f64) -> Vec<(usize, f64)> {
+    let Some(kd) = report.free.iter().position(|&i| i == fixed) else {
+        return Vec::new();
+    };
+    let others: Vec<usize> = (0..report.free.len()).filter(|&k| k != kd).collect();
+    let h = &report.jtj;
+    let h_oo = DMatrix::from_fn(others.len(), others.len(), |r, c| h[(others[r], others[c])]);
+    let h_od = DVector::from_fn(others.len(), |r, _| h[(others[r], kd)]);
+    match h_oo.cholesky() {
+        Some(chol) => {
+            let step = chol.solve(&h_od) * (-delta);
+            others
+                .iter()
+                .zip(step.iter())
+                .map(|(&k, &s)| (report.free[k], s))
+                .collect()
+        }
+        None => Vec::new(),
+    }
+}
+
+/// Mean and standard deviation of N(μ, s²) truncated to [a, b].
+fn truncated_normal(mu: f64, s: f64, a: f64, b: f64) -> (f64, f64) {
+    if s.is_nan() || s <= 0.0 || !s.is_finite() {
+        return (mu.clamp(a, b), 0.0);
+    }
+    if b.is_finite() {
+        return truncated_moments_by_quadrature(mu, s, a, b);
+    }
+    // Half-infinite interval [a, ∞): the closed form (inverse Mills ratio).
+    let za = (a - mu) / s;
+    let tail = 1.0 - normal_cdf(za);
+    if tail < 1e-300 {
+        return (a, 0.0);
+    }
+    let lambda = normal_pdf(za) / tail;
+    let var = s * s * (1.0 + za * lambda - lambda * lambda);
+    (mu + s * lambda, var.max(0.0).sqrt())
+}
+
+/// Moments of the truncated normal on a finite [a, b] by composite Simpson quadrature of the
+/// density relative to its largest value on the interval; no cancellation, whatever the ratio
+/// of the interval to s (closed forms lose all digits when the interval is narrow).
+fn truncated_moments_by_quadrature(mu: f64, s: f64, a: f64, b: f64) -> (f64, f64) {
+    const PANELS: usize = 256;
+    // Beyond 12 s from the peak the density is below e^-72 of its maximum: leave it out, so a
+    // narrow normal inside a wide interval is still resolved by the panels.
+    let peak = mu.clamp(a, b);
+    let (a, b) = (a.max(peak - 12.0 * s), b.min(peak + 12.0 * s));
+    let log_density = |x: f64| -0.5 * (((x - mu) / s).powi(2) - ((peak - mu) / s).powi(2));
+    let h = (b - a) / PANELS as f64;
+    let (mut m0, mut m1, mut m2) = (0.0, 0.0, 0.0);
+    for i in 0..=PANELS {
+        let w = if i == 0 || i == PANELS {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        let x = a + i as f64 * h;
+        let f = w * log_density(x).exp();
+        let dx = x - peak;
+        m0 += f;
+        m1 += f * dx;
+        m2 += f * dx * dx;
+    }
+    if m0 <= 0.0 {
+        return (peak, 0.0);
+    }
+    let mean = m1 / m0;
+    ((peak + mean), (m2 / m0 - mean * mean).max(0.0).sqrt())
+}
+
+fn normal_pdf(z: f64) -> f64 {
+    (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt()
+}
+
+/// Φ(z) through erfc (Chebyshev fit of Press et al., Numerical Recipes §6.2, relative error
+/// below 1.2e-7 everywhere; ample for a standard deviation).
+fn normal_cdf(z: f64) -> f64 {
+    0.5 * erfc(-z / std::f64::consts::SQRT_2)
+}
+
+fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let poly = -z * z - 1.265_512_23
+        + t * (1.000_023_68
+            + t * (0.374_091_96
+                + t * (0.096_784_18
+                    + t * (-0.186_288_06
+                        + t * (0.278_868_07
+                            + t * (-1.135_203_98
+                                + t * (1.488_515_87 + t * (-0.822_152_23 + t * 0.170_872_77))))))));
+    let r = t * poly.exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
+}
+
+/// An output-error fit whose switching function was re-estimated.
+#[derive(Clone, Debug)]
+pub struct SwitchedFit {
+    /// The best fit found.
+    pub fit: OutputErrorFit,
+    /// Number of output-error fits run.
+    pub fits: usize,
+    /// True when the estimated d reproduces the classification it was fitted with.
+    pub consistent: bool,
+}
+
+/// Output-error fit with h re-estimated (see the module docs); `scan` intervals on each side
+/// of d̂ are tried afterwards (0 for none).
+///
+/// `make(Some(h))` builds the model with the switching frozen at h, `make(None)` with the
+/// switching following d. `params` must contain a parameter named `d`.
+pub fn fit_with_switching_updates<M: OutputErrorModel>(
+    make: &dyn Fn(Option<Switching>) -> M,
+    data: &IdData,
+    params: &ParameterSet,
+    estimator: &OutputError,
+    scan: usize,
+    callback: &mut dyn FnMut(&IterationRecord) -> Control,
+) -> Result<SwitchedFit> {
+    let fixed_point = fixed_point(make, data, params, estimator, callback)?;
+    if scan == 0 {
+        return Ok(fixed_point);
+    }
+    let scanned = scan_intervals(make, data, &fixed_point.fit, estimator, scan)?;
+    Ok(match scanned {
+        Some((fit, fits))
+            if fit.report.cost < fixed_point.fit.report.cost || !fixed_point.consistent =>
+        {
+            SwitchedFit {
+                fit,
+                fits: fixed_point.fits + fits,
+                consistent: true,
+            }
+        }
+        Some((_, fits)) => SwitchedFit {
+            fits: fixed_point.fits + fits,
+            ..fixed_point
+        },
+        None => fixed_point,
+    })
+}
+
+/// Step 1 of the module docs.
+fn fixed_point<M: OutputErrorModel>(
+    make: &dyn Fn(Option<Switching>) -> M,
+    data: &IdData,
+    params: &ParameterSet,
+    estimator: &OutputError,
+    callback: &mut dyn FnMut(&IterationRecord) -> Control,
+) -> Result<SwitchedFit> {
+    const MAX_UPDATES: usize = 30;
+    let d_index = params.index_of("d")?;
+    let mut current = params.clone();
+    let mut h = classify(data, current.get(d_index).value);
+    let mut visited: Vec<Switching> = Vec::new();
+    let mut best: Option<(f64, OutputErrorFit)> = None;
+    for update in 1..=MAX_UPDATES {
+        let fit = estimator.estimate(&make(Some(h.clone())), data, &current, callback)?;
+        let h_new = classify(data, fit.parameters.get(d_index).value);
+        if h_new == h {
+            return Ok(SwitchedFit {
+                fit,
+                fits: update,
+                consistent: true,
+            });
+        }
+        let actual = true_cost(&make(None), data, &fit.parameters.values())?;
+        // Re-classifying must pay: once the true criterion stops falling, the best
+        // classification so far stands (long records otherwise creep through many nearly
+        // equal classifications).
+        if best.as_ref().is_some_and(|(c, _)| actual >= *c) {
+            break;
+        }
+        best = Some((actual, fit.clone()));
+        visited.push(std::mem::replace(&mut h, h_new));
+        if visited.contains(&h) {
+            break;
+        }
+        current = fit.parameters;
+    }
+    let (_, fit) = best.expect("at least one fit ran");
+    Ok(SwitchedFit {
+        fit,
+        fits: visited.len(),
+        consistent: false,
+    })
+}
+
+/// Step 2 of the module docs. A coarse pass fits up to [`COARSE_INTERVALS`] intervals spread
+/// over d̂ ± 3s (s the smooth standard deviation of d), because with noise the criterion over
+/// the intervals can hold a plateau a purely local search would not leave; a fine pass then
+/// tries every interval within `scan` of the best, re-centred while the best lies at the edge.
+/// Returns the best fit and the number of fits.
+fn scan_intervals<M: OutputErrorModel>(
+    make: &dyn Fn(Option<Switching>) -> M,
+    data: &IdData,
+    start: &OutputErrorFit,
+    estimator: &OutputError,
+    scan: usize,
+) -> Result<Option<(OutputErrorFit, usize)>> {
+    const MAX_ROUNDS: usize = 6;
+    let params = &start.parameters;
+    let d_index = params.index_of("d")?;
+    let edges = magnitudes(data);
+    if edges.len() < 2 {
+        return Ok(None);
+    }
+    let d_hat = params.get(d_index).value;
+    let radius = 3.0 * start.std()[d_index];
+    let mut results: Vec<(usize, OutputErrorFit)> = Vec::new();
+    let try_interval = |interval: usize, results: &mut Vec<(usize, OutputErrorFit)>| {
+        if !results.iter().any(|(i, _)| *i == interval) {
+            if let Some(fit) =
+                fit_in_interval(make, data, params, estimator, &edges, interval, d_index)
+            {
+                results.push((interval, fit));
+            }
+        }
+    };
+    if radius.is_finite() && radius > 0.0 {
+        let lo = interval_of(&edges, d_hat - radius);
+        let hi = interval_of(&edges, d_hat + radius);
+        let stride = ((hi - lo) / COARSE_INTERVALS).max(1);
+        for interval in (lo..=hi).step_by(stride) {
+            try_interval(interval, &mut results);
+        }
+    }
+    let mut centre = best_of(&results).unwrap_or_else(|| interval_of(&edges, d_hat));
+    for _ in 0..MAX_ROUNDS {
+        let lo = centre.saturating_sub(scan).max(1);
+        let hi = (centre + scan).min(edges.len() - 1);
+        for interval in lo..=hi {
+            try_interval(interval, &mut results);
+        }
+        let Some(best) = best_of(&results) else {
+            return Ok(None);
+        };
+        let at_edge = (best == lo && lo > 1) || (best == hi && hi < edges.len() - 1);
+        if !at_edge {
+            break;
+        }
+        centre = best;
+    }
+    let fits = results.len();
+    Ok(results
+        .into_iter()
+        .min_by(|a, b| a.1.report.cost.total_cmp(&b.1.report.cost))
+        .map(|(_, fit)| (fit, fits)))
+}
+
+/// Intervals tried by the coarse pass of the interval scan.
+const COARSE_INTERVALS: usize = 12;
+
+/// The interval with the lowest criterion among the fitted ones.
+fn best_of(results: &[(usize, OutputErrorFit)]) -> Option<usize> {
+    results
+        .iter()
+        .min_by(|a, b| a.1.report.cost.total_cmp(&b.1.report.cost))
+        .map(|(i, _)| *i)
+}
+
+/// The fit with d bounded to [edges[i−1], edges[i]) and h frozen accordingly; None when the
+/// fit fails there.
+fn fit_in_interval<M: OutputErrorModel>(
+    make: &dyn Fn(Option<Switching>) -> M,
+    data: &IdData,
+    start: &ParameterSet,
+    estimator: &OutputError,
+    edges: &[f64],
+    i: usize,
+    d_index: usize,
+) -> Option<OutputErrorFit> {
+    let (lo, hi) = (edges[i - 1], edges[i] - edges[i].abs() * 1e-14);
+    if hi.is_nan() || hi <= lo {
+        return None;
+    }
+    let mut params = start.clone();
+    let d = params.get_mut(d_index);
+    d.min = lo.max(d.min);
+    d.max = hi.min(d.max);
+    if d.min.is_nan() || d.min >= d.max {
+        return None;
+    }
+    d.value = d.value.clamp(d.min, d.max);
+    let h = classify(data, 0.5 * (lo + hi));
+    estimator
+        .estimate(&make(Some(h)), data, &params, &mut |_| Control::Continue)
+        .ok()
+}
+
+/// Sorted distinct |x(t)|, t ≥ 1, over all experiments: the edges of the intervals of d inside
+/// which the classification is constant.
+fn magnitudes(data: &IdData) -> Vec<f64> {
+    let mut m: Vec<f64> = data
+        .experiments()
+        .iter()
+        .flat_map(|e| e.input(0).iter().skip(1).map(|x| x.abs()))
+        .collect();
+    m.sort_by(f64::total_cmp);
+    m.dedup();
+    m
+}
+
+/// Index i of the interval [edges[i−1], edges[i]) that contains d (clamped to 1…len−1).
+fn interval_of(edges: &[f64], d: f64) -> usize {
+    edges
+        .partition_point(|&e| e <= d)
+        .clamp(1, edges.len().saturating_sub(1).max(1))
+}
+
+/// The output-error sum of squares of `model` at `theta` over output 0 of every experiment.
+pub fn true_cost(model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<f64> {
+    let mut total = 0.0;
+    for (e, exp) in data.experiments().iter().enumerate() {
+        let mut y = vec![vec![0.0; exp.len()]];
+        model.simulate(theta, data, e, &mut y)?;
+        total += exp
+            .output(0)
+            .iter()
+            .zip(&y[0])
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>();
+    }
+    Ok(total)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn truncated_normal_limits() {
+        // Wide normal over a narrow interval: uniform, mean the midpoint, std width/√12.
+        let (m, s) = truncated_normal(1.0, 100.0, 1.0, 1.2);
+        assert!(
+            (m - 1.1).abs() < 1e-4 && (s - 0.2 / 12f64.sqrt()).abs() < 1e-4,
+            "{m} {s}"
+        );
+        // Narrow normal inside a wide interval: untouched.
+        let (m, s) = truncated_normal(1.0, 1e-3, 0.0, 2.0);
+        assert!((m - 1.0).abs() < 1e-12 && (s - 1e-3).abs() < 1e-9);
+        // Half-infinite interval: the half-normal mean s·√(2/π).
+        let (m, _) = truncated_normal(0.0, 1.0, 0.0, f64::INFINITY);
+        assert!((m - (2.0 / std::f64::consts::PI).sqrt()).abs() < 1e-6);
+        assert!((normal_cdf(1.0) - 0.841_344_746).abs() < 1e-7);
+    }
+}

@@ -1,0 +1,131 @@
+//! Nonlinear grey-box models: continuous-time state-space models with physical parameters
+//! (MATLAB's `idnlgrey`), their simulation and their output-error estimation.
+//!
+//! A model implements [`StateSpaceModel`]:
+//!
+//! ```text
+//! ẋ(t) = f(t, x(t), u(t), θ)        y(t) = h(x(t), u(t), θ)
+//! ```
+//!
+//! with named states, inputs, outputs and parameters (value, unit, bounds, fixed flag), and
+//! optionally the analytic Jacobians ∂f/∂x, ∂f/∂θ, ∂h/∂x, ∂h/∂θ. With them, the estimator
+//! integrates the forward sensitivity equations Ṡ = (∂f/∂x)S + ∂f/∂θ alongside the states,
+//! which gives the exact derivative of the discretised simulation; without them it uses
+//! finite differences, one simulation per free parameter, in parallel.
+//!
+//! * [`simulate`]: integrators (RK4 with sub-steps, Newmark, adaptive Dormand–Prince) and the
+//!   input interpolation between samples.
+//! * [`stick_slip`]: RK4 steps that integrate Coulomb friction as stick–slip.
+//!
+//! Binding a model to data and estimating its parameters is the identify layer's
+//! ([`crate::identify::greybox`]).
+//! * [`models`]: the built-in models (Bouc–Wen oscillator, rigid body with friction).
+
+pub mod models;
+pub mod simulate;
+pub mod stick_slip;
+
+pub use simulate::{InputInterpolation, Integrator, Simulation};
+
+use crate::data::Channel;
+use crate::model::ParameterSet;
+
+/// A continuous-time state-space model with physical parameters.
+pub trait StateSpaceModel: Sync + Send {
+    /// The kind written in model files (`bouc_wen`, `rigid_body`, …).
+    fn kind(&self) -> &'static str;
+
+    /// The states, with units.
+    fn states(&self) -> Vec<Channel>;
+
+    /// The inputs, with units.
+    fn inputs(&self) -> Vec<Channel>;
+
+    /// The outputs, with units.
+    fn outputs(&self) -> Vec<Channel>;
+
+    /// The parameters with default values, units, bounds and fixed flags.
+    fn parameters(&self) -> ParameterSet;
+
+    /// ẋ = f(t, x, u, θ), written into `dx`.
+    fn rhs(&self, t: f64, x: &[f64], u: &[f64], theta: &[f64], dx: &mut [f64]);
+
+    /// y = h(x, u, θ), written into `y`.
+    fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]);
+
+    /// ∂f/∂x (n × n) and ∂f/∂θ (n × p), row-major, written into `fx` and `ftheta`; returns
+    /// false when the model does not provide them (the default).
+    fn rhs_jacobians(
+        &self,
+        _t: f64,
+        _x: &[f64],
+        _u: &[f64],
+        _theta: &[f64],
+        _fx: &mut [f64],
+        _ftheta: &mut [f64],
+    ) -> bool {
+        false
+    }
+
+    /// ∂h/∂x (n_y × n) and ∂h/∂θ (n_y × p), row-major; false when not provided.
+    fn output_jacobians(
+        &self,
+        _x: &[f64],
+        _u: &[f64],
+        _theta: &[f64],
+        _hx: &mut [f64],
+        _htheta: &mut [f64],
+    ) -> bool {
+        false
+    }
+
+    /// For second-order mechanical models, the number of degrees of freedom n: the first n
+    /// states are positions, the next n their velocities (ẋᵢ = x_{n+i}). Newmark
+    /// integration needs this layout.
+    fn mechanical_dofs(&self) -> Option<usize> {
+        None
+    }
+
+    /// For models with Coulomb friction: the index of the velocity state whose sign the
+    /// friction follows. RK4 then integrates stick–slip ([`stick_slip`]): a step that starts
+    /// sliding holds the friction direction ([`rhs_sliding`](Self::rhs_sliding)) and is cut
+    /// where the velocity reaches zero; at exactly zero velocity [`rhs`](Self::rhs) decides
+    /// between sticking and breaking away, so `rhs` must implement friction at rest as the
+    /// force that holds the body, clamp(applied, −Fc, Fc) ([`models::coulomb_direction`]).
+    /// None (the default) for smooth models.
+    fn stick_slip_velocity(&self) -> Option<usize> {
+        None
+    }
+
+    /// [`rhs`](Self::rhs) with the Coulomb friction held in `direction` (±1) whatever the sign
+    /// of the velocity, so that no stage of a sliding step sees the friction flip. Models that
+    /// name a [`stick_slip_velocity`](Self::stick_slip_velocity) must implement it; the
+    /// default is `rhs`.
+    fn rhs_sliding(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        _direction: f64,
+        dx: &mut [f64],
+    ) {
+        self.rhs(t, x, u, theta, dx);
+    }
+
+    /// [`rhs_jacobians`](Self::rhs_jacobians) with the Coulomb friction held in `direction`
+    /// (see [`rhs_sliding`](Self::rhs_sliding)); the default is `rhs_jacobians`.
+    #[allow(clippy::too_many_arguments)]
+    fn rhs_jacobians_sliding(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        _direction: f64,
+        fx: &mut [f64],
+        ftheta: &mut [f64],
+    ) -> bool {
+        self.rhs_jacobians(t, x, u, theta, fx, ftheta)
+    }
+}

@@ -1,0 +1,583 @@
+//! Fitted models and the saved-model file `hysid.model/1`.
+//!
+//! A fitted model is what an estimator returns and what `hysid simulate` loads: the model with
+//! its parameter values, standard deviations, units, bounds and fixed flags. The same JSON
+//! object is the `model` key of every report (`hysid.report/1`), so a report is also a model
+//! file:
+//!
+//! ```json
+//! {"schema": "hysid.model/1", "kind": "ch_cascade", "hysteresis": "ch4", "delay": 1,
+//!  "parameters": [
+//!    {"name": "alpha", "value": 0.3, "std": 0.001, "unit": "", "fixed": false,
+//!     "lower": 0.0, "upper": null},
+//!    {"name": "b1", "value": 1.0, "std": null, "unit": "", "fixed": true,
+//!     "lower": null, "upper": null}, …]}
+//! ```
+//!
+//! `parameters` is a flat list in the model's order: `std` is null where the parameter was not
+//! estimated (fixed, or unknown), `lower`/`upper` null where unbounded. Kinds and their
+//! structure keys:
+//!
+//! | kind | structure | parameters |
+//! |---|---|---|
+//! | `coleman_hodgdon` | `hysteresis` (`ch4`/`ch6`), `initial_output` (`measured`/`zero`) | α, m₁, c₁, d (ch6: and m₂, c₂) |
+//! | `ch_cascade` | `hysteresis`, `delay` | hysteresis, then b₁ (fixed at 1) … b_m, a₁ … a_n |
+//! | `bouc_wen`, `rigid_body`, `actuator_fixed`, `actuator_free` | `simulation`, `initial_state` | the grey-box model's |
+//!
+//! `simulation` saves the integrator faithfully: `{"integrator": "rk4", "substeps": 10,
+//! "interpolation": "zero_order_hold"}`, `newmark` with `substeps`, or `dopri5` with `rtol`
+//! and `atol`.
+
+use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
+use crate::model::greybox::simulate::{simulate as simulate_state_space, InputTrack};
+use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
+use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
+use crate::model::{Parameter, ParameterSet};
+use crate::{Error, Result};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The schema tag of a saved model.
+pub const MODEL_SCHEMA: &str = "hysid.model/1";
+
+/// One parameter of a saved model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ParameterRecord {
+    /// The literature's symbol (`alpha`, `m1`, `a1`, `b2`, `mL`, …).
+    pub name: String,
+    /// The value.
+    pub value: f64,
+    /// One standard deviation; null where the parameter was not estimated.
+    pub std: Option<f64>,
+    /// The unit ("" when dimensionless or unknown).
+    pub unit: String,
+    /// True when the value was held, not estimated.
+    pub fixed: bool,
+    /// Lower bound; null when unbounded.
+    pub lower: Option<f64>,
+    /// Upper bound; null when unbounded.
+    pub upper: Option<f64>,
+}
+
+impl ParameterRecord {
+    /// The record of `p` with standard deviation `std` (NaN, or a fixed parameter, gives null).
+    pub fn of(p: &Parameter, std: f64) -> Self {
+        Self {
+            name: p.name.clone(),
+            value: p.value,
+            std: (!p.fixed && std.is_finite()).then_some(std),
+            unit: p.unit.clone(),
+            fixed: p.fixed,
+            lower: p.min.is_finite().then_some(p.min),
+            upper: p.max.is_finite().then_some(p.max),
+        }
+    }
+
+    /// The parameter this record describes.
+    pub fn parameter(&self) -> Parameter {
+        Parameter::new(self.name.clone(), self.value)
+            .unit(self.unit.clone())
+            .bounds(
+                self.lower.unwrap_or(f64::NEG_INFINITY),
+                self.upper.unwrap_or(f64::INFINITY),
+            )
+            .fixed(self.fixed)
+    }
+
+    /// The standard deviation as a number (NaN when null).
+    pub fn std_or_nan(&self) -> f64 {
+        self.std.unwrap_or(f64::NAN)
+    }
+}
+
+/// The saved-model file `hysid.model/1` (see the module docs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// Always `hysid.model/1`.
+    pub schema: String,
+    /// The model kind (see the module docs).
+    pub kind: String,
+    /// The parameters in the model's order.
+    pub parameters: Vec<ParameterRecord>,
+    /// `ch4` or `ch6` (Coleman–Hodgdon kinds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hysteresis: Option<ChForm>,
+    /// Delay k of the linear block (cascade).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delay: Option<usize>,
+    /// Where the output of the hysteresis alone starts.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_output: Option<InitialOutput>,
+    /// How a grey-box model is simulated.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<SimulationSpec>,
+    /// Initial state of a grey-box model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_state: Option<Vec<f64>>,
+}
+
+/// The simulation settings in a model file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// `rk4`, `newmark` or `dopri5`.
+    pub integrator: String,
+    /// Sub-steps per sample (`rk4`, `newmark`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub substeps: Option<usize>,
+    /// Relative tolerance (`dopri5`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance (`dopri5`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atol: Option<f64>,
+    /// Input interpolation between samples.
+    pub interpolation: InputInterpolation,
+}
+
+/// The largest number of sub-steps a model file may ask for: beyond it a simulation of an
+/// ordinary record takes hours, and the file is more likely corrupt than meant.
+pub const MAX_SUBSTEPS: usize = 10_000;
+
+impl SimulationSpec {
+    /// The spec of a simulation, saved faithfully.
+    pub fn of(sim: &Simulation) -> Self {
+        let (integrator, substeps, rtol, atol) = match sim.integrator {
+            Integrator::Rk4 { substeps } => ("rk4", Some(substeps), None, None),
+            Integrator::Newmark { substeps } => ("newmark", Some(substeps), None, None),
+            Integrator::Adaptive { rtol, atol } => ("dopri5", None, Some(rtol), Some(atol)),
+        };
+        Self {
+            integrator: integrator.into(),
+            substeps,
+            rtol,
+            atol,
+            interpolation: sim.interpolation,
+        }
+    }
+
+    /// The simulation settings, checked.
+    pub fn simulation(&self) -> Result<Simulation> {
+        let substeps = || match self.substeps {
+            Some(n) if (1..=MAX_SUBSTEPS).contains(&n) => Ok(n),
+            Some(n) => Err(Error::Config(format!(
+                "substeps {n} is outside 1..={MAX_SUBSTEPS}"
+            ))),
+            None => Err(Error::Config(format!(
+                "the {} integrator needs \"substeps\"",
+                self.integrator
+            ))),
+        };
+        let tolerance = |name: &str, v: Option<f64>| match v {
+            Some(t) if t.is_finite() && t > 0.0 => Ok(t),
+            _ => Err(Error::Config(format!(
+                "the dopri5 integrator needs a positive finite \"{name}\""
+            ))),
+        };
+        let integrator = match self.integrator.as_str() {
+            "rk4" => Integrator::Rk4 {
+                substeps: substeps()?,
+            },
+            "newmark" => Integrator::Newmark {
+                substeps: substeps()?,
+            },
+            "dopri5" => Integrator::Adaptive {
+                rtol: tolerance("rtol", self.rtol)?,
+                atol: tolerance("atol", self.atol)?,
+            },
+            other => {
+                return Err(Error::Config(format!(
+                    "unknown integrator '{other}'; use rk4, newmark or dopri5"
+                )))
+            }
+        };
+        Ok(Simulation {
+            integrator,
+            interpolation: self.interpolation,
+        })
+    }
+}
+/// A fitted model that can simulate.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FittedModel {
+    /// The hysteresis alone.
+    Hysteresis {
+        /// The model.
+        model: ColemanHodgdon,
+        /// Where its output starts.
+        initial: InitialOutput,
+        /// Standard deviations in [`ChForm::parameter_names`] order.
+        std: Vec<f64>,
+    },
+    /// The cascade.
+    Cascade {
+        /// The model.
+        model: HysteresisCascade,
+        /// Standard deviations in [`HysteresisCascade::params`] order.
+        std: Vec<f64>,
+    },
+    /// A built-in grey-box model.
+    GreyBox {
+        /// Its kind (`bouc_wen`, `rigid_body`).
+        kind: String,
+        /// Its parameters (values, units, bounds, fixed flags).
+        parameters: ParameterSet,
+        /// Their standard deviations.
+        std: Vec<f64>,
+        /// How it is simulated.
+        simulation: Simulation,
+        /// Its initial state.
+        initial_state: Vec<f64>,
+    },
+}
+
+impl FittedModel {
+    /// Simulates the model's outputs for the input channels `inputs` sampled every `ts`;
+    /// `y0` is the measured initial output (used by a hysteresis with
+    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges.
+    pub fn simulate(&self, inputs: &[&[f64]], ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let first = || {
+            inputs
+                .first()
+                .copied()
+                .ok_or_else(|| Error::Config("no input channel given".into()))
+        };
+        match self {
+            FittedModel::Hysteresis { model, initial, .. } => {
+                let x = first()?;
+                model.check_rate(x)?;
+                let v0 = match initial {
+                    InitialOutput::Measured => y0.ok_or_else(|| {
+                        Error::Config(
+                            "this hysteresis starts from the measured output; give the output column (--output)"
+                                .into(),
+                        )
+                    })?,
+                    InitialOutput::Zero => 0.0,
+                };
+                Ok(vec![simulate_switched(model, x, v0, None)])
+            }
+            FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::GreyBox {
+                kind,
+                parameters,
+                simulation,
+                initial_state,
+                ..
+            } => {
+                let model = models::by_kind(kind)?;
+                if inputs.len() != model.inputs().len() {
+                    return Err(Error::Config(format!(
+                        "the {kind} model has {} input(s), {} given",
+                        model.inputs().len(),
+                        inputs.len()
+                    )));
+                }
+                let track = InputTrack::new(inputs, simulation)?;
+                let theta = parameters.values();
+                let mut outputs = vec![Vec::with_capacity(track.len()); model.outputs().len()];
+                let (mut u, mut y) = (vec![0.0; inputs.len()], vec![0.0; outputs.len()]);
+                simulate_state_space(
+                    model.as_ref(),
+                    &theta,
+                    initial_state,
+                    &track,
+                    ts,
+                    simulation.integrator,
+                    |k, x| {
+                        track.at(k, 0.0, &mut u);
+                        model.output(x, &u, &theta, &mut y);
+                        for (o, v) in outputs.iter_mut().zip(&y) {
+                            o.push(*v);
+                        }
+                    },
+                )?;
+                Ok(outputs)
+            }
+        }
+    }
+
+    /// The model file of this model.
+    pub fn to_file(&self) -> ModelFile {
+        let empty = |kind: &str, parameters: Vec<ParameterRecord>| ModelFile {
+            schema: MODEL_SCHEMA.into(),
+            kind: kind.into(),
+            parameters,
+            hysteresis: None,
+            delay: None,
+            initial_output: None,
+            simulation: None,
+            initial_state: None,
+        };
+        match self {
+            FittedModel::Hysteresis {
+                model,
+                initial,
+                std,
+            } => ModelFile {
+                hysteresis: Some(model.form()),
+                initial_output: Some(*initial),
+                ..empty("coleman_hodgdon", hysteresis_records(model, std))
+            },
+            FittedModel::Cascade { model, std } => ModelFile {
+                hysteresis: Some(model.hysteresis.form()),
+                delay: Some(model.linear.delay()),
+                ..empty("ch_cascade", cascade_records(model, std))
+            },
+            FittedModel::GreyBox {
+                kind,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+            } => ModelFile {
+                simulation: Some(SimulationSpec::of(simulation)),
+                initial_state: Some(initial_state.clone()),
+                ..empty(
+                    kind,
+                    parameters
+                        .iter()
+                        .zip(std)
+                        .map(|(p, s)| ParameterRecord::of(p, *s))
+                        .collect(),
+                )
+            },
+        }
+    }
+
+    /// Rebuilds a fitted model from a model file, checking every value.
+    pub fn from_file(file: &ModelFile) -> Result<Self> {
+        if file.schema != MODEL_SCHEMA {
+            return Err(Error::Config(format!(
+                "schema '{}' is not {MODEL_SCHEMA}; save the model again with this version",
+                file.schema
+            )));
+        }
+        if let Some(p) = file.parameters.iter().find(|p| !p.value.is_finite()) {
+            return Err(Error::Config(format!(
+                "parameter '{}' has no finite value",
+                p.name
+            )));
+        }
+        match file.kind.as_str() {
+            "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
+            kind => Self::grey_box_from_file(kind, file),
+        }
+    }
+
+    fn coleman_hodgdon_from_file(file: &ModelFile) -> Result<Self> {
+        let form = file.hysteresis.ok_or_else(|| {
+            Error::Config(format!(
+                "a {} model needs \"hysteresis\": \"ch4\" or \"ch6\"",
+                file.kind
+            ))
+        })?;
+        let mut values = Vec::new();
+        let mut std = Vec::new();
+        for name in form.parameter_names() {
+            let e = record(file, name)?;
+            values.push(e.value);
+            std.push(e.std_or_nan());
+        }
+        let hysteresis = ColemanHodgdon::from_params(form, &values)?;
+        if file.kind == "coleman_hodgdon" {
+            return Ok(FittedModel::Hysteresis {
+                model: hysteresis,
+                initial: file.initial_output.unwrap_or(InitialOutput::Measured),
+                std,
+            });
+        }
+        let b = coefficients(file, 'b')?;
+        let a = coefficients(file, 'a')?;
+        if b.is_empty() || b[0].value != 1.0 {
+            return Err(Error::Config(
+                "a ch_cascade model needs b1 = 1 (the gain sits in the hysteresis)".into(),
+            ));
+        }
+        let delay = file
+            .delay
+            .ok_or_else(|| Error::Config("a ch_cascade model needs \"delay\"".into()))?;
+        let linear = LinearBlock::new(
+            a.iter().map(|e| e.value).collect(),
+            b.iter().map(|e| e.value).collect(),
+            delay,
+        )?;
+        std.extend(b.iter().skip(1).map(ParameterRecord::std_or_nan));
+        std.extend(a.iter().map(ParameterRecord::std_or_nan));
+        Ok(FittedModel::Cascade {
+            model: HysteresisCascade::new(hysteresis, linear)?,
+            std,
+        })
+    }
+
+    fn grey_box_from_file(kind: &str, file: &ModelFile) -> Result<Self> {
+        let model = models::by_kind(kind).map_err(|_| {
+            Error::Config(format!(
+                "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed and actuator_free"
+            ))
+        })?;
+        let mut parameters = model.parameters();
+        let mut std = Vec::new();
+        for i in 0..parameters.len() {
+            let e = record(file, &parameters.get(i).name.clone())?;
+            *parameters.get_mut(i) = e.parameter();
+            std.push(e.std_or_nan());
+        }
+        parameters.validate()?;
+        let n = model.states().len();
+        let initial_state = file.initial_state.clone().unwrap_or_else(|| vec![0.0; n]);
+        if initial_state.len() != n || initial_state.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Config(format!(
+                "\"initial_state\" needs {n} finite values for the {kind} model"
+            )));
+        }
+        let simulation = file
+            .simulation
+            .as_ref()
+            .map_or(Ok(Simulation::default()), SimulationSpec::simulation)?;
+        Ok(FittedModel::GreyBox {
+            kind: kind.to_string(),
+            parameters,
+            std,
+            simulation,
+            initial_state,
+        })
+    }
+
+    /// Reads a model file, or the `model` object of a report.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let bad = |message: String| Error::ModelFile {
+            path: path.to_path_buf(),
+            message,
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(format!("not JSON: {e}")))?;
+        let object = match value.get("schema").and_then(|s| s.as_str()) {
+            Some(s) if s.starts_with("hysid.report/") => value
+                .get("model")
+                .cloned()
+                .ok_or_else(|| bad("this report holds no model (its \"model\" is null)".into()))?,
+            _ => value,
+        };
+        if object.is_null() {
+            return Err(bad(
+                "this report holds no model (its \"model\" is null)".into()
+            ));
+        }
+        let file: ModelFile = serde_json::from_value(object)
+            .map_err(|e| bad(format!("not a {MODEL_SCHEMA} model file: {e}")))?;
+        Self::from_file(&file).map_err(|e| bad(e.to_string()))
+    }
+}
+
+fn hysteresis_records(model: &ColemanHodgdon, std: &[f64]) -> Vec<ParameterRecord> {
+    model
+        .form()
+        .parameter_names()
+        .iter()
+        .zip(model.params().iter().zip(std))
+        .map(|(name, (v, s))| ParameterRecord::of(&Parameter::new(*name, *v), *s))
+        .collect()
+}
+
+fn cascade_records(model: &HysteresisCascade, std: &[f64]) -> Vec<ParameterRecord> {
+    let nh = model.hysteresis.form().n_params();
+    let nb = model.linear.nb();
+    let mut records = hysteresis_records(&model.hysteresis, &std[..nh]);
+    records.push(ParameterRecord::of(
+        &Parameter::new("b1", 1.0).fixed(true),
+        f64::NAN,
+    ));
+    let b = model.linear.b()[1..].iter().zip(&std[nh..nh + nb - 1]);
+    records
+        .extend(b.enumerate().map(|(j, (v, s))| {
+            ParameterRecord::of(&Parameter::new(format!("b{}", j + 2), *v), *s)
+        }));
+    let a = model.linear.a().iter().zip(&std[nh + nb - 1..]);
+    records
+        .extend(a.enumerate().map(|(i, (v, s))| {
+            ParameterRecord::of(&Parameter::new(format!("a{}", i + 1), *v), *s)
+        }));
+    records
+}
+
+fn record<'a>(file: &'a ModelFile, name: &str) -> Result<&'a ParameterRecord> {
+    file.parameters
+        .iter()
+        .find(|p| p.name == name)
+        .ok_or_else(|| {
+            Error::Config(format!(
+                "parameter '{name}' is missing from the {} model",
+                file.kind
+            ))
+        })
+}
+
+/// The coefficients `<letter>1`, `<letter>2`, … in order (none missing in between).
+fn coefficients(file: &ModelFile, letter: char) -> Result<Vec<ParameterRecord>> {
+    let mut found: Vec<(usize, &ParameterRecord)> = file
+        .parameters
+        .iter()
+        .filter_map(|p| {
+            let rest = p.name.strip_prefix(letter)?;
+            rest.parse::<usize>().ok().map(|k| (k, p))
+        })
+        .collect();
+    found.sort_by_key(|(k, _)| *k);
+    for (i, (k, _)) in found.iter().enumerate() {
+        if *k != i + 1 {
+            return Err(Error::Config(format!(
+                "coefficient {letter}{} is missing from the ch_cascade model",
+                i + 1
+            )));
+        }
+    }
+    Ok(found.into_iter().map(|(_, p)| p.clone()).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::voros::CascadeExample;
+
+    #[test]
+    fn cascade_round_trips_through_json() {
+        let truth = CascadeExample::example2().truth;
+        let std: Vec<f64> = (0..truth.params().len())
+            .map(|i| 0.01 * (i + 1) as f64)
+            .collect();
+        let fitted = FittedModel::Cascade { model: truth, std };
+        let json = serde_json::to_string(&fitted.to_file()).unwrap();
+        assert!(
+            json.contains("\"kind\":\"ch_cascade\"")
+                && json.contains("\"hysteresis\":\"ch6\"")
+                && json.contains("\"schema\":\"hysid.model/1\"")
+        );
+        let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
+        assert_eq!(back, fitted);
+    }
+
+    #[test]
+    fn unknown_std_is_null() {
+        let model = ColemanHodgdon::saturated(0.3, 1.0, 0.5, 3.0).unwrap();
+        let fitted = FittedModel::Hysteresis {
+            model,
+            initial: InitialOutput::Zero,
+            std: vec![f64::NAN, 0.1, 0.1, 0.1],
+        };
+        let json = serde_json::to_string(&fitted.to_file()).unwrap();
+        assert!(json.contains("\"std\":null"), "{json}");
+        let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
+        let FittedModel::Hysteresis { std, .. } = back else {
+            panic!()
+        };
+        assert!(std[0].is_nan());
+    }
+}

@@ -1,0 +1,484 @@
+//! The report every command writes: `hysid.report/1`.
+//!
+//! One typed [`Report`] (serde both ways, JSON Schema generated from the types by
+//! [`report_schema`]) with the same top-level keys for every command:
+//!
+//! | key | content |
+//! |---|---|
+//! | `schema` | `"hysid.report/1"` |
+//! | `command` | the command that wrote it, e.g. `"identify cascade"` |
+//! | `version` | hysid's version |
+//! | `data` | [`DataSummary`]: source files, samples, experiments, sample time |
+//! | `model` | the saved-model object ([`ModelFile`], `hysid.model/1`) |
+//! | `fit` | [`FitSummary`]: fit %, RMSE, loss, FPE, AIC, and per experiment |
+//! | `search` | [`SearchSummary`]: iterations, evaluations, termination `{code, message}`, elapsed |
+//! | `uncertainty` | [`UncertaintySummary`]: how the standard deviations were obtained |
+//! | `validation` | [`ValidationEntry`] per validation/test record |
+//! | `details` | command-specific (documented per command in `docs/report.md`) |
+//!
+//! A key that does not apply is `null` (an empty list for `validation`), never missing.
+//! Multi-step commands put each step's report in `details.steps`, each a `Report` itself.
+//!
+//! fit % is the normalised RMSE fit 100 (1 − ‖y − ŷ‖ / ‖y − ȳ‖) of MATLAB's `compare`;
+//! FPE and AIC are Akaike's (Ljung, *System Identification*, 2nd ed., 1999, §16.4).
+
+use crate::data::IdData;
+use crate::identify::OutputErrorFit;
+use crate::model::saved::ModelFile;
+use crate::numerics::{metrics, LmReport, Termination};
+use crate::{Error, Result};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The schema tag of a report.
+pub const REPORT_SCHEMA: &str = "hysid.report/1";
+
+/// The report of one command (see the module docs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Report {
+    /// Always `hysid.report/1`.
+    pub schema: String,
+    /// The command that wrote the report (`identify cascade`, `greybox fit`, …).
+    pub command: String,
+    /// hysid's version.
+    pub version: String,
+    /// The data the command read or made.
+    pub data: Option<DataSummary>,
+    /// The fitted or simulated model (`hysid.model/1`).
+    pub model: Option<ModelFile>,
+    /// How well the model's simulated output fits the data.
+    pub fit: Option<FitSummary>,
+    /// How the search went.
+    pub search: Option<SearchSummary>,
+    /// How the standard deviations were obtained.
+    pub uncertainty: Option<UncertaintySummary>,
+    /// One entry per validation or test record.
+    pub validation: Vec<ValidationEntry>,
+    /// Command-specific details (null when there are none).
+    pub details: serde_json::Value,
+}
+
+/// The data a command read or made.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DataSummary {
+    /// The files (or built-in generators) the data came from.
+    pub source: Vec<String>,
+    /// Samples over all experiments.
+    pub samples: usize,
+    /// Experiments.
+    pub experiments: usize,
+    /// Sample time in seconds.
+    pub ts: Option<f64>,
+}
+
+impl DataSummary {
+    /// The summary of `data` read from `source`.
+    pub fn of(data: &IdData, source: Vec<String>) -> Self {
+        Self {
+            source,
+            samples: data.n_samples(),
+            experiments: data.n_experiments(),
+            ts: Some(data.ts()),
+        }
+    }
+}
+
+/// How well a model's simulated output fits measured data.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct FitSummary {
+    /// fit % over all experiments, stacked.
+    pub fit_percent: f64,
+    /// Root-mean-square error over all experiments.
+    pub rmse: f64,
+    /// The estimator's loss V (mean squared weighted residual); null for a plain simulation.
+    pub loss: Option<f64>,
+    /// Akaike's final prediction error.
+    pub fpe: Option<f64>,
+    /// Akaike's information criterion.
+    pub aic: Option<f64>,
+    /// Per experiment.
+    pub per_experiment: Vec<ExperimentFit>,
+}
+
+/// The fit of one experiment.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentFit {
+    /// The experiment's name.
+    pub experiment: String,
+    /// Samples.
+    pub samples: usize,
+    /// fit %.
+    pub fit_percent: f64,
+    /// RMSE.
+    pub rmse: f64,
+}
+
+impl FitSummary {
+    /// The fit of simulated outputs `yhat` against measured `y`, one pair per experiment
+    /// (`names` name them); errors when a figure is not finite (the simulation failed).
+    pub fn of(names: &[String], y: &[&[f64]], yhat: &[&[f64]]) -> Result<Self> {
+        let stacked = |s: &[&[f64]]| s.iter().flat_map(|v| v.iter().copied()).collect();
+        let (ys, yhs): (Vec<f64>, Vec<f64>) = (stacked(y), stacked(yhat));
+        let per_experiment = names
+            .iter()
+            .zip(y.iter().zip(yhat))
+            .map(|(name, (y, yh))| ExperimentFit {
+                experiment: name.clone(),
+                samples: y.len(),
+                fit_percent: metrics::fit_percent(y, yh),
+                rmse: metrics::rmse(y, yh),
+            })
+            .collect();
+        let summary = Self {
+            fit_percent: metrics::fit_percent(&ys, &yhs),
+            rmse: metrics::rmse(&ys, &yhs),
+            loss: None,
+            fpe: None,
+            aic: None,
+            per_experiment,
+        };
+        summary.check()?;
+        Ok(summary)
+    }
+
+    /// The fit of output 0 of an output-error fit on `data`, with its loss, FPE and AIC.
+    pub fn of_output_error(fit: &OutputErrorFit, data: &IdData) -> Result<Self> {
+        let names: Vec<String> = data.experiments().iter().map(|e| e.name.clone()).collect();
+        let y: Vec<&[f64]> = data.experiments().iter().map(|e| e.output(0)).collect();
+        let yhat: Vec<&[f64]> = fit.simulated.iter().map(|s| s[0].as_slice()).collect();
+        let mut summary = Self::of(&names, &y, &yhat)?;
+        summary.loss = Some(fit.loss);
+        summary.fpe = fit.fpe.is_finite().then_some(fit.fpe);
+        summary.aic = fit.aic.is_finite().then_some(fit.aic);
+        summary.check()?;
+        Ok(summary)
+    }
+
+    fn check(&self) -> Result<()> {
+        let figures = [Some(self.fit_percent), Some(self.rmse), self.loss];
+        let experiments = self
+            .per_experiment
+            .iter()
+            .flat_map(|e| [Some(e.fit_percent), Some(e.rmse)]);
+        if figures
+            .into_iter()
+            .chain(experiments)
+            .flatten()
+            .all(f64::is_finite)
+        {
+            Ok(())
+        } else {
+            Err(Error::Config(
+                "the model's simulated output is not finite on these data: the model is unstable or the data are outside its range".into(),
+            ))
+        }
+    }
+}
+
+/// How a search went.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SearchSummary {
+    /// Iterations.
+    pub iterations: usize,
+    /// Criterion evaluations (simulations).
+    pub evaluations: usize,
+    /// Why the search stopped.
+    pub termination: TerminationSummary,
+    /// Wall-clock seconds.
+    pub elapsed_s: f64,
+}
+
+/// Why a search stopped: a stable code and a sentence.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct TerminationSummary {
+    /// `max_iterations`, `improvement_below_tolerance`, `step_below_tolerance`,
+    /// `gradient_below_tolerance`, `zero_residual`, `no_descent`, `stopped`,
+    /// `nothing_to_estimate`, `converged`, `diverged`, or `direct` for a direct solve.
+    pub code: String,
+    /// The reason in words.
+    pub message: String,
+    /// True when the reason means the search reached a (local) optimum.
+    pub converged: bool,
+}
+
+impl TerminationSummary {
+    /// The summary of `termination`.
+    pub fn of(termination: &Termination) -> Self {
+        let code = serde_json::to_value(termination)
+            .ok()
+            .and_then(|v| v.get("code").and_then(|c| c.as_str()).map(String::from))
+            .unwrap_or_else(|| "unknown".into());
+        Self {
+            code,
+            message: termination.to_string(),
+            converged: termination.converged(),
+        }
+    }
+
+    /// A direct (non-iterative) solve, such as linear least squares.
+    pub fn direct() -> Self {
+        Self {
+            code: "direct".into(),
+            message: "direct solve (no iterations)".into(),
+            converged: true,
+        }
+    }
+}
+
+impl SearchSummary {
+    /// The summary of a Levenberg–Marquardt report, timed over `elapsed_s`.
+    pub fn of(report: &LmReport, elapsed_s: f64) -> Self {
+        Self {
+            iterations: report.iterations,
+            evaluations: report.function_evaluations,
+            termination: TerminationSummary::of(&report.termination),
+            elapsed_s,
+        }
+    }
+
+    /// A direct solve that took `elapsed_s`.
+    pub fn direct(elapsed_s: f64) -> Self {
+        Self {
+            iterations: 0,
+            evaluations: 1,
+            termination: TerminationSummary::direct(),
+            elapsed_s,
+        }
+    }
+}
+
+/// How the standard deviations were obtained.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct UncertaintySummary {
+    /// `asymptotic` (σ²(JᵀJ)⁻¹ at the estimate), `bootstrap` (parametric bootstrap with
+    /// re-identification), `least_squares` (the covariance of a linear regression) or `none`.
+    pub method: String,
+    /// Bootstrap replicates.
+    pub replicates: Option<usize>,
+    /// Bootstrap replicates that failed to identify.
+    pub failed: Option<usize>,
+}
+
+impl UncertaintySummary {
+    /// Asymptotic standard deviations.
+    pub fn asymptotic() -> Self {
+        Self::named("asymptotic")
+    }
+
+    /// Standard deviations of a linear regression.
+    pub fn least_squares() -> Self {
+        Self::named("least_squares")
+    }
+
+    /// A parametric bootstrap of `replicates` replicates, `failed` of which failed.
+    pub fn bootstrap(replicates: usize, failed: usize) -> Self {
+        Self {
+            method: "bootstrap".into(),
+            replicates: Some(replicates),
+            failed: Some(failed),
+        }
+    }
+
+    fn named(method: &str) -> Self {
+        Self {
+            method: method.into(),
+            replicates: None,
+            failed: None,
+        }
+    }
+}
+
+/// The model's figures on one validation or test record.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ValidationEntry {
+    /// The record's source.
+    pub source: String,
+    /// Samples scored.
+    pub samples: usize,
+    /// fit %.
+    pub fit_percent: f64,
+    /// RMSE.
+    pub rmse: f64,
+    /// The benchmark's error measure where one defines it (Bouc–Wen: e_RMS).
+    pub e_rms: Option<f64>,
+}
+
+impl ValidationEntry {
+    /// The figures of simulated `yhat` against measured `y` from `source`.
+    pub fn of(source: String, y: &[f64], yhat: &[f64], e_rms: Option<f64>) -> Result<Self> {
+        let entry = Self {
+            source,
+            samples: y.len(),
+            fit_percent: metrics::fit_percent(y, yhat),
+            rmse: metrics::rmse(y, yhat),
+            e_rms,
+        };
+        if entry.fit_percent.is_finite()
+            && entry.rmse.is_finite()
+            && entry.e_rms.is_none_or(f64::is_finite)
+        {
+            Ok(entry)
+        } else {
+            Err(Error::Config(format!(
+                "the model's output on {} is not finite: the model is unstable or the data are outside its range",
+                entry.source
+            )))
+        }
+    }
+}
+
+impl Report {
+    /// An empty report of `command`: every key present, null where nothing is filled in.
+    pub fn new(command: &str) -> Self {
+        Self {
+            schema: REPORT_SCHEMA.into(),
+            command: command.into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+            data: None,
+            model: None,
+            fit: None,
+            search: None,
+            uncertainty: None,
+            validation: Vec::new(),
+            details: serde_json::Value::Null,
+        }
+    }
+
+    /// The report of an output-error fit of `model` on `data` (read from `source`).
+    pub fn of_output_error(
+        command: &str,
+        data: &IdData,
+        source: Vec<String>,
+        model: ModelFile,
+        fit: &OutputErrorFit,
+        elapsed_s: f64,
+        uncertainty: UncertaintySummary,
+    ) -> Result<Self> {
+        Ok(Self {
+            data: Some(DataSummary::of(data, source)),
+            model: Some(model),
+            fit: Some(FitSummary::of_output_error(fit, data)?),
+            search: Some(SearchSummary::of(&fit.report, elapsed_s)),
+            uncertainty: Some(uncertainty),
+            ..Self::new(command)
+        })
+    }
+
+    /// Sets `details`.
+    pub fn with_details(mut self, details: serde_json::Value) -> Self {
+        self.details = details;
+        self
+    }
+
+    /// The report as pretty JSON, refused when any number in it is not finite (serde would
+    /// write it as null and hide the failure).
+    pub fn to_json(&self) -> Result<String> {
+        self.check_finite()?;
+        serde_json::to_string_pretty(self).map_err(|e| Error::Config(format!("report: {e}")))
+    }
+
+    /// Errors naming the first non-finite number of the fit, search, validation or model.
+    pub fn check_finite(&self) -> Result<()> {
+        let mut bad = Vec::new();
+        if let Some(m) = &self.model {
+            bad.extend(
+                m.parameters
+                    .iter()
+                    .filter(|p| !p.value.is_finite() || p.std.is_some_and(|s| !s.is_finite()))
+                    .map(|p| format!("model parameter {}", p.name)),
+            );
+        }
+        if let Some(f) = &self.fit {
+            if f.check().is_err() {
+                bad.push("fit".into());
+            }
+        }
+        if let Some(s) = &self.search {
+            if !s.elapsed_s.is_finite() {
+                bad.push("search.elapsed_s".into());
+            }
+        }
+        match bad.first() {
+            None => Ok(()),
+            Some(what) => Err(Error::Config(format!(
+                "{what} is not a finite number; the estimate failed numerically"
+            ))),
+        }
+    }
+}
+
+/// The JSON Schema of [`Report`], generated from the types (published in
+/// `docs/schema/hysid.report.v1.json`).
+pub fn report_schema() -> serde_json::Value {
+    serde_json::to_value(schemars::schema_for!(Report)).unwrap_or_default()
+}
+
+/// The JSON Schema of the saved-model file (published in `docs/schema/hysid.model.v1.json`).
+pub fn model_schema() -> serde_json::Value {
+    serde_json::to_value(schemars::schema_for!(ModelFile)).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_empty_report_has_every_key_and_nulls() {
+        let v = serde_json::to_value(Report::new("simulate")).unwrap();
+        let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+        for k in [
+            "schema",
+            "command",
+            "version",
+            "data",
+            "model",
+            "fit",
+            "search",
+            "uncertainty",
+            "validation",
+            "details",
+        ] {
+            assert!(keys.contains(&k), "{k} missing");
+        }
+        assert!(v["fit"].is_null() && v["model"].is_null());
+    }
+
+    #[test]
+    fn published_schemas_are_up_to_date() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/schema");
+        for (file, schema) in [
+            ("hysid.report.v1.json", report_schema()),
+            ("hysid.model.v1.json", model_schema()),
+        ] {
+            let text = serde_json::to_string_pretty(&schema).unwrap() + "\n";
+            let path = root.join(file);
+            if std::env::var_os("HYSID_WRITE_SCHEMA").is_some() {
+                std::fs::create_dir_all(&root).unwrap();
+                std::fs::write(&path, &text).unwrap();
+            }
+            let committed = std::fs::read_to_string(&path).unwrap_or_default();
+            assert_eq!(
+                committed,
+                text,
+                "{} is out of date: run HYSID_WRITE_SCHEMA=1 cargo test -p hysid --lib published_schemas",
+                path.display()
+            );
+        }
+    }
+
+    #[test]
+    fn non_finite_figures_are_refused() {
+        let y = [1.0, 2.0, 3.0];
+        let bad = [1.0, f64::NAN, 3.0];
+        assert!(FitSummary::of(&["e1".into()], &[&y], &[&bad]).is_err());
+        assert!(ValidationEntry::of("t".into(), &y, &bad, None).is_err());
+    }
+}
