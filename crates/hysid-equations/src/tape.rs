@@ -8,15 +8,84 @@
 use crate::dag::{Graph, Id, Op};
 use crate::num::{self, Fn1, Fn2};
 
-/// One instruction; operands are register numbers.
+/// One instruction; operands are register numbers. One variant per operation (rather
+/// than an operation code inside a variant) so that evaluation dispatches once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Instr {
     Neg(u32),
-    Un(Fn1, u32),
-    Bin(Fn2, u32, u32),
+    Sin(u32),
+    Cos(u32),
+    Tan(u32),
+    Exp(u32),
+    Ln(u32),
+    Sqrt(u32),
+    Abs(u32),
+    Sign(u32),
+    Tanh(u32),
+    Atan(u32),
+    FiniteOr0(u32),
+    Add(u32, u32),
+    Sub(u32, u32),
+    Mul(u32, u32),
+    Div(u32, u32),
+    Pow(u32, u32),
+    Min(u32, u32),
+    Max(u32, u32),
+    Lt(u32, u32),
+    Le(u32, u32),
+    Eq(u32, u32),
+    Ne(u32, u32),
+    And(u32, u32),
+    Or(u32, u32),
+    Square(u32),
+    Cube(u32),
     Powi(u32, i32),
     Not(u32),
     Select(u32, u32, u32),
+}
+
+impl Instr {
+    fn unary(f: Fn1, a: u32) -> Instr {
+        match f {
+            Fn1::Sin => Instr::Sin(a),
+            Fn1::Cos => Instr::Cos(a),
+            Fn1::Tan => Instr::Tan(a),
+            Fn1::Exp => Instr::Exp(a),
+            Fn1::Ln => Instr::Ln(a),
+            Fn1::Sqrt => Instr::Sqrt(a),
+            Fn1::Abs => Instr::Abs(a),
+            Fn1::Sign => Instr::Sign(a),
+            Fn1::Tanh => Instr::Tanh(a),
+            Fn1::Atan => Instr::Atan(a),
+            Fn1::FiniteOr0 => Instr::FiniteOr0(a),
+        }
+    }
+
+    fn binary(f: Fn2, a: u32, b: u32) -> Instr {
+        match f {
+            Fn2::Add => Instr::Add(a, b),
+            Fn2::Sub => Instr::Sub(a, b),
+            Fn2::Mul => Instr::Mul(a, b),
+            Fn2::Div => Instr::Div(a, b),
+            Fn2::Pow => Instr::Pow(a, b),
+            Fn2::Min => Instr::Min(a, b),
+            Fn2::Max => Instr::Max(a, b),
+            Fn2::Lt => Instr::Lt(a, b),
+            Fn2::Le => Instr::Le(a, b),
+            Fn2::Eq => Instr::Eq(a, b),
+            Fn2::Ne => Instr::Ne(a, b),
+            Fn2::And => Instr::And(a, b),
+            Fn2::Or => Instr::Or(a, b),
+        }
+    }
+
+    fn power(a: u32, n: i32) -> Instr {
+        match n {
+            2 => Instr::Square(a),
+            3 => Instr::Cube(a),
+            _ => Instr::Powi(a, n),
+        }
+    }
 }
 
 /// A compiled tape.
@@ -80,9 +149,9 @@ impl Tape {
             let instr = match g.nodes[id] {
                 Op::Const(_) | Op::Var(_) => continue,
                 Op::Neg(a) => Instr::Neg(r(a)),
-                Op::Un(f, a) => Instr::Un(f, r(a)),
-                Op::Bin(f, a, b) => Instr::Bin(f, r(a), r(b)),
-                Op::Powi(a, k) => Instr::Powi(r(a), k),
+                Op::Un(f, a) => Instr::unary(f, r(a)),
+                Op::Bin(f, a, b) => Instr::binary(f, r(a), r(b)),
+                Op::Powi(a, k) => Instr::power(r(a), k),
                 Op::Not(a) => Instr::Not(r(a)),
                 Op::Select(c, a, b) => Instr::Select(r(c), r(a), r(b)),
             };
@@ -116,33 +185,53 @@ impl Tape {
     pub fn run(&self, regs: &mut [f64]) {
         let first = self.inputs + self.consts.len();
         regs[self.inputs..first].copy_from_slice(&self.consts);
-        let (read, write) = regs.split_at_mut(first);
-        let write = &mut write[..self.code.len()];
-        for k in 0..self.code.len() {
-            // Operands live either before `first` or in an earlier instruction's register.
-            let get = |r: u32, write: &[f64]| -> f64 {
-                let r = r as usize;
-                if r < first {
-                    read[r]
-                } else {
-                    write[r - first]
+        for (k, instr) in self.code.iter().enumerate() {
+            let r = |i: u32| regs[i as usize];
+            let v = match *instr {
+                Instr::Neg(a) => -r(a),
+                Instr::Sin(a) => r(a).sin(),
+                Instr::Cos(a) => r(a).cos(),
+                Instr::Tan(a) => r(a).tan(),
+                Instr::Exp(a) => r(a).exp(),
+                Instr::Ln(a) => r(a).ln(),
+                Instr::Sqrt(a) => r(a).sqrt(),
+                Instr::Abs(a) => r(a).abs(),
+                Instr::Sign(a) => num::sign0(r(a)),
+                Instr::Tanh(a) => r(a).tanh(),
+                Instr::Atan(a) => r(a).atan(),
+                Instr::FiniteOr0(a) => num::finite_or_zero(r(a)),
+                Instr::Add(a, b) => r(a) + r(b),
+                Instr::Sub(a, b) => r(a) - r(b),
+                Instr::Mul(a, b) => r(a) * r(b),
+                Instr::Div(a, b) => r(a) / r(b),
+                Instr::Pow(a, b) => r(a).powf(r(b)),
+                Instr::Min(a, b) => num::min(r(a), r(b)),
+                Instr::Max(a, b) => num::max(r(a), r(b)),
+                Instr::Lt(a, b) => num::truth(r(a) < r(b)),
+                Instr::Le(a, b) => num::truth(r(a) <= r(b)),
+                Instr::Eq(a, b) => num::truth(r(a) == r(b)),
+                Instr::Ne(a, b) => num::truth(r(a) != r(b)),
+                Instr::And(a, b) => num::truth(r(a) != 0.0 && r(b) != 0.0),
+                Instr::Or(a, b) => num::truth(r(a) != 0.0 || r(b) != 0.0),
+                Instr::Square(a) => {
+                    let x = r(a);
+                    x * x
                 }
-            };
-            let v = match self.code[k] {
-                Instr::Neg(a) => -get(a, write),
-                Instr::Un(f, a) => num::apply1(f, get(a, write)),
-                Instr::Bin(f, a, b) => num::apply2(f, get(a, write), get(b, write)),
-                Instr::Powi(a, n) => num::powi(get(a, write), n),
-                Instr::Not(a) => num::truth(get(a, write) == 0.0),
+                Instr::Cube(a) => {
+                    let x = r(a);
+                    x * x * x
+                }
+                Instr::Powi(a, n) => num::powi(r(a), n),
+                Instr::Not(a) => num::truth(r(a) == 0.0),
                 Instr::Select(c, a, b) => {
-                    if get(c, write) != 0.0 {
-                        get(a, write)
+                    if r(c) != 0.0 {
+                        r(a)
                     } else {
-                        get(b, write)
+                        r(b)
                     }
                 }
             };
-            write[k] = v;
+            regs[first + k] = v;
         }
     }
 
@@ -176,5 +265,46 @@ mod tests {
         let o = tape.outputs();
         assert_eq!(regs[o[0] as usize], 0.75f64.sin());
         assert_eq!(regs[o[1] as usize], 0.75f64.cos());
+    }
+
+    #[test]
+    fn every_instruction_computes_what_constant_folding_computes() {
+        use Fn1::*;
+        use Fn2::*;
+        let ones = [
+            Sin, Cos, Tan, Exp, Ln, Sqrt, Abs, Sign, Tanh, Atan, FiniteOr0,
+        ];
+        let twos = [Add, Sub, Mul, Div, Pow, Min, Max, Lt, Le, Eq, Ne, And, Or];
+        let points = [(0.7, 1.3), (-0.4, 2.0), (0.0, 0.0), (2.5, -1.5), (1.0, 1.0)];
+        for (a, b) in points {
+            let mut g = Graph::default();
+            let (x, y) = (g.var(1), g.var(2));
+            let mut roots = Vec::new();
+            let mut want = Vec::new();
+            for f in ones {
+                roots.push(g.un(f, x));
+                want.push(num::apply1(f, a));
+            }
+            for f in twos {
+                roots.push(g.bin(f, x, y));
+                want.push(num::apply2(f, a, b));
+            }
+            for n in [-3, 2, 3, 5] {
+                roots.push(g.powi(x, n));
+                want.push(num::powi(a, n));
+            }
+            let tape = Tape::compile(&g, 3, &roots);
+            let mut regs = vec![0.0; tape.registers()];
+            regs[1] = a;
+            regs[2] = b;
+            tape.run(&mut regs);
+            for (k, (&r, w)) in tape.outputs().iter().zip(want).enumerate() {
+                let got = regs[r as usize];
+                assert!(
+                    got == w || (got.is_nan() && w.is_nan()),
+                    "#{k} at ({a}, {b}): {got} vs {w}"
+                );
+            }
+        }
     }
 }

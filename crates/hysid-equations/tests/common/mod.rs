@@ -108,7 +108,8 @@ pub fn fd_output(m: &EquationModel, x: &[f64], u: &[f64], th: &[f64], arg: Arg) 
 }
 
 /// Asserts `got` ≈ `want` to `rel` relative, each row judged against the row's largest
-/// entry over `row_scale` (so that entries that are zero up to rounding compare sensibly).
+/// entry over `row_scale` (so that entries that are zero up to rounding compare sensibly);
+/// returns the largest relative difference seen.
 pub fn assert_rows_close(
     got: &[f64],
     want: &[f64],
@@ -116,17 +117,22 @@ pub fn assert_rows_close(
     row_scale: &[f64],
     rel: f64,
     what: &str,
-) {
+) -> f64 {
+    let mut worst = 0.0f64;
     assert_eq!(got.len(), want.len(), "{what}: lengths");
     let cols = got.len().checked_div(rows).unwrap_or(0);
     for i in 0..rows {
         for j in 0..cols {
             let (g, w) = (got[i * cols + j], want[i * cols + j]);
             let scale = w.abs().max(g.abs()).max(1e-3 * row_scale[i]);
+            if scale > 0.0 {
+                worst = worst.max((g - w).abs() / scale);
+            }
             assert!(
                 (g - w).abs() <= rel * scale,
                 "{what}[{i}][{j}]: got {g:e}, want {w:e} (scale {scale:e})"
             );
         }
     }
+    worst
 }
