@@ -21,16 +21,35 @@ pub enum Binding {
 pub struct Scope {
     /// Names usable here.
     pub names: HashMap<String, Binding>,
-    /// `[let]` quantities defined later (a use is a forward reference), with their line.
-    pub later: HashMap<String, usize>,
-    /// The `[let]` quantity being defined (a use of it is a cycle).
-    pub defining: Option<String>,
+    /// Every `[let]` quantity: its place in `[let]` and its line in the file.
+    pub lets: HashMap<String, (usize, usize)>,
+    /// The place in `[let]` of the quantity being defined (None outside `[let]`): a use of
+    /// it is a cycle, a use of a later one a forward reference.
+    pub defining: Option<usize>,
     /// Whether `t` is allowed (not in `[output]`).
     pub time_allowed: bool,
     /// The section named in messages (`[equations]`, …).
     pub section: &'static str,
-    /// "states: x, v; parameters: …" for the unknown-name message.
-    pub listing: String,
+    /// ("states", names), ("inputs", …), ("parameters", …) for the unknown-name message.
+    pub groups: Vec<(&'static str, Vec<String>)>,
+    /// `[let]` names in file order.
+    pub let_order: Vec<String>,
+}
+
+impl Scope {
+    /// "states: x, v; parameters: m, c; let: spring": the names usable here (built only
+    /// for a message, so that reading a long file stays linear).
+    fn listing(&self) -> String {
+        let visible = self.defining.unwrap_or(self.let_order.len());
+        self.groups
+            .iter()
+            .map(|(k, v)| (*k, &v[..]))
+            .chain(std::iter::once(("let", &self.let_order[..visible])))
+            .filter(|(_, v)| !v.is_empty())
+            .map(|(k, v)| format!("{k}: {}", v.join(", ")))
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
 }
 
 /// Whether a value is a number or a condition.
@@ -149,24 +168,29 @@ fn name_value(
             ),
         )),
         "pi" => Ok(g.konst(std::f64::consts::PI)),
-        _ if s.defining.as_deref() == Some(name) => Err(err(
-            pos,
-            format!("cycle in [let]: '{name}' is defined in terms of itself"),
-        )),
-        _ if s.later.contains_key(name) => Err(err(
-            pos,
-            format!(
-                "forward reference in [let]: '{name}' is defined later (line {}); [let] quantities may use only earlier ones",
-                s.later[name]
-            ),
-        )),
+        _ if s.lets.contains_key(name) => {
+            let (place, line) = s.lets[name];
+            if s.defining == Some(place) {
+                Err(err(
+                    pos,
+                    format!("cycle in [let]: '{name}' is defined in terms of itself"),
+                ))
+            } else {
+                Err(err(
+                    pos,
+                    format!(
+                        "forward reference in [let]: '{name}' is defined later (line {line}); [let] quantities may use only earlier ones"
+                    ),
+                ))
+            }
+        }
         _ if Func::by_name(name).is_some() || matches!(name, "and" | "or" | "not") => Err(err(
             pos,
             format!("'{name}' is a reserved word (a function or logical operator), not a value"),
         )),
         _ => Err(err(
             pos,
-            format!("unknown name '{name}' ({})", s.listing),
+            format!("unknown name '{name}' ({})", s.listing()),
         )),
     }
 }

@@ -449,29 +449,6 @@ fn check_len(v: &[f64], n: usize, what: &str) {
     );
 }
 
-/// "states: x, v; inputs: u; parameters: m, c; let: spring" (empty groups left out).
-fn listing(fm: &FileModel, lets: &[Named]) -> String {
-    let params: Vec<Named> = fm
-        .parameters
-        .iter()
-        .map(|(p, pos)| Named {
-            name: p.name.clone(),
-            pos: *pos,
-        })
-        .collect();
-    [
-        ("states", &fm.states[..]),
-        ("inputs", &fm.inputs[..]),
-        ("parameters", &params[..]),
-        ("let", lets),
-    ]
-    .iter()
-    .filter(|(_, v)| !v.is_empty())
-    .map(|(k, v)| format!("{k}: {}", file::list(v)))
-    .collect::<Vec<_>>()
-    .join("; ")
-}
-
 /// Parses and lowers one expression of the file.
 fn lower_text(
     text: &str,
@@ -539,29 +516,40 @@ fn compile(text: &str, fm: FileModel) -> Result<EquationModel, EquationError> {
     for (k, name) in slots.enumerate() {
         names.insert(name.clone(), Binding::Slot(1 + k as u32));
     }
-    let let_names: Vec<Named> = fm.lets.iter().map(|e| e.key.clone()).collect();
+    let names_of = |v: &[Named]| v.iter().map(|n| n.name.clone()).collect::<Vec<_>>();
+    let line_starts: Vec<usize> = std::iter::once(0)
+        .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+        .collect();
+    let line_of = |pos: usize| line_starts.partition_point(|&s| s <= pos);
     let mut scope = Scope {
         names,
+        lets: fm
+            .lets
+            .iter()
+            .enumerate()
+            .map(|(i, e)| (e.key.name.clone(), (i, line_of(e.key.pos))))
+            .collect(),
         time_allowed: true,
         section: "[let]",
-        listing: listing(&fm, &[]),
+        groups: vec![
+            ("states", names_of(&fm.states)),
+            ("inputs", names_of(&fm.inputs)),
+            (
+                "parameters",
+                fm.parameters.iter().map(|(p, _)| p.name.clone()).collect(),
+            ),
+        ],
+        let_order: fm.lets.iter().map(|e| e.key.name.clone()).collect(),
         ..Scope::default()
     };
     for (i, e) in fm.lets.iter().enumerate() {
-        scope.later = fm.lets[i + 1..]
-            .iter()
-            .map(|l| (l.key.name.clone(), line_column(text, l.key.pos).0))
-            .collect();
-        scope.defining = Some(e.key.name.clone());
-        scope.listing = listing(&fm, &let_names[..i]);
+        scope.defining = Some(i);
         let l = lower_text(text, &mut g, &scope, e)?;
         scope
             .names
             .insert(e.key.name.clone(), Binding::Let(l.id, l.uses_time));
     }
-    scope.later.clear();
     scope.defining = None;
-    scope.listing = listing(&fm, &let_names);
     scope.section = "[equations]";
     let eqs = match_entries(
         text,

@@ -290,3 +290,48 @@ fn columns_count_characters_and_follow_multi_line_strings() {
         "line 19, column 4: unknown name 'kk' (states: x, v; inputs: u; parameters: m, c, k, k3; let: spring)",
     );
 }
+
+#[test]
+fn hostile_sizes_are_refused_without_overflowing_the_stack() {
+    // Deep TOML nesting, deep expression nesting, long [let] chains.
+    for text in [
+        format!("a = {}", "[".repeat(50_000)),
+        format!("a = {}", "{ b = ".repeat(50_000)),
+        with(
+            "x = \"v\"",
+            &format!("x = \"{}v{}\"", "(".repeat(10_000), ")".repeat(10_000)),
+        ),
+        with("x = \"v\"", &format!("x = \"{}v\"", "-".repeat(10_000))),
+        with(
+            "x = \"v\"",
+            &format!("x = \"{}\"", vec!["v"; 20_000].join("+")),
+        ),
+    ] {
+        assert!(EquationModel::parse(&text).is_err());
+    }
+    // A chain of 2000 [let] quantities, each using the previous one, is fine: the graph
+    // is walked in loops, not recursively.
+    let mut lets = String::from("l0 = \"x\"\n");
+    for k in 1..2000 {
+        lets.push_str(&format!("l{k} = \"0.5*l{} + v\"\n", k - 1));
+    }
+    let text = with(
+        "spring = \"k*x + k3*x^3\"\n",
+        &format!("spring = \"k*x + k3*x^3\"\n{lets}"),
+    )
+    .replace("x = \"v\"", "x = \"l1999\"");
+    let m = EquationModel::parse(&text).unwrap();
+    let (mut dx, mut fx, mut ft) = ([0.0; 2], [0.0; 4], [0.0; 8]);
+    m.rhs_jacobians(
+        0.0,
+        &[1.0, 0.0],
+        &[0.0],
+        &[1.0, 0.1, 1.0, 0.0],
+        &mut dx,
+        &mut fx,
+        &mut ft,
+    );
+    // l_k = 0.5^k x at v = 0, ∂/∂v = Σ 0.5^j ≈ 2.
+    assert!(dx[0].abs() < 1e-300);
+    approx::assert_relative_eq!(fx[1], 2.0, max_relative = 1e-12);
+}
