@@ -71,7 +71,7 @@
 //! | | `states` | state names, the order of x (at least one) |
 //! | | `inputs` | input names, the order of u (may be empty or absent) |
 //! | | `outputs` | output names, the order of y (at least one) |
-//! | | `time` | `"continuous"` (default): `[equations]` give dx/dt; `"discrete"`: they give x[k+1] from x[k], u[k] |
+//! | | `time` | `"continuous"` (default): `[equations]` give dx/dt; `"discrete"`: they give `x[k+1]` from `x[k]`, `u[k]` |
 //! | | `units` | optional table `name = "unit"` for states, inputs and outputs |
 //! | `[parameters]` | `name = { … }` | `value` (required, finite), `lower` (default −∞), `upper` (default +∞), `unit` (default none), `fixed` (default false); `name = 1.5` is short for `{ value = 1.5 }`. The order of the file is the order of θ. |
 //! | `[initial]` | `state = { … }` | optional: `value` (finite), `fixed` (default true: known; false: to be estimated); `x = 0.5` is short for `{ value = 0.5 }`. A state not listed starts at 0, fixed. |

@@ -16,7 +16,7 @@ use crate::tape::Tape;
 pub enum TimeDomain {
     /// ẋ = f(t, x, u, θ) (`time = "continuous"`, the default).
     Continuous,
-    /// x[k+1] = f(t, x[k], u[k], θ) (`time = "discrete"`).
+    /// `x[k+1] = f(t, x[k], u[k], θ)` (`time = "discrete"`).
     Discrete,
 }
 
@@ -272,7 +272,7 @@ impl EquationModel {
         })
     }
 
-    /// ẋ = f(t, x, u, θ) (or x[k+1] in discrete time) into `dx`.
+    /// ẋ = f(t, x, u, θ) (or `x[k+1]` in discrete time) into `dx`.
     ///
     /// # Panics
     /// If x, u or θ do not have the lengths of [`Self::states`], [`Self::inputs`],
