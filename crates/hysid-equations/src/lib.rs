@@ -144,6 +144,9 @@
 //!   a = 0 with b < 1 (e.g. `x^0.5` at 0), and ∂a^b/∂b = a^b·ln a at a ≤ 0 (where ln a is
 //!   undefined; for a < 0 only integer b give a real a^b anyway). The factor b·a^(b−1) at
 //!   a = 0, b = 1 is 1 (0⁰ = 1).
+//! * Last, any Jacobian entry that still comes out infinite or NaN is reported as 0: a
+//!   chain of finite factors can still meet ∞·0, as in `exp(-1/x^2)` at x = 0, whose value
+//!   is 0 and whose derivative is 0. Values are never altered this way.
 //! * Consequence worth knowing: `sign(z)*abs(z)^nu` (the Bouc–Wen |z|^(ν−1)z) has
 //!   derivative 0 in z at exactly z = 0, a set of measure zero.
 //!

@@ -9,6 +9,7 @@ use crate::dag::{Graph, Id};
 use crate::error::{line_column, EquationError};
 use crate::file::{self, ExprText, FileModel, Named};
 use crate::lower::{lower, Binding, Scope};
+use crate::num::finite_or_zero;
 use crate::tape::Tape;
 
 /// Whether `[equations]` give derivatives or next states.
@@ -228,7 +229,8 @@ impl EquationModel {
         }
     }
 
-    /// Runs `tape` at (t, x, u, θ) and hands the results to `out`, in the scratch.
+    /// Runs `tape` at (t, x, u, θ) and copies the results to `out`: the values first, then
+    /// the Jacobian blocks (with an infinite or NaN entry reported as 0).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn eval(
@@ -257,9 +259,11 @@ impl EquationModel {
         regs[1 + n + m..1 + n + m + p].copy_from_slice(theta);
         tape.run(regs);
         let mut results = tape.outputs().iter();
-        for dst in out.iter_mut() {
+        for (k, dst) in out.iter_mut().enumerate() {
             for (d, r) in dst.iter_mut().zip(&mut results) {
-                *d = regs[*r as usize];
+                let v = regs[*r as usize];
+                // Values as computed; derivatives finite by convention (see the crate docs).
+                *d = if k == 0 { v } else { finite_or_zero(v) };
             }
         }
     }

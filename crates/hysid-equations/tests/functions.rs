@@ -158,7 +158,7 @@ fn every_function_has_its_value_and_central_difference_derivatives() {
 #[test]
 fn derivative_conventions_at_non_smooth_points() {
     // (expression, x, p, value, ∂/∂x, ∂/∂p)
-    let cases: [(&str, f64, f64, f64, f64, f64); 14] = [
+    let cases: [(&str, f64, f64, f64, f64, f64); 16] = [
         ("sign(x)", 0.0, 1.5, 0.0, 0.0, 0.0),
         ("sign(x)", -2.0, 1.5, -1.0, 0.0, 0.0),
         ("abs(x)", 0.0, 1.5, 0.0, 0.0, 0.0),
@@ -173,6 +173,8 @@ fn derivative_conventions_at_non_smooth_points() {
         ("max(p, x)", 1.5, 1.5, 1.5, 0.0, 1.0),
         ("if(x > 0, x^2, -x)", 0.0, 1.5, 0.0, -1.0, 0.0),
         ("abs(x)^p", 0.0, 1.0, 0.0, 0.0, 0.0), // sign(0)·1: Bouc–Wen's |z|^ν at z = 0
+        ("exp(-1/x^2)", 0.0, 1.5, 0.0, 0.0, 0.0), // ∞·0 inside the chain → 0
+        ("1/x", 0.0, 1.5, f64::INFINITY, 0.0, 0.0), // the value stays infinite
     ];
     for (expr, x, p, want, dfdx, dfdp) in cases {
         let (f, fx, ft) = first_row(&model(expr), x, 0.0, 0.0, p, 2.0);
