@@ -1,0 +1,655 @@
+//! The compiled model: specifications, and f, h with their Jacobians on flat tapes.
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::fmt;
+
+use crate::ast;
+use crate::dag::{Graph, Id};
+use crate::error::{line_column, EquationError};
+use crate::file::{self, ExprText, FileModel, Named};
+use crate::lower::{lower, Binding, Scope};
+use crate::num::finite_or_zero;
+use crate::tape::Tape;
+
+/// Whether `[equations]` give derivatives or next states.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimeDomain {
+    /// ẋ = f(t, x, u, θ) (`time = "continuous"`, the default).
+    Continuous,
+    /// `x[k+1] = f(t, x[k], u[k], θ)` (`time = "discrete"`).
+    Discrete,
+}
+
+/// A parameter as the file declares it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterSpec {
+    /// Name in expressions.
+    pub name: String,
+    /// Initial (or fixed) value.
+    pub value: f64,
+    /// Lower bound (−∞ when not given).
+    pub lower: f64,
+    /// Upper bound (+∞ when not given).
+    pub upper: f64,
+    /// Unit (free text, empty when not given).
+    pub unit: String,
+    /// Whether the value is held fixed during estimation (default false).
+    pub fixed: bool,
+}
+
+/// The initial value of a state as the file declares it (0, fixed, when not given).
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialSpec {
+    /// State name.
+    pub state: String,
+    /// Value at the first sample.
+    pub value: f64,
+    /// Whether it is known (true, the default) or to be estimated (false).
+    pub fixed: bool,
+}
+
+/// The six tapes of a model.
+#[derive(Clone, Debug)]
+struct Tapes {
+    /// f
+    f: Tape,
+    /// f, ∂f/∂x, ∂f/∂θ
+    f_jac: Tape,
+    /// f, ∂f/∂u
+    f_u: Tape,
+    /// h
+    h: Tape,
+    /// h, ∂h/∂x, ∂h/∂θ
+    h_jac: Tape,
+    /// h, ∂h/∂u
+    h_u: Tape,
+}
+
+/// A grey-box state-space model read from an equation file (the language is described
+/// in the crate docs):
+///
+/// ```text
+/// ẋ = f(t, x, u, θ)   (or x[k+1] = f(t, x[k], u[k], θ) for time = "discrete")
+/// y = h(x, u, θ)
+/// ```
+///
+/// Parsed and differentiated once; f, h and their Jacobians are then evaluated from flat
+/// instruction tapes without allocating (with a caller-owned [`Scratch`], or with a
+/// per-thread one by the plain methods).
+#[derive(Clone)]
+pub struct EquationModel {
+    source: String,
+    name: String,
+    time: TimeDomain,
+    states: Vec<String>,
+    inputs: Vec<String>,
+    outputs: Vec<String>,
+    units: Vec<(String, String)>,
+    parameters: Vec<ParameterSpec>,
+    initial: Vec<InitialSpec>,
+    tapes: Tapes,
+    registers: usize,
+}
+
+impl fmt::Debug for EquationModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("EquationModel")
+            .field("name", &self.name)
+            .field("time", &self.time)
+            .field("states", &self.states)
+            .field("inputs", &self.inputs)
+            .field("outputs", &self.outputs)
+            .field(
+                "parameters",
+                &self.parameters.iter().map(|p| &p.name).collect::<Vec<_>>(),
+            )
+            .field("tape_lengths", &self.tape_lengths())
+            .finish()
+    }
+}
+
+/// Registers for evaluating a model without allocation; one per thread or caller.
+///
+/// Grows on first use with a model that needs more registers, then never allocates again.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    regs: Vec<f64>,
+}
+
+impl Scratch {
+    /// An empty scratch (it grows to the size a model needs on first use).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn regs(&mut self, n: usize) -> &mut [f64] {
+        if self.regs.len() < n {
+            self.regs.resize(n, 0.0);
+        }
+        &mut self.regs[..n]
+    }
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = const { RefCell::new(Scratch { regs: Vec::new() }) };
+}
+
+impl EquationModel {
+    /// Reads, checks, differentiates and compiles a model file.
+    ///
+    /// Every problem is an [`EquationError`] with the line and column in `text`.
+    pub fn parse(text: &str) -> Result<Self, EquationError> {
+        let fm = file::read(text)?;
+        compile(text, fm)
+    }
+
+    /// The file text the model was parsed from (saved models embed it).
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// `[model] name`.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// State names in order (the order of x).
+    pub fn states(&self) -> &[String] {
+        &self.states
+    }
+
+    /// Input names in order (the order of u).
+    pub fn inputs(&self) -> &[String] {
+        &self.inputs
+    }
+
+    /// Output names in order (the order of y).
+    pub fn outputs(&self) -> &[String] {
+        &self.outputs
+    }
+
+    /// `[model] units`: (state, input or output name, unit) in file order.
+    pub fn units(&self) -> &[(String, String)] {
+        &self.units
+    }
+
+    /// The unit of a state, input, output or parameter, if the file gives one.
+    pub fn unit(&self, name: &str) -> Option<&str> {
+        self.units
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, u)| u.as_str())
+            .or_else(|| {
+                self.parameters
+                    .iter()
+                    .find(|p| p.name == name && !p.unit.is_empty())
+                    .map(|p| p.unit.as_str())
+            })
+    }
+
+    /// Parameters in file order (the order of θ).
+    pub fn parameters(&self) -> &[ParameterSpec] {
+        &self.parameters
+    }
+
+    /// θ at the declared values.
+    pub fn parameter_values(&self) -> Vec<f64> {
+        self.parameters.iter().map(|p| p.value).collect()
+    }
+
+    /// Initial values, one per state in state order.
+    pub fn initial(&self) -> &[InitialSpec] {
+        &self.initial
+    }
+
+    /// Continuous or discrete time.
+    pub fn time_domain(&self) -> TimeDomain {
+        self.time
+    }
+
+    /// Instruction counts of the tapes (f, f+∂f/∂x+∂f/∂θ, f+∂f/∂u, h, h+∂h/∂x+∂h/∂θ,
+    /// h+∂h/∂u).
+    pub fn tape_lengths(&self) -> [usize; 6] {
+        let t = &self.tapes;
+        [
+            t.f.len(),
+            t.f_jac.len(),
+            t.f_u.len(),
+            t.h.len(),
+            t.h_jac.len(),
+            t.h_u.len(),
+        ]
+    }
+
+    /// A scratch already sized for this model.
+    pub fn scratch(&self) -> Scratch {
+        Scratch {
+            regs: vec![0.0; self.registers],
+        }
+    }
+
+    /// Runs `tape` at (t, x, u, θ) and copies the results to `out`: the values first, then
+    /// the Jacobian blocks (with an infinite or NaN entry reported as 0).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn eval(
+        &self,
+        s: &mut Scratch,
+        tape: &Tape,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        out: &mut [&mut [f64]],
+    ) {
+        let (n, m, p) = (self.states.len(), self.inputs.len(), self.parameters.len());
+        assert!(
+            x.len() == n && u.len() == m && theta.len() == p,
+            "EquationModel '{}': expected {n} states, {m} inputs, {p} parameters, got {}, {}, {}",
+            self.name,
+            x.len(),
+            u.len(),
+            theta.len()
+        );
+        let regs = s.regs(self.registers);
+        regs[0] = t;
+        regs[1..1 + n].copy_from_slice(x);
+        regs[1 + n..1 + n + m].copy_from_slice(u);
+        regs[1 + n + m..1 + n + m + p].copy_from_slice(theta);
+        tape.run(regs);
+        let mut results = tape.outputs().iter();
+        for (k, dst) in out.iter_mut().enumerate() {
+            for (d, r) in dst.iter_mut().zip(&mut results) {
+                let v = regs[*r as usize];
+                // Values as computed; derivatives finite by convention (see the crate docs).
+                *d = if k == 0 { v } else { finite_or_zero(v) };
+            }
+        }
+    }
+
+    fn with_thread_scratch<R>(&self, f: impl FnOnce(&mut Scratch) -> R) -> R {
+        SCRATCH.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut s) => f(&mut s),
+            // Only reachable if evaluation were re-entered on one thread; stay correct.
+            Err(_) => f(&mut self.scratch()),
+        })
+    }
+
+    /// ẋ = f(t, x, u, θ) (or `x[k+1]` in discrete time) into `dx`.
+    ///
+    /// # Panics
+    /// If x, u or θ do not have the lengths of [`Self::states`], [`Self::inputs`],
+    /// [`Self::parameters`], or `dx` is shorter than x.
+    pub fn rhs_with(
+        &self,
+        s: &mut Scratch,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        dx: &mut [f64],
+    ) {
+        check_len(dx, self.states.len(), "dx");
+        self.eval(s, &self.tapes.f, t, x, u, theta, &mut [dx]);
+    }
+
+    /// y = h(x, u, θ) into `y` (outputs do not depend on t).
+    ///
+    /// # Panics
+    /// As [`Self::rhs_with`], with `y` of the length of [`Self::outputs`].
+    pub fn output_with(&self, s: &mut Scratch, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
+        check_len(y, self.outputs.len(), "y");
+        self.eval(s, &self.tapes.h, 0.0, x, u, theta, &mut [y]);
+    }
+
+    /// f with ∂f/∂x (n×n, row-major: `fx[i*n + j] = ∂fᵢ/∂xⱼ`) and ∂f/∂θ (n×p, row-major),
+    /// from one pass over one tape.
+    ///
+    /// # Panics
+    /// As [`Self::rhs_with`], with `fx` of n·n and `ftheta` of n·p entries.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rhs_jacobians_with(
+        &self,
+        s: &mut Scratch,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        dx: &mut [f64],
+        fx: &mut [f64],
+        ftheta: &mut [f64],
+    ) {
+        let (n, p) = (self.states.len(), self.parameters.len());
+        check_len(dx, n, "dx");
+        check_len(fx, n * n, "fx");
+        check_len(ftheta, n * p, "ftheta");
+        self.eval(s, &self.tapes.f_jac, t, x, u, theta, &mut [dx, fx, ftheta]);
+    }
+
+    /// h with ∂h/∂x (ny×n, row-major) and ∂h/∂θ (ny×p, row-major).
+    ///
+    /// # Panics
+    /// As [`Self::rhs_with`], with `hx` of ny·n and `htheta` of ny·p entries.
+    #[allow(clippy::too_many_arguments)]
+    pub fn output_jacobians_with(
+        &self,
+        s: &mut Scratch,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        y: &mut [f64],
+        hx: &mut [f64],
+        htheta: &mut [f64],
+    ) {
+        let (ny, n, p) = (self.outputs.len(), self.states.len(), self.parameters.len());
+        check_len(y, ny, "y");
+        check_len(hx, ny * n, "hx");
+        check_len(htheta, ny * p, "htheta");
+        self.eval(s, &self.tapes.h_jac, 0.0, x, u, theta, &mut [y, hx, htheta]);
+    }
+
+    /// f with ∂f/∂u (n×m, row-major).
+    #[allow(clippy::too_many_arguments)]
+    pub fn rhs_input_jacobian_with(
+        &self,
+        s: &mut Scratch,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        dx: &mut [f64],
+        fu: &mut [f64],
+    ) {
+        check_len(dx, self.states.len(), "dx");
+        check_len(fu, self.states.len() * self.inputs.len(), "fu");
+        self.eval(s, &self.tapes.f_u, t, x, u, theta, &mut [dx, fu]);
+    }
+
+    /// h with ∂h/∂u (ny×m, row-major).
+    pub fn output_input_jacobian_with(
+        &self,
+        s: &mut Scratch,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        y: &mut [f64],
+        hu: &mut [f64],
+    ) {
+        check_len(y, self.outputs.len(), "y");
+        check_len(hu, self.outputs.len() * self.inputs.len(), "hu");
+        self.eval(s, &self.tapes.h_u, 0.0, x, u, theta, &mut [y, hu]);
+    }
+
+    /// [`Self::rhs_with`] with this thread's scratch.
+    pub fn rhs(&self, t: f64, x: &[f64], u: &[f64], theta: &[f64], dx: &mut [f64]) {
+        self.with_thread_scratch(|s| self.rhs_with(s, t, x, u, theta, dx));
+    }
+
+    /// [`Self::output_with`] with this thread's scratch.
+    pub fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
+        self.with_thread_scratch(|s| self.output_with(s, x, u, theta, y));
+    }
+
+    /// [`Self::rhs_jacobians_with`] with this thread's scratch.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rhs_jacobians(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        dx: &mut [f64],
+        fx: &mut [f64],
+        ftheta: &mut [f64],
+    ) {
+        self.with_thread_scratch(|s| self.rhs_jacobians_with(s, t, x, u, theta, dx, fx, ftheta));
+    }
+
+    /// [`Self::output_jacobians_with`] with this thread's scratch.
+    pub fn output_jacobians(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        y: &mut [f64],
+        hx: &mut [f64],
+        htheta: &mut [f64],
+    ) {
+        self.with_thread_scratch(|s| self.output_jacobians_with(s, x, u, theta, y, hx, htheta));
+    }
+
+    /// [`Self::rhs_input_jacobian_with`] with this thread's scratch.
+    pub fn rhs_input_jacobian(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        dx: &mut [f64],
+        fu: &mut [f64],
+    ) {
+        self.with_thread_scratch(|s| self.rhs_input_jacobian_with(s, t, x, u, theta, dx, fu));
+    }
+
+    /// [`Self::output_input_jacobian_with`] with this thread's scratch.
+    pub fn output_input_jacobian(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        y: &mut [f64],
+        hu: &mut [f64],
+    ) {
+        self.with_thread_scratch(|s| self.output_input_jacobian_with(s, x, u, theta, y, hu));
+    }
+}
+
+fn check_len(v: &[f64], n: usize, what: &str) {
+    assert!(
+        v.len() == n,
+        "{what} must have {n} entries, has {}",
+        v.len()
+    );
+}
+
+/// Parses and lowers one expression of the file.
+fn lower_text(
+    text: &str,
+    g: &mut Graph,
+    scope: &Scope,
+    e: &ExprText,
+) -> Result<crate::lower::Lowered, EquationError> {
+    let at = |err: ast::SyntaxError| EquationError::at(text, e.file_offset(err.pos), err.message);
+    let tree = ast::parse(&e.text).map_err(at)?;
+    lower(g, scope, &tree).map_err(at)
+}
+
+/// One expression per name in `names` from `exprs` (none for a name not listed, none
+/// missing), in the order of `names`.
+fn match_entries<'e>(
+    text: &str,
+    names: &[Named],
+    exprs: &'e [ExprText],
+    section: &str,
+    section_pos: usize,
+    what: &str,
+) -> Result<Vec<&'e ExprText>, EquationError> {
+    for e in exprs {
+        if !names.iter().any(|n| n.name == e.key.name) {
+            return Err(EquationError::at(
+                text,
+                e.key.pos,
+                format!(
+                    "{section} has an entry for '{}', which is not {what} ({})",
+                    e.key.name,
+                    file::list(names)
+                ),
+            ));
+        }
+    }
+    names
+        .iter()
+        .map(|n| {
+            exprs.iter().find(|e| e.key.name == n.name).ok_or_else(|| {
+                EquationError::at(
+                    text,
+                    n.pos,
+                    format!(
+                        "'{}' has no expression in {section} (line {}); add {} = \"…\"",
+                        n.name,
+                        line_column(text, section_pos).0,
+                        n.name
+                    ),
+                )
+            })
+        })
+        .collect()
+}
+
+fn compile(text: &str, fm: FileModel) -> Result<EquationModel, EquationError> {
+    let (n, m, p) = (fm.states.len(), fm.inputs.len(), fm.parameters.len());
+    let mut g = Graph::default();
+    let mut names = HashMap::new();
+    let slots = fm
+        .states
+        .iter()
+        .map(|s| &s.name)
+        .chain(fm.inputs.iter().map(|s| &s.name))
+        .chain(fm.parameters.iter().map(|(p, _)| &p.name));
+    for (k, name) in slots.enumerate() {
+        names.insert(name.clone(), Binding::Slot(1 + k as u32));
+    }
+    let names_of = |v: &[Named]| v.iter().map(|n| n.name.clone()).collect::<Vec<_>>();
+    let line_starts: Vec<usize> = std::iter::once(0)
+        .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+        .collect();
+    let line_of = |pos: usize| line_starts.partition_point(|&s| s <= pos);
+    let mut scope = Scope {
+        names,
+        lets: fm
+            .lets
+            .iter()
+            .enumerate()
+            .map(|(i, e)| (e.key.name.clone(), (i, line_of(e.key.pos))))
+            .collect(),
+        time_allowed: true,
+        section: "[let]",
+        groups: vec![
+            ("states", names_of(&fm.states)),
+            ("inputs", names_of(&fm.inputs)),
+            (
+                "parameters",
+                fm.parameters.iter().map(|(p, _)| p.name.clone()).collect(),
+            ),
+        ],
+        let_order: fm.lets.iter().map(|e| e.key.name.clone()).collect(),
+        ..Scope::default()
+    };
+    for (i, e) in fm.lets.iter().enumerate() {
+        scope.defining = Some(i);
+        let l = lower_text(text, &mut g, &scope, e)?;
+        scope
+            .names
+            .insert(e.key.name.clone(), Binding::Let(l.id, l.uses_time));
+    }
+    scope.defining = None;
+    scope.section = "[equations]";
+    let eqs = match_entries(
+        text,
+        &fm.states,
+        &fm.equations,
+        "[equations]",
+        fm.equations_pos,
+        "a state",
+    )?;
+    let mut f = Vec::with_capacity(n);
+    for e in eqs {
+        f.push(lower_text(text, &mut g, &scope, e)?.id);
+    }
+    scope.section = "[output]";
+    scope.time_allowed = false;
+    let outs = match_entries(
+        text,
+        &fm.outputs,
+        &fm.output,
+        "[output]",
+        fm.output_pos,
+        "a listed output",
+    )?;
+    let mut h = Vec::with_capacity(fm.outputs.len());
+    for e in outs {
+        h.push(lower_text(text, &mut g, &scope, e)?.id);
+    }
+    let tapes = differentiate_and_compile(&mut g, n, m, p, &f, &h);
+    let registers = [
+        &tapes.f,
+        &tapes.f_jac,
+        &tapes.f_u,
+        &tapes.h,
+        &tapes.h_jac,
+        &tapes.h_u,
+    ]
+    .iter()
+    .map(|t| t.registers())
+    .max()
+    .unwrap_or(0);
+    Ok(EquationModel {
+        source: text.to_string(),
+        name: fm.name,
+        time: fm.time,
+        states: fm.states.into_iter().map(|s| s.name).collect(),
+        inputs: fm.inputs.into_iter().map(|s| s.name).collect(),
+        outputs: fm.outputs.into_iter().map(|s| s.name).collect(),
+        units: fm.units,
+        parameters: fm.parameters.into_iter().map(|(p, _)| p).collect(),
+        initial: fm.initial,
+        tapes,
+        registers,
+    })
+}
+
+/// The six tapes: derivatives of f and h with respect to every state, parameter and
+/// input (slots 1.., after t in slot 0), laid out row-major after the values.
+fn differentiate_and_compile(
+    g: &mut Graph,
+    n: usize,
+    m: usize,
+    p: usize,
+    f: &[Id],
+    h: &[Id],
+) -> Tapes {
+    let limit = g.nodes.len();
+    let slots = 1 + n + m + p;
+    // d[k][id]: derivative of node id with respect to slot 1 + k.
+    let d: Vec<Vec<Id>> = (1..slots as u32).map(|s| g.derivative(limit, s)).collect();
+    let state = |k: usize| k;
+    let input = |k: usize| n + k;
+    let param = |k: usize| n + m + k;
+    let block = |roots: &[Id], cols: &dyn Fn(usize) -> usize, count: usize| -> Vec<Id> {
+        roots
+            .iter()
+            .flat_map(|&r| (0..count).map(move |j| (r, j)))
+            .map(|(r, j)| d[cols(j)][r as usize])
+            .collect()
+    };
+    let jac = |roots: &[Id]| -> Vec<Id> {
+        let mut v = roots.to_vec();
+        v.extend(block(roots, &state, n));
+        v.extend(block(roots, &param, p));
+        v
+    };
+    let with_u = |roots: &[Id]| -> Vec<Id> {
+        let mut v = roots.to_vec();
+        v.extend(block(roots, &input, m));
+        v
+    };
+    Tapes {
+        f: Tape::compile(g, slots, f),
+        f_jac: Tape::compile(g, slots, &jac(f)),
+        f_u: Tape::compile(g, slots, &with_u(f)),
+        h: Tape::compile(g, slots, h),
+        h_jac: Tape::compile(g, slots, &jac(h)),
+        h_u: Tape::compile(g, slots, &with_u(h)),
+    }
+}
