@@ -64,7 +64,7 @@ pub struct RigSettings {
     #[arg(long, default_value_t = 1.0)]
     pub noise: f64,
     /// Seed of the noise.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// A true parameter, NAME=VALUE (repeatable; J, Fv, Fc, k1, k2, alpha, A; default
     /// Table I's m67).
@@ -86,9 +86,9 @@ pub struct ActuatorConstants {
 /// Options of `hysid actuator rig`.
 #[derive(Debug, Args)]
 pub struct RigArgs {
-    /// Directory for the data sets (created if needed).
-    #[arg(long)]
-    pub out: PathBuf,
+    /// Directory for the data sets (built beside it and swapped in when complete).
+    #[arg(long = "data-out")]
+    pub data_out: PathBuf,
     #[command(flatten)]
     pub constants: ActuatorConstants,
     #[command(flatten)]
@@ -135,9 +135,12 @@ pub struct ActuatorIdentifyArgs {
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Write the m67 model here (`hysid.model/1`, loadable by `hysid simulate --model`).
+    #[arg(long = "model-out")]
+    pub model_out: Option<PathBuf>,
     /// Directory for the tables (Markdown) and the plots (SVG).
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub plots: Option<PathBuf>,
 }
 
 /// Rigid-body commands.
@@ -186,6 +189,9 @@ pub struct RigidBodyLsArgs {
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Write the estimate as a `rigid_body` model here (`hysid.model/1`).
+    #[arg(long = "model-out")]
+    pub model_out: Option<PathBuf>,
 }
 
 /// Grey-box commands.
@@ -233,7 +239,7 @@ pub struct GreyboxFitArgs {
     pub model_out: Option<PathBuf>,
     /// Directory for plots (SVG).
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub plots: Option<PathBuf>,
 }
 
 /// How a grey-box model is simulated.
@@ -323,9 +329,12 @@ pub struct BoucWenArgs {
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Write the fitted model here (`hysid.model/1`, loadable by `hysid simulate --model`).
+    #[arg(long = "model-out")]
+    pub model_out: Option<PathBuf>,
     /// Directory for plots (SVG).
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub plots: Option<PathBuf>,
 }
 
 /// Search settings of the benchmark fit.
@@ -335,7 +344,7 @@ pub struct BenchmarkSearchArgs {
     #[arg(long, default_value_t = 8)]
     pub starts: usize,
     /// Seed of the random starts.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// RK4 steps per sample (750 Hz × 4 = 3 kHz; the training record's residual is its noise
     /// from 2 on).
@@ -363,14 +372,14 @@ pub struct BoucWenGenerateArgs {
     #[arg(long, default_value_t = 153_000)]
     pub samples: usize,
     /// Seed of the multisine phases.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// RMS of white Gaussian output noise to add (the training records use 8e-6 m).
     #[arg(long, default_value_t = 0.0)]
     pub noise: f64,
     /// The CSV file to write.
     #[arg(long)]
-    pub out: PathBuf,
+    pub csv: PathBuf,
 }
 
 /// Benchmark test signals.
@@ -402,11 +411,11 @@ pub struct GenerateVorosArgs {
     #[arg(long)]
     pub noise_free: bool,
     /// Seed of the input disturbance and the output noise.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// The CSV file to write.
     #[arg(long)]
-    pub out: PathBuf,
+    pub csv: PathBuf,
 }
 
 /// Built-in examples.
@@ -431,7 +440,7 @@ pub struct DemoActuatorArgs {
     pub steps: ThreeStepArgs,
     /// Directory for the data sets, tables and plots.
     #[arg(long, default_value = "hysid-out")]
-    pub out: PathBuf,
+    pub plots: PathBuf,
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -447,11 +456,11 @@ pub struct VorosArgs {
     #[arg(long)]
     pub noise_free: bool,
     /// Seed of the input disturbance and the output noise.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Directory for the plots (SVG).
     #[arg(long, default_value = "hysid-out")]
-    pub out: PathBuf,
+    pub plots: PathBuf,
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
@@ -510,12 +519,12 @@ pub struct OutputArgs {
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Write the fitted model here (loadable by `hysid simulate`).
-    #[arg(long)]
-    pub model: Option<PathBuf>,
+    /// Write the fitted model here (`hysid.model/1`, loadable by `hysid simulate --model`).
+    #[arg(long = "model-out")]
+    pub model_out: Option<PathBuf>,
     /// Directory for plots (SVG).
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub plots: Option<PathBuf>,
 }
 
 /// Options of `hysid identify cascade`.
@@ -595,8 +604,8 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub time: Option<String>,
     /// Write the input and the simulated output (and the measured one) as CSV here.
-    #[arg(long = "out")]
-    pub out_csv: Option<PathBuf>,
+    #[arg(long)]
+    pub csv: Option<PathBuf>,
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,

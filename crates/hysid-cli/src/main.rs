@@ -6,6 +6,7 @@
 
 mod cli;
 mod commands;
+mod deprecated;
 mod output;
 mod plot;
 mod progress;
@@ -15,7 +16,8 @@ use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = cli::Cli::parse();
+    let args = deprecated::rewrite(std::env::args_os().collect());
+    let cli = cli::Cli::parse_from(args);
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

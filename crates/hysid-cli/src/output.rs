@@ -11,6 +11,26 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     write_atomic(path, text.as_bytes())
 }
 
+/// Writes the report as pretty JSON to `path` atomically, refused when a number in it is
+/// not finite.
+pub fn write_report(path: &Path, report: &hysid::report::Report) -> Result<()> {
+    let text = report.to_json()?;
+    write_atomic(path, text.as_bytes()).context("writing the JSON report")
+}
+
+/// Writes the saved-model file of `model` to `path` atomically, refused when a parameter is
+/// not finite.
+pub fn write_model(path: &Path, model: &hysid::model::saved::FittedModel) -> Result<()> {
+    let file = model.to_file();
+    if let Some(p) = file.parameters.iter().find(|p| !p.value.is_finite()) {
+        anyhow::bail!(
+            "the estimate of {} is not finite; no model file written",
+            p.name
+        );
+    }
+    write_json(path, &file).context("writing the model file")
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same directory.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = writable_file(path)?;

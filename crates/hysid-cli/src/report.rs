@@ -3,91 +3,35 @@
 use hysid::data::IdData;
 use hysid::identify::OutputErrorFit;
 use hysid::model::saved::ModelFile;
-use hysid::numerics::metrics;
-use hysid::numerics::Termination;
-use serde::Serialize;
+pub use hysid::report::Report;
+use hysid::report::UncertaintySummary;
 
-/// The JSON report every identification command writes with `--json`.
-#[derive(Debug, Serialize)]
-pub struct Report {
-    /// The fitted model, in the model-file layout.
-    pub model: ModelFile,
-    /// fit % of the simulated against the measured output.
-    pub fit_percent: f64,
-    /// Root-mean-square error of the simulated output.
-    pub rmse: f64,
-    /// Iterations of the final output-error fit.
-    pub iterations: usize,
-    /// Why the final fit stopped, in words.
-    pub termination: String,
-    /// Why the final fit stopped, as a code.
-    pub termination_code: Termination,
-    /// Wall-clock time of the identification.
-    pub elapsed_s: f64,
-    /// Samples used.
-    pub samples: usize,
-    /// Mean squared residual.
-    pub loss: f64,
-    /// Akaike's final prediction error.
-    pub fpe: f64,
-    /// Akaike's information criterion.
-    pub aic: f64,
-    /// How the standard deviations were obtained.
-    pub uncertainty: String,
-    /// Command-specific details.
-    pub details: serde_json::Value,
+/// The report of an output-error fit (output 0 of every experiment of `data`, stacked).
+#[allow(clippy::too_many_arguments)]
+pub fn of_output_error(
+    command: &str,
+    fit: &OutputErrorFit,
+    data: &IdData,
+    sources: Vec<String>,
+    model: ModelFile,
+    elapsed_s: f64,
+    uncertainty: UncertaintySummary,
+    details: serde_json::Value,
+) -> hysid::Result<Report> {
+    Ok(
+        Report::of_output_error(command, data, sources, model, fit, elapsed_s, uncertainty)?
+            .with_details(details),
+    )
 }
 
-impl Report {
-    /// The report of an output-error fit whose simulated output `yhat` is compared with the
-    /// measured `y`.
-    pub fn new(
-        model: ModelFile,
-        fit: &OutputErrorFit,
-        (y, yhat): (&[f64], &[f64]),
-        elapsed_s: f64,
-        uncertainty: String,
-        details: serde_json::Value,
-    ) -> Self {
-        Self {
-            model,
-            fit_percent: metrics::fit_percent(y, yhat),
-            rmse: metrics::rmse(y, yhat),
-            iterations: fit.report.iterations,
-            termination: fit.report.termination.to_string(),
-            termination_code: fit.report.termination.clone(),
-            elapsed_s,
-            samples: y.len(),
-            loss: fit.loss,
-            fpe: fit.fpe,
-            aic: fit.aic,
-            uncertainty,
-            details,
-        }
-    }
-
-    /// [`Report::new`] over every experiment of `data`: output 0 of each, measured and
-    /// simulated, stacked.
-    pub fn stacked(
-        model: ModelFile,
-        fit: &OutputErrorFit,
-        data: &IdData,
-        elapsed_s: f64,
-        uncertainty: String,
-        details: serde_json::Value,
-    ) -> Self {
-        let y: Vec<f64> = data
-            .experiments()
-            .iter()
-            .flat_map(|e| e.output(0).iter().copied())
-            .collect();
-        let yhat: Vec<f64> = fit
-            .simulated
-            .iter()
-            .flat_map(|s| s[0].iter().copied())
-            .collect();
-        Self::new(model, fit, (&y, &yhat), elapsed_s, uncertainty, details)
-    }
+/// The fit % and RMSE of a report for printing (NaN when it holds no fit).
+pub fn figures(report: &Report) -> (f64, f64, f64) {
+    report
+        .fit
+        .as_ref()
+        .map_or((f64::NAN, f64::NAN, f64::NAN), |f| {
+            (f.fit_percent, f.rmse, f.fpe.unwrap_or(f64::NAN))
+        })
 }
 
 /// One row of the printed parameter table.

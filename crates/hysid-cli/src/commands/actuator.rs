@@ -5,7 +5,7 @@
 use crate::cli::{
     ActuatorConstants, ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs,
 };
-use crate::output::{ensure_dir, preflight, write_atomic, write_json};
+use crate::output::{ensure_dir, preflight, write_atomic, write_json, write_model, write_report};
 use crate::plot::{convergence, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
 use anyhow::{bail, Context, Result};
 use hysid::experiments::actuator_rig::Rig;
@@ -13,7 +13,10 @@ use hysid::identify::actuator::loops::{ascending, descending};
 use hysid::identify::actuator::{
     read_data_sets, ActuatorIdentification, Record, ThreeSteps, PARAMETERS,
 };
+use hysid::model::greybox::models::ActuatorFixed;
+use hysid::model::greybox::Simulation;
 use hysid::numerics::LmConfig;
+use hysid::report::actuator::three_steps_report;
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
@@ -23,12 +26,12 @@ use std::time::Instant;
 /// Writes the eight data sets of the virtual rig.
 pub fn rig(args: &RigArgs) -> Result<()> {
     let rig = rig_from(&args.rig, &args.constants)?;
-    preflight(&[], &[Some(&args.out)])?;
-    let files = write_rig(&rig, &args.out)?;
+    preflight(&[], &[Some(&args.data_out)])?;
+    let files = write_rig(&rig, &args.data_out)?;
     println!(
         "virtual actuator rig (Gunnar et al. 2006): {} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
         files.len(),
-        args.out.display(),
+        args.data_out.display(),
         rig.backlash,
         rig.angle_noise,
         rig.torque_noise,
@@ -39,27 +42,46 @@ pub fn rig(args: &RigArgs) -> Result<()> {
 
 /// The three steps on a data directory.
 pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
-    preflight(&[args.json.as_deref()], &[args.out.as_deref()])?;
+    preflight(
+        &[args.json.as_deref(), args.model_out.as_deref()],
+        &[args.plots.as_deref()],
+    )?;
     let records = read_data_sets(&args.data)?;
     let truth = rig_truth(&args.data)?;
     let clock = Instant::now();
-    let id = run(&three_steps(&args.steps, &args.constants), &records)?;
+    let steps = three_steps(&args.steps, &args.constants);
+    let id = run(&steps, &records)?;
+    let outputs = Outputs {
+        plots: args.plots.as_deref(),
+        json: args.json.as_deref(),
+        model_out: args.model_out.as_deref(),
+        sources: vec![args.data.display().to_string()],
+        simulation: steps.simulation,
+    };
     publish(
         &id,
         truth.as_deref(),
         &records,
-        args.out.as_deref(),
-        args.json.as_deref(),
-        json!({ "data": args.data, "elapsed_s": clock.elapsed().as_secs_f64() }),
+        &outputs,
+        json!({ "elapsed_s": clock.elapsed().as_secs_f64() }),
     )
+}
+
+/// Where the results of the three steps go.
+struct Outputs<'a> {
+    plots: Option<&'a Path>,
+    json: Option<&'a Path>,
+    model_out: Option<&'a Path>,
+    sources: Vec<String>,
+    simulation: Simulation,
 }
 
 /// The rig and the three steps on the default settings.
 pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     let clock = Instant::now();
     let rig = rig_from(&args.rig, &args.constants)?;
-    preflight(&[args.json.as_deref()], &[Some(&args.out)])?;
-    let data_dir = args.out.join("actuator-data");
+    preflight(&[args.json.as_deref()], &[Some(&args.plots)])?;
+    let data_dir = args.plots.join("actuator-data");
     write_rig(&rig, &data_dir)?;
     let records = read_data_sets(&data_dir)?;
     println!(
@@ -70,14 +92,22 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
         rig.seed,
         data_dir.display()
     );
-    let id = run(&three_steps(&args.steps, &args.constants), &records)?;
+    let steps = three_steps(&args.steps, &args.constants);
+    let id = run(&steps, &records)?;
+    let plots = args.plots.join("actuator");
+    let outputs = Outputs {
+        plots: Some(&plots),
+        json: args.json.as_deref(),
+        model_out: None,
+        sources: vec![data_dir.display().to_string()],
+        simulation: steps.simulation,
+    };
     publish(
         &id,
         Some(&rig.truth),
         &records,
-        Some(&args.out.join("actuator")),
-        args.json.as_deref(),
-        json!({ "data": data_dir, "rig": rig_json(&rig) }),
+        &outputs,
+        json!({ "rig": rig_json(&rig) }),
     )?;
     println!("  total time {:.1} s", clock.elapsed().as_secs_f64());
     Ok(())
@@ -100,10 +130,10 @@ fn publish(
     id: &ActuatorIdentification,
     truth: Option<&[f64]>,
     records: &BTreeMap<usize, Record>,
-    out: Option<&Path>,
-    json_path: Option<&Path>,
+    outputs: &Outputs,
     details: serde_json::Value,
 ) -> Result<()> {
+    let simulation = outputs.simulation;
     let markdown = id.markdown(truth);
     println!("\n{markdown}");
     for (name, fit) in &id.step3 {
@@ -112,17 +142,28 @@ fn publish(
             fit.fit.report.iterations, fit.fit.report.termination, fit.elapsed_s
         );
     }
-    if let Some(dir) = out {
+    if let Some(dir) = outputs.plots {
         ensure_dir(dir)?;
         write_atomic(&dir.join("tables.md"), markdown.as_bytes())?;
         let files = figures(dir, id, truth, records)?;
         println!("  tables and {} plots in {}", files.len(), dir.display());
     }
-    if let Some(path) = json_path {
-        let mut report = serde_json::to_value(id.report(truth))?;
-        report["details"] = details;
-        write_json(path, &report)?;
+    if let Some(path) = outputs.json {
+        let mut report = three_steps_report(id, truth, outputs.sources.clone(), simulation)?;
+        if let (Some(obj), serde_json::Value::Object(more)) =
+            (report.details.as_object_mut(), details)
+        {
+            obj.extend(more);
+        }
+        write_report(path, &report)?;
         println!("  report: {}", path.display());
+    }
+    if let Some(path) = outputs.model_out {
+        write_model(
+            path,
+            &id.step3["m67"].fitted_model(&ActuatorFixed, simulation),
+        )?;
+        println!("  model (m67): {}", path.display());
     }
     Ok(())
 }

@@ -3,10 +3,10 @@
 //! Fits the Bouc–Wen oscillator on a training record and scores test records by e_RMS in
 //! simulation mode (MODELS.md §3.1); `generate` makes test signals by the official recipe.
 
-use super::greybox::{configure, fitted_model, plots};
+use super::greybox::{configure, plots};
 use super::present::{print_fit, print_residuals, report};
 use crate::cli::{BoucWenArgs, BoucWenGenerate, BoucWenGenerateArgs, SignalArg};
-use crate::output::{ensure_dir, preflight, write_json};
+use crate::output::{ensure_dir, preflight, write_model, write_report};
 use crate::plot::{plot, Figure, Series};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
@@ -18,6 +18,7 @@ use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpa
 use hysid::model::saved::FittedModel;
 use hysid::numerics::metrics;
 use hysid::numerics::signal::{decimate_fir, gaussian_noise, multisine, sine_sweep};
+use hysid::report::ValidationEntry;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -36,7 +37,10 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
     if let Some(BoucWenGenerate::Generate(g)) = &args.generate {
         return generate(g);
     }
-    preflight(&[args.json.as_deref()], &[args.out.as_deref()])?;
+    preflight(
+        &[args.json.as_deref(), args.model_out.as_deref()],
+        &[args.plots.as_deref()],
+    )?;
     let Some(train) = &args.train else {
         bail!(
             "give the training record with --train FILE (columns t_s, u_N, y_m), or use `generate`"
@@ -57,28 +61,46 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
         "  training e_RMS {:.4e} m (the record's noise is 7.4e-6 m)",
         fit.fit.mse[0][0].sqrt()
     );
-    let fitted = fitted_model(&BoucWen, &fit, simulation);
+    let fitted = fit.fitted_model(&BoucWen, simulation);
     let tests = args
         .test
         .iter()
         .map(|path| score(&fitted, path, args.steady_state))
         .collect::<Result<Vec<_>>>()?;
     print_tests(&tests);
-    if let Some(dir) = &args.out {
+    if let Some(dir) = &args.plots {
         plots(dir, &fit, &data, &residuals)?;
         test_plots(dir, &tests)?;
         println!("  plots: {}", dir.display());
     }
     if let Some(path) = &args.json {
         let extra = json!({
-            "train": train,
             "training_e_rms": fit.fit.mse[0][0].sqrt(),
-            "tests": tests.iter().map(|t| json!({"file": t.file, "e_rms": t.e_rms, "fit_percent": t.fit_percent, "samples": t.y.len()})).collect::<Vec<_>>(),
+            "steady_state": args.steady_state,
             "published_multisine_e_rms": PUBLISHED.iter().map(|(who, e)| json!({"method": who, "e_rms": e})).collect::<Vec<_>>(),
             "residual_analysis": residuals,
         });
-        write_json(path, &report(&fit, &data, fitted.to_file(), extra))?;
+        let sources = vec![train.display().to_string()];
+        let mut report = report(
+            "benchmark bouc-wen",
+            &fit,
+            &data,
+            sources,
+            fitted.to_file(),
+            extra,
+        )?;
+        report.validation = tests
+            .iter()
+            .map(|t| {
+                ValidationEntry::of(t.file.display().to_string(), &t.y, &t.yhat, Some(t.e_rms))
+            })
+            .collect::<hysid::Result<_>>()?;
+        write_report(path, &report)?;
         println!("  report: {}", path.display());
+    }
+    if let Some(path) = &args.model_out {
+        write_model(path, &fitted)?;
+        println!("  model: {}", path.display());
     }
     Ok(())
 }
@@ -205,7 +227,7 @@ const UP: usize = 20;
 /// Simulates a test signal by the official recipe: the input at 15 kHz, Newmark (γ = ½,
 /// β = ¼) at 15 kHz, low-pass filtering and decimation back to 750 Hz.
 fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
-    preflight(&[Some(&args.out)], &[])?;
+    preflight(&[Some(&args.csv)], &[])?;
     let (u, u_fine) = match args.signal {
         SignalArg::Multisine => {
             anyhow::ensure!(args.periods >= 1, "--periods must be at least 1");
@@ -241,7 +263,7 @@ fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
         y.iter_mut().zip(&noise).for_each(|(a, b)| *a += b);
     }
     let t: Vec<f64> = (0..u.len()).map(|k| k as f64 / FS).collect();
-    write_csv(&args.out, &["t_s", "u_N", "y_m"], &[&t, &u, &y])?;
+    write_csv(&args.csv, &["t_s", "u_N", "y_m"], &[&t, &u, &y])?;
     println!(
         "Bouc–Wen {} test signal, {} samples at 750 Hz (Newmark at 15 kHz, decimated) -> {}",
         match args.signal {
@@ -249,7 +271,7 @@ fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
             SignalArg::Sweep => "sine-sweep",
         },
         u.len(),
-        args.out.display()
+        args.csv.display()
     );
     Ok(())
 }

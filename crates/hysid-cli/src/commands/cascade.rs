@@ -4,13 +4,15 @@
 use crate::cli::UncertaintyArg;
 use crate::output::ensure_dir;
 use crate::plot::{convergence, plot, Figure, Series, Style};
-use crate::report::{Report, Row};
+use crate::report::{figures, of_output_error, Report, Row};
 use anyhow::Result;
+use hysid::data::IdData;
 use hysid::identify::cascade::CascadeFit;
 use hysid::identify::Uncertainty;
 use hysid::model::saved::FittedModel;
 use hysid::model::HysteresisCascade;
 use hysid::numerics::metrics;
+use hysid::report::UncertaintySummary;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -48,15 +50,16 @@ pub fn rows(fit: &CascadeFit, truth: Option<&[f64]>, initial: Option<&[f64]>) ->
         .collect()
 }
 
-/// The JSON report of a cascade fit on output `y`.
+/// The report of a cascade fit on `data` (read from `sources`).
 pub fn report(
+    command: &str,
     fit: &CascadeFit,
-    y: &[f64],
+    data: &IdData,
+    sources: Vec<String>,
     uncertainty: Uncertainty,
     extra: serde_json::Value,
-) -> Report {
+) -> Result<Report> {
     let oe = &fit.output_error;
-    let yhat = &oe.simulated[0][0];
     let key_term = fit.key_term.as_ref().map(|k| {
         json!({
             "termination": k.termination.to_string(),
@@ -70,7 +73,6 @@ pub fn report(
         "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
         "threshold": fit.threshold,
         "switching_consistent": fit.switching_consistent,
-        "fit_percent_per_experiment": oe.fit_percent,
         "key_term_iteration": key_term,
         "output_error_history": oe.report.history,
         "candidates": fit.candidates.iter().map(|c| json!({"origin": c.origin, "cost": c.cost, "start": c.start, "refined": c.refined})).collect::<Vec<_>>(),
@@ -80,20 +82,20 @@ pub fn report(
     if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
         obj.extend(more);
     }
-    let uncertainty = match uncertainty {
-        Uncertainty::Asymptotic => "asymptotic (threshold d: truncated normal)".into(),
-        Uncertainty::Bootstrap(n) => {
-            format!("parametric bootstrap, {n} replicates (threshold d: truncated normal)")
-        }
+    let uncertainty = match (&fit.bootstrap, uncertainty) {
+        (Some(b), _) => UncertaintySummary::bootstrap(b.replicates.len(), b.failed),
+        (None, _) => UncertaintySummary::asymptotic(),
     };
-    Report::new(
-        fitted(fit).to_file(),
+    Ok(of_output_error(
+        command,
         oe,
-        (y, yhat),
+        data,
+        sources,
+        fitted(fit).to_file(),
         fit.elapsed_s,
         uncertainty,
         details,
-    )
+    )?)
 }
 
 /// Prints the lines under the table: the paper's iteration, the final fit, warnings.
@@ -110,9 +112,14 @@ pub fn print_summary(fit: &CascadeFit, report: &Report) {
         "  output-error fit: {} iterations, {} function evaluations, {}",
         oe.report.iterations, oe.report.function_evaluations, oe.report.termination
     );
+    let (fit_percent, rmse, fpe) = figures(report);
+    let method = report
+        .uncertainty
+        .as_ref()
+        .map_or("none", |u| u.method.as_str());
     println!(
-        "  fit {:.2} %   RMSE {:.4e}   FPE {:.4e}   time {:.2} s   std: {}",
-        report.fit_percent, report.rmse, report.fpe, fit.elapsed_s, report.uncertainty
+        "  fit {fit_percent:.2} %   RMSE {rmse:.4e}   FPE {fpe:.4e}   time {:.2} s   std: {method} (threshold d: truncated normal)",
+        fit.elapsed_s
     );
     let adm = fit.model.hysteresis.admissibility();
     if !adm.holds {

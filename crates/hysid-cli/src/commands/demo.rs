@@ -2,7 +2,7 @@
 
 use super::cascade::{plots, print_summary, report, rows, uncertainty};
 use crate::cli::{UncertaintyArg, VorosArgs};
-use crate::output::{preflight, write_json};
+use crate::output::{preflight, write_report};
 use crate::progress::FitProgress;
 use crate::report::print_table;
 use anyhow::Result;
@@ -13,7 +13,7 @@ use serde_json::json;
 /// Generates Example 1 or 2, identifies it and reports against the truth.
 pub fn voros(args: &VorosArgs) -> Result<()> {
     let ex = CascadeExample::number(args.example)?;
-    preflight(&[args.json.as_deref()], &[Some(&args.out)])?;
+    preflight(&[args.json.as_deref()], &[Some(&args.plots)])?;
     let generated = ex.generate(args.seed, !args.noise_free)?;
     let data = generated.id_data()?;
     let truth = &ex.truth;
@@ -66,13 +66,14 @@ pub fn voros(args: &VorosArgs) -> Result<()> {
         "true_parameters": truth_params,
         "initial_hysteresis": ex.initial.params(),
     });
-    let report = report(&fit, &generated.y, id.uncertainty, extra);
+    let source = vec![format!("built-in: project Example {}", args.example)];
+    let report = report("demo voros", &fit, &data, source, id.uncertainty, extra)?;
     print_summary(&fit, &report);
-    let dir = args.out.join(format!("voros-example{}", args.example));
+    let dir = args.plots.join(format!("voros-example{}", args.example));
     let files = plots(&dir, &fit, &generated.x, &generated.y, Some(truth))?;
     println!("  plots: {} files in {}", files.len(), dir.display());
     if let Some(path) = &args.json {
-        write_json(path, &report)?;
+        write_report(path, &report)?;
         println!("  report: {}", path.display());
     }
     Ok(())

@@ -9,14 +9,14 @@ use hysid::experiments::voros::CascadeExample;
 /// Writes columns t, x, y of Example 1 or 2 (optionally extended to `--samples`).
 pub fn voros(args: &GenerateVorosArgs) -> Result<()> {
     let mut ex = CascadeExample::number(args.example)?;
-    preflight(&[Some(&args.out)], &[])?;
+    preflight(&[Some(&args.csv)], &[])?;
     if let Some(n) = args.samples {
         anyhow::ensure!(n >= 2, "--samples must be at least 2, got {n}");
         ex = ex.extended(n);
     }
     let data = ex.generate(args.seed, !args.noise_free)?;
     let t: Vec<f64> = (0..data.x.len()).map(|k| k as f64).collect();
-    write_csv(&args.out, &["t", "x", "y"], &[&t, &data.x, &data.y])?;
+    write_csv(&args.csv, &["t", "x", "y"], &[&t, &data.x, &data.y])?;
     println!(
         "Example {} data: {} samples, seed {}, {} -> {}",
         args.example,
@@ -27,7 +27,7 @@ pub fn voros(args: &GenerateVorosArgs) -> Result<()> {
         } else {
             "SNR 50"
         },
-        args.out.display()
+        args.csv.display()
     );
     Ok(())
 }

@@ -3,7 +3,7 @@
 use super::present::{print_fit, print_residuals, print_sensitivity, report};
 use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
 use crate::commands::identify::load;
-use crate::output::{ensure_dir, preflight, write_json};
+use crate::output::{ensure_dir, preflight, write_model, write_report};
 use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
@@ -11,7 +11,6 @@ use hysid::data::IdData;
 use hysid::identify::greybox::{GreyBoxEstimation, GreyBoxFit, InitialStates};
 use hysid::identify::validate::{sensitivity_table, ResidualAnalysis};
 use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, StateSpaceModel};
-use hysid::model::saved::FittedModel;
 use hysid::model::ParameterSet;
 use hysid::numerics::LmConfig;
 use serde_json::json;
@@ -23,7 +22,7 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     let model: Arc<dyn StateSpaceModel> = Arc::from(models::by_kind(&args.model)?);
     preflight(
         &[args.json.as_deref(), args.model_out.as_deref()],
-        &[args.out.as_deref()],
+        &[args.plots.as_deref()],
     )?;
     let data = load(&args.data)?;
     let params = configure(
@@ -73,20 +72,20 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     } else {
         None
     };
-    let fitted = fitted_model(model.as_ref(), &fit, estimation.simulation);
-    if let Some(dir) = &args.out {
+    let fitted = fit.fitted_model(model.as_ref(), estimation.simulation);
+    if let Some(dir) = &args.plots {
         plots(dir, &fit, &data, &residuals)?;
         println!("  plots: {}", dir.display());
     }
-    let extra =
-        json!({"data": args.data.data, "residual_analysis": residuals, "sensitivity": sensitivity});
-    let report = report(&fit, &data, fitted.to_file(), extra);
+    let extra = json!({"residual_analysis": residuals, "sensitivity": sensitivity});
+    let sources = vec![args.data.data.display().to_string()];
+    let report = report("greybox fit", &fit, &data, sources, fitted.to_file(), extra)?;
     if let Some(path) = &args.json {
-        write_json(path, &report).context("writing the JSON report")?;
+        write_report(path, &report)?;
         println!("  report: {}", path.display());
     }
     if let Some(path) = &args.model_out {
-        write_json(path, &fitted.to_file()).context("writing the model file")?;
+        write_model(path, &fitted)?;
         println!("  model: {}", path.display());
     }
     Ok(())
@@ -184,28 +183,6 @@ pub fn simulation(args: &SimulationArgs) -> Simulation {
             InterpolationArg::Linear => InputInterpolation::Linear,
             InterpolationArg::BandLimited => InputInterpolation::BandLimited,
         },
-    }
-}
-
-/// The model file content: the model's own parameters, their std, and the first
-/// experiment's initial state.
-pub fn fitted_model(
-    model: &dyn StateSpaceModel,
-    fit: &GreyBoxFit,
-    simulation: Simulation,
-) -> FittedModel {
-    let p = model.parameters().len();
-    let n = model.states().len();
-    let all = &fit.fit.parameters;
-    let parameters =
-        ParameterSet::new(all.iter().take(p).cloned().collect()).expect("names are unique");
-    let values = all.values();
-    FittedModel::GreyBox {
-        kind: model.kind().to_string(),
-        parameters,
-        std: fit.fit.std()[..p].to_vec(),
-        simulation,
-        initial_state: values[p..p + n].to_vec(),
     }
 }
 

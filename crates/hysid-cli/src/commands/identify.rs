@@ -2,16 +2,17 @@
 
 use super::cascade::{fitted, plots, print_summary, report, rows, uncertainty};
 use crate::cli::{CascadeArgs, DataArgs, HysteresisArgs, InitialArg, OutputArgs};
-use crate::output::{ensure_dir, write_json};
+use crate::output::{ensure_dir, write_model, write_report};
 use crate::plot::{plot, Figure, Series, Style};
 use crate::progress::FitProgress;
-use crate::report::{print_table, Report, Row};
-use anyhow::{Context, Result};
+use crate::report::{figures, of_output_error, print_table, Report, Row};
+use anyhow::Result;
 use hysid::data::{Channel, CsvSpec, Experiment, IdData};
 use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::hysteresis::{HysteresisFit, HysteresisIdentification, InitialOutput};
 use hysid::model::saved::FittedModel;
 use hysid::model::ChForm;
+use hysid::report::UncertaintySummary;
 use hysid::Error;
 use serde_json::json;
 use std::path::Path;
@@ -90,11 +91,17 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         x.len()
     );
     print_table(&rows(&fit, None, None));
-    let extra =
-        json!({"data": args.data.data, "input": args.data.input, "output": args.data.output});
-    let report = report(&fit, y, id.uncertainty, extra);
+    let extra = json!({"input": args.data.input, "output": args.data.output});
+    let report = report(
+        "identify cascade",
+        &fit,
+        &data,
+        vec![args.data.data.display().to_string()],
+        id.uncertainty,
+        extra,
+    )?;
     print_summary(&fit, &report);
-    if let Some(dir) = &args.output.out {
+    if let Some(dir) = &args.output.plots {
         let files = plots(dir, &fit, x, y, None)?;
         println!("  plots: {} files in {}", files.len(), dir.display());
     }
@@ -137,7 +144,8 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
         })
         .collect();
     print_table(&rows);
-    let report = hysteresis_report(&fit, &data, id.initial);
+    let sources = vec![args.data.data.display().to_string()];
+    let report = hysteresis_report(&fit, &data, sources, id.initial)?;
     println!(
         "  separated regression: d re-estimated {} times ({}); output-error fit: {} iterations, {}",
         fit.separated.d_history.len().saturating_sub(1),
@@ -145,9 +153,10 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
         fit.output_error.report.iterations,
         fit.output_error.report.termination
     );
+    let (fit_percent, rmse, _) = figures(&report);
     println!(
-        "  fit {:.2} %   RMSE {:.4e}   time {:.2} s",
-        report.fit_percent, report.rmse, report.elapsed_s
+        "  fit {fit_percent:.2} %   RMSE {rmse:.4e}   time {:.2} s",
+        fit.elapsed_s
     );
     let adm = fit.model.admissibility();
     if !adm.holds {
@@ -156,7 +165,7 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
             adm.violations.join("; ")
         );
     }
-    if let Some(dir) = &args.output.out {
+    if let Some(dir) = &args.output.plots {
         hysteresis_plots(dir, &fit, &data)?;
         println!("  plots: {}", dir.display());
     }
@@ -168,7 +177,12 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
     finish(&args.output, &report, &fitted)
 }
 
-fn hysteresis_report(fit: &HysteresisFit, data: &IdData, initial: InitialOutput) -> Report {
+fn hysteresis_report(
+    fit: &HysteresisFit,
+    data: &IdData,
+    sources: Vec<String>,
+    initial: InitialOutput,
+) -> Result<Report> {
     let oe = &fit.output_error;
     let fitted = FittedModel::Hysteresis {
         model: fit.model.clone(),
@@ -176,7 +190,6 @@ fn hysteresis_report(fit: &HysteresisFit, data: &IdData, initial: InitialOutput)
         std: fit.std(),
     };
     let details = json!({
-        "fit_percent_per_experiment": oe.fit_percent,
         "admissibility": fit.model.admissibility(),
         "threshold": fit.threshold,
         "separated_regression": {
@@ -185,14 +198,16 @@ fn hysteresis_report(fit: &HysteresisFit, data: &IdData, initial: InitialOutput)
         },
         "output_error_history": oe.report.history,
     });
-    Report::stacked(
-        fitted.to_file(),
+    Ok(of_output_error(
+        "identify hysteresis",
         oe,
         data,
+        sources,
+        fitted.to_file(),
         fit.elapsed_s,
-        "asymptotic (threshold d: truncated normal)".into(),
+        UncertaintySummary::asymptotic(),
         details,
-    )
+    )?)
 }
 
 fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()> {
@@ -240,11 +255,11 @@ fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()
 /// Writes the report and the model file when asked for.
 fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<()> {
     if let Some(path) = &output.json {
-        write_json(path, report).context("writing the JSON report")?;
+        write_report(path, report)?;
         println!("  report: {}", path.display());
     }
-    if let Some(path) = &output.model {
-        write_json(path, &model.to_file()).context("writing the model file")?;
+    if let Some(path) = &output.model_out {
+        write_model(path, model)?;
         println!("  model: {}", path.display());
     }
     Ok(())
@@ -253,7 +268,7 @@ fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<(
 /// Checks the report, model and plot destinations before the fit.
 fn preflight_outputs(output: &OutputArgs) -> Result<()> {
     crate::output::preflight(
-        &[output.json.as_deref(), output.model.as_deref()],
-        &[output.out.as_deref()],
+        &[output.json.as_deref(), output.model_out.as_deref()],
+        &[output.plots.as_deref()],
     )
 }

@@ -2,10 +2,12 @@
 //! bounds and fixed flags; strong correlations; fit per experiment; loss, FPE, AIC; why the
 //! search stopped; residual analysis; optional sensitivity table.
 
-use crate::report::Report;
+use crate::report::{of_output_error, Report};
+use anyhow::Result;
 use hysid::data::IdData;
 use hysid::identify::greybox::GreyBoxFit;
 use hysid::identify::validate::{residual_analysis, ResidualAnalysis, SensitivityRow};
+use hysid::report::UncertaintySummary;
 use serde_json::json;
 
 /// Prints the parameter table and the fit statistics.
@@ -123,20 +125,20 @@ pub fn print_sensitivity(rows: &[SensitivityRow]) {
 
 /// The JSON report of a grey-box fit.
 pub fn report(
+    command: &str,
     fit: &GreyBoxFit,
     data: &IdData,
+    sources: Vec<String>,
     model_file: hysid::model::saved::ModelFile,
     extra: serde_json::Value,
-) -> Report {
+) -> Result<Report> {
     let oe = &fit.fit;
     let n = oe.parameters.len();
     let correlation: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| oe.covariance.correlation[(i, j)]).collect())
         .collect();
     let mut details = json!({
-        "fit_percent_per_experiment": oe.fit_percent,
         "mse_per_experiment": oe.mse,
-        "function_evaluations": oe.report.function_evaluations,
         "rejected_trials": oe.report.rejected_trials,
         "correlation": correlation,
         "history": oe.report.history,
@@ -145,12 +147,14 @@ pub fn report(
     if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
         obj.extend(more);
     }
-    Report::stacked(
-        model_file,
+    Ok(of_output_error(
+        command,
         oe,
         data,
+        sources,
+        model_file,
         fit.elapsed_s,
-        "asymptotic".into(),
+        UncertaintySummary::asymptotic(),
         details,
-    )
+    )?)
 }

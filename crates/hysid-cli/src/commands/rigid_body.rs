@@ -2,16 +2,21 @@
 //! 1 of Gunnar et al. 2006; the reference method of the EMPS benchmark, Janot et al. 2019).
 
 use crate::cli::RigidBodyLsArgs;
-use crate::output::{preflight, write_json};
+use crate::output::{preflight, write_model, write_report};
 use anyhow::{Context, Result};
 use hysid::data::{CsvSpec, IdData};
 use hysid::identify::rigid_body::{RigidBodyEstimate, RigidBodyLs};
+use hysid::model::greybox::models::RigidBody;
+use hysid::model::greybox::{Simulation, StateSpaceModel};
+use hysid::model::saved::FittedModel;
+use hysid::report::{DataSummary, Report, SearchSummary, UncertaintySummary};
 use serde_json::json;
 use std::path::Path;
 
 /// Estimates on one record; relative errors on every validation record.
 pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
-    preflight(&[args.json.as_deref()], &[])?;
+    preflight(&[args.json.as_deref(), args.model_out.as_deref()], &[])?;
+    let clock = std::time::Instant::now();
     let ls = RigidBodyLs {
         inertia_name: "M".into(),
         gain: args.gain,
@@ -43,9 +48,20 @@ pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
             "relative_error_percent": error,
         }));
     }
+    let report = report(
+        &estimate,
+        records,
+        args,
+        q.len(),
+        clock.elapsed().as_secs_f64(),
+    );
     if let Some(path) = &args.json {
-        write_json(path, &report(&estimate, records, args))?;
+        write_report(path, &report)?;
         println!("  report: {}", path.display());
+    }
+    if let Some(path) = &args.model_out {
+        write_model(path, &fitted(&estimate, args))?;
+        println!("  model: {}", path.display());
     }
     Ok(())
 }
@@ -82,37 +98,69 @@ fn print_estimate(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) {
     );
 }
 
-/// The JSON report: parameters by name, a relative error per record, the settings.
+/// The report: the estimate as a `rigid_body` model (M q̈ + Fv q̇ + Fc sgn(q̇) + offset =
+/// gain·u), `fit` null (an inverse-dynamics fit predicts the force, it does not simulate),
+/// the relative error per record, the condition numbers and the settings in `details`.
 fn report(
     estimate: &RigidBodyEstimate,
     records: Vec<serde_json::Value>,
     args: &RigidBodyLsArgs,
-) -> serde_json::Value {
-    let parameters: serde_json::Map<String, serde_json::Value> = (0..estimate.names.len())
-        .map(|i| {
-            (
-                estimate.names[i].clone(),
-                json!({
-                    "value": estimate.values[i],
-                    "std": estimate.std[i],
-                    "relative_std_percent": estimate.relative_std_percent[i],
-                }),
-            )
-        })
-        .collect();
-    json!({
-        "model": "rigid_body",
-        "parameters": parameters,
-        "records": records,
-        "condition_number": estimate.condition_number_unscaled,
-        "condition_number_scaled": estimate.condition_number,
-        "equations": estimate.equations,
-        "settings": {
-            "gain": args.gain, "offset": args.offset, "cutoff_hz": args.cutoff,
-            "filter_order": args.order, "decimation": args.decimate, "border": args.border,
-            "position": args.position, "input": args.input,
-        },
-    })
+    samples: usize,
+    elapsed_s: f64,
+) -> Report {
+    Report {
+        data: Some(DataSummary {
+            source: vec![args.data.display().to_string()],
+            samples,
+            experiments: 1,
+            ts: None,
+        }),
+        model: Some(fitted(estimate, args).to_file()),
+        search: Some(SearchSummary::direct(elapsed_s)),
+        uncertainty: Some(UncertaintySummary::least_squares()),
+        details: json!({
+            "relative_std_percent": estimate.names.iter().cloned().zip(estimate.relative_std_percent.iter().copied()).collect::<std::collections::BTreeMap<_, _>>(),
+            "records": records,
+            "condition_number": estimate.condition_number_unscaled,
+            "condition_number_scaled": estimate.condition_number,
+            "equations": estimate.equations,
+            "settings": {
+                "gain": args.gain, "offset": args.offset, "cutoff_hz": args.cutoff,
+                "filter_order": args.order, "decimation": args.decimate, "border": args.border,
+                "position": args.position, "input": args.input,
+            },
+        }),
+        ..Report::new("rigid-body ls")
+    }
+}
+
+/// The estimate as the built-in `rigid_body` grey-box model (offset fixed at 0 when not
+/// estimated, the gain fixed at `--gain`).
+fn fitted(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) -> FittedModel {
+    let mut parameters = RigidBody.parameters();
+    let mut std = vec![f64::NAN; parameters.len()];
+    for i in 0..parameters.len() {
+        let p = parameters.get_mut(i);
+        match estimate.names.iter().position(|n| *n == p.name) {
+            Some(k) => {
+                p.value = estimate.values[k];
+                std[i] = estimate.std[k];
+            }
+            None => {
+                p.fixed = true;
+                if p.name == "gain" {
+                    p.value = args.gain;
+                }
+            }
+        }
+    }
+    FittedModel::GreyBox {
+        kind: "rigid_body".into(),
+        parameters,
+        std,
+        simulation: Simulation::default(),
+        initial_state: vec![0.0; RigidBody.states().len()],
+    }
 }
 
 /// Position, drive signal and sample time of a record.

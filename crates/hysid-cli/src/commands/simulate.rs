@@ -1,17 +1,16 @@
 //! `hysid simulate`: run a saved model on new input data.
 
 use crate::cli::SimulateArgs;
-use crate::output::{preflight, write_json};
+use crate::output::{preflight, write_report};
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::model::saved::FittedModel;
-use hysid::numerics::metrics;
-use serde_json::json;
+use hysid::report::{DataSummary, FitSummary, Report};
 
 /// Simulates the model on the input columns; compares with the output column when given.
 pub fn run(args: &SimulateArgs) -> Result<()> {
     let model = FittedModel::load(&args.model)?;
-    preflight(&[args.out_csv.as_deref(), args.json.as_deref()], &[])?;
+    preflight(&[args.csv.as_deref(), args.json.as_deref()], &[])?;
     let spec = CsvSpec {
         inputs: args.input.clone(),
         outputs: args.output.iter().cloned().collect(),
@@ -30,17 +29,27 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         )
         .with_context(|| format!("simulating on {}", args.data.display()))?;
     let yhat = &outputs[0];
-    let kind = model.to_file().kind;
+    let file = model.to_file();
     println!(
-        "Simulated {kind} on {} ({} samples)",
+        "Simulated {} on {} ({} samples)",
+        file.kind,
         args.data.display(),
         exp.len()
     );
-    let scores = measured.map(|y| (metrics::fit_percent(y, yhat), metrics::rmse(y, yhat)));
-    if let Some((fit, rmse)) = scores {
-        println!("  fit {fit:.2} %   RMSE {rmse:.4e}");
+    let mut report = Report::new("simulate");
+    report.data = Some(DataSummary::of(
+        &data,
+        vec![args.data.display().to_string()],
+    ));
+    if let Some(y) = measured {
+        let fit = FitSummary::of(&[exp.name.clone()], &[y], &[yhat])?;
+        println!("  fit {:.2} %   RMSE {:.4e}", fit.fit_percent, fit.rmse);
+        report.fit = Some(fit);
+    } else if yhat.iter().any(|v| !v.is_finite()) {
+        anyhow::bail!("the simulated output is not finite: the model is unstable on this input");
     }
-    if let Some(path) = &args.out_csv {
+    report.model = Some(file);
+    if let Some(path) = &args.csv {
         let mut headers: Vec<&str> = args.input.iter().map(String::as_str).collect();
         headers.push("simulated");
         let mut cols: Vec<&[f64]> = inputs.clone();
@@ -53,13 +62,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         println!("  simulated output: {}", path.display());
     }
     if let Some(path) = &args.json {
-        let report = json!({
-            "model": model.to_file(),
-            "samples": exp.len(),
-            "fit_percent": scores.map(|s| s.0),
-            "rmse": scores.map(|s| s.1),
-        });
-        write_json(path, &report)?;
+        write_report(path, &report)?;
         println!("  report: {}", path.display());
     }
     Ok(())

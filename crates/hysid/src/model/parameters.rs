@@ -73,6 +73,13 @@ impl ParameterSet {
         Ok(Self { params })
     }
 
+    /// The first `n` parameters (all when there are fewer).
+    pub fn leading(&self, n: usize) -> Self {
+        Self {
+            params: self.params.iter().take(n).cloned().collect(),
+        }
+    }
+
     /// Free parameters named `names` with values `values`, unbounded.
     pub fn from_values(names: &[String], values: &[f64]) -> Result<Self> {
         Self::new(

@@ -22,6 +22,8 @@
 //! fit % is the normalised RMSE fit 100 (1 − ‖y − ŷ‖ / ‖y − ȳ‖) of MATLAB's `compare`;
 //! FPE and AIC are Akaike's (Ljung, *System Identification*, 2nd ed., 1999, §16.4).
 
+pub mod actuator;
+
 use crate::data::IdData;
 use crate::identify::OutputErrorFit;
 use crate::model::saved::ModelFile;
@@ -370,6 +372,21 @@ impl Report {
             uncertainty: Some(uncertainty),
             ..Self::new(command)
         })
+    }
+
+    /// Sets the model and the figures of its fit.
+    pub fn with_model(
+        mut self,
+        model: Option<ModelFile>,
+        fit: Option<FitSummary>,
+        search: Option<SearchSummary>,
+        uncertainty: Option<UncertaintySummary>,
+    ) -> Self {
+        self.model = model;
+        self.fit = fit;
+        self.search = search;
+        self.uncertainty = uncertainty;
+        self
     }
 
     /// Sets `details`.

@@ -9,6 +9,7 @@ use crate::data::IdData;
 use crate::identify::multistart::{best_of, draw_starts, StartOutcome};
 use crate::identify::{OutputError, OutputErrorFit};
 use crate::model::greybox::{Simulation, StateSpaceModel};
+use crate::model::saved::FittedModel;
 use crate::model::ParameterSet;
 use crate::numerics::{Control, IterationRecord, LmConfig};
 use crate::{Error, Result};
@@ -57,6 +58,24 @@ pub struct GreyBoxFit {
     pub starts: Vec<StartOutcome>,
     /// Wall-clock time of the whole estimation.
     pub elapsed_s: f64,
+}
+
+impl GreyBoxFit {
+    /// The fitted model: the model's own parameters (the leading ones of the estimate) with
+    /// their standard deviations, the first experiment's initial state, and `simulation`.
+    pub fn fitted_model(&self, model: &dyn StateSpaceModel, simulation: Simulation) -> FittedModel {
+        let p = model.parameters().len();
+        let n = model.states().len();
+        let all = &self.fit.parameters;
+        let values = all.values();
+        FittedModel::GreyBox {
+            kind: model.kind().to_string(),
+            parameters: all.leading(p),
+            std: self.fit.std()[..p].to_vec(),
+            simulation,
+            initial_state: values[p..p + n].to_vec(),
+        }
+    }
 }
 
 impl GreyBoxEstimation {
