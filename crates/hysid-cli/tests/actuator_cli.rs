@@ -24,12 +24,32 @@ fn one_line_error(cmd: &mut Command) -> String {
 fn rig(dir: &Path, extra: &[&str]) -> PathBuf {
     let data = dir.join("rig");
     hysid()
-        .args(["actuator", "rig", "--out"])
+        .args(["actuator", "rig", "--data-out"])
         .arg(&data)
         .args(extra)
         .assert()
         .success();
     data
+}
+
+/// The report of step `name` (`step 1`, `step 2`, `step 3 m67`, …) of an actuator report.
+fn step<'a>(r: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    r["details"]["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["command"].as_str().unwrap().ends_with(name))
+        .unwrap_or_else(|| panic!("no {name} in the report"))
+}
+
+/// The entry of parameter `name` in a report's `model.parameters`.
+fn parameter<'a>(r: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    r["model"]["parameters"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == name)
+        .unwrap_or_else(|| panic!("no parameter {name}"))
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -55,7 +75,7 @@ fn rig_and_identify_regenerate_the_tables() {
     let stdout = hysid()
         .args(["actuator", "identify", "--data"])
         .arg(&data)
-        .arg("--out")
+        .arg("--plots")
         .arg(&out)
         .arg("--json")
         .arg(&report)
@@ -78,25 +98,21 @@ fn rig_and_identify_regenerate_the_tables() {
         assert!(out.join(file).is_file(), "{file}");
     }
     let r = json(&report);
-    let truth = &r["truth"];
+    let truth = &r["details"]["truth"];
     for name in ["J", "Fv", "Fc", "k1", "k2", "alpha", "A"] {
-        let estimate = r["models"]["m67"]["parameters"][name]["value"]
-            .as_f64()
-            .unwrap();
+        let estimate = parameter(step(&r, "m67"), name)["value"].as_f64().unwrap();
         let t = truth[name].as_f64().unwrap();
         assert!(
             ((estimate - t) / t).abs() < 1e-3,
             "{name}: {estimate} vs {t}"
         );
-        assert!(r["models"]["m67f"]["parameters"]["J"]["fixed"]
-            .as_bool()
-            .unwrap());
+        assert!(parameter(step(&r, "m67f"), "J")["fixed"].as_bool().unwrap());
     }
     assert_eq!(
-        r["models"]["m68"]["estimated_on"],
-        serde_json::json!([6, 8])
+        step(&r, "m68")["data"]["source"],
+        serde_json::json!(["data sets 6 and 8"])
     );
-    assert_eq!(r["sensitivity"].as_array().unwrap().len(), 7);
+    assert_eq!(r["details"]["sensitivity"].as_array().unwrap().len(), 7);
 }
 
 #[test]
@@ -104,7 +120,7 @@ fn demo_runs_the_rig_and_all_three_steps() {
     let dir = TempDir::new().unwrap();
     let report = dir.path().join("demo.json");
     let stdout = hysid()
-        .args(["demo", "actuator", "--out"])
+        .args(["demo", "actuator", "--plots"])
         .arg(dir.path())
         .arg("--json")
         .arg(&report)
@@ -120,7 +136,7 @@ fn demo_runs_the_rig_and_all_three_steps() {
     );
     let r = json(&report);
     for m in ["m0", "m67", "m68", "m67f", "m68f"] {
-        let fits = r["models"][m]["fit_percent"].as_array().unwrap();
+        let fits = r["details"]["fit_table"][m].as_array().unwrap();
         assert!(
             fits.iter().all(|f| f.as_f64().unwrap() > 95.0),
             "{m}: {fits:?}"
@@ -170,13 +186,13 @@ fn bad_rig_settings_are_one_line() {
     let dir = TempDir::new().unwrap();
     let err = one_line_error(
         hysid()
-            .args(["actuator", "rig", "--noise=-1", "--out"])
+            .args(["actuator", "rig", "--noise=-1", "--data-out"])
             .arg(dir.path().join("x")),
     );
     assert!(err.contains("--noise"), "{err}");
     let err = one_line_error(
         hysid()
-            .args(["actuator", "rig", "--truth", "beta=3", "--out"])
+            .args(["actuator", "rig", "--truth", "beta=3", "--data-out"])
             .arg(dir.path().join("x")),
     );
     assert!(err.contains("alpha"), "{err}");
@@ -206,18 +222,18 @@ fn rigid_body_ls_reproduces_the_emps_reference() {
         .assert()
         .success();
     let r = json(&report);
-    let p = &r["parameters"];
+    let p = |name: &str| parameter(&r, name);
     for (name, published, tol) in [
         ("M", 95.1089, 0.005),
         ("Fv", 203.5034, 0.005),
         ("Fc", 20.3935, 0.005),
         ("offset", -3.1648, 0.02),
     ] {
-        let v = p[name]["value"].as_f64().unwrap();
+        let v = p(name)["value"].as_f64().unwrap();
         assert!(((v - published) / published).abs() < tol, "{name}: {v}");
-        assert!(p[name]["relative_std_percent"].as_f64().unwrap() > 0.0);
+        assert!(r["details"]["relative_std_percent"][name].as_f64().unwrap() > 0.0);
     }
-    let records = r["records"].as_array().unwrap();
+    let records = r["details"]["records"].as_array().unwrap();
     assert_eq!(records.len(), 2);
     for rec in records {
         let e = rec["relative_error_percent"].as_f64().unwrap();
@@ -288,7 +304,7 @@ fn rig_and_identify_take_the_actuator_constants() {
     let dir = TempDir::new().unwrap();
     let err = one_line_error(
         hysid()
-            .args(["actuator", "rig", "--gear-ratio", "0", "--out"])
+            .args(["actuator", "rig", "--gear-ratio", "0", "--data-out"])
             .arg(dir.path().join("x")),
     );
     assert!(err.contains("gear ratio"), "{err}");
@@ -305,8 +321,8 @@ fn rig_and_identify_take_the_actuator_constants() {
             .assert()
             .success();
         let r = json(&report);
-        let truth = r["truth"]["J"].as_f64().unwrap();
-        let j = r["models"]["m0"]["parameters"]["J"]["value"]
+        let truth = r["details"]["truth"]["J"].as_f64().unwrap();
+        let j = parameter(step(&r, "step 2"), "J")["value"]
             .as_f64()
             .unwrap();
         (j - truth) / truth
@@ -336,9 +352,12 @@ fn rigid_body_ls_reads_the_official_matlab_file() {
     let mat = emps().with_extension("mat");
     let from_mat = run(mat, "qm", "vir", &dir.path().join("m.json"));
     let from_csv = run(emps(), "qm_m", "vir_V", &dir.path().join("c.json"));
-    assert_eq!(from_mat["parameters"], from_csv["parameters"]);
     assert_eq!(
-        from_mat["records"][0]["relative_error_percent"],
-        from_csv["records"][0]["relative_error_percent"]
+        from_mat["model"]["parameters"],
+        from_csv["model"]["parameters"]
+    );
+    assert_eq!(
+        from_mat["details"]["records"][0]["relative_error_percent"],
+        from_csv["details"]["records"][0]["relative_error_percent"]
     );
 }
