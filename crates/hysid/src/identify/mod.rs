@@ -1,0 +1,3 @@
+//! Identification recipes.
+
+pub mod operators;
