@@ -140,7 +140,18 @@ impl GramAccumulator {
         }
         let c = self.block.columns(0, self.filled);
         let t = self.targets.rows(0, self.filled);
-        self.g.gemm(1.0, &c, &c.transpose(), 1.0);
+        let ct = c.transpose();
+        // only the blocks on and below the diagonal: G is symmetric
+        let p = self.g.nrows();
+        let step = 64;
+        for i0 in (0..p).step_by(step) {
+            let ni = step.min(p - i0);
+            for j0 in (0..=i0).step_by(step) {
+                let nj = step.min(p - j0);
+                let mut gij = self.g.view_mut((i0, j0), (ni, nj));
+                gij.gemm(1.0, &c.rows(i0, ni), &ct.columns(j0, nj), 1.0);
+            }
+        }
         self.b.gemv(1.0, &c, &t, 1.0);
         self.filled = 0;
     }
@@ -148,6 +159,7 @@ impl GramAccumulator {
     /// The accumulated normal equations.
     pub fn finish(mut self) -> (DMatrix<f64>, DVector<f64>, f64, usize) {
         self.flush();
+        self.g.fill_upper_triangle_with_lower_triangle();
         (self.g, self.b, self.yy, self.n)
     }
 

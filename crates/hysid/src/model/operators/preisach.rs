@@ -100,21 +100,24 @@ impl Memory {
         }
     }
 
-    /// Moves the input to x, wiping out the extrema it passes.
-    pub fn apply(&mut self, grid: &Grid, x: f64) {
+    /// Moves the input to x, wiping out the extrema it passes; returns the index of the first
+    /// point that changed (the points' length when none did).
+    pub fn apply(&mut self, grid: &Grid, x: f64) -> usize {
         let v = x.clamp(grid.lower, grid.upper);
         let p = &mut self.points;
         let len = p.len();
         let cur = p[len - 1];
         if v == cur {
-            return;
+            return len;
         }
         let continuing = len >= 2 && ((cur > p[len - 2]) == (v > cur));
-        if continuing {
+        let mut first = if continuing {
             p[len - 1] = v;
+            len - 1
         } else {
             p.push(v);
-        }
+            len
+        };
         // wiping-out: the new value passes the previous extremum of its kind
         while p.len() >= 3 {
             let n = p.len();
@@ -125,24 +128,63 @@ impl Memory {
             }
             if n == 3 && !rising {
                 p.truncate(1);
+                first = 1;
                 break;
             }
             p.drain(n - 3..n - 1);
+            first = first.min(n - 3);
         }
-        if p.len() == 2 && p[1] <= p[0] {
-            p.truncate(1);
-        }
+        first
+    }
+
+    /// The strip s = (m_{s}, m_{s+1} (or M when it is the last point), M_{s+1}).
+    fn strip(&self, s: usize) -> (f64, f64, f64) {
+        let p = &self.points;
+        let k = 2 * s + 1;
+        let m_next = if k + 1 < p.len() { p[k + 1] } else { p[k] };
+        (p[k - 1], m_next, p[k])
+    }
+
+    /// Number of strips.
+    fn n_strips(&self) -> usize {
+        self.points.len() / 2
     }
 
     /// The strips (m_{k−1}, m_k, M_k) whose union is S⁺.
     pub fn strips(&self) -> impl Iterator<Item = (f64, f64, f64)> + '_ {
-        let p = &self.points;
-        (1..p.len()).step_by(2).map(move |k| {
-            let m_prev = p[k - 1];
-            let big = p[k];
-            let m_next = if k + 1 < p.len() { p[k + 1] } else { big };
-            (m_prev, m_next, big)
-        })
+        (0..self.n_strips()).map(move |s| self.strip(s))
+    }
+}
+
+/// The memory with the running sums of the strips' Everett integrals
+/// Σ_{t≤s} [E(M_t, m_{t−1}) − E(M_t, m_t)], so that a sample costs only the strips it changes.
+#[derive(Clone, Debug)]
+struct State {
+    memory: Memory,
+    prefix: Vec<f64>,
+}
+
+impl State {
+    fn new(grid: &Grid) -> Self {
+        Self {
+            memory: Memory::new(grid),
+            prefix: Vec::new(),
+        }
+    }
+
+    /// Moves the input to x and returns the integral of μ over S⁺.
+    fn advance(&mut self, model: &Preisach, x: f64) -> f64 {
+        let first = self.memory.apply(&model.grid, x);
+        // strip s uses points 2s … 2s + 2
+        let keep = first.saturating_sub(2) / 2;
+        self.prefix.truncate(keep.min(self.prefix.len()));
+        for s in self.prefix.len()..self.memory.n_strips() {
+            let (m_prev, m_next, big) = self.memory.strip(s);
+            let a = model.everett(big, m_prev) - model.everett(big, m_next);
+            let before = self.prefix.last().copied().unwrap_or(0.0);
+            self.prefix.push(before + a);
+        }
+        self.prefix.last().copied().unwrap_or(0.0)
     }
 }
 
@@ -276,12 +318,8 @@ impl Preisach {
         full + partial_row + partial_col
     }
 
-    /// The output for the current memory and input x.
-    fn output(&self, memory: &Memory, x: f64) -> f64 {
-        let up: f64 = memory
-            .strips()
-            .map(|(m_prev, m_next, big)| self.everett(big, m_prev) - self.everett(big, m_next))
-            .sum();
+    /// The output from the integral over S⁺ and the input x.
+    fn output(&self, up: f64, x: f64) -> f64 {
         self.offset + self.a0 * x + 2.0 * up - self.q[self.grid.n - 1]
     }
 }
@@ -323,18 +361,18 @@ pub(crate) fn regressors(grid: &Grid, memory: &Memory, phi: &mut [f64]) {
 
 impl Core for Preisach {
     fn forward(&self, u: &[f64]) -> Vec<f64> {
-        let mut memory = Memory::new(&self.grid);
+        let mut state = State::new(&self.grid);
         u.iter()
             .map(|&x| {
-                memory.apply(&self.grid, x);
-                self.output(&memory, x)
+                let up = state.advance(self, x);
+                self.output(up, x)
             })
             .collect()
     }
 
     fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
         let g = self.grid;
-        let mut memory = Memory::new(&g);
+        let mut state = State::new(&g);
         let branch = Branch {
             center: 0.5 * (g.lower + g.upper),
             span: 0.5 * (g.upper - g.lower) * (1.0 + 1e-12),
@@ -344,15 +382,15 @@ impl Core for Preisach {
         let (mut u, mut clipped) = (Vec::with_capacity(v.len()), Vec::new());
         for (k, &vk) in v.iter().enumerate() {
             let trial = |x: f64| {
-                let mut m = memory.clone();
-                m.apply(&g, x);
-                self.output(&m, x)
+                let mut trial_state = state.clone();
+                let up = trial_state.advance(self, x);
+                self.output(up, x)
             };
             let (x, c) = solve_monotone(trial, vk, branch);
             if c {
                 clipped.push(k);
             }
-            memory.apply(&g, x);
+            state.advance(self, x);
             u.push(x);
         }
         (u, clipped)
