@@ -64,7 +64,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &PreisachOptions) -> Result<OperatorFi
     let o = orientation(u, y, options.orientation)?;
     let (x, v) = o.core_data(u, y);
     let (lower, upper) = options.range.unwrap_or_else(|| range(&x));
-    if !(upper > lower) || !lower.is_finite() || !upper.is_finite() {
+    if upper <= lower || !lower.is_finite() || !upper.is_finite() {
         return Err(Error::Config(format!(
             "Preisach grid range [{lower}, {upper}] is empty; give lower < upper"
         )));
