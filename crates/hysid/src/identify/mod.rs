@@ -17,6 +17,7 @@
 //! * [`greybox`]: output-error estimation of continuous-time grey-box models with
 //!   multi-start (MATLAB's `nlgreyest`).
 //! * [`actuator`]: the three-step identification of Gunnar et al. (2006).
+//! * [`operators`]: identification of the hysteresis operator families from the data alone.
 //! * [`validate`]: residual analysis and the one-at-a-time sensitivity table.
 
 pub mod actuator;
@@ -27,6 +28,7 @@ pub mod greybox;
 pub mod hysteresis;
 pub mod key_term;
 pub mod multistart;
+pub mod operators;
 pub mod output_error;
 pub mod rigid_body;
 pub mod rls;

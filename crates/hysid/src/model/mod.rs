@@ -16,6 +16,7 @@ mod cascade;
 pub mod coleman_hodgdon;
 pub mod greybox;
 mod linear;
+pub mod operators;
 mod parameters;
 pub mod saved;
 

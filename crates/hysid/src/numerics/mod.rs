@@ -6,6 +6,7 @@
 //! * [`levenberg_marquardt`]: the bounded Levenberg–Marquardt engine (options struct,
 //!   report with the termination reason, covariance).
 //! * [`mod@least_squares`]: linear least squares by QR with covariance and a rank check.
+//! * [`nnls`]: non-negative least squares (Lawson–Hanson) on the Gram matrix.
 //! * [`nelder_mead`]: a small simplex minimiser for non-smooth one- and two-dimensional
 //!   profiles.
 //! * [`signal`]: excitation signals, seeded noise and MATLAB-compatible filters (`butter`,
@@ -17,6 +18,7 @@ pub mod least_squares;
 pub mod levenberg_marquardt;
 pub mod metrics;
 pub mod nelder_mead;
+pub mod nnls;
 pub mod signal;
 pub mod termination;
 

@@ -1,0 +1,294 @@
+//! Identification of backlash y = c + g·F_r[u] from data alone.
+//!
+//! For a fixed half-width r the model is linear in (g, c), so the criterion is profiled over
+//! r on a grid rₖ = k·(max u − min u)/(2P), k = 0 … P − 1, with the closed-form least-squares
+//! (g, c) at each; the best point starts a Levenberg–Marquardt polish of (g, r, c) with the
+//! exact Jacobian [F_r[u], g·∂F_r/∂r, 1], where ∂zₖ/∂r = −1 while the play is dragged up
+//! (zₖ = uₖ − r), +1 while dragged down (zₖ = uₖ + r) and ∂zₖ₋₁/∂r while it holds. Standard
+//! deviations σ²(JᵀJ)⁻¹ at the optimum. A clockwise loop is fitted as u = c + g·F_r[y]
+//! (Γ = G⁻¹, the right inverse).
+//!
+//! Reference: M. A. Krasnosel'skii, A. V. Pokrovskii, *Systems with Hysteresis*, Springer 1989.
+
+use super::linear_support::{check_data, finish, orientation, range};
+use super::OperatorFit;
+use crate::model::operators::{play_step, Backlash, Orientation};
+use crate::{Error, Result};
+use nalgebra::{Matrix3, Vector3};
+use std::time::Instant;
+
+/// Options of the backlash identification.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BacklashOptions {
+    /// Points of the profile over r (60).
+    pub profile_points: usize,
+    /// Maximum Levenberg–Marquardt iterations (100).
+    pub max_iterations: usize,
+    /// The orientation; detected from the data when None.
+    pub orientation: Option<Orientation>,
+}
+
+impl Default for BacklashOptions {
+    fn default() -> Self {
+        Self {
+            profile_points: 60,
+            max_iterations: 100,
+            orientation: None,
+        }
+    }
+}
+
+/// The play output and its derivative with respect to r.
+fn play_with_sensitivity(x: &[f64], r: f64) -> (Vec<f64>, Vec<f64>) {
+    let (mut z, mut s) = (0.0, 0.0);
+    let mut out = (Vec::with_capacity(x.len()), Vec::with_capacity(x.len()));
+    for &xk in x {
+        let next = play_step(z, xk, r);
+        if next == xk - r && next != z {
+            s = -1.0;
+        } else if next == xk + r && next != z {
+            s = 1.0;
+        } else if next != z {
+            s = 0.0;
+        }
+        z = next;
+        out.0.push(z);
+        out.1.push(s);
+    }
+    out
+}
+
+/// Closed-form (g, c, rss) of v ≈ g·z + c.
+fn gain_offset(z: &[f64], v: &[f64]) -> (f64, f64, f64) {
+    let n = z.len() as f64;
+    let (mz, mv) = (z.iter().sum::<f64>() / n, v.iter().sum::<f64>() / n);
+    let szz: f64 = z.iter().map(|a| (a - mz).powi(2)).sum();
+    let szv: f64 = z.iter().zip(v).map(|(a, b)| (a - mz) * (b - mv)).sum();
+    let g = if szz > 0.0 { szv / szz } else { 0.0 };
+    let c = mv - g * mz;
+    let rss = z.iter().zip(v).map(|(a, b)| (b - g * a - c).powi(2)).sum();
+    (g, c, rss)
+}
+
+fn rss_at(x: &[f64], v: &[f64], theta: &Vector3<f64>) -> f64 {
+    let mut z = 0.0;
+    x.iter()
+        .zip(v)
+        .map(|(&xk, &vk)| {
+            z = play_step(z, xk, theta[1]);
+            (vk - theta[0] * z - theta[2]).powi(2)
+        })
+        .sum()
+}
+
+/// Fits backlash to input `u` and output `y`.
+pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFit<Backlash>> {
+    let start = Instant::now();
+    check_data(u, y, 3)?;
+    if options.profile_points < 2 {
+        return Err(Error::Config(
+            "backlash: give at least 2 profile points".into(),
+        ));
+    }
+    let o = orientation(u, y, options.orientation)?;
+    let (x, v) = o.core_data(u, y);
+    let (lo, hi) = range(&x);
+    let step = (hi - lo) / (2.0 * options.profile_points as f64);
+    let mut evaluations = 0;
+    let mut best = (f64::INFINITY, Vector3::zeros());
+    for k in 0..options.profile_points {
+        let r = k as f64 * step;
+        let z: Vec<f64> = {
+            let mut s = 0.0;
+            x.iter()
+                .map(|&xk| {
+                    s = play_step(s, xk, r);
+                    s
+                })
+                .collect()
+        };
+        let (g, c, rss) = gain_offset(&z, &v);
+        evaluations += 1;
+        if g > 0.0 && rss < best.0 {
+            best = (rss, Vector3::new(g, r, c));
+        }
+    }
+    if !best.0.is_finite() {
+        return Err(Error::NotExciting {
+            channel: "u".into(),
+            reason: "no positive backlash gain fits these data; check the columns".into(),
+        });
+    }
+    let (theta, jtj, iterations, evals, converged) = polish(&x, &v, best, options.max_iterations);
+    evaluations += evals;
+    let n = x.len();
+    let rss = rss_at(&x, &v, &theta);
+    let sigma2 = rss / (n.saturating_sub(3).max(1)) as f64;
+    let std: Vec<Option<f64>> = match jtj.try_inverse() {
+        Some(inv) => (0..3)
+            .map(|i| Some((sigma2 * inv[(i, i)]).max(0.0).sqrt()))
+            .collect(),
+        None => vec![None; 3],
+    };
+    let model = Backlash::new(theta[0], theta[1].max(0.0), theta[2], o)?;
+    Ok(finish(
+        model,
+        o,
+        u,
+        y,
+        std,
+        iterations,
+        evaluations,
+        converged,
+        start,
+    ))
+}
+
+/// Levenberg–Marquardt on (g, r, c) from the profile's best point.
+fn polish(
+    x: &[f64],
+    v: &[f64],
+    start: (f64, Vector3<f64>),
+    max_iterations: usize,
+) -> (Vector3<f64>, Matrix3<f64>, usize, usize, bool) {
+    let (mut rss, mut theta) = start;
+    let mut mu = 1e-3;
+    let mut evaluations = 0;
+    let scale: f64 = v.iter().map(|a| a * a).sum::<f64>().max(f64::MIN_POSITIVE);
+    for it in 0..max_iterations {
+        let (z, s) = play_with_sensitivity(x, theta[1]);
+        let (mut jtj, mut jte) = (Matrix3::zeros(), Vector3::zeros());
+        for k in 0..x.len() {
+            let j = Vector3::new(z[k], theta[0] * s[k], 1.0);
+            let e = v[k] - theta[0] * z[k] - theta[2];
+            jtj += j * j.transpose();
+            jte += j * e;
+        }
+        if rss <= 1e-28 * scale {
+            return (theta, jtj, it, evaluations, true);
+        }
+        let mut accepted = false;
+        for _ in 0..30 {
+            let mut a = jtj;
+            for i in 0..3 {
+                a[(i, i)] += mu * jtj[(i, i)].max(1e-300);
+            }
+            let Some(delta) = a.lu().solve(&jte) else {
+                mu *= 10.0;
+                continue;
+            };
+            let mut next = theta + delta;
+            next[1] = next[1].max(0.0);
+            let r_next = rss_at(x, v, &next);
+            evaluations += 1;
+            if r_next < rss {
+                let small = (next - theta).norm() <= 1e-13 * (1.0 + theta.norm());
+                let flat = rss - r_next <= 1e-15 * rss;
+                theta = next;
+                rss = r_next;
+                mu = (mu / 10.0).max(1e-12);
+                accepted = true;
+                if small || flat {
+                    let (z, s) = play_with_sensitivity(x, theta[1]);
+                    let jtj = jacobian_gram(&z, &s, theta[0]);
+                    return (theta, jtj, it + 1, evaluations, true);
+                }
+                break;
+            }
+            mu *= 10.0;
+        }
+        if !accepted {
+            // no step decreases the criterion: a (local) minimum to working precision
+            return (theta, jtj, it + 1, evaluations, true);
+        }
+    }
+    let (z, s) = play_with_sensitivity(x, theta[1]);
+    (
+        theta,
+        jacobian_gram(&z, &s, theta[0]),
+        max_iterations,
+        evaluations,
+        false,
+    )
+}
+
+fn jacobian_gram(z: &[f64], s: &[f64], g: f64) -> Matrix3<f64> {
+    let mut jtj = Matrix3::zeros();
+    for k in 0..z.len() {
+        let j = Vector3::new(z[k], g * s[k], 1.0);
+        jtj += j * j.transpose();
+    }
+    jtj
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::operators::HysteresisOperator;
+    use crate::numerics::metrics;
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+
+    fn input(n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64 / n as f64;
+                3.0 * (1.0 - 0.7 * t) * (29.0 * t).sin() + 0.8 * (113.0 * t).sin()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn recovers_parameters_both_orientations() {
+        let u = input(3000);
+        for o in [Orientation::COUNTER_CLOCKWISE, Orientation::CLOCKWISE] {
+            let t = Backlash::new(1.7, 0.437, -0.3, o).unwrap();
+            let y = t.simulate(&u).unwrap();
+            let f = fit(&u, &y, &BacklashOptions::default()).unwrap();
+            assert_eq!(f.model.orientation(), o);
+            assert!((f.model.gain() - 1.7).abs() < 1e-6, "{o:?} {:?}", f.model);
+            assert!(
+                (f.model.half_width() - 0.437).abs() < 1e-6,
+                "{o:?} {:?}",
+                f.model
+            );
+            assert!((f.model.offset() + 0.3).abs() < 1e-6, "{o:?} {:?}", f.model);
+            assert!(
+                f.termination.converged()
+                    || f.termination == crate::numerics::Termination::ZeroResidual
+            );
+        }
+    }
+
+    #[test]
+    fn noisy_parameters_within_three_sigma() {
+        let u = input(3000);
+        let t = Backlash::new(1.7, 0.437, -0.3, Orientation::COUNTER_CLOCKWISE).unwrap();
+        let clean = t.simulate(&u).unwrap();
+        let sd = metrics::std_dev(&clean) / 100.0;
+        let (mut inside, mut total) = (0, 0);
+        for seed in 0..6u64 {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(100 + seed);
+            let normal = Normal::new(0.0, sd).unwrap();
+            let y: Vec<f64> = clean.iter().map(|v| v + normal.sample(&mut rng)).collect();
+            let f = fit(&u, &y, &BacklashOptions::default()).unwrap();
+            for (i, tv) in [1.7, 0.437, -0.3].into_iter().enumerate() {
+                let s = f.std[i].unwrap();
+                inside += ((f.parameters.get(i).value - tv).abs() <= 3.0 * s) as usize;
+                total += 1;
+            }
+        }
+        assert!(inside * 10 >= total * 9, "{inside}/{total}");
+    }
+
+    #[test]
+    fn too_few_reversals_are_refused() {
+        let u: Vec<f64> = (0..100).map(|k| (k as f64 * 0.03).sin()).collect();
+        let y = u.clone();
+        let e = fit(&u, &y, &BacklashOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("reversal"), "{e}");
+    }
+}

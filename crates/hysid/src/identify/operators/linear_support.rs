@@ -1,0 +1,284 @@
+//! Shared steps of the linear-in-weights recipes: data checks, threshold grids, the Gram
+//! matrix accumulated in blocks, NNLS with standard deviations, and the fit report.
+
+use super::OperatorFit;
+use crate::model::operators::elementary::{check_signal, oriented_simulate_saturating, Core};
+use crate::model::operators::{HysteresisOperator, Orientation};
+use crate::numerics::metrics;
+use crate::numerics::nnls::{nnls_gram, passive_inverse};
+use crate::numerics::Termination;
+use crate::{Error, Result};
+use nalgebra::{DMatrix, DVector};
+use std::time::Instant;
+
+/// Checks equal lengths, finite samples, enough samples and at least two input reversals.
+pub(crate) fn check_data(u: &[f64], y: &[f64], parameters: usize) -> Result<()> {
+    check_signal("u", u)?;
+    check_signal("y", y)?;
+    if u.len() != y.len() {
+        return Err(Error::InvalidData(format!(
+            "u has {} samples and y {}; give equal lengths",
+            u.len(),
+            y.len()
+        )));
+    }
+    let needed = (2 * parameters).max(parameters + 10);
+    if u.len() < needed {
+        return Err(Error::TooFewSamples {
+            samples: u.len(),
+            parameters,
+            needed,
+        });
+    }
+    let reversals = count_reversals(u);
+    if reversals < 2 {
+        return Err(Error::NotExciting {
+            channel: "u".into(),
+            reason: format!(
+                "{reversals} reversal(s) of the input; a hysteresis loop needs at least 2 \
+                 (rise, fall, rise); excite with a periodic or decaying oscillating input"
+            ),
+        });
+    }
+    let (lo, hi) = range(y);
+    if lo == hi {
+        return Err(Error::NotExciting {
+            channel: "y".into(),
+            reason: "the output is constant: nothing to fit".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Number of direction changes of a signal.
+pub(crate) fn count_reversals(x: &[f64]) -> usize {
+    let mut last = 0.0f64;
+    let mut count = 0;
+    for w in x.windows(2) {
+        let d = w[1] - w[0];
+        if d != 0.0 {
+            if last != 0.0 && d.signum() != last.signum() {
+                count += 1;
+            }
+            last = d;
+        }
+    }
+    count
+}
+
+/// (min, max) of a signal.
+pub(crate) fn range(x: &[f64]) -> (f64, f64) {
+    x.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        })
+}
+
+/// The default threshold grid rᵢ = i·(max x − min x)/(2(n + 1)), i = 1 … n: a play of
+/// half-width ≥ half the input range would never move after its first reversal.
+pub(crate) fn threshold_grid(x: &[f64], n: usize) -> Result<Vec<f64>> {
+    if n == 0 {
+        return Err(Error::Config(
+            "the number of thresholds must be >= 1".into(),
+        ));
+    }
+    let (lo, hi) = range(x);
+    let span = hi - lo;
+    if span.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err(Error::NotExciting {
+            channel: "u".into(),
+            reason: "the input is constant".into(),
+        });
+    }
+    Ok((1..=n)
+        .map(|i| i as f64 * span / (2.0 * (n + 1) as f64))
+        .collect())
+}
+
+/// ΦᵀΦ, Φᵀy and yᵀy accumulated over blocks of rows (one regressor row per sample), the
+/// products done as matrix–matrix multiplications.
+pub(crate) struct GramAccumulator {
+    block: DMatrix<f64>,
+    targets: DVector<f64>,
+    filled: usize,
+    pub g: DMatrix<f64>,
+    pub b: DVector<f64>,
+    pub yy: f64,
+    pub n: usize,
+}
+
+const BLOCK: usize = 2048;
+
+impl GramAccumulator {
+    pub fn new(p: usize) -> Self {
+        Self {
+            block: DMatrix::zeros(p, BLOCK),
+            targets: DVector::zeros(BLOCK),
+            filled: 0,
+            g: DMatrix::zeros(p, p),
+            b: DVector::zeros(p),
+            yy: 0.0,
+            n: 0,
+        }
+    }
+
+    /// Adds one sample: regressor row `phi`, target `y`.
+    pub fn push(&mut self, phi: &[f64], y: f64) {
+        self.block.column_mut(self.filled).copy_from_slice(phi);
+        self.targets[self.filled] = y;
+        self.filled += 1;
+        self.yy += y * y;
+        self.n += 1;
+        if self.filled == BLOCK {
+            self.flush();
+        }
+    }
+
+    fn flush(&mut self) {
+        if self.filled == 0 {
+            return;
+        }
+        let c = self.block.columns(0, self.filled);
+        let t = self.targets.rows(0, self.filled);
+        let ct = c.transpose();
+        // only the blocks on and below the diagonal: G is symmetric
+        let p = self.g.nrows();
+        let step = 64;
+        for i0 in (0..p).step_by(step) {
+            let ni = step.min(p - i0);
+            for j0 in (0..=i0).step_by(step) {
+                let nj = step.min(p - j0);
+                let mut gij = self.g.view_mut((i0, j0), (ni, nj));
+                gij.gemm(1.0, &c.rows(i0, ni), &ct.columns(j0, nj), 1.0);
+            }
+        }
+        self.b.gemv(1.0, &c, &t, 1.0);
+        self.filled = 0;
+    }
+
+    /// The accumulated normal equations.
+    pub fn finish(mut self) -> (DMatrix<f64>, DVector<f64>, f64, usize) {
+        self.flush();
+        self.g.fill_upper_triangle_with_lower_triangle();
+        (self.g, self.b, self.yy, self.n)
+    }
+
+    /// Normal equations from whole columns (one vector per regressor).
+    pub fn from_columns(
+        columns: &[Vec<f64>],
+        y: &[f64],
+    ) -> (DMatrix<f64>, DVector<f64>, f64, usize) {
+        let mut acc = Self::new(columns.len());
+        let mut row = vec![0.0; columns.len()];
+        for (k, &yk) in y.iter().enumerate() {
+            for (r, c) in row.iter_mut().zip(columns) {
+                *r = c[k];
+            }
+            acc.push(&row, yk);
+        }
+        acc.finish()
+    }
+}
+
+/// An NNLS solution with its standard deviations σ²(G_FF)⁻¹ on the free set F.
+pub(crate) struct WeightSolution {
+    pub x: Vec<f64>,
+    pub std: Vec<Option<f64>>,
+    pub iterations: usize,
+    pub converged: bool,
+}
+
+/// Solves the normal equations under x ≥ 0 (except the unconstrained variables) and the
+/// standard deviations with σ² = RSS/(N − |F|); `penalty` (already in G) is excluded from
+/// the RSS by the caller giving the unpenalised `g_plain`.
+pub(crate) fn solve_weights(
+    g: &DMatrix<f64>,
+    b: &DVector<f64>,
+    yy: f64,
+    n: usize,
+    unconstrained: &[bool],
+    g_plain: Option<&DMatrix<f64>>,
+) -> Result<WeightSolution> {
+    let sol = nnls_gram(g, b, unconstrained)?;
+    let x = DVector::from_column_slice(&sol.x);
+    let gp = g_plain.unwrap_or(g);
+    let rss = (yy - 2.0 * b.dot(&x) + x.dot(&(gp * &x))).max(0.0);
+    let free = sol.passive.iter().filter(|&&p| p).count();
+    let sigma2 = if n > free {
+        rss / (n - free) as f64
+    } else {
+        0.0
+    };
+    let mut std = vec![None; sol.x.len()];
+    if let Some((idx, inv)) = passive_inverse(g, &sol.passive) {
+        for (k, &i) in idx.iter().enumerate() {
+            std[i] = Some((sigma2 * inv[(k, k)]).max(0.0).sqrt());
+        }
+    }
+    Ok(WeightSolution {
+        x: sol.x,
+        std,
+        iterations: sol.iterations,
+        converged: sol.converged,
+    })
+}
+
+/// Everything a fit reports, from the model and the data.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn finish<M: HysteresisOperator + Core>(
+    model: M,
+    orientation: Orientation,
+    u: &[f64],
+    y: &[f64],
+    std: Vec<Option<f64>>,
+    iterations: usize,
+    evaluations: usize,
+    converged: bool,
+    start: Instant,
+) -> OperatorFit<M> {
+    let (simulated, _) = oriented_simulate_saturating(&model, orientation, u);
+    let parameters = model.parameters();
+    let estimated = std.iter().filter(|s| s.is_some()).count();
+    let n = y.len();
+    let loss = metrics::mse(y, &simulated);
+    let rmse = loss.sqrt();
+    let termination = if rmse <= 1e-9 * metrics::std_dev(y) {
+        Termination::ZeroResidual
+    } else if converged {
+        Termination::Converged { change: 0.0 }
+    } else {
+        Termination::MaxIterations
+    };
+    OperatorFit {
+        fit_percent: metrics::fit_percent(y, &simulated),
+        rmse,
+        loss,
+        fpe: metrics::fpe(loss, n, estimated),
+        aic: metrics::aic(loss, n, estimated),
+        model,
+        parameters,
+        std,
+        simulated,
+        iterations,
+        evaluations,
+        termination,
+        elapsed_s: start.elapsed().as_secs_f64(),
+    }
+}
+
+/// The orientation to fit: the given one or the detected one.
+pub(crate) fn orientation(u: &[f64], y: &[f64], given: Option<Orientation>) -> Result<Orientation> {
+    check_signal("u", u)?;
+    check_signal("y", y)?;
+    if u.len() != y.len() {
+        return Err(Error::InvalidData(format!(
+            "u has {} samples and y {}; give equal lengths",
+            u.len(),
+            y.len()
+        )));
+    }
+    match given {
+        Some(o) => Ok(o),
+        None => Orientation::detect(u, y),
+    }
+}

@@ -1,0 +1,54 @@
+//! Identification recipes of the hysteresis operators in [`crate::model::operators`], each
+//! from the measured input and output alone (no initial guess):
+//!
+//! * [`backlash`]: profile over the half-width r with closed-form gain and offset, then a
+//!   Levenberg–Marquardt polish on (g, r, c).
+//! * [`pi`], [`maxwell_slip`]: non-negative least squares ([`crate::numerics::nnls`]) on the play/stop outputs
+//!   of a threshold grid.
+//! * [`gpi`]: the same plus the inverse dead zones, linear in the equation error
+//!   S⁻¹[y] = H[u] (Kuhnen 2003).
+//! * [`preisach`]: regularised non-negative least squares on the cell regressors of a
+//!   triangular Preisach grid.
+//!
+//! The loop orientation is detected from the data ([`crate::model::operators::Orientation::detect`]) unless given; a
+//! clockwise loop is fitted in the inverse-operator parameterisation (the core operator from
+//! y to u).
+use crate::model::ParameterSet;
+use crate::numerics::Termination;
+use serde::Serialize;
+
+pub mod backlash;
+pub mod gpi;
+mod linear_support;
+pub mod maxwell_slip;
+pub mod pi;
+pub mod preisach;
+
+/// A fitted operator and how it was obtained.
+#[allow(missing_docs)] // the shared item documents several fields in one comment
+#[derive(Clone, Debug, Serialize)]
+pub struct OperatorFit<M> {
+    /// The fitted operator.
+    pub model: M,
+    /// Estimated parameters (the same names as `model.parameters()`).
+    pub parameters: ParameterSet,
+    /// Standard deviation per parameter (None where the parameter was not estimated, e.g. fixed
+    /// thresholds or a weight held at the NNLS bound 0).
+    pub std: Vec<Option<f64>>,
+    /// Γ[u] of the fitted operator on the estimation data.
+    pub simulated: Vec<f64>,
+    /// fit % = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖), RMSE, loss V = mean squared residual, FPE, AIC
+    pub fit_percent: f64,
+    pub rmse: f64,
+    pub loss: f64,
+    pub fpe: f64,
+    pub aic: f64,
+    /// Iterations and criterion evaluations of the search (0/1 for a direct least-squares solve).
+    pub iterations: usize,
+    pub evaluations: usize,
+    /// Why the search stopped (`Termination::ZeroResidual`/`Converged` for a direct solve); a
+    /// search that did not converge must say so here, never be reported as success.
+    pub termination: Termination,
+    /// Wall-clock seconds of the fit.
+    pub elapsed_s: f64,
+}

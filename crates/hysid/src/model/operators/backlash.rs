@@ -1,0 +1,171 @@
+//! Backlash: the play operator with gain and offset.
+//!
+//! G[u]ₖ = c + g·zₖ, zₖ = max(uₖ − r, min(uₖ + r, zₖ₋₁)), z₋₁ = 0, so
+//! z₀ = max(u₀ − r, min(u₀ + r, 0)) (Krasnosel'skii & Pokrovskii 1989); g > 0 is the gain and
+//! 2r ≥ 0 the dead band.
+//!
+//! **Inverse** (the play's right inverse, Tao & Kokotović 1996): the play output w = (v − c)/g
+//! is produced by uₖ = wₖ + r when w rises, uₖ = wₖ − r when it falls and uₖ = uₖ₋₁ when it
+//! holds, so the input jumps across the dead band at every reversal. Every reference is
+//! reachable. In the clockwise orientation (Γ = G⁻¹) the references Γ can produce are those
+//! with G⁻¹[G[ρ]] = ρ; others are listed as clipped.
+//!
+//! References: M. A. Krasnosel'skii, A. V. Pokrovskii, *Systems with Hysteresis*, Springer
+//! 1989; G. Tao, P. V. Kokotović, *Adaptive Control of Systems with Actuator and Sensor
+//! Nonlinearities*, Wiley 1996.
+
+use super::elementary::{
+    check_finite, oriented_invert, oriented_simulate, play_step, Core, Orientation,
+};
+use super::{HysteresisOperator, Inversion};
+use crate::model::{Parameter, ParameterSet};
+use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// Backlash y = c + g·F_r[u] in an [`Orientation`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Backlash {
+    g: f64,
+    r: f64,
+    offset: f64,
+    orientation: Orientation,
+}
+
+impl Backlash {
+    /// Backlash with gain g > 0, half-width r ≥ 0 and offset c.
+    pub fn new(g: f64, r: f64, offset: f64, orientation: Orientation) -> Result<Self> {
+        check_finite("g", g)?;
+        check_finite("r", r)?;
+        check_finite("c", offset)?;
+        if g <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "g".into(),
+                value: g,
+                reason: "the gain must be > 0 (a decreasing loop is an orientation)".into(),
+            });
+        }
+        if r < 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "r".into(),
+                value: r,
+                reason: "the half-width must be >= 0".into(),
+            });
+        }
+        Ok(Self {
+            g,
+            r,
+            offset,
+            orientation,
+        })
+    }
+
+    /// The gain g.
+    pub fn gain(&self) -> f64 {
+        self.g
+    }
+    /// The half-width r (the dead band is 2r).
+    pub fn half_width(&self) -> f64 {
+        self.r
+    }
+    /// The offset c.
+    pub fn offset(&self) -> f64 {
+        self.offset
+    }
+    /// The orientation.
+    pub fn orientation(&self) -> Orientation {
+        self.orientation
+    }
+}
+
+impl Core for Backlash {
+    fn forward(&self, u: &[f64]) -> Vec<f64> {
+        let mut z = 0.0;
+        u.iter()
+            .map(|&uk| {
+                z = play_step(z, uk, self.r);
+                self.offset + self.g * z
+            })
+            .collect()
+    }
+
+    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
+        let (mut z, mut u_prev) = (0.0, 0.0);
+        let u = v
+            .iter()
+            .map(|&vk| {
+                let w = (vk - self.offset) / self.g;
+                let uk = if w > z {
+                    w + self.r
+                } else if w < z {
+                    w - self.r
+                } else {
+                    u_prev
+                };
+                z = w;
+                u_prev = uk;
+                uk
+            })
+            .collect();
+        (u, Vec::new())
+    }
+}
+
+impl HysteresisOperator for Backlash {
+    fn family(&self) -> &'static str {
+        "backlash"
+    }
+
+    fn parameters(&self) -> ParameterSet {
+        ParameterSet::new(vec![
+            Parameter::new("g", self.g).bounds(0.0, f64::INFINITY),
+            Parameter::new("r", self.r).bounds(0.0, f64::INFINITY),
+            Parameter::new("c", self.offset),
+        ])
+        .unwrap_or_default()
+    }
+
+    fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
+        oriented_simulate(self, self.orientation, u)
+    }
+
+    fn invert(&self, reference: &[f64]) -> Result<Inversion> {
+        oriented_invert(self, self.orientation, reference)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn right_inverse_jumps_across_the_dead_band() {
+        let b = Backlash::new(2.0, 0.5, 1.0, Orientation::default()).unwrap();
+        let reference = [1.0, 2.0, 3.0, 3.0, 2.0, 1.5, 2.5];
+        let inv = b.invert(&reference).unwrap();
+        assert_eq!(inv.u, vec![0.0, 1.0, 1.5, 1.5, 0.0, -0.25, 1.25]);
+        for (p, r) in inv.predicted.iter().zip(&reference) {
+            assert!((p - r).abs() < 1e-12);
+        }
+        assert!(inv.clipped.is_empty());
+    }
+
+    #[test]
+    fn clockwise_backlash_lists_unreachable_references() {
+        let b = Backlash::new(1.0, 0.5, 0.0, Orientation::CLOCKWISE).unwrap();
+        // Γ = G⁻¹ jumps at reversals: a reference moving smoothly back cannot be produced.
+        let u = [0.0, 1.0, 2.0, 1.0, 0.0];
+        let y = b.simulate(&u).unwrap();
+        assert_eq!(y, vec![0.0, 1.5, 2.5, 0.5, -0.5]);
+        let inv = b.invert(&y).unwrap();
+        assert!(inv.clipped.is_empty());
+        let inv = b.invert(&[0.0, 1.5, 2.5, 2.0]).unwrap();
+        assert_eq!(inv.clipped, vec![3]);
+    }
+
+    #[test]
+    fn bad_parameters_are_refused() {
+        assert!(Backlash::new(0.0, 0.5, 0.0, Orientation::default()).is_err());
+        assert!(Backlash::new(1.0, -0.5, 0.0, Orientation::default()).is_err());
+        assert!(Backlash::new(1.0, f64::INFINITY, 0.0, Orientation::default()).is_err());
+    }
+}

@@ -1,0 +1,395 @@
+//! Elementary operators shared by the linear-in-weights families: the play and stop operators
+//! (Krasnosel'skii & Pokrovskii 1989), the loop orientation, input checks and the monotone
+//! per-sample solve used by the numerical inverses.
+
+use super::Inversion;
+use crate::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// One step of the play (backlash) operator of half-width r:
+/// z_k = max(u_k − r, min(u_k + r, z_{k−1})) (Krasnosel'skii & Pokrovskii 1989).
+#[inline]
+pub fn play_step(z: f64, u: f64, r: f64) -> f64 {
+    (u - r).max((u + r).min(z))
+}
+
+/// The play operator F_r[u] from the state z₋₁ = 0: z₀ = max(u₀ − r, min(u₀ + r, 0)).
+pub fn play(u: &[f64], r: f64) -> Vec<f64> {
+    let mut z = 0.0;
+    u.iter()
+        .map(|&uk| {
+            z = play_step(z, uk, r);
+            z
+        })
+        .collect()
+}
+
+/// The stop operator E_r[u] = u − F_r[u]: the force of a spring whose end slips beyond ±r
+/// (the elasto-plastic element of a Maxwell-slip model), from the same state 0.
+pub fn stop(u: &[f64], r: f64) -> Vec<f64> {
+    play(u, r).iter().zip(u).map(|(z, x)| x - z).collect()
+}
+
+/// Checks that a threshold grid is finite, positive and strictly increasing.
+pub fn validate_thresholds(name: &str, r: &[f64]) -> Result<()> {
+    for (i, &ri) in r.iter().enumerate() {
+        if !ri.is_finite() || ri <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: format!("{name}{}", i + 1),
+                value: ri,
+                reason: "thresholds must be finite and > 0; give a positive grid".into(),
+            });
+        }
+        if i > 0 && ri <= r[i - 1] {
+            return Err(Error::InvalidParameter {
+                name: format!("{name}{}", i + 1),
+                value: ri,
+                reason: format!(
+                    "threshold grid is not strictly increasing ({name}{} = {}); sort it and remove duplicates",
+                    i,
+                    r[i - 1]
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks that a signal is non-empty and finite.
+pub(crate) fn check_signal(channel: &str, x: &[f64]) -> Result<()> {
+    if x.is_empty() {
+        return Err(Error::InvalidData(format!(
+            "'{channel}' is empty; give at least one sample"
+        )));
+    }
+    match x.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(Error::NonFinite {
+            channel: channel.into(),
+            index,
+            value: x[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks that a weight or parameter is finite.
+pub(crate) fn check_finite(name: &str, value: f64) -> Result<()> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.into(),
+            value,
+            reason: "must be finite".into(),
+        })
+    }
+}
+
+/// How a loop's orientation is mapped onto a family's core operator G.
+///
+/// * counter-clockwise, increasing (the output lags, as the play operator): Γ = G;
+/// * clockwise, increasing (the output leads): Γ = G⁻¹ — the *inverse-operator
+///   parameterisation*, G identified from y to u (exchanging the axes mirrors the loop and
+///   reverses its orientation);
+/// * a decreasing trend flips the output's sign: Γ = −G or Γ = −G⁻¹.
+///
+/// The inverse of Γ is then G⁻¹[±r] or G[±r] respectively. The Maxwell-slip elements
+/// (stop operators) are the exception: their own loop is clockwise, so for them `inverse`
+/// marks a counter-clockwise loop.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Orientation {
+    /// True when Γ = G⁻¹ (a clockwise loop with an increasing trend).
+    pub inverse: bool,
+    /// True when the output decreases with the input (Γ = −G or −G⁻¹).
+    pub decreasing: bool,
+}
+
+impl Orientation {
+    /// Γ = G: counter-clockwise loop, increasing.
+    pub const COUNTER_CLOCKWISE: Orientation = Orientation {
+        inverse: false,
+        decreasing: false,
+    };
+    /// Γ = G⁻¹: clockwise loop, increasing.
+    pub const CLOCKWISE: Orientation = Orientation {
+        inverse: true,
+        decreasing: false,
+    };
+
+    /// Detects the orientation of a measured loop: the trend is the sign of cov(u, y); with
+    /// ỹ = ±y made increasing, the loop is clockwise when ∫ỹ du > 0 (the output is higher on
+    /// the rising branch than on the falling one), counter-clockwise when < 0.
+    pub fn detect(u: &[f64], y: &[f64]) -> Result<Orientation> {
+        let n = u.len().min(y.len()) as f64;
+        let (mu, my) = (u.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+        let cov: f64 = u.iter().zip(y).map(|(a, b)| (a - mu) * (b - my)).sum();
+        if cov == 0.0 || !cov.is_finite() {
+            return Err(Error::NotExciting {
+                channel: "u".into(),
+                reason: "the output does not follow the input (zero covariance); \
+                         check the columns"
+                    .into(),
+            });
+        }
+        let decreasing = cov < 0.0;
+        let s = if decreasing { -1.0 } else { 1.0 };
+        let area: f64 = (1..u.len().min(y.len()))
+            .map(|k| (u[k] - u[k - 1]) * s * (y[k] + y[k - 1]) / 2.0)
+            .sum();
+        Ok(Orientation {
+            inverse: area > 0.0,
+            decreasing,
+        })
+    }
+
+    /// ±1: the output's sign.
+    pub fn sign(&self) -> f64 {
+        if self.decreasing {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
+    /// The pair (input of G, output of G) for data (u, y) in this orientation.
+    pub fn core_data(&self, u: &[f64], y: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let s = self.sign();
+        let ys: Vec<f64> = y.iter().map(|v| s * v).collect();
+        if self.inverse {
+            (ys, u.to_vec())
+        } else {
+            (u.to_vec(), ys)
+        }
+    }
+}
+
+/// A family's core operator G (counter-clockwise, increasing) and its inverse, from which
+/// [`Orientation`] builds Γ.
+pub(crate) trait Core {
+    /// G[u] from the initial state.
+    fn forward(&self, u: &[f64]) -> Vec<f64>;
+    /// G⁻¹[v] from the consistent initial state; returns the input and the clipped indices.
+    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>);
+}
+
+/// Γ[u] for a core in an orientation; an input outside the domain of G⁻¹ is an error.
+pub(crate) fn oriented_simulate(core: &impl Core, o: Orientation, u: &[f64]) -> Result<Vec<f64>> {
+    check_signal("u", u)?;
+    let s = o.sign();
+    let y = if o.inverse {
+        let (y, clipped) = core.backward(u);
+        if let Some(&k) = clipped.first() {
+            return Err(Error::InvalidData(format!(
+                "input sample {k} = {} lies outside the range this (clockwise) operator \
+                 can take; scale the input into the identification range",
+                u[k]
+            )));
+        }
+        y
+    } else {
+        core.forward(u)
+    };
+    Ok(y.into_iter().map(|v| s * v).collect())
+}
+
+/// Γ[u] for a core in an orientation, inputs outside the domain of G⁻¹ mapped to the
+/// saturation level (for fit reports on the estimation data); returns the number so mapped.
+pub(crate) fn oriented_simulate_saturating(
+    core: &impl Core,
+    o: Orientation,
+    u: &[f64],
+) -> (Vec<f64>, usize) {
+    let s = o.sign();
+    let (y, n) = if o.inverse {
+        let (y, clipped) = core.backward(u);
+        (y, clipped.len())
+    } else {
+        (core.forward(u), 0)
+    };
+    (y.into_iter().map(|v| s * v).collect(), n)
+}
+
+/// Γ⁻¹[reference] for a core in an orientation, with Γ of the result and the clipped samples.
+pub(crate) fn oriented_invert(
+    core: &impl Core,
+    o: Orientation,
+    reference: &[f64],
+) -> Result<Inversion> {
+    check_signal("reference", reference)?;
+    let s = o.sign();
+    let rho: Vec<f64> = reference.iter().map(|v| s * v).collect();
+    if o.inverse {
+        let u = core.forward(&rho);
+        let (y, _) = core.backward(&u);
+        let scale = rho.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        let clipped = (0..y.len())
+            .filter(|&k| (y[k] - rho[k]).abs() > 1e-9 * scale)
+            .collect();
+        Ok(Inversion {
+            u,
+            predicted: y.into_iter().map(|v| s * v).collect(),
+            clipped,
+        })
+    } else {
+        let (u, clipped) = core.backward(&rho);
+        let predicted = core.forward(&u).into_iter().map(|v| s * v).collect();
+        Ok(Inversion {
+            u,
+            predicted,
+            clipped,
+        })
+    }
+}
+
+/// Where to look for the solution of a monotone branch equation f(u) = target: f is
+/// non-decreasing, constant or linear outside [center − span, center + span], unbounded
+/// below/above when the flags say so (saturating otherwise).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Branch {
+    /// Centre of the bracket (usually the previous input).
+    pub center: f64,
+    /// Half-width beyond which f is linear or constant (> 0).
+    pub span: f64,
+    /// f → −∞ as u → −∞.
+    pub unbounded_below: bool,
+    /// f → +∞ as u → +∞.
+    pub unbounded_above: bool,
+}
+
+/// Solves f(u) = target for a continuous non-decreasing f (a hysteresis branch from the current
+/// memory state) by bracketing and the Illinois variant of regula falsi, to machine precision.
+/// Returns (u, clipped): a target beyond a saturation level is clipped to it.
+pub fn solve_monotone(f: impl Fn(f64) -> f64, target: f64, branch: Branch) -> (f64, bool) {
+    let span = if branch.span > 0.0 && branch.span.is_finite() {
+        branch.span
+    } else {
+        1.0
+    };
+    let (mut lo, mut hi) = (branch.center - span, branch.center + span);
+    let (mut flo, mut fhi) = (f(lo), f(hi));
+    let tol = 1e-12 * (1.0 + target.abs());
+    let mut step = span;
+    while fhi < target {
+        if !branch.unbounded_above || step > 1e150 {
+            return (hi, target - fhi > tol);
+        }
+        (lo, flo) = (hi, fhi);
+        step *= 2.0;
+        hi += step;
+        fhi = f(hi);
+    }
+    step = span;
+    while flo > target {
+        if !branch.unbounded_below || step > 1e150 {
+            return (lo, flo - target > tol);
+        }
+        (hi, fhi) = (lo, flo);
+        step *= 2.0;
+        lo -= step;
+        flo = f(lo);
+    }
+    (illinois(&f, target, (lo, flo), (hi, fhi)), false)
+}
+
+/// Illinois regula falsi on a bracket with f(lo) ≤ target ≤ f(hi).
+fn illinois(f: &impl Fn(f64) -> f64, target: f64, a: (f64, f64), b: (f64, f64)) -> f64 {
+    let ((mut lo, mut flo), (mut hi, mut fhi)) = ((a.0, a.1 - target), (b.0, b.1 - target));
+    if flo == 0.0 {
+        return lo;
+    }
+    if fhi == 0.0 {
+        return hi;
+    }
+    let mut side = 0i8;
+    for _ in 0..300 {
+        if hi - lo <= 2.0 * f64::EPSILON * lo.abs().max(hi.abs()).max(1e-300) {
+            break;
+        }
+        let mut m = (lo * fhi - hi * flo) / (fhi - flo);
+        if !(m > lo && m < hi) {
+            m = 0.5 * (lo + hi);
+        }
+        let fm = f(m) - target;
+        if fm == 0.0 {
+            return m;
+        }
+        if fm < 0.0 {
+            (lo, flo) = (m, fm);
+            if side == -1 {
+                fhi *= 0.5;
+            }
+            side = -1;
+        } else {
+            (hi, fhi) = (m, fm);
+            if side == 1 {
+                flo *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    if (f(lo) - target).abs() <= (f(hi) - target).abs() {
+        lo
+    } else {
+        hi
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn play_follows_its_definition() {
+        // r = 1: rises with u − 1, holds inside the band, falls with u + 1.
+        let u = [0.5, 2.0, 3.0, 2.5, 1.0, 0.0];
+        assert_eq!(play(&u, 1.0), vec![0.0, 1.0, 2.0, 2.0, 2.0, 1.0]);
+        assert_eq!(stop(&u, 1.0), vec![0.5, 1.0, 1.0, 0.5, -1.0, -1.0]);
+    }
+
+    #[test]
+    fn thresholds_are_checked() {
+        assert!(validate_thresholds("r", &[0.1, 0.2]).is_ok());
+        let e = validate_thresholds("r", &[0.2, 0.1])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not strictly increasing"), "{e}");
+        assert!(validate_thresholds("r", &[0.0, 0.1]).is_err());
+        assert!(validate_thresholds("r", &[f64::NAN]).is_err());
+    }
+
+    #[test]
+    fn monotone_solve_finds_roots_and_clips() {
+        let f = |u: f64| (u - 1.0).max(0.0) - (-1.0 - u).max(0.0);
+        let b = Branch {
+            center: 0.0,
+            span: 2.0,
+            unbounded_below: true,
+            unbounded_above: true,
+        };
+        let (u, c) = solve_monotone(f, 37.5, b);
+        assert!((f(u) - 37.5).abs() < 1e-12 && !c);
+        let sat = |u: f64| u.clamp(-1.0, 1.0);
+        let b = Branch {
+            unbounded_above: false,
+            ..b
+        };
+        let (u, c) = solve_monotone(sat, 3.0, b);
+        assert!(c && sat(u) == 1.0);
+        let (u, c) = solve_monotone(sat, 0.25, b);
+        assert!(!c && (u - 0.25).abs() < 1e-15);
+    }
+
+    #[test]
+    fn orientation_is_detected() {
+        let u: Vec<f64> = (0..400).map(|k| (k as f64 * 0.05).sin()).collect();
+        let y = play(&u, 0.3);
+        assert_eq!(
+            Orientation::detect(&u, &y).unwrap(),
+            Orientation::COUNTER_CLOCKWISE
+        );
+        assert_eq!(Orientation::detect(&y, &u).unwrap(), Orientation::CLOCKWISE);
+        let neg: Vec<f64> = y.iter().map(|v| -v).collect();
+        let o = Orientation::detect(&u, &neg).unwrap();
+        assert!(o.decreasing && !o.inverse);
+    }
+}
