@@ -40,6 +40,8 @@ pub mod estimate;
 pub mod examples;
 pub mod fitted;
 pub mod greybox;
+/// Identification recipes (the hysteresis operators of [`model::operators`]).
+pub mod identify;
 pub mod metrics;
 pub mod model;
 pub mod signal;

@@ -8,6 +8,7 @@
 mod cascade;
 pub mod coleman_hodgdon;
 mod linear;
+pub mod operators;
 
 pub use cascade::{CascadeOutput, HysteresisCascade};
 pub use coleman_hodgdon::{Admissibility, ChForm, ColemanHodgdon};
