@@ -85,15 +85,8 @@ pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit
         simulate: &simulate,
         n_params: 7,
     };
-    let best = common::best_of(&problem, &starts, &search)?;
-    common::report(
-        model_of(&best.theta)?,
-        u,
-        y,
-        &[best.clone()],
-        &best,
-        started,
-    )
+    let searched = common::best_of(&problem, &starts, &search)?;
+    common::report(model_of(&searched.best.theta)?, u, y, &searched, started)
 }
 
 /// The best grid points (module doc) as full parameter vectors.

@@ -83,13 +83,12 @@ pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Da
         simulate: &simulate,
         n_params: 4,
     };
-    let best = common::best_of(&problem, &starts, &search)?;
+    let searched = common::best_of(&problem, &starts, &search)?;
     common::report(
-        model_of(&best.theta, orientation)?,
+        model_of(&searched.best.theta, orientation)?,
         u,
         y,
-        &[best.clone()],
-        &best,
+        &searched,
         started,
     )
 }

@@ -34,7 +34,8 @@ pub fn reversals(u: &[f64]) -> usize {
 }
 
 /// Checks a record for a fit with `p` parameters: equal lengths, finite samples, at least
-/// max(20, 5p) samples, two input reversals (one closed loop), a non-constant output.
+/// max(20, 5p) samples, one reversal of the input (an ascending and a descending branch: a
+/// measured loop from its tip has exactly one), a non-constant output.
 pub fn check_record(family: &str, u: &[f64], y: &[f64], p: usize) -> Result<()> {
     if u.len() != y.len() {
         return Err(Error::InvalidData(format!(
@@ -53,12 +54,12 @@ pub fn check_record(family: &str, u: &[f64], y: &[f64], p: usize) -> Result<()> 
             needed,
         });
     }
-    if reversals(u) < 2 {
+    if reversals(u) < 1 {
         return Err(Error::NotExciting {
             channel: "input".into(),
             reason: format!(
-                "{} reversal(s) of direction; a {family} fit needs at least 2 (one closed loop)",
-                reversals(u)
+                "it never reverses direction; a {family} fit needs an ascending and a \
+                 descending branch (at least one reversal)"
             ),
         });
     }
@@ -123,10 +124,21 @@ pub fn default_config() -> LmConfig {
     }
 }
 
+/// The outcome of a multi-start search.
+pub struct Searched {
+    /// The report of the start with the lowest cost.
+    pub best: LmReport,
+    /// Iterations of all starts together.
+    pub iterations: usize,
+    /// Criterion evaluations of all starts together.
+    pub evaluations: usize,
+}
+
 /// Runs the search from every start and keeps the lowest cost; errors only when no start can
 /// be simulated.
-pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) -> Result<LmReport> {
+pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) -> Result<Searched> {
     let mut best: Option<LmReport> = None;
+    let (mut iterations, mut evaluations) = (0, 0);
     let mut first_error = None;
     for start in starts {
         let theta: Vec<f64> = start
@@ -144,6 +156,8 @@ pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) ->
             &mut |_| crate::estimate::Control::Continue,
         ) {
             Ok(report) => {
+                iterations += report.iterations;
+                evaluations += report.function_evaluations;
                 let exact = report.termination == crate::estimate::Termination::ZeroResidual;
                 if best.as_ref().is_none_or(|b| report.cost < b.cost) {
                     best = Some(report);
@@ -158,8 +172,13 @@ pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) ->
             }
         }
     }
-    best.ok_or_else(|| {
+    let best = best.ok_or_else(|| {
         first_error.unwrap_or_else(|| Error::Config("no start for the search".into()))
+    })?;
+    Ok(Searched {
+        best,
+        iterations,
+        evaluations,
     })
 }
 
@@ -168,10 +187,10 @@ pub fn report<M: HysteresisOperator>(
     model: M,
     u: &[f64],
     y: &[f64],
-    lm: &[LmReport],
-    best: &LmReport,
+    searched: &Searched,
     started: Instant,
 ) -> Result<OperatorFit<M>> {
+    let best = &searched.best;
     let simulated = model.simulate(u)?;
     let parameters: ParameterSet = model.parameters();
     let cov = best.covariance();
@@ -194,8 +213,8 @@ pub fn report<M: HysteresisOperator>(
         fpe: metrics::fpe(loss, n, p),
         aic: metrics::aic(loss, n, p),
         simulated,
-        iterations: lm.iter().map(|r| r.iterations).sum(),
-        evaluations: lm.iter().map(|r| r.function_evaluations).sum(),
+        iterations: searched.iterations,
+        evaluations: searched.evaluations,
         termination: best.termination.clone(),
         elapsed_s: started.elapsed().as_secs_f64(),
     })

@@ -103,13 +103,12 @@ pub fn fit(
         simulate: &simulate,
         n_params: 6,
     };
-    let best = common::best_of(&problem, &starts, &search)?;
+    let searched = common::best_of(&problem, &starts, &search)?;
     common::report(
-        model_of(&best.theta, structure)?,
+        model_of(&searched.best.theta, structure)?,
         u,
         y,
-        &[best.clone()],
-        &best,
+        &searched,
         started,
     )
 }
