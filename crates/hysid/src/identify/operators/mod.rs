@@ -9,6 +9,9 @@
 //!   S⁻¹[y] = H[u] (Kuhnen 2003).
 //! * [`preisach`]: regularised non-negative least squares on the cell regressors of a
 //!   triangular Preisach grid.
+//! * [`jiles_atherton`], [`bouc_wen`], [`duhem`], [`dahl`]: bounded Levenberg–Marquardt
+//!   output-error fits of the differential operators ([`differential_fit`] holds their common
+//!   part).
 //!
 //! The loop orientation is detected from the data ([`crate::model::operators::Orientation::detect`]) unless given; a
 //! clockwise loop is fitted in the inverse-operator parameterisation (the core operator from
@@ -18,7 +21,12 @@ use crate::numerics::Termination;
 use serde::Serialize;
 
 pub mod backlash;
+pub mod bouc_wen;
+pub mod dahl;
+pub mod differential_fit;
+pub mod duhem;
 pub mod gpi;
+pub mod jiles_atherton;
 mod linear_support;
 pub mod maxwell_slip;
 pub mod pi;

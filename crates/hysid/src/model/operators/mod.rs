@@ -13,6 +13,12 @@
 //! * [`MaxwellSlip`] — generalised Maxwell-slip friction elements (Lampaert, Al-Bender &
 //!   Swevers 2003), a stop-operator superposition, inverted through the PI inverse.
 //!
+//! The differential families:
+//! * differential operators, a state x with dx/du = F(u, x, sign du) integrated in the input
+//!   ([`differential`]): Jiles–Atherton (`jiles-atherton`, [`JilesAtherton`]), the static
+//!   Bouc–Wen operator (`bouc-wen`, [`BoucWen`]), the generalised Duhem / Coleman–Hodgdon
+//!   operator (`duhem`, [`Duhem`]) and Dahl friction (`dahl`, [`Dahl`]).
+//!
 //! **Initial states.** Every play/stop operator starts from the state 0 as if the input had
 //! been 0 before the first sample: F_r[u]₀ = max(u₀ − r, min(u₀ + r, 0)). The Preisach plane
 //! starts in negative saturation (all relays down, as if the input came from below the grid).
@@ -23,22 +29,42 @@
 //! by the *inverse-operator parameterisation* Γ = G⁻¹, G fitted from y to u; a decreasing
 //! trend is a sign flip of the output. See [`Orientation`]. The inverse of Γ then is G itself
 //! (for the clockwise case) — exact and analytic.
+//!
+//! For the differential families: A loop is counter-clockwise when its ascending branch lies below the
+//! descending one ([`LoopOrientation`]). Each family says how it represents the other
+//! orientation: Bouc–Wen by the sign of k_w, Duhem by the sign of c − a, Jiles–Atherton
+//! (natively counter-clockwise) and Dahl (natively clockwise) by a sign flip of the input (the
+//! loop is mirrored, so its slope changes sign too).
+//!
+//! **Initial states.** Every differential operator carries its state at the first input
+//! sample as a parameter (`m0`, `w0`, `y0`, `f0`), so a record that starts anywhere on a loop
+//! can be simulated and fitted.
 use crate::model::ParameterSet;
 use crate::Result;
 use serde::{Deserialize, Serialize};
 
 pub(crate) mod backlash;
+pub mod bouc_wen;
+pub mod dahl;
+pub mod differential;
+pub mod duhem;
 pub(crate) mod elementary;
 pub(crate) mod gpi;
+pub mod jiles_atherton;
 pub(crate) mod maxwell_slip;
 pub(crate) mod pi;
 pub(crate) mod preisach;
 
 pub use backlash::Backlash;
+pub use bouc_wen::BoucWen;
+pub use dahl::Dahl;
+pub use differential::{InputOde, LoopOrientation};
+pub use duhem::Duhem;
 pub use elementary::{
     play, play_step, solve_monotone, stop, validate_thresholds, Branch, Orientation,
 };
 pub use gpi::{DeadZones, GeneralizedPi};
+pub use jiles_atherton::{Anhysteretic, JaOutput, JilesAtherton};
 pub use maxwell_slip::MaxwellSlip;
 pub use pi::PrandtlIshlinskii;
 pub use preisach::Preisach;
