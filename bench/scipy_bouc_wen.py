@@ -2,7 +2,7 @@
 """The Bouc–Wen training fit as a SciPy user writes it, for comparison with hysid.
 
 Same problem as `hysid benchmark bouc-wen --train data/bouc-wen/train_multisine_5periods.csv
---start-factor 2 --starts 1`: the benchmark's oscillator (MODELS.md §3.1) in the identifiable
+--start-factor 2 --starts 1`: the benchmark's oscillator (docs/benchmarks.md §1.1) in the identifiable
 parameters (mL, cL, kL, alpha, beta_gamma, beta_delta; nu = 1), simulated by fixed-step RK4 at
 4 steps per sample with the band-limited (FFT-resampled) input, fitted by output error from
 every parameter at twice its nominal value with scipy.optimize.least_squares (trust-region

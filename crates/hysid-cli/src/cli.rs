@@ -394,7 +394,7 @@ pub enum SignalArg {
 /// Data generators.
 #[derive(Debug, Subcommand)]
 pub enum Generate {
-    /// The cascade examples of MODELS.md §1.6 (columns t, x, y).
+    /// The cascade examples of docs/models/coleman-hodgdon-cascade.md §13 (columns t, x, y).
     Voros(GenerateVorosArgs),
 }
 
@@ -422,7 +422,7 @@ pub struct GenerateVorosArgs {
 #[derive(Debug, Subcommand)]
 pub enum Demo {
     /// Vörös (2015): Coleman–Hodgdon hysteresis followed by a linear block, the project's
-    /// Example 1 or 2 (MODELS.md §1.6).
+    /// Example 1 or 2 (docs/models/coleman-hodgdon-cascade.md §13).
     Voros(VorosArgs),
     /// Gunnar et al. (2006): the virtual actuator rig and the three steps, with the paper's
     /// tables and figures.

@@ -198,7 +198,7 @@ fn bad_rig_settings_are_one_line() {
     assert!(err.contains("alpha"), "{err}");
 }
 
-/// EMPS: the published inverse-dynamics estimates (MODELS.md §3.2).
+/// EMPS: the published inverse-dynamics estimates (docs/benchmarks.md §2.2).
 #[test]
 fn rigid_body_ls_reproduces_the_emps_reference() {
     let dir = TempDir::new().unwrap();

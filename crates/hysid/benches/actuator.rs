@@ -1,6 +1,6 @@
 //! Criterion benchmarks of the actuator work of Gunnar et al. (2006): the virtual rig's eight
 //! experiments, the three steps on them (step 1, step 2, the four output-error fits of step 3
-//! and the tables), and the EMPS inverse-dynamics least squares (MODELS.md §3.2).
+//! and the tables), and the EMPS inverse-dynamics least squares (docs/benchmarks.md §2.2).
 //!
 //! Run with `cargo bench -p hysid --bench actuator`.
 

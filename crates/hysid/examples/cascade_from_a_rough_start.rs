@@ -1,7 +1,8 @@
 //! Vörös (2015): a Coleman–Hodgdon hysteresis followed by a linear system, identified from
 //! its input and noisy output alone — the hysteresis output is never measured.
 //!
-//! The data are the project's Example 1 (MODELS.md §1.6, a reconstruction: the paper's own
+//! The data are the project's Example 1 (docs/models/coleman-hodgdon-cascade.md §13, a
+//! project setting: the paper's own
 //! numbers were lost) at SNR 50. No initial values are given: the estimator searches a grid
 //! over (α, d), solves the bilinear rest by over-parameterised least squares and a rank-one
 //! factorisation, runs the paper's key-term-separation iteration from there and finishes by

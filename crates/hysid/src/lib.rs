@@ -26,7 +26,7 @@
 //! * J. Vörös, "Modeling and Identification of Discrete-Time Nonlinear Dynamic Cascade Systems
 //!   with Input Hysteresis", Mathematical Problems in Engineering 2015, Article ID 393572.
 //!   The copy this project holds lost its formulas; the equations used here are the
-//!   reconstruction documented in the project's `MODELS.md` §1, and the docs say where.
+//!   reconstruction in `docs/models/coleman-hodgdon-cascade.md`, and the docs say where.
 //! * J. Gunnar, E. Wernholt, G. Hovland, T. Brogårdh, "Nonlinear Grey-Box Identification of
 //!   Linear Actuators Containing Hysteresis", ICRA 2006.
 

@@ -1,6 +1,6 @@
 //! The bars of the cascade identification on the project's Examples 1 and 2
-//! (MODELS.md §1.6): exact recovery without noise from the documented initial values and from
-//! random rough starts.
+//! (docs/models/coleman-hodgdon-cascade.md §13): exact recovery without noise from the
+//! documented initial values and from random rough starts.
 
 use hysid::experiments::voros::CascadeExample;
 use hysid::identify::cascade::{CascadeFit, CascadeIdentification};

@@ -1,5 +1,5 @@
 //! Step 1 on real data: the EMPS positioning system's inverse-dynamics least squares with the
-//! published preprocessing reproduces the published reference model (MODELS.md §3.2).
+//! published preprocessing reproduces the published reference model (docs/benchmarks.md §2.2).
 
 use hysid::data::{CsvSpec, IdData};
 use hysid::identify::rigid_body::RigidBodyLs;

@@ -250,7 +250,7 @@ fn benchmark_noise_estimates_lie_within_their_standard_deviations() {
     );
 }
 
-/// MODELS.md §3.1: with the true parameters, band-limited input and RK4 at 15 kHz, the
+/// docs/benchmarks.md §1.3: with the true parameters, band-limited input and RK4 at 15 kHz, the
 /// training record's residual is its noise, RMS 7.4e-6 m (±20 %); with zero-order hold it is
 /// about 1e-4 m.
 #[test]

@@ -25,7 +25,7 @@ fn seeded(cases: u32) -> Config {
 }
 
 /// An admissible 4-parameter Coleman–Hodgdon model: c1 between its lower bound
-/// m1(1 − e^{−αd})/(2 − e^{−αd}) and m1 (MODELS.md §1.1).
+/// m1(1 − e^{−αd})/(2 − e^{−αd}) and m1 (docs/models/coleman-hodgdon-cascade.md §4).
 fn admissible_saturated() -> impl Strategy<Value = ColemanHodgdon> {
     (0.5..2.0f64, 0.5..2.0f64, 0.5..2.0f64, 0.0..1.0f64).prop_map(|(alpha, m1, d, s)| {
         let e = (-alpha * d).exp();
@@ -110,7 +110,8 @@ proptest! {
         }
     }
 
-    /// The Dhaouadi loop (MODELS.md §2.2): the branches meet at the reversals with the value
+    /// The Dhaouadi loop (docs/models/actuator.md §2): the branches meet at the reversals
+    /// with the value
     /// ±(A/α) tanh(αQ), the half-width is (A/α)(1 − cosh(αx)/cosh(αQ)) and the centre
     /// (A/α) sinh(αx)/cosh(αQ), for every A, α, Q and x in [−Q, Q].
     #[test]

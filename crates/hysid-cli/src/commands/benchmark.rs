@@ -1,7 +1,7 @@
 //! `hysid benchmark bouc-wen`: the hysteretic benchmark of Noël & Schoukens (2016).
 //!
 //! Fits the Bouc–Wen oscillator on a training record and scores test records by e_RMS in
-//! simulation mode (MODELS.md §3.1); `generate` makes test signals by the official recipe.
+//! simulation mode (docs/benchmarks.md §1); `generate` makes test signals by the official recipe.
 
 use super::greybox::{configure, plots};
 use super::present::{print_fit, print_residuals, report};
@@ -25,7 +25,7 @@ use std::sync::Arc;
 
 /// Sampling frequency of the benchmark records.
 const FS: f64 = 750.0;
-/// Published e_RMS on the official multisine test set (MODELS.md §3.1).
+/// Published e_RMS on the official multisine test set (docs/benchmarks.md §1.4).
 const PUBLISHED: [(&str, f64); 3] = [
     ("dynoNet (Forgione & Piga 2021)", 4.52e-5),
     ("decoupled polynomial nonlinear state space", 1.87e-5),

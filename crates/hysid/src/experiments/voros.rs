@@ -1,4 +1,5 @@
-//! The project's numerical examples for the hysteresis cascade (MODELS.md §1.6).
+//! The project's numerical examples for the hysteresis cascade
+//! (docs/models/coleman-hodgdon-cascade.md §13).
 //!
 //! These are PROJECT settings: the seed copy of Vörös (2015) lost the numbers of its two
 //! examples, so Example 1 and Example 2 here follow the paper's *description* (periodic

@@ -4,10 +4,10 @@
 //! # Why
 //!
 //! The key-term-separation iteration and the output-error fit are local methods: from a rough
-//! start they can stall or settle in a wrong minimum (MODELS.md §1.4). This stage needs no
-//! starting values at all.
+//! start they can stall or settle in a wrong minimum (docs/models/coleman-hodgdon-cascade.md
+//! §8). This stage needs no starting values at all.
 //!
-//! # Method (DERIVED, documented in MODELS.md §1.4 as "one route seen to work")
+//! # Method (DERIVED; docs/models/coleman-hodgdon-cascade.md §9)
 //!
 //! For fixed α and d the switching h(t) and the decay factor (1 − α|Δx(t)|) are known, and the
 //! hysteresis output is *linear* in the remaining parameters ℓ = (m1, m2, c1, c2) (ch4: m1, c1):

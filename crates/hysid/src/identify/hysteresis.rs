@@ -3,8 +3,8 @@
 //! # Method
 //!
 //! 1. **Profile over d.** For a fixed threshold d the switching function h is known and the
-//!    separated model (MODELS.md §1.2) is linear in α·m1, α·m2, α, c1, c2 once θ3 is tied to
-//!    d, θ3 = (θ1 − θ2)·d:
+//!    separated model (docs/models/coleman-hodgdon-cascade.md §5) is linear in α·m1, α·m2,
+//!    α, c1, c2 once θ3 is tied to d, θ3 = (θ1 − θ2)·d:
 //!
 //!    ```text
 //!    Δy = αm1·|Δx|(x(1−h) + d·sgn(x)h) + αm2·|Δx|(x·h − d·sgn(x)h) − α·|Δx|y(t−1) + c1(1−h)Δx + c2·hΔx

@@ -1,6 +1,6 @@
 //! The iterative key-term-separation estimator of Vörös (2015) for the hysteresis cascade.
 //!
-//! # Regression (MODELS.md §1.3, RECONSTRUCTED)
+//! # Regression (docs/models/coleman-hodgdon-cascade.md §7, RECONSTRUCTED)
 //!
 //! With b1 = 1, the key term v(t−k) of the linear block is replaced by one step of the
 //! hysteresis recursion, v(t−k) = v(t−k−1) + φ_h(t−k)ᵀθ_h, which makes the cascade linear in
@@ -12,7 +12,7 @@
 //! θ    = [ θ_hᵀ, b2, …, bm, a1, …, an ]
 //! ```
 //!
-//! # Iteration (SEED steps, details RECONSTRUCTED, MODELS.md §1.4)
+//! # Iteration (SEED steps, details RECONSTRUCTED, docs/models/coleman-hodgdon-cascade.md §8)
 //!
 //! (a) least squares for θ with the current internal variables v̂, ĥ; (b) recover the physical
 //! hysteresis parameters, recompute ĥ from d̂ and v̂ by running the recursion with them;

@@ -23,7 +23,8 @@
 //! the outer segment of the material functions while the input stays below d.
 //!
 //! The physical parameters are recovered from θ̂ at every sample (α = θ4, m1 = θ1/α, …,
-//! MODELS.md §1.2); they keep their last valid values when the recovery is undefined.
+//! docs/models/coleman-hodgdon-cascade.md §5); they keep their last valid values when the
+//! recovery is undefined.
 //!
 //! References: L. Ljung, T. Söderström, Theory and Practice of Recursive Identification, MIT
 //! Press 1983, ch. 2 and §5.6; D. Wang, F. Ding, Y. Chu, Information Sciences 222, 2013

@@ -14,7 +14,8 @@
 //! Parameter vector used by the estimators, [`HysteresisCascade::params`]:
 //! `[hysteresis parameters (ChForm order), b2 … bm, a1 … an]`.
 //!
-//! Reference: Vörös (2015), Section 3; layout RECONSTRUCTED (MODELS.md §1.3).
+//! Reference: Vörös (2015), Section 3; layout RECONSTRUCTED
+//! (docs/models/coleman-hodgdon-cascade.md §6).
 
 use super::{ChForm, ColemanHodgdon, LinearBlock};
 use crate::{Error, Result};

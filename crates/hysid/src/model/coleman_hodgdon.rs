@@ -9,13 +9,13 @@
 //! ```
 //!
 //! Replacing differentials by differences (Vörös 2015; the explicit form is the project's
-//! RECONSTRUCTION, MODELS.md §1.1), with Δx(t) = x(t) − x(t−1):
+//! RECONSTRUCTION, docs/models/coleman-hodgdon-cascade.md §3), with Δx(t) = x(t) − x(t−1):
 //!
 //! ```text
 //! y(t) = y(t−1) + α |Δx(t)| [ f(x(t)) − y(t−1) ] + g(x(t)) Δx(t)          (D)
 //! ```
 //!
-//! The material functions are piecewise linear (RECONSTRUCTED, MODELS.md §1.1):
+//! The material functions are piecewise linear (RECONSTRUCTED, docs/models/coleman-hodgdon-cascade.md §4):
 //!
 //! ```text
 //! f(x) = m1·x                        |x| ≤ d       g(x) = c1     |x| ≤ d
@@ -38,7 +38,7 @@
 //! the recursion meaningless; [`ColemanHodgdon::simulate`] refuses them with
 //! [`Error::RateLimit`].
 //!
-//! # Switching function and separated parameters (MODELS.md §1.2, RECONSTRUCTED)
+//! # Switching function and separated parameters (docs/models/coleman-hodgdon-cascade.md §5, RECONSTRUCTED)
 //!
 //! With the switching function h(t) = 1 when |x(t)| > d and 0 otherwise, (D) is linear in the
 //! separated parameter vector θ_h: Δy(t) = φ_h(t)ᵀ θ_h with
@@ -106,7 +106,8 @@ impl ChForm {
 /// The result of checking the admissibility condition of the material functions.
 ///
 /// For the piecewise-linear functions the condition
-/// f'(x) ≥ g(x) ≥ α e^{αx} ∫ₓ^∞ |f'(ξ) − g(ξ)| e^{−αξ} dξ (x > 0) becomes (DERIVED, MODELS.md §1.1)
+/// f'(x) ≥ g(x) ≥ α e^{αx} ∫ₓ^∞ |f'(ξ) − g(ξ)| e^{−αξ} dξ (x > 0) becomes (DERIVED,
+/// docs/models/coleman-hodgdon-cascade.md §4)
 ///
 /// ```text
 /// m1 ≥ c1 ≥ (m1 − c1)(1 − e^{−αd}) + |m2 − c2| e^{−αd}   and   m2 ≥ c2.
@@ -128,7 +129,7 @@ pub struct Admissibility {
 ///
 /// ```
 /// use hysid::model::ColemanHodgdon;
-/// // MODELS.md §1.6 recursion test vector: first step from x = 0 to x = 0.5.
+/// // The recursion test vector of docs/models/coleman-hodgdon-cascade.md §14: x from 0 to 0.5.
 /// let ch = ColemanHodgdon::general(0.5, 1.0, 0.2, 0.5, 0.2, 3.0).unwrap();
 /// let y = ch.simulate(&[0.0, 0.5, 1.0], 0.0).unwrap();
 /// assert!((y[1] - 0.375).abs() < 1e-12);
@@ -543,7 +544,8 @@ pub fn simulate_switched(ch: &ColemanHodgdon, x: &[f64], v0: f64, h: Option<&[bo
 mod tests {
     use super::*;
 
-    /// MODELS.md §1.6 recursion test vector (6-parameter set, y(0) = 0).
+    /// The recursion test vector of docs/models/coleman-hodgdon-cascade.md §14
+    /// (6-parameter set, y(0) = 0).
     #[test]
     fn recursion_test_vector() {
         let ch = ColemanHodgdon::general(0.5, 1.0, 0.2, 0.5, 0.2, 3.0).unwrap();

@@ -16,7 +16,8 @@
 //!
 //! Samples before t = 0 are zero (the block starts at rest).
 //!
-//! Reference: Vörös (2015), Section 3 (layout RECONSTRUCTED, MODELS.md §1.3).
+//! Reference: Vörös (2015), Section 3 (layout RECONSTRUCTED,
+//! docs/models/coleman-hodgdon-cascade.md §6).
 
 use crate::{Error, Result};
 use nalgebra::DMatrix;

@@ -1,6 +1,6 @@
 //! Steady-state hysteresis loops of the Dhaouadi model (step 2 of Gunnar et al. 2006).
 //!
-//! # Formula (MODELS.md §2.2, DERIVED; corrects the seed copy's sign)
+//! # Formula (docs/models/actuator.md §2, DERIVED; corrects the seed copy's sign)
 //!
 //! Under x1 = Q sin(ωt), the hysteresis torque x4 of ẋ4 = −α|ẋ1|x4 + A ẋ1 follows, on the
 //! ascending (ẋ1 > 0) and the descending branch,
@@ -95,7 +95,7 @@ pub fn branch_samples(x: &[f64], points: &[(usize, f64)], margin: f64) -> Vec<(u
 mod tests {
     use super::*;
 
-    /// MODELS.md §2.2 test vectors.
+    /// The test vectors of docs/models/actuator.md §2.
     #[test]
     fn loop_formula_test_vectors() {
         let cases = [

@@ -5,10 +5,10 @@
 //!    deviations; J = Jt − r²m.
 //! 2. **Steady-state loops** (data sets 2–5, saddle fixed, one period each): nonlinear least
 //!    squares of τn = k1 x1 + k2 x1³ + Cu/d(x1) with the corrected loop formula
-//!    ([`loops`]), τn = τ − Fc sgn(x2) (viscous friction neglected at these low speeds,
-//!    as in the paper). For fixed α the model is linear in (k1, k2, A), so α is found by a
-//!    profile search (log grid and golden section) and the rest by least squares: no start
-//!    values are needed.
+//!    ([`loops`]), τn = τ − Fv x2 − Fc·(branch direction), Fv and Fc from step 1
+//!    (docs/models/actuator.md §2). For fixed α the model is linear in (k1, k2, A), so α
+//!    is found by a profile search (log grid and golden section) and the rest by least
+//!    squares: no start values are needed.
 //! 3. **Output error** (data set 6 with 7, and with 8): the saddle-fixed model
 //!    [`ActuatorFixed`] from m0 = (J, Fv, Fc from step 1; k1, k2, α, A from step 2), all seven
 //!    parameters free (m67, m68) or J, Fv, Fc fixed (m67f, m68f); stopped after 30 iterations

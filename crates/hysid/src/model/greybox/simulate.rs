@@ -13,8 +13,8 @@
 //! * [`InputInterpolation::Linear`]: straight lines between samples.
 //! * [`InputInterpolation::BandLimited`]: the input's Fourier series up to the Nyquist
 //!   frequency (zero-padding of its DFT), right for band-limited *periodic* excitations such
-//!   as multisines; for a non-periodic record the ends ring. MODELS.md §3.1 shows what the
-//!   choice costs on the Bouc–Wen benchmark.
+//!   as multisines; for a non-periodic record the ends ring. docs/benchmarks.md §1.3 shows
+//!   what the choice costs on the Bouc–Wen benchmark.
 //!
 //! # Integrators
 //!

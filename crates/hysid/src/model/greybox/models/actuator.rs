@@ -1,7 +1,7 @@
 //! The two-mass linear actuator with a Dhaouadi hysteresis in its flexibility (Gunnar,
 //! Wernholt, Hovland & Brogårdh 2006).
 //!
-//! # Equations (MODELS.md §2.1, SEED)
+//! # Equations (docs/models/actuator.md §1, SEED)
 //!
 //! States x1 = θ − z/r (torsion of the flexibility), x2 = θ̇ (motor speed), x3 = ż (saddle
 //! speed), x4 (hysteresis torque); input τ (motor torque); output x1.

@@ -1,6 +1,6 @@
 //! The Bouc–Wen oscillator of the hysteretic benchmark (Noël & Schoukens 2016).
 //!
-//! # Equations (MODELS.md §3.1, VERIFIED)
+//! # Equations (docs/benchmarks.md §1.1, VERIFIED)
 //!
 //! ```text
 //! mL ÿ + cL ẏ + kL y + z = u
