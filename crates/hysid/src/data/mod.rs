@@ -14,6 +14,7 @@ use std::ops::Range;
 
 use crate::error::{Error, Result};
 
+pub mod actuator_records;
 pub mod csv_io;
 pub mod mat_io;
 

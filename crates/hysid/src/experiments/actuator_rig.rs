@@ -28,8 +28,8 @@
 //! Without backlash and noise, the saddle-fixed sets are exactly what the identification
 //! model [`ActuatorFixed`] simulates with the same integrator.
 
+use crate::data::actuator_records::{data_set_path, Record, COLUMNS};
 use crate::data::write_csv;
-use crate::identify::actuator::{data_set_path, Record, COLUMNS};
 use crate::model::greybox::models::{coulomb_direction, ActuatorFixed, ActuatorFree};
 use crate::model::greybox::simulate::rk4_step;
 use crate::model::greybox::stick_slip::Rk4;
