@@ -81,6 +81,10 @@ pub struct ModelFile {
     pub initial_state: Option<Vec<f64>>,
 }
 
+/// The most integrator sub-steps per sample a model file may ask for: beyond it a
+/// simulation is work without end in sight, not accuracy.
+pub const MAX_SUBSTEPS: usize = 1000;
+
 /// The simulation settings in a model file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SimulationSpec {
@@ -109,7 +113,13 @@ impl SimulationSpec {
 
     /// The simulation settings.
     pub fn simulation(&self) -> Result<Simulation> {
-        let substeps = self.substeps.max(1);
+        if !(1..=MAX_SUBSTEPS).contains(&self.substeps) {
+            return Err(Error::Config(format!(
+                "\"substeps\": {} is out of range 1..={MAX_SUBSTEPS}; give a number of RK4 sub-steps per sample in that range",
+                self.substeps
+            )));
+        }
+        let substeps = self.substeps;
         let integrator = match self.integrator.as_str() {
             "rk4" => Integrator::Rk4 { substeps },
             "newmark" => Integrator::Newmark { substeps },
@@ -163,8 +173,32 @@ pub enum FittedModel {
 impl FittedModel {
     /// Simulates the model's outputs for the input channels `inputs` sampled every `ts`;
     /// `y0` is the measured initial output (used by a hysteresis with
-    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges.
+    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges
+    /// (an output that is NaN or ±∞, e.g. an unstable linear block, is
+    /// [`Error::Diverged`], never returned).
     pub fn simulate(&self, inputs: &[&[f64]], ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let outputs = self.simulate_unchecked(inputs, ts, y0)?;
+        for (channel, y) in outputs.iter().enumerate() {
+            if let Some(index) = y.iter().position(|v| !v.is_finite()) {
+                return Err(Error::Diverged {
+                    index,
+                    reason: format!(
+                        "output {} is {}; the model is unstable or its parameters are out of range for this input",
+                        channel + 1,
+                        y[index]
+                    ),
+                });
+            }
+        }
+        Ok(outputs)
+    }
+
+    fn simulate_unchecked(
+        &self,
+        inputs: &[&[f64]],
+        ts: f64,
+        y0: Option<f64>,
+    ) -> Result<Vec<Vec<f64>>> {
         let first = || {
             inputs
                 .first()

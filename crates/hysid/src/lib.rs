@@ -40,6 +40,7 @@ pub mod estimate;
 pub mod examples;
 pub mod fitted;
 pub mod greybox;
+pub mod io;
 pub mod metrics;
 pub mod model;
 pub mod signal;

@@ -15,6 +15,7 @@ use std::ops::Range;
 use crate::error::{Error, Result};
 
 pub mod csv_io;
+pub mod mat5;
 pub mod mat_io;
 
 pub use csv_io::{read_columns, write_csv, CsvSpec};
