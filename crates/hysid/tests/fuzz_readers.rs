@@ -44,7 +44,7 @@ fn check_data(result: hysid::Result<IdData>) -> Result<(), TestCaseError> {
             prop_assert!(data.ts().is_finite() && data.ts() > 0.0, "ts {}", data.ts());
             for k in 0..data.n_experiments() {
                 let exp = data.experiment(k);
-                prop_assert!(exp.len() > 0);
+                prop_assert!(!exp.is_empty());
                 for c in 0..data.input_channels().len() {
                     prop_assert!(exp.input(c).len() == exp.len());
                     prop_assert!(exp.input(c).iter().all(|v| v.is_finite()));
@@ -186,7 +186,7 @@ fn uncompressed_fixture(compressed: &[u8]) -> Vec<u8> {
         } else {
             out.extend_from_slice(&compressed[at..at + 8 + len]);
         }
-        while out.len() % 8 != 0 {
+        while !out.len().is_multiple_of(8) {
             out.push(0);
         }
         at += 8 + len;

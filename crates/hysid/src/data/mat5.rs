@@ -64,8 +64,7 @@ pub fn decompression_limit(file_bytes: usize) -> u64 {
     let file_bytes = u64::try_from(file_bytes).unwrap_or(u64::MAX);
     file_bytes
         .saturating_mul(MAX_EXPANSION)
-        .max(MIN_BUDGET)
-        .min(MAX_DECOMPRESSED)
+        .clamp(MIN_BUDGET, MAX_DECOMPRESSED)
 }
 
 /// The dense numeric arrays of a level-5 MAT-file (header included in `bytes`).
@@ -387,7 +386,7 @@ mod tests {
             m.extend_from_slice(&kind.to_le_bytes());
             m.extend_from_slice(&(data.len() as u32).to_le_bytes());
             m.extend_from_slice(data);
-            while m.len() % 8 != 0 {
+            while !m.len().is_multiple_of(8) {
                 m.push(0);
             }
         };
