@@ -1,44 +1,65 @@
 //! `hysid`: identify dynamic systems with hysteresis from the command line.
 //!
 //! Every command prints a short human report on stdout, writes progress to stderr, and, with
-//! `--json FILE`, a machine-readable report. Errors are one line on stderr with exit code 1
-//! (2 for command-line usage errors, from clap).
+//! `--json FILE`, a machine-readable report. Every error is one line on stderr, and the exit
+//! code says its class: 0 success, 1 bad input or data, 2 usage, 3 numerical failure, 4 I/O
+//! (the table is in [`exit`]).
 
 mod cli;
 mod commands;
 mod deprecated;
+mod exit;
 mod output;
 mod plot;
 mod progress;
 mod report;
 
-use clap::Parser;
+use clap::error::ErrorKind;
+use clap::{CommandFactory, Parser};
+use exit::ExitClass;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    exit::one_line_panics();
     let args = deprecated::rewrite(std::env::args_os().collect());
-    let cli = cli::Cli::parse_from(args);
+    let cli = match cli::Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => return parser_exit(&e),
+    };
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", one_line(&e));
-            ExitCode::FAILURE
+            eprintln!("error: {}", exit::one_line(&e));
+            exit::classify(&e).exit_code()
         }
     }
 }
 
-/// The error chain on one line, "context: cause", leaving out causes the message already
-/// quotes (the library's errors include their source in their own text).
-fn one_line(e: &anyhow::Error) -> String {
-    let mut message = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if !message.contains(&text) {
-            if !message.is_empty() {
-                message.push_str(": ");
-            }
-            message.push_str(&text);
+/// `--help` and `--version` print as usual (exit 0); every other parser error is one line
+/// on stderr with exit 2.
+fn parser_exit(e: &clap::Error) -> ExitCode {
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            // Printing help to a closed pipe is not worth an error.
+            let _ = e.print();
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            let command = exit::usage_command(&e.render().to_string());
+            eprintln!("error: '{command}' needs a subcommand; run '{command} --help' for the list");
+            ExitClass::Usage.exit_code()
+        }
+        _ => {
+            let args: Vec<String> = std::env::args_os()
+                .skip(1)
+                .map(|a| a.to_string_lossy().into_owned())
+                .collect();
+            let command = exit::command_path(&cli::Cli::command(), &args);
+            eprintln!(
+                "error: {}",
+                exit::usage_line(&e.render().to_string(), &command)
+            );
+            ExitClass::Usage.exit_code()
         }
     }
-    message.replace('\n', " ")
 }

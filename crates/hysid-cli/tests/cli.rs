@@ -310,7 +310,9 @@ fn input_too_fast_for_the_model_is_a_one_line_error() {
         dir.path(),
         "fast.csv",
         "x",
-        &rows(50, |i| format!("{}", if i % 2 == 0 { -5.0 } else { 5.0 })),
+        &rows(50, |i| {
+            format!("{}", if i.is_multiple_of(2) { -5.0 } else { 5.0 })
+        }),
     );
     let out_csv = dir.path().join("sim.csv");
     let out = hysid()

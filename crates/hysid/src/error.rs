@@ -145,6 +145,18 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+
+    /// A result to be written holds NaN or ±∞ (a numerical failure, not bad data).
+    #[error(
+        "the result holds {value} at '{key}', which cannot be written; the estimate diverged \
+         (check the data's scaling, the start values and the bounds)"
+    )]
+    NonFiniteResult {
+        /// Key path of the first non-finite number (`model.parameters.alpha.value`).
+        key: String,
+        /// The number found.
+        value: f64,
+    },
 }
 
 /// Shorthand for results in this crate.

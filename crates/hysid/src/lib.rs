@@ -34,6 +34,7 @@ pub mod data;
 pub mod error;
 pub mod experiments;
 pub mod identify;
+pub mod io;
 pub mod model;
 pub mod numerics;
 pub mod report;

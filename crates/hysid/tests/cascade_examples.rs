@@ -45,7 +45,11 @@ fn noise_free_examples_are_recovered_from_the_documented_initial_values() {
 /// 20 rough starts per example: d̂₀ uniform in 0.5–1.0 × max|x|, every other hysteresis
 /// parameter within a factor 2 of the truth (log-uniform), linear parameters at zero (the
 /// estimator's own start for them).
+/// The long coverage test of the start space (40 identifications, about a minute on two
+/// quiet cores): `#[ignore]`d so that the default test command stays under 3 minutes; CI
+/// runs it with `cargo test --workspace --release -- --ignored`.
 #[test]
+#[ignore = "long coverage test (~1 min): CI runs it with `cargo test --release -- --ignored`"]
 fn noise_free_examples_are_recovered_from_random_rough_starts() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(2015);
     for n in [1, 2] {

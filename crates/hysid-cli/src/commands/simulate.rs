@@ -1,16 +1,20 @@
-//! `hysid simulate`: run a saved model on new input data.
+//! `hysid simulate`: run a saved model (or the model of a report) on new input data.
 
 use crate::cli::SimulateArgs;
-use crate::output::{preflight, write_report};
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
+use hysid::io::atomic::OutputSet;
 use hysid::model::saved::FittedModel;
 use hysid::report::{DataSummary, FitSummary, Report};
 
 /// Simulates the model on the input columns; compares with the output column when given.
+/// The outputs are one transaction: written to temporaries, renamed into place together at
+/// the end, and never an input file.
 pub fn run(args: &SimulateArgs) -> Result<()> {
+    let mut files = OutputSet::new(&[args.model.as_path(), args.data.as_path()])?;
+    let csv_tmp = args.csv.as_deref().map(|p| files.file(p)).transpose()?;
+    let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
     let model = FittedModel::load(&args.model)?;
-    preflight(&[args.csv.as_deref(), args.json.as_deref()], &[])?;
     let spec = CsvSpec {
         inputs: args.input.clone(),
         outputs: args.output.iter().cloned().collect(),
@@ -21,6 +25,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let exp = data.experiment(0);
     let inputs: Vec<&[f64]> = (0..args.input.len()).map(|c| exp.input(c)).collect();
     let measured = args.output.as_ref().map(|_| exp.output(0));
+    // Errors (never returns) when the simulated output is not finite.
     let outputs = model
         .simulate(
             &inputs,
@@ -30,26 +35,17 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .with_context(|| format!("simulating on {}", args.data.display()))?;
     let yhat = &outputs[0];
     let file = model.to_file();
-    println!(
-        "Simulated {} on {} ({} samples)",
-        file.kind,
-        args.data.display(),
-        exp.len()
-    );
+    let kind = file.kind.clone();
     let mut report = Report::new("simulate");
     report.data = Some(DataSummary::of(
         &data,
         vec![args.data.display().to_string()],
     ));
     if let Some(y) = measured {
-        let fit = FitSummary::of(&[exp.name.clone()], &[y], &[yhat])?;
-        println!("  fit {:.2} %   RMSE {:.4e}", fit.fit_percent, fit.rmse);
-        report.fit = Some(fit);
-    } else if yhat.iter().any(|v| !v.is_finite()) {
-        anyhow::bail!("the simulated output is not finite: the model is unstable on this input");
+        report.fit = Some(FitSummary::of(&[exp.name.clone()], &[y], &[yhat])?);
     }
     report.model = Some(file);
-    if let Some(path) = &args.csv {
+    if let Some(path) = &csv_tmp {
         let mut headers: Vec<&str> = args.input.iter().map(String::as_str).collect();
         headers.push("simulated");
         let mut cols: Vec<&[f64]> = inputs.clone();
@@ -59,10 +55,24 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             cols.push(y);
         }
         write_csv(path, &headers, &cols)?;
+    }
+    if let Some(path) = &json_tmp {
+        let text = report.to_json()?;
+        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    files.commit()?;
+    println!(
+        "Simulated {kind} on {} ({} samples)",
+        args.data.display(),
+        exp.len()
+    );
+    if let Some(fit) = &report.fit {
+        println!("  fit {:.2} %   RMSE {:.4e}", fit.fit_percent, fit.rmse);
+    }
+    if let Some(path) = &args.csv {
         println!("  simulated output: {}", path.display());
     }
     if let Some(path) = &args.json {
-        write_report(path, &report)?;
         println!("  report: {}", path.display());
     }
     Ok(())

@@ -19,9 +19,8 @@
 use std::fs;
 use std::path::Path;
 
-use matfile::{Array, MatFile, NumericData};
-
 use super::csv_io::{uniform_step, TIME_COLUMN_NAMES};
+use super::mat5::{self, MatArray as Array};
 use super::{one_line, Channel, CsvSpec, Experiment, IdData};
 use crate::error::{Error, Result};
 
@@ -48,7 +47,20 @@ impl IdData {
         if spec.inputs.is_empty() && spec.outputs.is_empty() {
             return Err(invalid(path, "no input or output variables were asked for"));
         }
-        let file = MatVariables::open(path)?;
+        let bytes = fs::read(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_mat_bytes(path, &bytes, spec)
+    }
+
+    /// [`from_mat`](Self::from_mat) on the contents of a MAT-file already in memory;
+    /// `path` names it in messages and gives the experiment its name.
+    pub fn from_mat_bytes(path: &Path, bytes: &[u8], spec: &CsvSpec) -> Result<IdData> {
+        if spec.inputs.is_empty() && spec.outputs.is_empty() {
+            return Err(invalid(path, "no input or output variables were asked for"));
+        }
+        let file = MatVariables::parse(path, bytes)?;
         let mut columns = spec
             .inputs
             .iter()
@@ -97,30 +109,26 @@ pub fn is_mat(path: &Path) -> bool {
 /// The numeric variables of a parsed MAT-file.
 struct MatVariables<'p> {
     path: &'p Path,
-    file: MatFile,
+    arrays: Vec<Array>,
 }
 
 impl<'p> MatVariables<'p> {
-    fn open(path: &'p Path) -> Result<Self> {
-        let bytes = fs::read(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        check_header(path, &bytes)?;
-        let file = MatFile::parse(bytes.as_slice()).map_err(|e| {
+    fn parse(path: &'p Path, bytes: &[u8]) -> Result<Self> {
+        check_header(path, bytes)?;
+        let arrays = mat5::parse(bytes).map_err(|e| {
             invalid(
                 path,
                 &format!(
-                    "cannot read the MAT-file ({e}); save it again with save(..., '-v7') or export CSV"
+                    "cannot read the MAT-file: {e}; save it again with save(..., '-v7') or export CSV"
                 ),
             )
         })?;
-        Ok(Self { path, file })
+        Ok(Self { path, arrays })
     }
 
     /// The variable called `name`: the exact match, else the only case-insensitive one.
     fn variable(&self, name: &str) -> Result<&Array> {
-        let arrays = self.file.arrays();
+        let arrays = &self.arrays;
         if let Some(array) = arrays.iter().find(|a| a.name() == name) {
             return Ok(array);
         }
@@ -220,8 +228,7 @@ impl<'p> MatVariables<'p> {
             .chain(&spec.outputs)
             .map(|n| n.trim().to_lowercase())
             .collect();
-        self.file
-            .arrays()
+        self.arrays
             .iter()
             .map(|a| a.name().to_string())
             .find(|name| {
@@ -233,8 +240,7 @@ impl<'p> MatVariables<'p> {
     /// "name [rows×cols], …" of every numeric variable.
     fn listing(&self) -> String {
         let names: Vec<String> = self
-            .file
-            .arrays()
+            .arrays
             .iter()
             .map(|a| {
                 let dims: Vec<String> = a.size().iter().map(|d| d.to_string()).collect();
@@ -287,35 +293,15 @@ fn parse_selector(spec: &str) -> std::result::Result<(&str, Option<usize>), Stri
     }
 }
 
-/// The values of a real numeric array as `f64`, column-major.
+/// The values of a real numeric array, column-major.
 fn real_values(array: &Array) -> std::result::Result<Vec<f64>, String> {
-    fn convert<T: Copy + Into<f64>>(real: &[T], imag: &Option<Vec<T>>) -> Option<Vec<f64>> {
-        imag.is_none()
-            .then(|| real.iter().map(|&v| v.into()).collect())
-    }
-    let values = match array.data() {
-        NumericData::Double { real, imag } => convert(real, imag),
-        NumericData::Single { real, imag } => convert(real, imag),
-        NumericData::Int8 { real, imag } => convert(real, imag),
-        NumericData::UInt8 { real, imag } => convert(real, imag),
-        NumericData::Int16 { real, imag } => convert(real, imag),
-        NumericData::UInt16 { real, imag } => convert(real, imag),
-        NumericData::Int32 { real, imag } => convert(real, imag),
-        NumericData::UInt32 { real, imag } => convert(real, imag),
-        // 64-bit integers have no lossless `Into<f64>`; counts and indices fit anyway.
-        NumericData::Int64 { real, imag } => imag
-            .is_none()
-            .then(|| real.iter().map(|&v| v as f64).collect()),
-        NumericData::UInt64 { real, imag } => imag
-            .is_none()
-            .then(|| real.iter().map(|&v| v as f64).collect()),
-    };
-    values.ok_or_else(|| {
-        format!(
+    if array.is_complex() {
+        return Err(format!(
             "variable '{}' is complex; give a real variable",
             one_line(array.name())
-        )
-    })
+        ));
+    }
+    Ok(array.real().to_vec())
 }
 
 fn invalid(path: &Path, message: &str) -> Error {

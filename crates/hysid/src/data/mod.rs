@@ -16,6 +16,7 @@ use crate::error::{Error, Result};
 
 pub mod actuator_records;
 pub mod csv_io;
+pub mod mat5;
 pub mod mat_io;
 
 pub use csv_io::{read_columns, write_csv, CsvSpec};

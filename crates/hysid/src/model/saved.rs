@@ -140,7 +140,7 @@ pub struct SimulationSpec {
 
 /// The largest number of sub-steps a model file may ask for: beyond it a simulation of an
 /// ordinary record takes hours, and the file is more likely corrupt than meant.
-pub const MAX_SUBSTEPS: usize = 10_000;
+pub const MAX_SUBSTEPS: usize = 1000;
 
 impl SimulationSpec {
     /// The spec of a simulation, saved faithfully.
@@ -237,8 +237,32 @@ pub enum FittedModel {
 impl FittedModel {
     /// Simulates the model's outputs for the input channels `inputs` sampled every `ts`;
     /// `y0` is the measured initial output (used by a hysteresis with
-    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges.
+    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges
+    /// (an output that is NaN or ±∞, e.g. an unstable linear block, is
+    /// [`Error::Diverged`], never returned).
     pub fn simulate(&self, inputs: &[&[f64]], ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let outputs = self.simulate_unchecked(inputs, ts, y0)?;
+        for (channel, y) in outputs.iter().enumerate() {
+            if let Some(index) = y.iter().position(|v| !v.is_finite()) {
+                return Err(Error::Diverged {
+                    index,
+                    reason: format!(
+                        "output {} is {}; the model is unstable or its parameters are out of range for this input",
+                        channel + 1,
+                        y[index]
+                    ),
+                });
+            }
+        }
+        Ok(outputs)
+    }
+
+    fn simulate_unchecked(
+        &self,
+        inputs: &[&[f64]],
+        ts: f64,
+        y0: Option<f64>,
+    ) -> Result<Vec<Vec<f64>>> {
         let first = || {
             inputs
                 .first()

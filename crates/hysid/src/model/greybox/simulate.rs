@@ -189,7 +189,7 @@ pub fn band_limited_upsample(x: &[f64], factor: usize) -> Vec<f64> {
     for k in 1..n - half {
         padded[m - k] = spectrum[n - k];
     }
-    if n % 2 == 0 {
+    if n.is_multiple_of(2) {
         // The Nyquist bin belongs to both halves of the longer spectrum.
         let nyquist = spectrum[half] * 0.5;
         padded[half] = nyquist;

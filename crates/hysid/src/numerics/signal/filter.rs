@@ -71,7 +71,7 @@ pub fn cheby1(order: usize, ripple_db: f64, wn: f64) -> Result<TransferFunction>
         .iter()
         .fold(Complex::new(1.0, 0.0), |g, p| g * (-p))
         .re;
-    let gain = if order % 2 == 0 {
+    let gain = if order.is_multiple_of(2) {
         prototype_gain / (1.0 + eps * eps).sqrt()
     } else {
         prototype_gain

@@ -1,0 +1,274 @@
+//! Exit codes and one-line error messages.
+//!
+//! | code | meaning |
+//! | --- | --- |
+//! | 0 | success (also `--help` and `--version`) |
+//! | 1 | bad input or data: a malformed or inconsistent file, a parameter out of its range, data that cannot identify the model |
+//! | 2 | usage: the command line itself is wrong (unknown option, missing or unparsable value) |
+//! | 3 | numerical failure: a singular regression, a diverged simulation, a non-finite result |
+//! | 4 | I/O: a file could not be opened, read or written |
+//! | 101 | an internal fault (a panic) — a bug to report |
+//!
+//! Every error is one line on stderr: what is wrong, where, and what to do. Usage errors
+//! from the argument parser are folded to one line and end with the `--help` to run.
+
+use hysid::Error;
+use std::process::ExitCode;
+
+/// The class of a failed run, which fixes its exit code (see the [module table](self)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ExitClass {
+    /// Bad input or data (exit 1).
+    BadInput,
+    /// The command line is wrong (exit 2).
+    Usage,
+    /// A numerical failure (exit 3).
+    Numerical,
+    /// A file could not be read or written (exit 4).
+    Io,
+}
+
+impl ExitClass {
+    /// The process exit code of this class.
+    pub fn code(self) -> u8 {
+        match self {
+            ExitClass::BadInput => 1,
+            ExitClass::Usage => 2,
+            ExitClass::Numerical => 3,
+            ExitClass::Io => 4,
+        }
+    }
+
+    /// The class as a process exit code.
+    pub fn exit_code(self) -> ExitCode {
+        ExitCode::from(self.code())
+    }
+}
+
+/// The class of a library error, by the meaning of its variant: an unreadable or
+/// unwritable file is I/O, a singular regression or a diverged simulation is numerical,
+/// everything about the content of files and parameters is bad input.
+pub fn library_class(error: &Error) -> ExitClass {
+    match error {
+        Error::Io { .. } => ExitClass::Io,
+        Error::Singular(_) | Error::Diverged { .. } | Error::NonFiniteResult { .. } => {
+            ExitClass::Numerical
+        }
+        // Csv, MissingColumn, NotNumeric, NonFinite, InvalidData, TooFewSamples,
+        // NotExciting, RateLimit, InvalidParameter, Config, ModelFile — and any variant added
+        // later until it is classified here — describe what the user gave.
+        _ => ExitClass::BadInput,
+    }
+}
+
+/// The class of a command's error: that of the first library or I/O error in its chain,
+/// else bad input (the command's own checks are about what the user gave).
+pub fn classify(error: &anyhow::Error) -> ExitClass {
+    for cause in error.chain() {
+        if let Some(e) = cause.downcast_ref::<Error>() {
+            return library_class(e);
+        }
+        if cause.downcast_ref::<std::io::Error>().is_some() {
+            return ExitClass::Io;
+        }
+    }
+    ExitClass::BadInput
+}
+
+/// The error chain on one line, "context: cause", leaving out causes the message already
+/// quotes (the library's errors include their source in their own text).
+pub fn one_line(e: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if !message.contains(&text) {
+            if !message.is_empty() {
+                message.push_str(": ");
+            }
+            message.push_str(&text);
+        }
+    }
+    collapse(&message)
+}
+
+/// Folds a parser error (several lines: the error, a usage block, tips) to one line:
+/// "what; tips; run 'hysid CMD --help' for the options".
+/// `command` names the subcommand when the message has no usage line to name it.
+pub fn usage_line(rendered: &str, command: &str) -> String {
+    let mut what = Vec::new();
+    let mut tips = Vec::new();
+    let mut command = command.to_string();
+    let mut in_error = true;
+    for line in rendered.lines() {
+        let trimmed = line.trim();
+        if trimmed.is_empty() {
+            in_error = false;
+            continue;
+        }
+        if let Some(usage) = trimmed.strip_prefix("Usage:") {
+            command = command_of(usage);
+            in_error = false;
+        } else if let Some(tip) = trimmed.strip_prefix("tip:") {
+            tips.push(tip.trim().to_string());
+        } else if trimmed.starts_with("For more information") {
+            in_error = false;
+        } else if in_error {
+            what.push(trimmed.strip_prefix("error:").unwrap_or(trimmed).trim());
+        }
+    }
+    let mut message = what.join(" ");
+    if message.is_empty() {
+        message = "the command line is not valid".into();
+    }
+    for tip in tips {
+        message.push_str("; ");
+        message.push_str(&tip);
+    }
+    collapse(&format!(
+        "{message}; run '{command} --help' for the options"
+    ))
+}
+
+/// The command a parser error is about ("hysid identify cascade"), from its usage line.
+pub fn usage_command(rendered: &str) -> String {
+    rendered
+        .lines()
+        .find_map(|line| line.trim().strip_prefix("Usage:"))
+        .map(command_of)
+        .unwrap_or_else(|| "hysid".into())
+}
+
+/// "hysid identify cascade" from a usage line "hysid identify cascade [OPTIONS] --data <F> …".
+fn command_of(usage: &str) -> String {
+    let words: Vec<&str> = usage
+        .split_whitespace()
+        .take_while(|w| {
+            !w.starts_with('-')
+                && !w.starts_with('[')
+                && !w.starts_with('<')
+                && w.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        })
+        .collect();
+    if words.is_empty() {
+        "hysid".into()
+    } else {
+        words.join(" ")
+    }
+}
+
+/// The subcommand path named on the command line ("hysid identify cascade"): the leading
+/// words of `args` (after the program) that are subcommands of `root`.
+pub fn command_path(root: &clap::Command, args: &[String]) -> String {
+    let mut path = vec![root.get_name().to_string()];
+    let mut command = root;
+    for arg in args {
+        match command.find_subcommand(arg) {
+            Some(sub) => {
+                path.push(sub.get_name().to_string());
+                command = sub;
+            }
+            None => break,
+        }
+    }
+    path.join(" ")
+}
+
+/// Whitespace (newlines included) collapsed to single spaces.
+fn collapse(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Installs a panic hook that reports an internal fault on one line (where, what, and to
+/// report it) instead of the runtime's multi-line message; the exit code stays 101.
+pub fn one_line_panics() {
+    std::panic::set_hook(Box::new(|info| {
+        let what = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown fault".into());
+        let place = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        eprintln!(
+            "error: internal fault{place}: {}; please report it with the command line that caused it",
+            collapse(&what)
+        );
+    }));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exit_codes_follow_the_table() {
+        let codes: Vec<u8> = [
+            ExitClass::BadInput,
+            ExitClass::Usage,
+            ExitClass::Numerical,
+            ExitClass::Io,
+        ]
+        .iter()
+        .map(|c| c.code())
+        .collect();
+        assert_eq!(codes, [1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn library_errors_are_classified_by_meaning() {
+        let io = Error::Io {
+            path: "x.csv".into(),
+            source: std::io::Error::other("disk full"),
+        };
+        assert_eq!(library_class(&io), ExitClass::Io);
+        assert_eq!(
+            library_class(&Error::Singular("rank 2 of 3".into())),
+            ExitClass::Numerical
+        );
+        let diverged = Error::Diverged {
+            index: 3,
+            reason: "x1 is inf".into(),
+        };
+        assert_eq!(library_class(&diverged), ExitClass::Numerical);
+        assert_eq!(
+            library_class(&Error::InvalidData("empty".into())),
+            ExitClass::BadInput
+        );
+        let wrapped = anyhow::Error::from(io).context("reading the data");
+        assert_eq!(classify(&wrapped), ExitClass::Io);
+        assert_eq!(classify(&anyhow::anyhow!("bad --fix")), ExitClass::BadInput);
+        let nan = anyhow::Error::from(Error::NonFiniteResult {
+            key: "fit".into(),
+            value: f64::NAN,
+        });
+        assert_eq!(classify(&nan), ExitClass::Numerical);
+    }
+
+    #[test]
+    fn parser_errors_fold_to_one_line() {
+        let rendered = "error: invalid value 'abc' for '--delay <K>': invalid digit found in string\n\nUsage: hysid identify cascade [OPTIONS] --data <F>\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            usage_line(rendered, "hysid"),
+            "invalid value 'abc' for '--delay <K>': invalid digit found in string; run 'hysid identify cascade --help' for the options"
+        );
+        let missing = "error: the following required arguments were not provided:\n  --data <F>\n  --input <COL>\n\nUsage: hysid simulate --model <FILE> --data <F>\n\nFor more information, try '--help'.\n";
+        assert_eq!(
+            usage_line(missing, "hysid"),
+            "the following required arguments were not provided: --data <F> --input <COL>; run 'hysid simulate --help' for the options"
+        );
+        let no_usage = "error: invalid value 'x' for '--na <NA>': invalid digit found in string\n";
+        assert_eq!(
+            usage_line(no_usage, "hysid identify cascade"),
+            "invalid value 'x' for '--na <NA>': invalid digit found in string; run 'hysid identify cascade --help' for the options"
+        );
+        let tip = "error: unexpected argument '--foo' found\n\n  tip: to pass '--foo' as a value, use '-- --foo'\n\nUsage: hysid generate voros [OPTIONS]\n";
+        assert_eq!(
+            usage_line(tip, "hysid"),
+            "unexpected argument '--foo' found; to pass '--foo' as a value, use '-- --foo'; run 'hysid generate voros --help' for the options"
+        );
+    }
+}

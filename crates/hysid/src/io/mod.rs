@@ -1,0 +1,3 @@
+//! Writing results safely: all-or-nothing output sets and checks of what is written.
+
+pub mod atomic;
