@@ -20,7 +20,9 @@
 
 pub mod bootstrap;
 pub mod cascade;
+pub mod cascade_pass;
 pub mod global;
+pub mod grid_regression;
 pub mod hysteresis;
 pub mod inverse_dynamics;
 pub mod key_term;
