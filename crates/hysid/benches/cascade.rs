@@ -1,11 +1,14 @@
 //! Criterion benchmarks of the cascade: one simulation, one set of normal equations (the
-//! Jacobian work of one Levenberg–Marquardt iteration) and one full identification.
+//! Jacobian work of one Levenberg–Marquardt iteration), one point of the global (α, d) grid
+//! on 10⁶ samples, and full identifications (the examples, and 10⁶ samples as
+//! `hysid identify cascade` runs them).
 //!
 //! Run with `cargo bench -p hysid --bench cascade`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::experiments::voros::CascadeExample;
 use hysid::identify::cascade::{CascadeIdentification, CascadeStructure};
+use hysid::identify::grid_regression::EquationError;
 use hysid::identify::output_error::OutputErrorProblem;
 use hysid::numerics::levenberg_marquardt::LeastSquaresProblem;
 use hysid::numerics::Control;
@@ -64,5 +67,42 @@ fn identification(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, simulation, normal_equations, identification);
+fn grid_point(c: &mut Criterion) {
+    let ex = CascadeExample::example1().extended(1_000_000);
+    let gen = ex.generate(1, true).unwrap();
+    let h = &ex.truth.hysteresis;
+    let regression = EquationError::new(h.form(), 2, 2, 1, &gen.x, &gen.y);
+    let mut scratch = regression.scratch();
+    c.bench_function("cascade grid point (equation error), 1e6 samples", |b| {
+        b.iter(|| {
+            black_box(
+                regression
+                    .cost(black_box(h.alpha()), black_box(h.d()), &mut scratch)
+                    .unwrap(),
+            )
+        })
+    });
+}
+
+fn identification_1e6(c: &mut Criterion) {
+    let mut group = c.benchmark_group("identification");
+    group.sample_size(10);
+    let ex = CascadeExample::example1().extended(1_000_000);
+    let data = ex.generate(1, true).unwrap().id_data().unwrap();
+    let id = CascadeIdentification::new(ex.truth.hysteresis.form(), 2, 2, 1);
+    group.bench_function(
+        "Example 1 pattern, 1e6 samples, SNR 50, no initial values",
+        |b| b.iter(|| black_box(id.estimate(&data, &mut |_| Control::Continue).unwrap())),
+    );
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    simulation,
+    normal_equations,
+    grid_point,
+    identification,
+    identification_1e6
+);
 criterion_main!(benches);

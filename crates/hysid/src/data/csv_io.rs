@@ -267,19 +267,23 @@ impl Table {
     /// Parses the given columns of every remaining row.
     fn read(&mut self, indices: &[usize]) -> Result<Vec<Vec<f64>>> {
         let mut columns = vec![Vec::new(); indices.len()];
-        // One record reused for every row: no allocation per row.
-        let mut record = ByteRecord::new();
+        // Records are reused batch after batch: no allocation per row.
         let mut row = 0;
-        while self
-            .reader
-            .read_byte_record(&mut record)
-            .map_err(|e| csv_error(&self.path, e))?
-        {
-            for (&col, column) in indices.iter().zip(&mut columns) {
-                column.push(self.parse_cell(&record, col, row)?);
+        let Self {
+            path,
+            reader,
+            header,
+        } = self;
+        pipeline::for_each_batch(reader, |records| {
+            for record in records {
+                for (&col, column) in indices.iter().zip(&mut columns) {
+                    column.push(Self::parse_cell(path, header, record, col, row)?);
+                }
+                row += 1;
             }
-            row += 1;
-        }
+            Ok(())
+        })
+        .map_err(|e| csv_error(path, e))??;
         if row == 0 {
             return Err(Error::InvalidData(format!(
                 "{}: no data rows below the header",
@@ -289,20 +293,26 @@ impl Table {
         Ok(columns)
     }
 
-    fn parse_cell(&self, record: &ByteRecord, col: usize, row: usize) -> Result<f64> {
+    fn parse_cell(
+        path: &Path,
+        header: &[String],
+        record: &ByteRecord,
+        col: usize,
+        row: usize,
+    ) -> Result<f64> {
         let cell = record.get(col).unwrap_or_default().trim_ascii();
-        let value = std::str::from_utf8(cell)
-            .ok()
-            .and_then(|text| text.parse::<f64>().ok())
+        // Most cells take the exact fast path; the rest (and every error) the full parser.
+        let value = float::parse_fast(cell)
+            .or_else(|| std::str::from_utf8(cell).ok()?.parse::<f64>().ok())
             .ok_or_else(|| Error::NotNumeric {
-                path: self.path.clone(),
+                path: path.to_path_buf(),
                 line: record.position().map_or(0, |p| p.line()),
-                column: one_line(&self.header[col]).into_owned(),
+                column: one_line(&header[col]).into_owned(),
                 text: one_line(&String::from_utf8_lossy(cell)).into_owned(),
             })?;
         if !value.is_finite() {
             return Err(Error::NonFinite {
-                channel: one_line(&self.header[col]).into_owned(),
+                channel: one_line(&header[col]).into_owned(),
                 index: row,
                 value,
             });
@@ -515,5 +525,7 @@ impl Drop for TempFile {
     }
 }
 
+mod float;
+mod pipeline;
 #[cfg(test)]
 mod tests;

@@ -21,10 +21,10 @@
 //! u = [Σⱼ bⱼ s(t−k−j+1), v(t−k−j+1) for b_j, −ŷ(t−i) for aᵢ].
 
 use super::bootstrap::{parametric_bootstrap, Bootstrap};
+use super::cascade_pass::{simulate_into, stream_sensitivities};
 use super::global::{GlobalSearch, GridCandidate};
 use super::hysteresis::{
-    bounded_parameter, check_excitation, check_finite, hysteresis_sensitivities, max_increment,
-    rate_error, simulate_switched,
+    bounded_parameter, check_excitation, check_finite, max_increment, rate_error,
 };
 use super::key_term::{KeyTermFit, KeyTermSeparation};
 use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel, SensitivitySink};
@@ -94,8 +94,7 @@ impl OutputErrorModel for CascadeStructure {
     fn simulate(&self, theta: &[f64], data: &IdData, exp: usize, y: &mut [Vec<f64>]) -> Result<()> {
         let cascade = self.cascade(theta)?;
         let h = self.switching.as_ref().map(|s| s[exp].as_slice());
-        let v = simulate_switched(&cascade.hysteresis, data.experiment(exp).input(0), 0.0, h);
-        y[0] = cascade.linear.simulate(&v);
+        simulate_into(&cascade, data.experiment(exp).input(0), h, &mut y[0]);
         check_finite(&y[0])
     }
 
@@ -114,109 +113,11 @@ impl OutputErrorModel for CascadeStructure {
         let h = self.switching.as_ref().map(|s| s[exp].as_slice());
         Some(stream_sensitivities(
             &cascade,
-            data.experiment(exp),
+            data.experiment(exp).input(0),
             h,
             free,
             sink,
         ))
-    }
-}
-
-/// Ring buffers of the recent samples the linear block needs.
-struct History {
-    len: usize,
-    width: usize,
-    values: Vec<f64>,
-}
-
-impl History {
-    fn new(len: usize, width: usize) -> Self {
-        Self {
-            len,
-            width,
-            values: vec![0.0; len * width],
-        }
-    }
-
-    /// The row stored for sample `t − lag`, or None before the record starts.
-    #[inline]
-    fn get(&self, t: usize, lag: usize) -> Option<&[f64]> {
-        let s = t.checked_sub(lag)?;
-        let i = (s % self.len) * self.width;
-        Some(&self.values[i..i + self.width])
-    }
-
-    #[inline]
-    fn row_mut(&mut self, t: usize) -> &mut [f64] {
-        let i = (t % self.len) * self.width;
-        &mut self.values[i..i + self.width]
-    }
-}
-
-/// Simulates the cascade with its output sensitivities (see the module docs).
-fn stream_sensitivities(
-    cascade: &HysteresisCascade,
-    exp: &Experiment,
-    h: Option<&[bool]>,
-    free: &[usize],
-    sink: &mut SensitivitySink<'_>,
-) -> Result<()> {
-    let lin = &cascade.linear;
-    let (k, m, na) = (lin.delay(), lin.nb(), lin.na());
-    let nh = cascade.hysteresis.form().n_params();
-    let p = nh + m - 1 + na;
-    let x = exp.input(0);
-    // v(t) and s(t) = ∂v/∂θ_h are needed at lags k … k+m−1; ŷ and ∂ŷ at lags 1 … n.
-    let mut hyst = History::new(k + m, 1 + nh);
-    let mut out = History::new(na + 1, 1 + p);
-    let mut u = vec![0.0; p];
-    let mut row = vec![0.0; free.len()];
-    let mut failed = None;
-    hysteresis_sensitivities(&cascade.hysteresis, x, 0.0, h, |t, v, s| {
-        let slot = hyst.row_mut(t);
-        slot[0] = v;
-        slot[1..].copy_from_slice(s);
-        u.iter_mut().for_each(|ui| *ui = 0.0);
-        let mut yhat = 0.0;
-        for (j, &bj) in lin.b().iter().enumerate() {
-            if let Some(past) = hyst.get(t, k + j) {
-                yhat += bj * past[0];
-                for (ui, si) in u[..nh].iter_mut().zip(&past[1..]) {
-                    *ui += bj * si;
-                }
-                if j > 0 {
-                    u[nh + j - 1] = past[0];
-                }
-            }
-        }
-        // u becomes ∂ŷ(t) in place: ∂ŷ(t) = u(t) − Σ aᵢ ∂ŷ(t−i).
-        let dy = &mut u;
-        for (i, &ai) in lin.a().iter().enumerate() {
-            if let Some(past) = out.get(t, i + 1) {
-                yhat -= ai * past[0];
-                dy[nh + m - 1 + i] -= past[0];
-                for (d, pd) in dy.iter_mut().zip(&past[1..]) {
-                    *d -= ai * pd;
-                }
-            }
-        }
-        if !yhat.is_finite() && failed.is_none() {
-            failed = Some(t);
-        }
-        let slot = out.row_mut(t);
-        slot[0] = yhat;
-        slot[1..].copy_from_slice(dy);
-        for (r, &i) in row.iter_mut().zip(free) {
-            *r = dy[i];
-        }
-        sink(t, &[yhat], &row);
-    });
-    match failed {
-        None => Ok(()),
-        Some(index) => Err(Error::Diverged {
-            index,
-            reason: "the simulated cascade output is not finite".into(),
-        }),
     }
 }
 
@@ -348,8 +249,14 @@ impl CascadeIdentification {
             window.experiment(0).output(0),
         );
         let grid = self.grid.search(x, y)?;
-        let key_term = self.run_key_term(&window, &grid)?;
-        let candidates = self.refine_candidates(&window, &grid, key_term.as_ref());
+        // The paper's iteration and the grid candidates' refinement are independent: run them
+        // side by side, then refine the iteration's result (candidates keep their order).
+        let (key_term, mut candidates) = rayon::join(
+            || self.run_key_term(&window, &grid),
+            || self.refine_candidates(&window, &grid, None),
+        );
+        let key_term = key_term?;
+        candidates.extend(self.refine_candidates(&window, &[], key_term.as_ref()));
         let best = candidates
             .iter()
             .min_by(|a, b| a.cost.total_cmp(&b.cost))

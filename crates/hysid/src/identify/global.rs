@@ -41,6 +41,7 @@
 //! Hammerstein–Wiener nonlinear systems", Automatica 34(3), 1998 (over-parameterisation and
 //! rank-one factorisation).
 
+use super::grid_regression::EquationError;
 use crate::model::coleman_hodgdon::switching;
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::numerics::nelder_mead::nelder_mead;
@@ -105,13 +106,14 @@ impl GlobalSearch {
         let grid = self.grid(x)?;
         // Stage A: plain equation error over the whole grid. Its *cost* ranks (α, d) well even
         // with output noise; its linear estimates are what the noise biases.
+        let regression = EquationError::new(self.form, self.na, self.nb, self.delay, x, y);
         let mut ranked: Vec<(f64, f64, f64)> = grid
             .par_iter()
-            .filter_map(|&(alpha, d)| {
-                let psi = basis_signals(self.form, x, alpha, d);
-                let (_, cost) = self.overparameterised_fit(y, &psi)?;
-                Some((alpha, d, cost))
-            })
+            .map_init(
+                || regression.scratch(),
+                |s, &(alpha, d)| Some((alpha, d, regression.cost(alpha, d, s)?)),
+            )
+            .flatten()
             .collect();
         if ranked.is_empty() {
             return Err(Error::Singular(
@@ -187,14 +189,16 @@ impl GlobalSearch {
         let (alpha_step, d_step) = grid_steps(&grid, self.d_points);
         let alpha_max = grid.iter().map(|g| g.0).fold(0.0, f64::max);
         let d_max = d_step * (self.d_points + 1) as f64;
+        let regression = EquationError::new(self.form, self.na, self.nb, self.delay, x, y);
+        let scratch = std::cell::RefCell::new(regression.scratch());
         let cost = |p: &[f64]| {
             let (a, dd) = (p[0].exp(), p[1]);
             if a > alpha_max || dd <= 0.0 || dd >= d_max {
                 return f64::INFINITY;
             }
-            let psi = basis_signals(self.form, x, a, dd);
-            self.overparameterised_fit(y, &psi)
-                .map_or(f64::INFINITY, |(_, c)| c)
+            regression
+                .cost(a, dd, &mut scratch.borrow_mut())
+                .unwrap_or(f64::INFINITY)
         };
         let (best, _) = nelder_mead(
             cost,

@@ -23,8 +23,10 @@
 pub mod actuator;
 pub mod bootstrap;
 pub mod cascade;
+pub mod cascade_pass;
 pub mod global;
 pub mod greybox;
+pub mod grid_regression;
 pub mod hysteresis;
 pub mod key_term;
 pub mod multistart;
