@@ -55,6 +55,10 @@ pub fn print_fit(title: &str, fit: &GreyBoxFit) {
         "  stopped: {}   time {:.2} s",
         oe.report.termination, fit.elapsed_s
     );
+    println!(
+        "  simulations: {} without sensitivities, {} with",
+        oe.report.residual_evaluations, oe.report.sensitivity_evaluations
+    );
     if fit.starts.len() > 1 {
         let good = fit
             .starts
@@ -137,6 +141,8 @@ pub fn report(
         "fit_percent_per_experiment": oe.fit_percent,
         "mse_per_experiment": oe.mse,
         "function_evaluations": oe.report.function_evaluations,
+        "simulations_without_sensitivities": oe.report.residual_evaluations,
+        "simulations_with_sensitivities": oe.report.sensitivity_evaluations,
         "rejected_trials": oe.report.rejected_trials,
         "correlation": correlation,
         "history": oe.report.history,
