@@ -1,6 +1,6 @@
 //! Criterion benchmarks of the grey-box engine on the Bouc–Wen benchmark's training record
 //! (40 960 samples): one simulation, one set of normal equations (the Jacobian work of one
-//! Levenberg–Marquardt iteration), one full fit with 8 starts.
+//! Levenberg–Marquardt iteration), the full fit from one start and from 8 starts.
 //!
 //! Run with `cargo bench -p hysid --bench greybox`.
 
@@ -78,6 +78,26 @@ fn bouc_wen(c: &mut Criterion) {
     for i in start.free_indices() {
         start.get_mut(i).value *= 2.0;
     }
+    let single = GreyBoxEstimation {
+        simulation: simulation(),
+        ..Default::default()
+    };
+    // What `hysid benchmark bouc-wen --start-factor 2 --starts 1` does.
+    group.bench_function("Bouc-Wen training record from x2, 1 start", |b| {
+        b.iter(|| {
+            black_box(
+                single
+                    .estimate(
+                        Arc::new(BoucWen),
+                        &data,
+                        &start,
+                        InitialStates::at_rest(3, 1),
+                        &mut |_| Control::Continue,
+                    )
+                    .unwrap(),
+            )
+        })
+    });
     let estimation = GreyBoxEstimation {
         simulation: simulation(),
         starts: 8,

@@ -57,6 +57,10 @@ pub fn print_fit(title: &str, fit: &GreyBoxFit) {
         "  stopped: {}   time {:.2} s",
         oe.report.termination, fit.elapsed_s
     );
+    println!(
+        "  simulations: {} without sensitivities, {} with",
+        oe.report.residual_evaluations, oe.report.sensitivity_evaluations
+    );
     if fit.starts.len() > 1 {
         let good = fit
             .starts
@@ -139,6 +143,8 @@ pub fn report(
         .collect();
     let mut details = json!({
         "mse_per_experiment": oe.mse,
+        "simulations_without_sensitivities": oe.report.residual_evaluations,
+        "simulations_with_sensitivities": oe.report.sensitivity_evaluations,
         "rejected_trials": oe.report.rejected_trials,
         "correlation": correlation,
         "history": oe.report.history,

@@ -32,8 +32,9 @@ use crate::data::actuator_records::{data_set_path, Record, COLUMNS};
 use crate::data::write_csv;
 use crate::model::greybox::models::{coulomb_direction, ActuatorFixed, ActuatorFree};
 use crate::model::greybox::simulate::rk4_step;
-use crate::model::greybox::stick_slip::Rk4;
+use crate::model::greybox::stick_slip::StickSlip;
 use crate::model::greybox::StateSpaceModel;
+use crate::numerics::integrate::Stage;
 use crate::numerics::signal::{gaussian_noise, multisine};
 use crate::{Error, Result};
 use rayon::prelude::*;
@@ -402,7 +403,7 @@ impl Plant {
         let (j, fv, fc) = (th[0], th[1], th[2]);
         let (r, m, free) = (self.r, self.m, self.saddle_free);
         // (θ, θ̇, z, ż) with the spring torque g held over the step.
-        let mut rate = |_: f64, s: &[f64], held: Option<f64>, ds: &mut [f64]| {
+        let mut rate = |_: Stage, s: &[f64], held: Option<f64>, ds: &mut [f64]| {
             let applied = tau - g - fv * s[1];
             let direction = held.or_else(|| coulomb_direction(s[1], applied, fc));
             ds[0] = s[1];
@@ -411,7 +412,7 @@ impl Plant {
             ds[3] = if free { g / (r * m) } else { 0.0 };
         };
         let mut s = [x[0], x[1], x[2], x[3]];
-        Rk4::new(4).step(&mut rate, &mut s, h, Some(1), None);
+        StickSlip::new(4).step(&mut rate, &mut s, h, Some(1), None);
         x[..4].copy_from_slice(&s);
         let x1 = x[0] - x[2] / r;
         let half = 0.5 * self.backlash;

@@ -258,8 +258,8 @@ fn recursion(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::coleman_hodgdon::simulate_switched;
     use crate::experiments::voros::CascadeExample;
+    use crate::model::coleman_hodgdon::simulate_switched;
 
     /// The in-place simulation is bit-identical to the hysteresis simulation followed by the
     /// linear block, with and without a frozen switching.

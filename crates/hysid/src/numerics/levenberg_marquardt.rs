@@ -143,6 +143,12 @@ pub struct LmReport {
     pub iterations: usize,
     /// Residual evaluations (trial points and finite differences).
     pub function_evaluations: usize,
+    /// Evaluations of the residuals alone (for a simulated model: simulations without
+    /// sensitivities): the start, every trial point, every finite-difference column.
+    pub residual_evaluations: usize,
+    /// Evaluations of the analytic normal equations (for a simulated model: simulations with
+    /// forward sensitivities), one per accepted point and one at the start.
+    pub sensitivity_evaluations: usize,
     /// Trial points rejected because the model could not be evaluated there.
     pub rejected_trials: usize,
     /// Why the search stopped.
@@ -281,6 +287,10 @@ struct State<'a> {
     nu: f64,
     iterations: usize,
     fevals: usize,
+    /// Residual-only evaluations.
+    plain_evals: usize,
+    /// Analytic normal-equation evaluations.
+    sensitivity_evals: usize,
     rejected: usize,
     history: Vec<IterationRecord>,
 }
@@ -339,6 +349,8 @@ impl<'a> State<'a> {
             nu: 2.0,
             iterations: 0,
             fevals: 1,
+            plain_evals: 1,
+            sensitivity_evals: 0,
             rejected: 0,
             history: Vec::new(),
         };
@@ -443,6 +455,7 @@ impl<'a> State<'a> {
             }
             let predicted = self.predicted_decrease(&candidate);
             self.fevals += 1;
+            self.plain_evals += 1;
             let cost = match self.problem.residuals(&candidate, &mut trial) {
                 Ok(()) if trial.iter().all(|r| r.is_finite()) => {
                     trial.iter().map(|r| r * r).sum::<f64>()
@@ -560,6 +573,7 @@ impl<'a> State<'a> {
     fn normal_equations(&mut self) -> Result<NormalEquations> {
         if let Some(system) = self.problem.normal_equations(&self.theta, &self.free) {
             self.fevals += 1;
+            self.sensitivity_evals += 1;
             let system = system?;
             if !system.cost.is_finite() {
                 return Err(Error::Diverged {
@@ -591,6 +605,7 @@ impl<'a> State<'a> {
             })
             .collect();
         self.fevals += self.free.len();
+        self.plain_evals += self.free.len();
         let mut jac = DMatrix::zeros(n, self.free.len());
         for (k, column) in columns.into_iter().enumerate() {
             jac.set_column(k, &DVector::from_vec(column?));
@@ -612,6 +627,8 @@ impl<'a> State<'a> {
             n_residuals: self.residuals.len(),
             iterations: self.iterations,
             function_evaluations: self.fevals,
+            residual_evaluations: self.plain_evals,
+            sensitivity_evaluations: self.sensitivity_evals,
             rejected_trials: self.rejected,
             termination,
             history: self.history,

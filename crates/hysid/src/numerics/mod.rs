@@ -11,9 +11,11 @@
 //!   profiles.
 //! * [`signal`]: excitation signals, seeded noise and MATLAB-compatible filters (`butter`,
 //!   `cheby1`, `filter`, `filtfilt`, `decimate`, `gradient`).
+//! * [`integrate`]: the classical RK4 step shared by every fixed-step simulation.
 //! * [`metrics`]: fit %, RMSE, NRMSE, FPE and AIC.
 //! * [`termination`]: why an iterative method stopped.
 
+pub mod integrate;
 pub mod least_squares;
 pub mod levenberg_marquardt;
 pub mod metrics;

@@ -16,12 +16,14 @@
 //! * [`simulate`]: integrators (RK4 with sub-steps, Newmark, adaptive Dormand–Prince) and the
 //!   input interpolation between samples.
 //! * [`stick_slip`]: RK4 steps that integrate Coulomb friction as stick–slip.
+//! * [`sensitivity`]: the right-hand side of the forward sensitivity equations.
 //!
 //! Binding a model to data and estimating its parameters is the identify layer's
 //! ([`crate::identify::greybox`]).
 //! * [`models`]: the built-in models (Bouc–Wen oscillator, rigid body with friction).
 
 pub mod models;
+pub mod sensitivity;
 pub mod simulate;
 pub mod stick_slip;
 
@@ -29,6 +31,7 @@ pub use simulate::{InputInterpolation, Integrator, Simulation};
 
 use crate::data::Channel;
 use crate::model::ParameterSet;
+pub use sensitivity::JacobianScratch;
 
 /// A continuous-time state-space model with physical parameters.
 pub trait StateSpaceModel: Sync + Send {
@@ -127,5 +130,31 @@ pub trait StateSpaceModel: Sync + Send {
         ftheta: &mut [f64],
     ) -> bool {
         self.rhs_jacobians(t, x, u, theta, fx, ftheta)
+    }
+
+    /// ẋ and the forward-sensitivity rates Ṡ = (∂f/∂x)·S + ∂f/∂θ[:, params] for S (n × q,
+    /// row-major: first the columns of θ[params], then initial-state columns, which have no
+    /// direct term), friction held in `held` when Some ([`sensitivity`]). Returns false when
+    /// the model has no analytic Jacobians. The default evaluates [`rhs`](Self::rhs) and
+    /// [`rhs_jacobians`](Self::rhs_jacobians) into `scratch`
+    /// ([`sensitivity::default_rhs_sensitivities`]); a model may override it to fuse the two
+    /// and skip known zeros, with the same values.
+    #[allow(clippy::too_many_arguments)]
+    fn rhs_sensitivities(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        held: Option<f64>,
+        params: &[usize],
+        s: &[f64],
+        scratch: &mut JacobianScratch,
+        dx: &mut [f64],
+        ds: &mut [f64],
+    ) -> bool {
+        sensitivity::default_rhs_sensitivities(
+            self, t, x, u, theta, held, params, s, scratch, dx, ds,
+        )
     }
 }

@@ -30,8 +30,9 @@
 //! * [`Integrator::Adaptive`]: Dormand–Prince 5(4) with error control, restarted at every
 //!   sample (the input may jump there); the reference the tests compare the others with.
 
-use super::stick_slip::{Rk4, Sensitivities};
-use super::StateSpaceModel;
+use super::stick_slip::{Sensitivities, StickSlip};
+use super::{JacobianScratch, StateSpaceModel};
+use crate::numerics::integrate::Stage;
 use crate::{Error, Result};
 use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
@@ -147,6 +148,35 @@ impl InputTrack {
         self.len() == 0
     }
 
+    /// Points per sample interval of the input grid ([`at_node`](Self::at_node)).
+    pub fn resolution(&self) -> usize {
+        self.resolution
+    }
+
+    /// u at node `index` ∈ [0, resolution] of the grid of [`resolution`](Self::resolution)
+    /// points per sample interval k, i.e. u(t_k + index/resolution·ts): read from the table
+    /// prepared once in [`new`](Self::new) (band-limited) or the samples, never searched for.
+    /// RK4 with m sub-steps evaluates the input only at these nodes when the resolution
+    /// is 2m.
+    #[inline]
+    pub fn at_node(&self, k: usize, index: usize, out: &mut [f64]) {
+        for (c, o) in out.iter_mut().enumerate() {
+            let s = &self.samples[c];
+            *o = match self.interpolation {
+                InputInterpolation::ZeroOrderHold => s[k],
+                InputInterpolation::Linear => {
+                    let tau = index as f64 / self.resolution as f64;
+                    let next = s.get(k + 1).copied().unwrap_or(s[k]);
+                    s[k] + tau * (next - s[k])
+                }
+                InputInterpolation::BandLimited => {
+                    let f = &self.fine[c];
+                    f[(k * self.resolution + index).min(f.len() - 1)]
+                }
+            };
+        }
+    }
+
     /// u(t_k + τ·ts) for τ ∈ [0, 1], written into `out`. With zero-order hold τ = 1 still
     /// gives u_k: the value held over the interval that ends there.
     #[inline]
@@ -244,6 +274,24 @@ fn rate(
     model.rhs((k as f64 + tau) * ts, x, u, theta, out);
 }
 
+/// The input at a stage of RK4 sub-step j of m in sample interval k: from the input grid when
+/// the stage lies on it, else interpolated at τ.
+#[inline]
+fn stage_input(
+    input: &InputTrack,
+    m: usize,
+    k: usize,
+    j: usize,
+    stage: Stage,
+    tau: f64,
+    u: &mut [f64],
+) {
+    match stage.node {
+        Some(node) if input.resolution() == 2 * m => input.at_node(k, 2 * j + node as usize, u),
+        _ => input.at(k, tau, u),
+    }
+}
+
 fn diverged(k: usize) -> Error {
     Error::Diverged {
         index: k,
@@ -259,7 +307,7 @@ struct Stepper<'a> {
     ts: f64,
     integrator: Integrator,
     u: Vec<f64>,
-    rk4: Rk4,
+    rk4: StickSlip,
     k: [Vec<f64>; 7],
 }
 
@@ -293,7 +341,7 @@ impl<'a> Stepper<'a> {
             ts,
             integrator,
             u: vec![0.0; input.n_channels()],
-            rk4: Rk4::new(n),
+            rk4: StickSlip::new(n),
             k: std::array::from_fn(|_| vec![0.0; n]),
         })
     }
@@ -304,7 +352,7 @@ impl<'a> Stepper<'a> {
             Integrator::Rk4 { substeps } => {
                 let m = substeps.max(1);
                 for j in 0..m {
-                    self.rk4_step(k, j as f64 / m as f64, 1.0 / m as f64, x);
+                    self.rk4_step(k, j, m, x);
                 }
                 Ok(())
             }
@@ -335,14 +383,15 @@ impl<'a> Stepper<'a> {
         );
     }
 
-    /// One RK4 step of fraction `dtau` of the sample interval from τ (stick–slip aware,
-    /// see [`super::stick_slip`]).
-    fn rk4_step(&mut self, k: usize, tau: f64, dtau: f64, x: &mut [f64]) {
+    /// RK4 sub-step j of m of sample interval k (stick–slip aware, see
+    /// [`super::stick_slip`]).
+    fn rk4_step(&mut self, k: usize, j: usize, m: usize, x: &mut [f64]) {
         let (model, theta, input, ts) = (self.model, self.theta, self.input, self.ts);
+        let (tau, dtau) = (j as f64 / m as f64, 1.0 / m as f64);
         let u = &mut self.u;
-        let mut f = |dt: f64, x: &[f64], held: Option<f64>, out: &mut [f64]| {
-            let tau = tau + dt / ts;
-            input.at(k, tau, u);
+        let mut f = |stage: Stage, x: &[f64], held: Option<f64>, out: &mut [f64]| {
+            let tau = tau + stage.dt / ts;
+            stage_input(input, m, k, j, stage, tau, u);
             let t = (k as f64 + tau) * ts;
             match held {
                 Some(d) => model.rhs_sliding(t, x, u, theta, d, out),
@@ -565,14 +614,26 @@ pub fn simulate_sensitivities(
     let n_samples = input.len();
     let p = theta.len();
     let q = params.len() + initial.len();
-    let mut fx = vec![0.0; n * n];
-    let mut ft = vec![0.0; n * p];
+    let mut scratch = JacobianScratch::new(n, p);
     let mut u = vec![0.0; input.n_channels()];
     input.at(0, 0.0, &mut u);
-    if !model.rhs_jacobians(0.0, x0, &u, theta, &mut fx, &mut ft) {
+    let (mut dx, mut ds) = (vec![0.0; n], vec![0.0; n * q]);
+    let s0 = vec![0.0; n * q];
+    if !model.rhs_sensitivities(
+        0.0,
+        x0,
+        &u,
+        theta,
+        None,
+        params,
+        &s0,
+        &mut scratch,
+        &mut dx,
+        &mut ds,
+    ) {
         return Ok(false);
     }
-    // Augmented state z = [x, S (row-major n × q)].
+    // Augmented state z = [x, S (row-major n × q)], allocated once.
     let dim = n + n * q;
     let mut z = vec![0.0; dim];
     z[..n].copy_from_slice(x0);
@@ -581,38 +642,9 @@ pub fn simulate_sensitivities(
     }
     let m = substeps.max(1);
     let h = ts / m as f64;
-    let mut rk4 = Rk4::new(dim);
+    let mut rk4 = StickSlip::new(dim);
     let velocity = model.stick_slip_velocity();
     let layout = Some(Sensitivities { n, q });
-    let mut rate = |kk: usize, tau: f64, zs: &[f64], held: Option<f64>, out: &mut [f64]| {
-        input.at(kk, tau, &mut u);
-        let t = (kk as f64 + tau) * ts;
-        let x = &zs[..n];
-        match held {
-            Some(d) => {
-                model.rhs_sliding(t, x, &u, theta, d, &mut out[..n]);
-                model.rhs_jacobians_sliding(t, x, &u, theta, d, &mut fx, &mut ft);
-            }
-            None => {
-                model.rhs(t, x, &u, theta, &mut out[..n]);
-                model.rhs_jacobians(t, x, &u, theta, &mut fx, &mut ft);
-            }
-        }
-        // Ṡ = fx·S + fθ[:, params] (initial-state columns have no direct term).
-        for r in 0..n {
-            for c in 0..q {
-                let mut acc = if c < params.len() {
-                    ft[r * p + params[c]]
-                } else {
-                    0.0
-                };
-                for j in 0..n {
-                    acc += fx[r * n + j] * zs[n + j * q + c];
-                }
-                out[n + r * q + c] = acc;
-            }
-        }
-    };
     for k in 0..n_samples {
         if z.iter().any(|v| !v.is_finite()) {
             return Err(diverged(k));
@@ -623,8 +655,13 @@ pub fn simulate_sensitivities(
         }
         for j in 0..m {
             let tau = j as f64 / m as f64;
-            let mut f = |dt: f64, zs: &[f64], held: Option<f64>, out: &mut [f64]| {
-                rate(k, tau + dt / ts, zs, held, out)
+            let mut f = |stage: Stage, zs: &[f64], held: Option<f64>, out: &mut [f64]| {
+                let tau = tau + stage.dt / ts;
+                stage_input(input, m, k, j, stage, tau, &mut u);
+                let t = (k as f64 + tau) * ts;
+                let (x, s) = zs.split_at(n);
+                let (dx, ds) = out.split_at_mut(n);
+                model.rhs_sensitivities(t, x, &u, theta, held, params, s, &mut scratch, dx, ds);
             };
             rk4.step(&mut f, &mut z, h, velocity, layout);
         }
@@ -770,10 +807,10 @@ pub fn rk4_step(
     u: &[f64],
     h: f64,
 ) {
-    let mut f = |dt: f64, x: &[f64], held: Option<f64>, out: &mut [f64]| match held {
-        Some(d) => model.rhs_sliding(t + dt, x, u, theta, d, out),
-        None => model.rhs(t + dt, x, u, theta, out),
+    let mut f = |stage: Stage, x: &[f64], held: Option<f64>, out: &mut [f64]| match held {
+        Some(d) => model.rhs_sliding(t + stage.dt, x, u, theta, d, out),
+        None => model.rhs(t + stage.dt, x, u, theta, out),
     };
     let velocity = model.stick_slip_velocity();
-    Rk4::new(x.len()).step(&mut f, x, h, velocity, None);
+    StickSlip::new(x.len()).step(&mut f, x, h, velocity, None);
 }

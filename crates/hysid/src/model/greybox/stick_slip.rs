@@ -34,6 +34,7 @@
 //! systems", J. Dynamic Systems, Measurement, and Control 107(1), 1985.
 
 use super::models::sign0;
+use crate::numerics::integrate::{Rk4, Stage};
 
 /// Iterations of the root search for a velocity zero crossing inside a step.
 const ROOT_ITERATIONS: usize = 60;
@@ -50,25 +51,25 @@ pub(crate) struct Sensitivities {
     pub q: usize,
 }
 
-/// The working buffers of RK4 steps on a state of dimension `dim`.
-pub(crate) struct Rk4 {
-    k: [Vec<f64>; 4],
-    stage: Vec<f64>,
+/// RK4 steps on a state of dimension `dim` that stop at friction-velocity zero crossings:
+/// the classical stages of [`Rk4`] plus the buffer of a trial step.
+pub(crate) struct StickSlip {
+    rk4: Rk4,
     trial: Vec<f64>,
 }
 
-impl Rk4 {
+impl StickSlip {
     /// Buffers for states of dimension `dim`.
     pub(crate) fn new(dim: usize) -> Self {
         Self {
-            k: std::array::from_fn(|_| vec![0.0; dim]),
-            stage: vec![0.0; dim],
+            rk4: Rk4::new(dim),
             trial: vec![0.0; dim],
         }
     }
 
-    /// One RK4 step of length `h` from `x`, in place. `rate(dt, x, direction, ẋ)` is the
-    /// right-hand side at `dt` seconds after the start of the step, with the friction held in
+    /// One RK4 step of length `h` from `x`, in place. `rate(stage, x, direction, ẋ)` is the
+    /// right-hand side at `stage.dt` seconds after the start of the step (whole steps report
+    /// their half-step [`Stage::node`], cut ones none), with the friction held in
     /// `direction` when it is Some. With `velocity` = Some(i), state i is the friction
     /// velocity and the step stops at its zero crossing (see the module docs). With
     /// `sensitivities`, x carries S and the event is differentiated.
@@ -80,15 +81,15 @@ impl Rk4 {
         velocity: Option<usize>,
         sensitivities: Option<Sensitivities>,
     ) where
-        F: FnMut(f64, &[f64], Option<f64>, &mut [f64]),
+        F: FnMut(Stage, &[f64], Option<f64>, &mut [f64]),
     {
         let Some(iv) = velocity else {
-            self.stages(rate, x, 0.0, h, None);
+            self.stages(rate, x, 0.0, h, None, true);
             return;
         };
         let side = sign0(x[iv]);
         if side == 0.0 {
-            self.stages(rate, x, 0.0, h, None);
+            self.stages(rate, x, 0.0, h, None, true);
             return;
         }
         let end = self.sliding_velocity(rate, x, 1.0, h, iv, side);
@@ -101,7 +102,7 @@ impl Rk4 {
             self.sliding_velocity(rate, x, phi, h, iv, side);
             x.copy_from_slice(&self.trial);
             x[iv] = 0.0;
-            self.stages(rate, x, phi * h, (1.0 - phi) * h, None);
+            self.stages(rate, x, phi * h, (1.0 - phi) * h, None, false);
             return;
         };
         // ∂x/∂φ at the event, then ∂φ/∂θ = −Sᵥ/(∂v/∂φ).
@@ -124,12 +125,12 @@ impl Rk4 {
         let mut ends = [event.clone(), event.clone()];
         for (end, sign) in ends.iter_mut().zip([1.0, -1.0]) {
             let start = phi + sign * DPHI;
-            self.stages(rate, end, start * h, (1.0 - start) * h, None);
+            self.stages(rate, end, start * h, (1.0 - start) * h, None, false);
         }
         let dx_end: Vec<f64> = (0..n)
             .map(|i| (ends[0][i] - ends[1][i]) / (2.0 * DPHI))
             .collect();
-        self.stages(rate, x, phi * h, (1.0 - phi) * h, None);
+        self.stages(rate, x, phi * h, (1.0 - phi) * h, None, false);
         add_outer(x, layout, &dx_end, &dphi);
     }
 
@@ -137,7 +138,7 @@ impl Rk4 {
     /// zero, by Illinois regula falsi from v(0) = x[iv] and v(1) = `v1` (not on `side`).
     fn crossing<F>(&mut self, rate: &mut F, x: &[f64], h: f64, iv: usize, side: f64, v1: f64) -> f64
     where
-        F: FnMut(f64, &[f64], Option<f64>, &mut [f64]),
+        F: FnMut(Stage, &[f64], Option<f64>, &mut [f64]),
     {
         let (mut a, mut fa, mut b, mut fb) = (0.0, x[iv], 1.0, v1);
         let mut last_side = 0;
@@ -183,39 +184,30 @@ impl Rk4 {
         side: f64,
     ) -> f64
     where
-        F: FnMut(f64, &[f64], Option<f64>, &mut [f64]),
+        F: FnMut(Stage, &[f64], Option<f64>, &mut [f64]),
     {
         let mut trial = std::mem::take(&mut self.trial);
         trial.copy_from_slice(x);
-        self.stages(rate, &mut trial, 0.0, phi * h, Some(side));
+        self.stages(rate, &mut trial, 0.0, phi * h, Some(side), phi == 1.0);
         self.trial = trial;
         self.trial[iv]
     }
 
     /// The classical RK4 step of length h from (t0, x), in place, friction held in
-    /// `direction` when Some.
-    fn stages<F>(&mut self, rate: &mut F, x: &mut [f64], t0: f64, h: f64, direction: Option<f64>)
-    where
-        F: FnMut(f64, &[f64], Option<f64>, &mut [f64]),
+    /// `direction` when Some; `on_grid` for a whole step.
+    fn stages<F>(
+        &mut self,
+        rate: &mut F,
+        x: &mut [f64],
+        t0: f64,
+        h: f64,
+        direction: Option<f64>,
+        on_grid: bool,
+    ) where
+        F: FnMut(Stage, &[f64], Option<f64>, &mut [f64]),
     {
-        let [k1, k2, k3, k4] = &mut self.k;
-        let stage = &mut self.stage;
-        rate(t0, x, direction, k1);
-        for i in 0..x.len() {
-            stage[i] = x[i] + 0.5 * h * k1[i];
-        }
-        rate(t0 + 0.5 * h, stage, direction, k2);
-        for i in 0..x.len() {
-            stage[i] = x[i] + 0.5 * h * k2[i];
-        }
-        rate(t0 + 0.5 * h, stage, direction, k3);
-        for i in 0..x.len() {
-            stage[i] = x[i] + h * k3[i];
-        }
-        rate(t0 + h, stage, direction, k4);
-        for i in 0..x.len() {
-            x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
+        let mut held = |stage: Stage, x: &[f64], dx: &mut [f64]| rate(stage, x, direction, dx);
+        self.rk4.step(&mut held, x, t0, h, on_grid);
     }
 }
 
@@ -243,8 +235,8 @@ mod tests {
     use super::*;
 
     /// A unit mass with Coulomb friction 1 under a constant force f.
-    fn block(f: f64) -> impl FnMut(f64, &[f64], Option<f64>, &mut [f64]) {
-        move |_, x: &[f64], held: Option<f64>, dx: &mut [f64]| {
+    fn block(f: f64) -> impl FnMut(Stage, &[f64], Option<f64>, &mut [f64]) {
+        move |_: Stage, x: &[f64], held: Option<f64>, dx: &mut [f64]| {
             let friction = match held {
                 Some(d) => d,
                 None if x[1] != 0.0 => sign0(x[1]),
@@ -256,7 +248,7 @@ mod tests {
     }
 
     fn run(f: f64, h: f64, steps: usize, velocity: Option<usize>) -> [f64; 2] {
-        let mut rk = Rk4::new(2);
+        let mut rk = StickSlip::new(2);
         let mut rate = block(f);
         let mut x = [0.0, 1.0];
         for _ in 0..steps {

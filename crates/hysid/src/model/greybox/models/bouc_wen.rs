@@ -29,7 +29,7 @@
 
 use super::sign0;
 use crate::data::Channel;
-use crate::model::greybox::StateSpaceModel;
+use crate::model::greybox::{JacobianScratch, StateSpaceModel};
 use crate::model::{Parameter, ParameterSet};
 
 /// The Bouc–Wen oscillator (see the module docs).
@@ -99,7 +99,7 @@ impl StateSpaceModel for BoucWen {
         let (y, v, z) = (x[0], x[1], x[2]);
         dx[0] = v;
         dx[1] = (u[0] - th[CL] * v - th[KL] * y - z) / th[ML];
-        let a = z.abs().powf(th[NU]);
+        let a = abs_pow(z, th[NU]);
         dx[2] = th[ALPHA] * v - th[BG] * v.abs() * sign0(z) * a - th[BD] * v * a;
     }
 
@@ -118,7 +118,7 @@ impl StateSpaceModel for BoucWen {
     ) -> bool {
         let (y, v, z) = (x[0], x[1], x[2]);
         let nu = th[NU];
-        let a = z.abs().powf(nu);
+        let a = abs_pow(z, nu);
         // d|z|^ν/dz = ν|z|^(ν−1)·sgn z, d(sgn z·|z|^ν)/dz = ν|z|^(ν−1); |z|^(ν−1) → 1 at
         // z = 0 for ν = 1, the only exponent for which z = 0 is not a singular point.
         let da = if z == 0.0 {
@@ -128,22 +128,24 @@ impl StateSpaceModel for BoucWen {
                 0.0
             }
         } else {
-            nu * z.abs().powf(nu - 1.0)
+            nu * abs_pow(z, nu - 1.0)
         };
         let m = th[ML];
+        // One division; the six entries divided by m multiply by its reciprocal.
+        let inv_m = 1.0 / m;
         fx.fill(0.0);
         ft.fill(0.0);
         fx[1] = 1.0; // ∂ẏ/∂v
-        fx[3] = -th[KL] / m;
-        fx[4] = -th[CL] / m;
-        fx[5] = -1.0 / m;
+        fx[3] = -th[KL] * inv_m;
+        fx[4] = -th[CL] * inv_m;
+        fx[5] = -inv_m;
         fx[7] = th[ALPHA] - th[BG] * sign0(v) * sign0(z) * a - th[BD] * a;
         fx[8] = -th[BG] * v.abs() * da - th[BD] * v * da * sign0(z);
         let p = th.len();
         let acc = (u[0] - th[CL] * v - th[KL] * y - z) / m;
-        ft[p + ML] = -acc / m;
-        ft[p + CL] = -v / m;
-        ft[p + KL] = -y / m;
+        ft[p + ML] = -acc * inv_m;
+        ft[p + CL] = -v * inv_m;
+        ft[p + KL] = -y * inv_m;
         let ln = if z == 0.0 { 0.0 } else { z.abs().ln() };
         ft[2 * p + ALPHA] = v;
         ft[2 * p + BG] = -v.abs() * sign0(z) * a;
@@ -168,5 +170,89 @@ impl StateSpaceModel for BoucWen {
 
     fn mechanical_dofs(&self) -> Option<usize> {
         Some(1)
+    }
+
+    /// The fused form of `rhs` and `rhs_jacobians` (same values, same order of operations):
+    /// only the six non-constant Jacobian entries are formed, and ln|z| (∂ż/∂ν) only when ν
+    /// is among `params`.
+    fn rhs_sensitivities(
+        &self,
+        _t: f64,
+        x: &[f64],
+        u: &[f64],
+        th: &[f64],
+        _held: Option<f64>,
+        params: &[usize],
+        s: &[f64],
+        _scratch: &mut JacobianScratch,
+        dx: &mut [f64],
+        ds: &mut [f64],
+    ) -> bool {
+        let (y, v, z) = (x[0], x[1], x[2]);
+        let nu = th[NU];
+        let m = th[ML];
+        let a = abs_pow(z, nu);
+        let sz = sign0(z);
+        let acc = (u[0] - th[CL] * v - th[KL] * y - z) / m;
+        dx[0] = v;
+        dx[1] = acc;
+        dx[2] = th[ALPHA] * v - th[BG] * v.abs() * sz * a - th[BD] * v * a;
+        let da = if z == 0.0 {
+            if nu == 1.0 {
+                1.0
+            } else {
+                0.0
+            }
+        } else {
+            nu * abs_pow(z, nu - 1.0)
+        };
+        // Rows 1 and 2 of ∂f/∂x (row 0 is [0, 1, 0]).
+        let inv_m = 1.0 / m;
+        let (f10, f11, f12) = (-th[KL] * inv_m, -th[CL] * inv_m, -inv_m);
+        let f21 = th[ALPHA] - th[BG] * sign0(v) * sz * a - th[BD] * a;
+        let f22 = -th[BG] * v.abs() * da - th[BD] * v * da * sz;
+        // Rows 1 and 2 of ∂f/∂θ.
+        let mut d1 = [0.0; 7];
+        let mut d2 = [0.0; 7];
+        d1[ML] = -acc * inv_m;
+        d1[CL] = -v * inv_m;
+        d1[KL] = -y * inv_m;
+        d2[ALPHA] = v;
+        d2[BG] = -v.abs() * sz * a;
+        d2[BD] = -v * a;
+        if params.contains(&NU) {
+            let ln = if z == 0.0 { 0.0 } else { z.abs().ln() };
+            d2[NU] = -(th[BG] * v.abs() * sz + th[BD] * v) * a * ln;
+        }
+        let q = s.len() / 3;
+        let (s0, rest) = s.split_at(q);
+        let (s1, s2) = rest.split_at(q);
+        let (ds0, rest) = ds.split_at_mut(q);
+        let (ds1, ds2) = rest.split_at_mut(q);
+        ds0.copy_from_slice(s1);
+        for c in 0..q {
+            let (direct1, direct2) = match params.get(c) {
+                Some(&i) if i < 7 => (d1[i], d2[i]),
+                _ => (0.0, 0.0),
+            };
+            ds1[c] = direct1 + f10 * s0[c] + f11 * s1[c] + f12 * s2[c];
+            ds2[c] = direct2 + f21 * s1[c] + f22 * s2[c];
+        }
+        true
+    }
+}
+
+/// |z|^ν with the exponents that occur in practice (ν = 1, the benchmark's, and ν = 2)
+/// computed without `powf`: exactly equal, and several times cheaper.
+#[inline]
+fn abs_pow(z: f64, nu: f64) -> f64 {
+    if nu == 1.0 {
+        z.abs()
+    } else if nu == 2.0 {
+        z * z
+    } else if nu == 0.0 {
+        1.0
+    } else {
+        z.abs().powf(nu)
     }
 }
