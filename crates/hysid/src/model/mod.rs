@@ -18,6 +18,7 @@ pub mod greybox;
 mod linear;
 mod parameters;
 pub mod saved;
+mod saved_equations;
 
 pub use cascade::{CascadeOutput, HysteresisCascade};
 pub use coleman_hodgdon::{Admissibility, ChForm, ColemanHodgdon};

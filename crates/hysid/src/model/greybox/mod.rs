@@ -21,6 +21,7 @@
 //! ([`crate::identify::greybox`]).
 //! * [`models`]: the built-in models (Bouc–Wen oscillator, rigid body with friction).
 
+pub mod equation_model;
 pub mod models;
 pub mod simulate;
 pub mod stick_slip;
