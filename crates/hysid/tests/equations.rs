@@ -146,12 +146,14 @@ fn sensitivities_equal_the_built_in_models() {
     let v = velocities(&ActuatorFixed, &act_data, &act_x0, 1);
     let slowest = v.iter().fold(f64::INFINITY, |m, x| m.min(*x));
     assert!(slowest > 0.5, "the motor must keep moving: {slowest} rad/s");
-    let cases: Vec<(
+    // (built-in model, its equation file, record, initial state)
+    type Case = (
         Arc<dyn StateSpaceModel>,
         Arc<dyn StateSpaceModel>,
         IdData,
         Vec<f64>,
-    )> = vec![
+    );
+    let cases: Vec<Case> = vec![
         (
             Arc::new(BoucWen),
             Arc::new(example("bouc_wen")),
