@@ -205,8 +205,15 @@ pub enum Greybox {
 #[derive(Debug, Args)]
 pub struct GreyboxFitArgs {
     /// The model: bouc-wen, rigid-body, actuator-fixed or actuator-free.
-    #[arg(long)]
-    pub model: String,
+    #[arg(
+        long,
+        required_unless_present = "model_file",
+        conflicts_with = "model_file"
+    )]
+    pub model: Option<String>,
+    /// Or a model written as equations: a TOML equation file (see examples/equations/).
+    #[arg(long = "model-file")]
+    pub model_file: Option<PathBuf>,
     #[command(flatten)]
     pub data: DataArgs,
     /// Keep this parameter at its value (repeatable).

@@ -137,6 +137,10 @@ pub enum Error {
         reason: String,
     },
 
+    /// An equation-file model is invalid (see [`EquationFileError`]).
+    #[error(transparent)]
+    Equations(#[from] EquationFileError),
+
     /// A saved model or report could not be (de)serialised.
     #[error("model file {}: {message}", path.display())]
     ModelFile {
@@ -157,6 +161,21 @@ pub enum Error {
         /// The number found.
         value: f64,
     },
+}
+
+/// An equation-file model (`hysid-equations`) is invalid: parse, name or bound error at
+/// a line and column of the file.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{origin}: line {line}, column {column}: {message}")]
+pub struct EquationFileError {
+    /// Where the text came from: the file's path, or the saved model that embeds it.
+    pub origin: String,
+    /// 1-based line in the text.
+    pub line: usize,
+    /// 1-based column (in characters).
+    pub column: usize,
+    /// What is wrong and what to do (one line).
+    pub message: String,
 }
 
 /// Shorthand for results in this crate.

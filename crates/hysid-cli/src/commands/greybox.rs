@@ -10,6 +10,7 @@ use anyhow::{bail, Context, Result};
 use hysid::data::IdData;
 use hysid::identify::greybox::{GreyBoxEstimation, GreyBoxFit, InitialStates};
 use hysid::identify::validate::{sensitivity_table, ResidualAnalysis};
+use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, StateSpaceModel};
 use hysid::model::ParameterSet;
 use hysid::numerics::LmConfig;
@@ -19,7 +20,15 @@ use std::sync::Arc;
 
 /// Runs `hysid greybox fit`.
 pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
-    let model: Arc<dyn StateSpaceModel> = Arc::from(models::by_kind(&args.model)?);
+    // A built-in model by name, or an equation file (whose [initial] and text also count).
+    let equations = match &args.model_file {
+        Some(path) => Some(Arc::new(EquationStateSpace::load(path)?)),
+        None => None,
+    };
+    let model: Arc<dyn StateSpaceModel> = match (&equations, &args.model) {
+        (Some(eq), _) => eq.clone(),
+        (None, name) => Arc::from(models::by_kind(name.as_deref().unwrap_or_default())?),
+    };
     preflight(
         &[args.json.as_deref(), args.model_out.as_deref()],
         &[args.plots.as_deref()],
@@ -32,7 +41,10 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         &args.init,
         &args.bounds,
     )?;
-    let initial = initial_states(model.as_ref(), &data, &args.estimate_x0)?;
+    let mut initial = initial_states(model.as_ref(), &data, &args.estimate_x0)?;
+    if let Some(eq) = &equations {
+        initial = InitialStates::of_equations(eq, data.n_experiments(), &initial.estimated);
+    }
     let estimation = GreyBoxEstimation {
         simulation: simulation(&args.simulation),
         lm: LmConfig {
@@ -72,7 +84,10 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     } else {
         None
     };
-    let fitted = fit.fitted_model(model.as_ref(), estimation.simulation);
+    let mut fitted = fit.fitted_model(model.as_ref(), estimation.simulation);
+    if let Some(eq) = &equations {
+        fitted = fitted.with_equations(eq.source());
+    }
     if let Some(dir) = &args.plots {
         plots(dir, &fit, &data, &residuals)?;
         println!("  plots: {}", dir.display());

@@ -281,7 +281,7 @@ impl Table {
                 }
                 row += 1;
             }
-            Ok(())
+            Ok::<(), Error>(())
         })
         .map_err(|e| csv_error(path, e))??;
         if row == 0 {

@@ -19,6 +19,7 @@ mod linear;
 pub mod operators;
 mod parameters;
 pub mod saved;
+mod saved_equations;
 
 pub use cascade::{CascadeOutput, HysteresisCascade};
 pub use coleman_hodgdon::{Admissibility, ChForm, ColemanHodgdon};

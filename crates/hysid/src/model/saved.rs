@@ -23,14 +23,17 @@
 //! | `coleman_hodgdon` | `hysteresis` (`ch4`/`ch6`), `initial_output` (`measured`/`zero`) | α, m₁, c₁, d (ch6: and m₂, c₂) |
 //! | `ch_cascade` | `hysteresis`, `delay` | hysteresis, then b₁ (fixed at 1) … b_m, a₁ … a_n |
 //! | `bouc_wen`, `rigid_body`, `actuator_fixed`, `actuator_free` | `simulation`, `initial_state` | the grey-box model's |
+//! | `equations` | `equations` (the equation file's text), `simulation`, `initial_state` | the file's `[parameters]` |
 //!
 //! `simulation` saves the integrator faithfully: `{"integrator": "rk4", "substeps": 10,
 //! "interpolation": "zero_order_hold"}`, `newmark` with `substeps`, or `dopri5` with `rtol`
 //! and `atol`.
 
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
+use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
 use crate::model::greybox::simulate::{simulate as simulate_state_space, InputTrack};
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
+use crate::model::saved_equations::{equations_from_file, simulate_outputs};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -117,6 +120,10 @@ pub struct ModelFile {
     /// Initial state of a grey-box model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_state: Option<Vec<f64>>,
+    /// The equation file's text (kind `equations`), so that the saved model is
+    /// self-contained.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub equations: Option<String>,
 }
 
 /// The simulation settings in a model file.
@@ -232,6 +239,19 @@ pub enum FittedModel {
         /// Its initial state.
         initial_state: Vec<f64>,
     },
+    /// A grey-box model written as equations (`hysid-equations`).
+    Equations {
+        /// The equation file's text.
+        equations: String,
+        /// Its parameters (values, units, bounds, fixed flags) in the file's order.
+        parameters: ParameterSet,
+        /// Their standard deviations.
+        std: Vec<f64>,
+        /// How it is simulated.
+        simulation: Simulation,
+        /// Its initial state.
+        initial_state: Vec<f64>,
+    },
 }
 
 impl FittedModel {
@@ -321,6 +341,44 @@ impl FittedModel {
                 )?;
                 Ok(outputs)
             }
+            FittedModel::Equations {
+                equations,
+                parameters,
+                simulation,
+                initial_state,
+                ..
+            } => {
+                let model = EquationStateSpace::parse(equations, "saved model")?;
+                simulate_outputs(
+                    &model,
+                    &parameters.values(),
+                    initial_state,
+                    inputs,
+                    ts,
+                    simulation,
+                )
+            }
+        }
+    }
+
+    /// A built-in-style grey-box fit ([`FittedModel::GreyBox`]) of the equation model with
+    /// file text `equations`, as [`FittedModel::Equations`]; other variants unchanged.
+    pub fn with_equations(self, equations: &str) -> Self {
+        match self {
+            FittedModel::GreyBox {
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                ..
+            } => FittedModel::Equations {
+                equations: equations.to_string(),
+                parameters,
+                std,
+                simulation,
+                initial_state,
+            },
+            other => other,
         }
     }
 
@@ -335,6 +393,7 @@ impl FittedModel {
             initial_output: None,
             simulation: None,
             initial_state: None,
+            equations: None,
         };
         match self {
             FittedModel::Hysteresis {
@@ -369,6 +428,25 @@ impl FittedModel {
                         .collect(),
                 )
             },
+            FittedModel::Equations {
+                equations,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+            } => ModelFile {
+                simulation: Some(SimulationSpec::of(simulation)),
+                initial_state: Some(initial_state.clone()),
+                equations: Some(equations.clone()),
+                ..empty(
+                    EQUATIONS_KIND,
+                    parameters
+                        .iter()
+                        .zip(std)
+                        .map(|(p, s)| ParameterRecord::of(p, *s))
+                        .collect(),
+                )
+            },
         }
     }
 
@@ -388,6 +466,7 @@ impl FittedModel {
         }
         match file.kind.as_str() {
             "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
+            EQUATIONS_KIND => equations_from_file(file),
             kind => Self::grey_box_from_file(kind, file),
         }
     }
@@ -440,7 +519,7 @@ impl FittedModel {
     fn grey_box_from_file(kind: &str, file: &ModelFile) -> Result<Self> {
         let model = models::by_kind(kind).map_err(|_| {
             Error::Config(format!(
-                "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed and actuator_free"
+                "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed, actuator_free and equations"
             ))
         })?;
         let mut parameters = model.parameters();

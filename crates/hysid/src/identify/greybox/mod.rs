@@ -5,6 +5,7 @@
 //!   [`OutputErrorModel`](crate::identify::OutputErrorModel).
 //! * [`estimate`]: output-error estimation with multi-start.
 
+pub mod equations;
 pub mod estimate;
 pub mod structure;
 

@@ -22,6 +22,7 @@
 //! ([`crate::identify::greybox`]).
 //! * [`models`]: the built-in models (Bouc–Wen oscillator, rigid body with friction).
 
+pub mod equation_model;
 pub mod models;
 pub mod sensitivity;
 pub mod simulate;

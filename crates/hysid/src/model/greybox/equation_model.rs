@@ -1,0 +1,292 @@
+//! Grey-box models written as equations in a text file (`hysid-equations`), usable wherever
+//! a built-in model is.
+//!
+//! The file gives
+//!
+//! ```text
+//! ẋ = f(t, x, u, θ)        y = h(x, u, θ)
+//! ```
+//!
+//! with named states, inputs, outputs and parameters (value, unit, bounds, fixed flag) and
+//! optional initial states; `hysid-equations` differentiates f and h symbolically and
+//! compiles them, with ∂f/∂x, ∂f/∂θ, ∂h/∂x, ∂h/∂θ, into flat instruction tapes. So an
+//! equation model has analytic Jacobians, and the estimator integrates the forward
+//! sensitivity equations Ṡ = (∂f/∂x)S + ∂f/∂θ through RK4 exactly as for a built-in model
+//! (L. Ljung, *System Identification: Theory for the User*, 2nd ed., 1999, §4.5 and §10.2
+//! on output-error estimation of physically parameterised state-space models).
+//!
+//! Differences from the built-in models:
+//!
+//! * no stick–slip handling: a Coulomb friction written `Fc*sign(v)` is integrated as the
+//!   plain discontinuous law (the built-in `actuator_fixed` also holds the body at rest
+//!   while the applied force is below Fc);
+//! * no second-order layout ([`StateSpaceModel::mechanical_dofs`] is None), so Newmark
+//!   integration is refused: use RK4 (or the adaptive integrator);
+//! * discrete-time files (`time = "discrete"`) are **refused** with an error: the
+//!   simulation path integrates ẋ = f, and a map x[k+1] = f(x[k]) is not a derivative.
+
+use super::StateSpaceModel;
+use crate::data::Channel;
+use crate::error::EquationFileError;
+use crate::model::{Parameter, ParameterSet};
+use crate::{Error, Result};
+use hysid_equations::{EquationError, EquationModel, Scratch, TimeDomain};
+use std::cell::RefCell;
+use std::path::Path;
+
+/// The model kind of equation-file models in saved models and reports.
+pub const EQUATIONS_KIND: &str = "equations";
+
+/// A continuous-time grey-box model read from an equation file (see the module docs):
+/// ẋ = f(t, x, u, θ), y = h(x, u, θ), with analytic Jacobians from the compiled tape.
+///
+/// ```
+/// use hysid::model::greybox::equation_model::EquationStateSpace;
+/// use hysid::model::greybox::StateSpaceModel;
+/// let text = "[model]\nstates = [\"x\"]\ninputs = [\"u\"]\noutputs = [\"y\"]\n\
+///             [parameters]\na = 2.0\n[equations]\nx = \"-a*x + u\"\n[output]\ny = \"x\"\n";
+/// let m = EquationStateSpace::parse(text, "example").unwrap();
+/// let mut dx = [0.0];
+/// m.rhs(0.0, &[1.0], &[0.5], &[2.0], &mut dx);
+/// assert_eq!(dx[0], -1.5);
+/// assert_eq!(m.kind(), "equations");
+/// ```
+#[derive(Clone, Debug)]
+pub struct EquationStateSpace {
+    model: EquationModel,
+    states: Vec<Channel>,
+    inputs: Vec<Channel>,
+    outputs: Vec<Channel>,
+    parameters: ParameterSet,
+}
+
+/// Per-thread registers and value buffers, so that the trait's Jacobian methods (which do
+/// not return f or h) never allocate after their first call on a thread.
+#[derive(Default)]
+struct Work {
+    scratch: Scratch,
+    values: Vec<f64>,
+}
+
+thread_local! {
+    static WORK: RefCell<Work> = RefCell::new(Work::default());
+}
+
+/// Runs `f` with this thread's work buffers, `values` sized to `n`.
+fn with_work<R>(n: usize, f: impl FnOnce(&mut Scratch, &mut [f64]) -> R) -> R {
+    WORK.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut w) => {
+            let w = &mut *w;
+            if w.values.len() < n {
+                w.values.resize(n, 0.0);
+            }
+            f(&mut w.scratch, &mut w.values[..n])
+        }
+        // Re-entered on one thread (not done by hysid): stay correct with fresh buffers.
+        Err(_) => f(&mut Scratch::new(), &mut vec![0.0; n]),
+    })
+}
+
+/// The language's error as hysid's, with where the text came from.
+fn located(origin: &str, e: EquationError) -> Error {
+    Error::Equations(EquationFileError {
+        origin: origin.to_string(),
+        line: e.line,
+        column: e.column,
+        message: e.message,
+    })
+}
+
+impl EquationStateSpace {
+    /// Parses, checks and compiles the equation-file text `text`; `origin` names where it
+    /// came from in error messages (a path, or "saved model").
+    ///
+    /// Errors: any language error (with line and column), a discrete-time file, or a
+    /// parameter whose bounds are empty (lower = upper).
+    pub fn parse(text: &str, origin: &str) -> Result<Self> {
+        let model = EquationModel::parse(text).map_err(|e| located(origin, e))?;
+        Self::new(model, origin)
+    }
+
+    /// Reads and compiles the equation file at `path`.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Wraps a compiled model (see [`Self::parse`] for what is refused).
+    pub fn new(model: EquationModel, origin: &str) -> Result<Self> {
+        if model.time_domain() == TimeDomain::Discrete {
+            return Err(Error::Config(format!(
+                "{origin}: model '{}' is discrete-time (time = \"discrete\"); grey-box estimation integrates continuous-time models only: write its [equations] as derivatives",
+                model.name()
+            )));
+        }
+        let channel = |name: &String| {
+            Channel::new(name.clone()).with_unit(model.unit(name).unwrap_or_default())
+        };
+        let parameters = ParameterSet::new(
+            model
+                .parameters()
+                .iter()
+                .map(|p| {
+                    Parameter::new(p.name.clone(), p.value)
+                        .unit(p.unit.clone())
+                        .bounds(p.lower, p.upper)
+                        .fixed(p.fixed)
+                })
+                .collect(),
+        )?;
+        parameters
+            .validate()
+            .map_err(|e| Error::Config(format!("{origin}: {e}")))?;
+        Ok(Self {
+            states: model.states().iter().map(channel).collect(),
+            inputs: model.inputs().iter().map(channel).collect(),
+            outputs: model.outputs().iter().map(channel).collect(),
+            parameters,
+            model,
+        })
+    }
+
+    /// The compiled equations.
+    pub fn equations(&self) -> &EquationModel {
+        &self.model
+    }
+
+    /// The file text (saved models embed it).
+    pub fn source(&self) -> &str {
+        self.model.source()
+    }
+
+    /// `[model] name` of the file.
+    pub fn name(&self) -> &str {
+        self.model.name()
+    }
+
+    /// x(t₀) as `[initial]` declares it (0 for a state not listed).
+    pub fn initial_values(&self) -> Vec<f64> {
+        self.model.initial().iter().map(|s| s.value).collect()
+    }
+
+    /// Per state, whether `[initial]` asks for it to be estimated (`fixed = false`).
+    pub fn initial_estimated(&self) -> Vec<bool> {
+        self.model.initial().iter().map(|s| !s.fixed).collect()
+    }
+}
+
+impl StateSpaceModel for EquationStateSpace {
+    /// Always `equations` (the file's own name is [`EquationStateSpace::name`]).
+    fn kind(&self) -> &'static str {
+        EQUATIONS_KIND
+    }
+
+    fn states(&self) -> Vec<Channel> {
+        self.states.clone()
+    }
+
+    fn inputs(&self) -> Vec<Channel> {
+        self.inputs.clone()
+    }
+
+    fn outputs(&self) -> Vec<Channel> {
+        self.outputs.clone()
+    }
+
+    fn parameters(&self) -> ParameterSet {
+        self.parameters.clone()
+    }
+
+    #[inline]
+    fn rhs(&self, t: f64, x: &[f64], u: &[f64], theta: &[f64], dx: &mut [f64]) {
+        self.model.rhs(t, x, u, theta, dx);
+    }
+
+    #[inline]
+    fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
+        self.model.output(x, u, theta, y);
+    }
+
+    /// From the tape that computes f, ∂f/∂x and ∂f/∂θ in one pass (f is discarded).
+    fn rhs_jacobians(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        fx: &mut [f64],
+        ftheta: &mut [f64],
+    ) -> bool {
+        with_work(x.len(), |s, dx| {
+            self.model
+                .rhs_jacobians_with(s, t, x, u, theta, dx, fx, ftheta)
+        });
+        true
+    }
+
+    /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded).
+    fn output_jacobians(
+        &self,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        hx: &mut [f64],
+        htheta: &mut [f64],
+    ) -> bool {
+        with_work(self.outputs.len(), |s, y| {
+            self.model
+                .output_jacobians_with(s, x, u, theta, y, hx, htheta)
+        });
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DECAY: &str = "[model]\nstates = [\"x\"]\ninputs = [\"u\"]\noutputs = [\"y\"]\n\
+        [parameters]\na = { value = 2.0, lower = 0.0 }\n[initial]\nx = { value = 0.5, fixed = false }\n\
+        [equations]\nx = \"-a*x + u\"\n[output]\ny = \"x\"\n";
+
+    #[test]
+    fn parameters_initial_states_and_jacobians_come_from_the_file() {
+        let m = EquationStateSpace::parse(DECAY, "decay").unwrap();
+        let p = m.parameters();
+        assert_eq!(p.names(), ["a"]);
+        assert_eq!((p.get(0).min, p.get(0).max), (0.0, f64::INFINITY));
+        assert_eq!(m.initial_values(), [0.5]);
+        assert_eq!(m.initial_estimated(), [true]);
+        let (mut fx, mut ft) = ([0.0], [0.0]);
+        assert!(m.rhs_jacobians(0.0, &[3.0], &[1.0], &[2.0], &mut fx, &mut ft));
+        assert_eq!((fx[0], ft[0]), (-2.0, -3.0));
+        let (mut hx, mut ht) = ([0.0], [0.0]);
+        assert!(m.output_jacobians(&[3.0], &[1.0], &[2.0], &mut hx, &mut ht));
+        assert_eq!((hx[0], ht[0]), (1.0, 0.0));
+    }
+
+    #[test]
+    fn language_errors_keep_their_line_and_column() {
+        let bad = DECAY.replace("-a*x", "-aa*x");
+        let e = EquationStateSpace::parse(&bad, "decay.toml").unwrap_err();
+        let Error::Equations(located) = &e else {
+            panic!("{e}")
+        };
+        assert_eq!((located.line, located.column), (10, 7));
+        assert!(
+            e.to_string()
+                .starts_with("decay.toml: line 10, column 7: unknown name 'aa'"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn discrete_time_files_are_refused() {
+        let text = DECAY.replace("[model]\n", "[model]\ntime = \"discrete\"\n");
+        let e = EquationStateSpace::parse(&text, "d.toml").unwrap_err();
+        assert!(e.to_string().contains("discrete-time"), "{e}");
+    }
+}
