@@ -1,0 +1,59 @@
+from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tuple
+import os
+import numpy as np
+import numpy.typing as npt
+from . import fleet as fleet
+from ._hysid import (CallbackError as CallbackError, ConfigError as ConfigError, DataError as DataError,
+    HysidError as HysidError, InternalError as InternalError, ModelFileError as ModelFileError,
+    NumericalError as NumericalError)
+
+__version__: str
+BOUC_WEN_FS: float
+_ArrayLike = Any
+
+class Parameter:
+    name: str
+    value: float
+    lower: float
+    upper: float
+    fixed: bool
+    unit: str
+    std: Optional[float]
+    def __init__(self, name: str, value: float, *, lower: float = ..., upper: float = ..., fixed: bool = ..., unit: str = ..., std: Optional[float] = ...) -> None: ...
+
+class GreyBoxModel:
+    states: List[str]
+    parameters: List[Parameter]
+    inputs: int
+    outputs: int
+    x0: npt.NDArray[np.float64]
+    def __init__(self, states: Any, parameters: Sequence[Parameter], rhs: Callable[..., Any], output: Callable[..., Any], *, inputs: int = ..., x0: Optional[_ArrayLike] = ...) -> None: ...
+
+class Model:
+    file: Dict[str, Any]
+    @property
+    def kind(self) -> str: ...
+    @property
+    def parameters(self) -> Dict[str, Parameter]: ...
+    def simulate(self, u: _ArrayLike, *, ts: float, y0: Optional[float] = ...) -> npt.NDArray[np.float64]: ...
+    def save(self, path: "os.PathLike[str] | str") -> None: ...
+
+class Result:
+    parameters: Dict[str, Parameter]
+    fit_percent: Optional[float]
+    rmse: Optional[float]
+    termination: str
+    converged: bool
+    elapsed_s: Optional[float]
+    validation: List[Dict[str, Any]]
+    model: Optional[Model]
+    def report(self) -> Dict[str, Any]: ...
+    def to_json(self) -> str: ...
+    def to_dataframe(self) -> Any: ...
+
+def load_model(path: "os.PathLike[str] | str") -> Model: ...
+def identify_cascade(x: Any, y: Any = ..., *, hysteresis: str = ..., na: int, nb: int, delay: int, ts: float = ..., uncertainty: str = ..., seed: int = ..., replicates: int = ...) -> Result: ...
+def identify_hysteresis(x: Any, y: Any = ..., *, hysteresis: str = ..., ts: float = ..., initial_output: str = ...) -> Result: ...
+def greybox_fit(model: "str | GreyBoxModel", u: Any, y: Any = ..., *, ts: Optional[float] = ..., init: Optional[Dict[str, float]] = ..., fix: Iterable[str] = ..., bounds: Optional[Dict[str, Tuple[float, float]]] = ..., starts: int = ..., seed: int = ..., integrator: str = ..., substeps: int = ..., interpolation: str = ...) -> Result: ...
+def benchmark_bouc_wen(u_train: Any, y_train: Any = ..., *, tests: Sequence[Any] = ..., steady_state: bool = ..., ts: Optional[float] = ..., starts: int = ..., seed: int = ..., substeps: int = ..., start_factor: float = ...) -> Result: ...
+def rigid_body_ls(q: Any, u: Any, *, ts: float, gain: float = ..., offset: bool = ..., cutoff_hz: float = ..., order: int = ..., decimation: int = ..., border: int = ..., inertia_name: str = ...) -> Result: ...
