@@ -270,8 +270,11 @@ def check_cli(root):
 
 
 def main():
-    root = Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).resolve().parent.parent)
-    library, cli = check_library(root), check_cli(root)
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    library_only = "--library-only" in sys.argv[1:]
+    root = Path(args[0] if args else Path(__file__).resolve().parent.parent)
+    library = check_library(root)
+    cli = [] if library_only else check_cli(root)
     for line in library + cli:
         print(line)
     print(

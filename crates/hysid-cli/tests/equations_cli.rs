@@ -67,7 +67,7 @@ fn equation_file_fit_saves_a_self_contained_model() {
         .arg(&sim)
         .assert()
         .success();
-    let rmse = json(&sim)["rmse"].as_f64().unwrap();
+    let rmse = json(&sim)["fit"]["rmse"].as_f64().unwrap();
     assert!(rmse < 0.53, "validation RMSE {rmse} V");
 }
 

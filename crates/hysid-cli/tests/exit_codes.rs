@@ -33,13 +33,24 @@ fn example_data(dir: &Path, samples: &str) -> std::path::PathBuf {
 /// A ch_cascade model file with the linear block A(q⁻¹) = 1 + a1 q⁻¹ + a2 q⁻².
 fn model_file(dir: &Path, a1: f64, a2: f64) -> std::path::PathBuf {
     let path = dir.join("model.json");
+    let p = |name: &str, value: f64, fixed: bool| {
+        format!(
+            r#"{{"name": "{name}", "value": {value}, "std": null, "unit": "", "fixed": {fixed}, "lower": null, "upper": null}}"#
+        )
+    };
+    let parameters = [
+        p("alpha", 0.3, false),
+        p("m1", 1.0, false),
+        p("c1", 0.5, false),
+        p("d", 3.0, false),
+        p("b1", 1.0, true),
+        p("b2", 0.5, false),
+        p("a1", a1, false),
+        p("a2", a2, false),
+    ]
+    .join(", ");
     let text = format!(
-        r#"{{"kind": "ch_cascade", "hysteresis": "ch4",
-            "parameters": {{"alpha": {{"value": 0.3, "std": 0}}, "m1": {{"value": 1.0, "std": 0}},
-                           "c1": {{"value": 0.5, "std": 0}}, "d": {{"value": 3.0, "std": 0}},
-                           "a": [{{"value": {a1}, "std": 0}}, {{"value": {a2}, "std": 0}}],
-                           "b": [{{"value": 1.0, "std": 0}}, {{"value": 0.5, "std": 0}}]}},
-            "delay": 1}}"#
+        r#"{{"schema": "hysid.model/1", "kind": "ch_cascade", "hysteresis": "ch4", "delay": 1, "parameters": [{parameters}]}}"#
     );
     fs::write(&path, text).unwrap();
     path
@@ -189,9 +200,9 @@ fn simulate_refuses_to_write_over_its_input_and_commits_both_outputs() {
         .success();
     let report: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
-    assert_eq!(report["samples"], 300);
+    assert_eq!(report["data"]["samples"], 300);
     // The true model on its own noisy data: the fit is that of Example 1 (SNR 50).
-    let fit = report["fit_percent"].as_f64().unwrap();
+    let fit = report["fit"]["fit_percent"].as_f64().unwrap();
     assert!(fit > 90.0 && fit < 100.0, "{fit}");
     assert_eq!(fs::read_to_string(&csv).unwrap().lines().count(), 301);
     assert!(!fs::read_dir(dir.path()).unwrap().any(|e| e

@@ -30,7 +30,7 @@ pub fn voros(args: &VorosArgs) -> Result<()> {
     id.bootstrap_seed = args.seed;
 
     println!(
-        "Vörös (2015) cascade, project Example {} (MODELS.md §1.6; the paper's own numbers were lost):",
+        "Vörös (2015) cascade, project Example {} (docs/models/coleman-hodgdon-cascade.md §13; the paper's own numbers were lost):",
         args.example
     );
     println!(
