@@ -139,12 +139,12 @@ fn report(
 fn fitted(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) -> FittedModel {
     let mut parameters = RigidBody.parameters();
     let mut std = vec![f64::NAN; parameters.len()];
-    for i in 0..parameters.len() {
+    for (i, sigma) in std.iter_mut().enumerate() {
         let p = parameters.get_mut(i);
         match estimate.names.iter().position(|n| *n == p.name) {
             Some(k) => {
                 p.value = estimate.values[k];
-                std[i] = estimate.std[k];
+                *sigma = estimate.std[k];
             }
             None => {
                 p.fixed = true;

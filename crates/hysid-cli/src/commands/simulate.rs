@@ -42,7 +42,11 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         vec![args.data.display().to_string()],
     ));
     if let Some(y) = measured {
-        report.fit = Some(FitSummary::of(&[exp.name.clone()], &[y], &[yhat])?);
+        report.fit = Some(FitSummary::of(
+            std::slice::from_ref(&exp.name),
+            &[y],
+            &[yhat],
+        )?);
     }
     report.model = Some(file);
     if let Some(path) = &csv_tmp {
