@@ -1,11 +1,11 @@
-//! Identification of backlash y = c + g·F_r[u] from data alone.
+//! Identification of backlash y = c + g·F_r\[u\] from data alone.
 //!
 //! For a fixed half-width r the model is linear in (g, c), so the criterion is profiled over
 //! r on a grid rₖ = k·(max u − min u)/(2P), k = 0 … P − 1, with the closed-form least-squares
 //! (g, c) at each; the best point starts a Levenberg–Marquardt polish of (g, r, c) with the
-//! exact Jacobian [F_r[u], g·∂F_r/∂r, 1], where ∂zₖ/∂r = −1 while the play is dragged up
+//! exact Jacobian \[F_r[u\], g·∂F_r/∂r, 1], where ∂zₖ/∂r = −1 while the play is dragged up
 //! (zₖ = uₖ − r), +1 while dragged down (zₖ = uₖ + r) and ∂zₖ₋₁/∂r while it holds. Standard
-//! deviations σ²(JᵀJ)⁻¹ at the optimum. A clockwise loop is fitted as u = c + g·F_r[y]
+//! deviations σ²(JᵀJ)⁻¹ at the optimum. A clockwise loop is fitted as u = c + g·F_r\[y\]
 //! (Γ = G⁻¹, the right inverse).
 //!
 //! Reference: M. A. Krasnosel'skii, A. V. Pokrovskii, *Systems with Hysteresis*, Springer 1989.

@@ -7,7 +7,7 @@
 //! w_s = (β + γ)^{-1/n} (2 %…100 % of the input's half range) and ratios γ/β ∈ {−½, 0, ½, 1},
 //! the state w is simulated and (k_x, k_w) solved by linear least squares (y is linear in
 //! them); the best grid points start a bounded Levenberg–Marquardt search of
-//! (k_x, k_w, β, γ, [n], w0), forward finite-difference sensitivities.
+//! (k_x, k_w, β, γ, \[n\], w0), forward finite-difference sensitivities.
 //!
 //! References: Ismail, Ikhouane & Rodellar (2009); Ikhouane & Rodellar (2007), see
 //! [`crate::model::operators::bouc_wen`].

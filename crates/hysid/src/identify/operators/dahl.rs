@@ -10,7 +10,7 @@
 //! ρ = σ/F_c, so for fixed ρ the force is linear in (σ, f0): f0·e^{−ρ·TV(x)} (TV the total
 //! variation travelled) plus σ times the unit-σ response. A grid of ρ (1 to 200 per input
 //! range) with (σ, f0) by linear least squares gives the starts of a bounded
-//! Levenberg–Marquardt search of (σ, F_c, [i], f0), forward finite-difference sensitivities.
+//! Levenberg–Marquardt search of (σ, F_c, \[i\], f0), forward finite-difference sensitivities.
 //!
 //! References: Dahl (1968, 1976), see [`crate::model::operators::dahl`].
 

@@ -2,7 +2,7 @@
 //! output-error least-squares problem, the multi-start Levenberg–Marquardt search and the
 //! [`OperatorFit`] report.
 //!
-//! The criterion is V(θ) = Σ_t (y_t − Γ_θ[u]_t)², the simulated (output-error) residual,
+//! The criterion is V(θ) = Σ_t (y_t − Γ_θ\[u\]_t)², the simulated (output-error) residual,
 //! minimised by the bounded Levenberg–Marquardt engine
 //! ([`crate::numerics::levenberg_marquardt`]) with forward finite-difference sensitivities of
 //! the H/u-integration, from each start of a small multi-start; the start with the lowest V

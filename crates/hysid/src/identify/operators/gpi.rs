@@ -1,11 +1,11 @@
 //! Identification of Kuhnen's modified Prandtl–Ishlinskii operator G = S∘H.
 //!
-//! Following Kuhnen (2003) the fit is done in the *equation error* S⁻¹[y] = H[u], which is
+//! Following Kuhnen (2003) the fit is done in the *equation error* S⁻¹\[y\] = H\[u\], which is
 //! linear in the weights: with S⁻¹(v) = v + Σⱼ d'ⱼ·S_{z'ⱼ}(v) (one-sided dead zones
 //! S_z(v) = max(v − z, 0) for z > 0, min(v − z, 0) for z < 0; d'₀ = 1 fixes the common scale of
 //! H and S⁻¹),
 //!
-//! v = c + a₀u + Σᵢ aᵢ F_{rᵢ}[u] − Σⱼ d'ⱼ S_{z'ⱼ}(v),
+//! v = c + a₀u + Σᵢ aᵢ F_{rᵢ}\[u\] − Σⱼ d'ⱼ S_{z'ⱼ}(v),
 //!
 //! solved by NNLS with aᵢ ≥ 0 and the d'ⱼ free; if the free d' make S⁻¹ non-monotone, the fit
 //! is repeated with d'ⱼ ≥ 0 (a convex S⁻¹, always invertible). S is then the analytic inverse

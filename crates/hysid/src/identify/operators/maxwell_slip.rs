@@ -1,12 +1,12 @@
 //! Identification of generalised Maxwell-slip elements (rate-independent part).
 //!
-//! F = c + k₀x + Σᵢ kᵢ E_{δᵢ}[x] is linear in the stiffnesses once the slip widths δᵢ = Wᵢ/kᵢ
+//! F = c + k₀x + Σᵢ kᵢ E_{δᵢ}\[x\] is linear in the stiffnesses once the slip widths δᵢ = Wᵢ/kᵢ
 //! are fixed on a grid over the displacement range (default δᵢ = i·(max x − min x)/(2(n+1))):
 //! kᵢ ≥ 0 by non-negative least squares on the stop-operator outputs (c free), Wᵢ = kᵢδᵢ, and
 //! the standard deviations σ(Wᵢ) = δᵢσ(kᵢ). Elements whose stiffness lands on 0 are absent.
 //! The elements' own loop is clockwise (the force leads the displacement), so a detected
 //! clockwise loop is fitted directly and a counter-clockwise one in the inverse
-//! parameterisation (x = G[F], `Orientation::inverse`).
+//! parameterisation (x = G\[F\], `Orientation::inverse`).
 //!
 //! References: V. Lampaert, F. Al-Bender, J. Swevers, "A generalized Maxwell-slip friction
 //! model appropriate for control purposes", Proc. PhysCon 2003; F. Al-Bender, V. Lampaert,

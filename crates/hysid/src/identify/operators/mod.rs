@@ -6,7 +6,7 @@
 //! * [`pi`], [`maxwell_slip`]: non-negative least squares ([`crate::numerics::nnls`]) on the play/stop outputs
 //!   of a threshold grid.
 //! * [`gpi`]: the same plus the inverse dead zones, linear in the equation error
-//!   S⁻¹[y] = H[u] (Kuhnen 2003).
+//!   S⁻¹\[y\] = H\[u\] (Kuhnen 2003).
 //! * [`preisach`]: regularised non-negative least squares on the cell regressors of a
 //!   triangular Preisach grid.
 //! * [`jiles_atherton`], [`bouc_wen`], [`duhem`], [`dahl`]: bounded Levenberg–Marquardt
@@ -43,7 +43,7 @@ pub struct OperatorFit<M> {
     /// Standard deviation per parameter (None where the parameter was not estimated, e.g. fixed
     /// thresholds or a weight held at the NNLS bound 0).
     pub std: Vec<Option<f64>>,
-    /// Γ[u] of the fitted operator on the estimation data.
+    /// Γ\[u\] of the fitted operator on the estimation data.
     pub simulated: Vec<f64>,
     /// fit % = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖), RMSE, loss V = mean squared residual, FPE, AIC
     pub fit_percent: f64,

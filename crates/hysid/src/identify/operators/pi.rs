@@ -1,6 +1,6 @@
 //! Identification of a Prandtl–Ishlinskii operator by non-negative least squares.
 //!
-//! y = c + a₀u + Σᵢ aᵢ F_{rᵢ}[u] is linear in (a₀, a₁ … aₙ, c) once the thresholds are fixed
+//! y = c + a₀u + Σᵢ aᵢ F_{rᵢ}\[u\] is linear in (a₀, a₁ … aₙ, c) once the thresholds are fixed
 //! on a grid over the input range (default rᵢ = i·(max u − min u)/(2(n+1))): each play output
 //! is one pass over the data, the (n + 2)² normal equations are accumulated once, and the
 //! weights are the NNLS solution (aᵢ ≥ 0 keeps the operator monotone and its analytic inverse
@@ -8,7 +8,7 @@
 //! a weight held at 0 has none. The count n can also be chosen by validation
 //! ([`PiOptions::select`]).
 //!
-//! A clockwise loop is fitted in the inverse parameterisation (u = G[y], thresholds over the
+//! A clockwise loop is fitted in the inverse parameterisation (u = G\[y\], thresholds over the
 //! output range) and Γ = G⁻¹ (Kuhnen 2003); the reported weights are then those of G.
 //!
 //! Reference: K. Kuhnen, "Modeling, identification and compensation of complex hysteretic

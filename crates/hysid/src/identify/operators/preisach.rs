@@ -1,6 +1,6 @@
 //! Identification of a discrete Preisach operator by regularised non-negative least squares.
 //!
-//! With the grid fixed (N intervals over the input range), G[u] = c + a₀u + Σ w_{ij} φ_{ij}[u]
+//! With the grid fixed (N intervals over the input range), G\[u\] = c + a₀u + Σ w_{ij} φ_{ij}\[u\]
 //! is linear in (a₀, w, c); the regressors φ_{ij} (see [`crate::model::operators::Preisach`])
 //! are built per sample from the staircase memory, touching only the cells under its strips,
 //! and accumulated into the Gram matrix in blocks. The weights minimise
@@ -11,7 +11,7 @@
 //! sweep take their neighbours' values instead of arbitrary ones; λ → 0 recovers the exact
 //! weights of data produced by the model itself. Standard deviations are those of the
 //! penalised normal equations (σ² from the unpenalised residual). A clockwise loop is fitted
-//! in the inverse parameterisation (u = G[y]).
+//! in the inverse parameterisation (u = G\[y\]).
 //!
 //! Reference: I. D. Mayergoyz, *Mathematical Models of Hysteresis*, Springer 1991.
 

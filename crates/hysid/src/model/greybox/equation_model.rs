@@ -23,7 +23,7 @@
 //! * no second-order layout ([`StateSpaceModel::mechanical_dofs`] is None), so Newmark
 //!   integration is refused: use RK4 (or the adaptive integrator);
 //! * discrete-time files (`time = "discrete"`) are **refused** with an error: the
-//!   simulation path integrates ẋ = f, and a map x[k+1] = f(x[k]) is not a derivative.
+//!   simulation path integrates ẋ = f, and a map x\[k+1\] = f(x\[k\]) is not a derivative.
 
 use super::StateSpaceModel;
 use crate::data::Channel;

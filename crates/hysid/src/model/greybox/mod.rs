@@ -134,7 +134,7 @@ pub trait StateSpaceModel: Sync + Send {
     }
 
     /// ẋ and the forward-sensitivity rates Ṡ = (∂f/∂x)·S + ∂f/∂θ[:, params] for S (n × q,
-    /// row-major: first the columns of θ[params], then initial-state columns, which have no
+    /// row-major: first the columns of θ\[params\], then initial-state columns, which have no
     /// direct term), friction held in `held` when Some ([`sensitivity`]). Returns false when
     /// the model has no analytic Jacobians. The default evaluates [`rhs`](Self::rhs) and
     /// [`rhs_jacobians`](Self::rhs_jacobians) into `scratch`

@@ -1,7 +1,7 @@
 //! The right-hand side of the forward sensitivity equations of a state-space model.
 //!
 //! For ẋ = f(t, x, u, θ) and the sensitivities S = ∂x/∂p to q quantities p (parameters
-//! θ[params] first, then initial states),
+//! θ\[params\] first, then initial states),
 //!
 //! ```text
 //! Ṡ = (∂f/∂x)·S + ∂f/∂p,      ∂f/∂p = [∂f/∂θ[params], 0]

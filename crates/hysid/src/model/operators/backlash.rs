@@ -22,7 +22,7 @@ use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
-/// Backlash y = c + g·F_r[u] in an [`Orientation`].
+/// Backlash y = c + g·F_r\[u\] in an [`Orientation`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Backlash {
     g: f64,

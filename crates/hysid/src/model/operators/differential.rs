@@ -218,7 +218,7 @@ fn dormand_prince(ode: &dyn InputOde, u: f64, x: f64, h: f64, d: f64) -> (f64, f
     (x5, err.abs())
 }
 
-/// The states x_k along the input `u`, from the operator's initial state at u[0].
+/// The states x_k along the input `u`, from the operator's initial state at u\[0\].
 pub fn states(ode: &dyn InputOde, u: &[f64]) -> Result<Vec<f64>> {
     check_signal("input", u)?;
     let mut x = ode.initial_state();

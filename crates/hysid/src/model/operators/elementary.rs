@@ -13,7 +13,7 @@ pub fn play_step(z: f64, u: f64, r: f64) -> f64 {
     (u - r).max((u + r).min(z))
 }
 
-/// The play operator F_r[u] from the state z₋₁ = 0: z₀ = max(u₀ − r, min(u₀ + r, 0)).
+/// The play operator F_r\[u\] from the state z₋₁ = 0: z₀ = max(u₀ − r, min(u₀ + r, 0)).
 pub fn play(u: &[f64], r: f64) -> Vec<f64> {
     let mut z = 0.0;
     u.iter()
@@ -24,7 +24,7 @@ pub fn play(u: &[f64], r: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The stop operator E_r[u] = u − F_r[u]: the force of a spring whose end slips beyond ±r
+/// The stop operator E_r\[u\] = u − F_r\[u\]: the force of a spring whose end slips beyond ±r
 /// (the elasto-plastic element of a Maxwell-slip model), from the same state 0.
 pub fn stop(u: &[f64], r: f64) -> Vec<f64> {
     play(u, r).iter().zip(u).map(|(z, x)| x - z).collect()

@@ -130,7 +130,7 @@ impl DeadZones {
     }
 }
 
-/// Kuhnen's modified PI operator G[u] = S[H[u]] in an [`Orientation`].
+/// Kuhnen's modified PI operator G\[u\] = S\[H[u\]] in an [`Orientation`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GeneralizedPi {
     pi: PrandtlIshlinskii,

@@ -1,4 +1,4 @@
-//! Hysteresis operators y = Γ[u]: rate-independent (and rate-dependent) hysteresis families
+//! Hysteresis operators y = Γ\[u\]: rate-independent (and rate-dependent) hysteresis families
 //! with their simulation from a documented initial state and their inverse for feed-forward
 //! compensation.
 //!
@@ -20,7 +20,7 @@
 //!   operator (`duhem`, [`Duhem`]) and Dahl friction (`dahl`, [`Dahl`]).
 //!
 //! **Initial states.** Every play/stop operator starts from the state 0 as if the input had
-//! been 0 before the first sample: F_r[u]₀ = max(u₀ − r, min(u₀ + r, 0)). The Preisach plane
+//! been 0 before the first sample: F_r\[u\]₀ = max(u₀ − r, min(u₀ + r, 0)). The Preisach plane
 //! starts in negative saturation (all relays down, as if the input came from below the grid).
 //!
 //! **Orientation.** A counter-clockwise loop (the output lags the input, as most B(H) loops and
@@ -74,7 +74,7 @@ pub use preisach::Preisach;
 pub struct Inversion {
     /// The input u that makes the operator's output follow the reference.
     pub u: Vec<f64>,
-    /// Γ[u]: the operator's output for `u` (equal to the reference where it is reachable).
+    /// Γ\[u\]: the operator's output for `u` (equal to the reference where it is reachable).
     pub predicted: Vec<f64>,
     /// Indices of the samples where the reference lay outside the reachable range and was clipped.
     pub clipped: Vec<usize>,
@@ -88,7 +88,7 @@ pub trait HysteresisOperator: Send + Sync + std::fmt::Debug {
     /// The parameters, names from the literature, flattened (`a0`, `a1`, …, `r1`, …), with units and
     /// bounds where they have them.
     fn parameters(&self) -> ParameterSet;
-    /// Γ[u] from the documented initial state (u[0] is the first input sample).
+    /// Γ\[u\] from the documented initial state (u\[0\] is the first input sample).
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>>;
     /// The input that makes Γ follow `reference`, from the same initial state; samples outside the
     /// reachable range are clipped to it and listed, never silently.

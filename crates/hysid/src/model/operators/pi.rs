@@ -27,7 +27,7 @@ use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
-/// A Prandtl–Ishlinskii operator y = c + a₀u + Σ aᵢ F_{rᵢ}[u] in an [`Orientation`].
+/// A Prandtl–Ishlinskii operator y = c + a₀u + Σ aᵢ F_{rᵢ}\[u\] in an [`Orientation`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PrandtlIshlinskii {
     a0: f64,

@@ -188,7 +188,7 @@ impl State {
     }
 }
 
-/// A discrete Preisach operator G[u] = c + a₀u + Σ w_{ij} φ_{ij}[u] in an [`Orientation`].
+/// A discrete Preisach operator G\[u\] = c + a₀u + Σ w_{ij} φ_{ij}\[u\] in an [`Orientation`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Preisach {
     grid: Grid,
