@@ -31,7 +31,6 @@
 
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
-use crate::model::greybox::simulate::{simulate as simulate_state_space, InputTrack};
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::saved_equations::{equations_from_file, simulate_outputs};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
@@ -313,33 +312,15 @@ impl FittedModel {
                 ..
             } => {
                 let model = models::by_kind(kind)?;
-                if inputs.len() != model.inputs().len() {
-                    return Err(Error::Config(format!(
-                        "the {kind} model has {} input(s), {} given",
-                        model.inputs().len(),
-                        inputs.len()
-                    )));
-                }
-                let track = InputTrack::new(inputs, simulation)?;
                 let theta = parameters.values();
-                let mut outputs = vec![Vec::with_capacity(track.len()); model.outputs().len()];
-                let (mut u, mut y) = (vec![0.0; inputs.len()], vec![0.0; outputs.len()]);
-                simulate_state_space(
+                simulate_outputs(
                     model.as_ref(),
                     &theta,
                     initial_state,
-                    &track,
+                    inputs,
                     ts,
-                    simulation.integrator,
-                    |k, x| {
-                        track.at(k, 0.0, &mut u);
-                        model.output(x, &u, &theta, &mut y);
-                        for (o, v) in outputs.iter_mut().zip(&y) {
-                            o.push(*v);
-                        }
-                    },
-                )?;
-                Ok(outputs)
+                    simulation,
+                )
             }
             FittedModel::Equations {
                 equations,

@@ -71,7 +71,8 @@ pub(crate) fn simulate_outputs(
 ) -> Result<Vec<Vec<f64>>> {
     if inputs.len() != model.inputs().len() {
         return Err(Error::Config(format!(
-            "the model has {} input(s), {} given",
+            "the {} model has {} input(s), {} given",
+            model.kind(),
             model.inputs().len(),
             inputs.len()
         )));
