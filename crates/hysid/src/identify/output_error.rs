@@ -59,6 +59,14 @@ pub trait OutputErrorModel: Sync {
     ) -> Option<Result<()>> {
         None
     }
+
+    /// Whether the estimator should compute the sensitivities together with the residuals at
+    /// every trial point (see [`Speculation`]). Worth it when a simulation with sensitivities
+    /// costs little more than one without and most trial points are accepted, as for the
+    /// continuous-time grey-box models; `false` (the default) keeps trial points cheap.
+    fn speculative_sensitivities(&self) -> bool {
+        false
+    }
 }
 
 /// Settings of the output-error estimator (MATLAB `nlgreyestOptions`).
@@ -157,9 +165,12 @@ impl OutputError {
     ) -> Result<OutputErrorFit> {
         params.validate()?;
         check_outputs_vary(data)?;
-        let problem =
+        let mut problem =
             OutputErrorProblem::new(model, data, self.weights(model.n_outputs())?, self.skip)?;
         let free = params.free_indices();
+        if model.speculative_sensitivities() {
+            problem.speculate(&free);
+        }
         if problem.n_residuals() <= free.len() {
             return Err(Error::TooFewSamples {
                 samples: problem.n_residuals(),
@@ -169,7 +180,7 @@ impl OutputError {
         }
         let lower: Vec<f64> = params.iter().map(|p| p.min).collect();
         let upper: Vec<f64> = params.iter().map(|p| p.max).collect();
-        let report = minimize(
+        let mut report = minimize(
             &problem,
             &params.values(),
             &free,
@@ -178,6 +189,7 @@ impl OutputError {
             &self.config,
             callback,
         )?;
+        problem.count_simulations(&mut report);
         let mut parameters = params.clone();
         parameters.set_values(&report.theta);
         summarize(&problem, parameters, report)
@@ -242,6 +254,27 @@ pub struct OutputErrorProblem<'a> {
     skip: usize,
     n_residuals: usize,
     data_scale: f64,
+    speculation: Option<Speculation>,
+}
+
+/// Speculative sensitivities: every trial point is simulated *with* its sensitivities, and the
+/// normal equations are kept for the engine's request that follows when the point is accepted.
+///
+/// Levenberg–Marquardt simulates a trial point, and at an accepted one asks for the normal
+/// equations JᵀJ, Jᵀr, which repeat the same simulation with the sensitivities. When most
+/// trial points are accepted (a good start, a smooth criterion) computing both in one pass
+/// saves a plain simulation per iteration at the price of the sensitivities of the few
+/// rejected points. When the search runs alone (not inside a parallel multi-start) and the
+/// experiments leave a core idle, the sensitivity columns are split between two threads
+/// ([`rayon::join`]), each integrating the state with half of the columns: the state is
+/// integrated twice, the sensitivities once.
+struct Speculation {
+    free: Vec<usize>,
+    split: bool,
+    cache: std::sync::Mutex<Option<(Vec<f64>, NormalEquations)>>,
+    with_sensitivities: std::sync::atomic::AtomicUsize,
+    without: std::sync::atomic::AtomicUsize,
+    disabled: std::sync::atomic::AtomicBool,
 }
 
 impl<'a> OutputErrorProblem<'a> {
@@ -284,7 +317,138 @@ impl<'a> OutputErrorProblem<'a> {
             skip,
             n_residuals,
             data_scale,
+            speculation: None,
         })
+    }
+
+    /// Turns on speculative sensitivities for the parameters `free` (see [`Speculation`]) when
+    /// the search runs alone and a core is idle for the split columns.
+    pub fn speculate(&mut self, free: &[usize]) {
+        // Inside a rayon job (a multi-start) the other core is busy already.
+        let alone = rayon::current_thread_index().is_none();
+        let idle_cores = rayon::current_num_threads() > self.data.n_experiments();
+        // On one core a plain simulation is several times cheaper than one with
+        // sensitivities, so speculating pays only when the columns can be split.
+        if !(alone && idle_cores && free.len() >= 2) {
+            return;
+        }
+        self.speculation = Some(Speculation {
+            free: free.to_vec(),
+            split: true,
+            cache: std::sync::Mutex::new(None),
+            with_sensitivities: 0.into(),
+            without: 0.into(),
+            disabled: false.into(),
+        });
+    }
+
+    /// Replaces the engine's request counts by the simulations actually run, when trial
+    /// points were simulated with their sensitivities (the engine counts requests; a request
+    /// for normal equations answered from a trial point's pass simulates nothing).
+    fn count_simulations(&self, report: &mut LmReport) {
+        use std::sync::atomic::Ordering::Relaxed;
+        if let Some(spec) = &self.speculation {
+            let with = spec.with_sensitivities.load(Relaxed);
+            let without = spec.without.load(Relaxed);
+            report.sensitivity_evaluations = with;
+            report.residual_evaluations = without;
+            report.function_evaluations = with + without;
+        }
+    }
+
+    /// Residuals and normal equations of every experiment in one pass per experiment; None
+    /// when the model has no analytic sensitivities.
+    fn residuals_with_normal_equations(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+        split: bool,
+        r: &mut [f64],
+    ) -> Option<Result<NormalEquations>> {
+        let ny = self.model.n_outputs();
+        let mut chunks: Vec<(usize, &mut [f64])> = Vec::new();
+        let mut rest = r;
+        for e in 0..self.data.n_experiments() {
+            let len = ny * (self.data.experiment(e).len() - self.skip);
+            let (chunk, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            chunks.push((e, chunk));
+            rest = tail;
+        }
+        let parts: Vec<Option<Result<NormalEquations>>> = chunks
+            .into_par_iter()
+            .map(|(e, chunk)| {
+                if split {
+                    self.experiment_split(theta, free, e, chunk)
+                } else {
+                    self.experiment_normal_equations(theta, free, e, Some(chunk))
+                }
+            })
+            .collect();
+        sum_normal_equations(parts)
+    }
+
+    /// One experiment's residuals and normal equations with the sensitivity columns split
+    /// between two threads (the Jacobian block is stored, JᵀJ formed by one product).
+    fn experiment_split(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+        e: usize,
+        r: &mut [f64],
+    ) -> Option<Result<NormalEquations>> {
+        let (first, second) = free.split_at(free.len() / 2);
+        let (a, b) = rayon::join(
+            || self.experiment_columns(theta, first, e, Some(&mut *r)),
+            || self.experiment_columns(theta, second, e, None),
+        );
+        let (mut a, b) = match (a?, b?) {
+            (Ok(a), Ok(b)) => (a, b),
+            (Err(err), _) | (_, Err(err)) => return Some(Err(err)),
+        };
+        a.extend_from_slice(&b);
+        let jac = DMatrix::from_vec(r.len(), free.len(), a);
+        let res = DVector::from_column_slice(r);
+        Some(Ok(NormalEquations {
+            jtj: jac.tr_mul(&jac),
+            jtr: jac.tr_mul(&res),
+            cost: res.norm_squared(),
+        }))
+    }
+
+    /// The Jacobian columns of one experiment's residuals for the parameters `free`,
+    /// column-major, and its residuals into `r` when given.
+    fn experiment_columns(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+        e: usize,
+        mut r: Option<&mut [f64]>,
+    ) -> Option<Result<Vec<f64>>> {
+        let p = free.len();
+        let exp = self.data.experiment(e);
+        let rows = exp.len() - self.skip;
+        let mut jac = vec![0.0; rows * self.weights.len() * p];
+        let n_rows = rows * self.weights.len();
+        let skip = self.skip;
+        let weights = &self.weights;
+        let mut sink = |t: usize, yhat: &[f64], dyhat: &[f64]| {
+            if t < skip {
+                return;
+            }
+            for (o, w) in weights.iter().enumerate() {
+                let row = o * rows + t - skip;
+                if let Some(r) = r.as_deref_mut() {
+                    r[row] = w * (exp.output(o)[t] - yhat[o]);
+                }
+                for k in 0..p {
+                    jac[k * n_rows + row] = -w * dyhat[o * p + k];
+                }
+            }
+        };
+        let outcome = self
+            .model
+            .simulate_sensitivities(theta, self.data, e, free, &mut sink)?;
+        Some(outcome.map(|()| jac))
     }
 
     /// Simulated outputs of every experiment, `[experiment][output][t]`.
@@ -300,15 +464,18 @@ impl<'a> OutputErrorProblem<'a> {
             .collect()
     }
 
-    /// Streams one experiment's sensitivities into normal equations.
+    /// Streams one experiment's sensitivities into normal equations, and its residuals into
+    /// `residuals` when given.
     fn experiment_normal_equations(
         &self,
         theta: &[f64],
         free: &[usize],
         e: usize,
+        mut residuals: Option<&mut [f64]>,
     ) -> Option<Result<NormalEquations>> {
         let p = free.len();
         let exp = self.data.experiment(e);
+        let rows = exp.len() - self.skip;
         let mut acc = Accumulator::new(p);
         let mut row = vec![0.0; p];
         let skip = self.skip;
@@ -319,6 +486,9 @@ impl<'a> OutputErrorProblem<'a> {
             }
             for (o, w) in weights.iter().enumerate() {
                 let r = w * (exp.output(o)[t] - yhat[o]);
+                if let Some(out) = residuals.as_deref_mut() {
+                    out[o * rows + t - skip] = r;
+                }
                 for (k, rk) in row.iter_mut().enumerate() {
                     *rk = -w * dyhat[o * p + k];
                 }
@@ -342,6 +512,26 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 
     fn residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
+        use std::sync::atomic::Ordering::Relaxed;
+        if let Some(spec) = self
+            .speculation
+            .as_ref()
+            .filter(|s| !s.disabled.load(Relaxed))
+        {
+            match self.residuals_with_normal_equations(theta, &spec.free, spec.split, r) {
+                Some(system) => {
+                    spec.with_sensitivities.fetch_add(1, Relaxed);
+                    let system = system?;
+                    *spec.cache.lock().unwrap_or_else(|p| p.into_inner()) =
+                        Some((theta.to_vec(), system));
+                    return Ok(());
+                }
+                None => spec.disabled.store(true, Relaxed),
+            }
+        }
+        if let Some(spec) = &self.speculation {
+            spec.without.fetch_add(1, Relaxed);
+        }
         let sims = self.simulate_all(theta)?;
         let mut k = 0;
         for (e, sim) in sims.iter().enumerate() {
@@ -358,33 +548,54 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 
     fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
+        if let Some(spec) = &self.speculation {
+            let mut cache = spec.cache.lock().unwrap_or_else(|p| p.into_inner());
+            if let Some((at, system)) = cache.take() {
+                if at == theta && spec.free == free {
+                    return Some(Ok(system));
+                }
+            }
+            drop(cache);
+            if !spec.disabled.load(std::sync::atomic::Ordering::Relaxed) {
+                spec.with_sensitivities
+                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
         let parts: Vec<Option<Result<NormalEquations>>> = (0..self.data.n_experiments())
             .into_par_iter()
-            .map(|e| self.experiment_normal_equations(theta, free, e))
+            .map(|e| self.experiment_normal_equations(theta, free, e, None))
             .collect();
-        let mut total: Option<NormalEquations> = None;
-        for part in parts {
-            let part = match part? {
-                Ok(p) => p,
-                Err(e) => return Some(Err(e)),
-            };
-            total = Some(match total {
-                None => part,
-                Some(mut t) => {
-                    t.jtj += part.jtj;
-                    t.jtr += part.jtr;
-                    t.cost += part.cost;
-                    t
-                }
-            });
-        }
-        total.map(Ok)
+        sum_normal_equations(parts)
     }
 
     fn cost_floor(&self) -> f64 {
         // Residuals at the 1e-13 relative level are round-off: the fit is exact.
         1e-26 * self.data_scale
     }
+}
+
+/// The sum of the experiments' normal equations; None when any experiment has no analytic
+/// sensitivities.
+fn sum_normal_equations(
+    parts: Vec<Option<Result<NormalEquations>>>,
+) -> Option<Result<NormalEquations>> {
+    let mut total: Option<NormalEquations> = None;
+    for part in parts {
+        let part = match part? {
+            Ok(p) => p,
+            Err(e) => return Some(Err(e)),
+        };
+        total = Some(match total {
+            None => part,
+            Some(mut t) => {
+                t.jtj += part.jtj;
+                t.jtr += part.jtr;
+                t.cost += part.cost;
+                t
+            }
+        });
+    }
+    total.map(Ok)
 }
 
 /// Accumulates JᵀJ, Jᵀr and Σr² row by row, in blocks so the rank-k update runs through a

@@ -142,6 +142,13 @@ impl OutputErrorModel for GreyBox {
         self.model.outputs().len()
     }
 
+    /// A simulation with sensitivities costs a few plain ones, and from a reasonable start
+    /// nearly every trial point is accepted: computing them at every trial point saves the
+    /// repeated simulation of each accepted one.
+    fn speculative_sensitivities(&self) -> bool {
+        true
+    }
+
     fn simulate(
         &self,
         theta: &[f64],

@@ -230,13 +230,30 @@ impl StateSpaceModel for BoucWen {
         let (ds0, rest) = ds.split_at_mut(q);
         let (ds1, ds2) = rest.split_at_mut(q);
         ds0.copy_from_slice(s1);
-        for c in 0..q {
-            let (direct1, direct2) = match params.get(c) {
-                Some(&i) if i < 7 => (d1[i], d2[i]),
-                _ => (0.0, 0.0),
-            };
-            ds1[c] = direct1 + f10 * s0[c] + f11 * s1[c] + f12 * s2[c];
-            ds2[c] = direct2 + f21 * s1[c] + f22 * s2[c];
+        // Parameter columns (with their direct terms) first, then the initial-state columns;
+        // zipped slices of one length, so the loops carry no bounds checks or lookups.
+        let np = params.len().min(q);
+        let parameter_columns = ds1[..np]
+            .iter_mut()
+            .zip(&mut ds2[..np])
+            .zip(&s0[..np])
+            .zip(&s1[..np])
+            .zip(&s2[..np])
+            .zip(params);
+        for (((((o1, o2), a), b), c), &i) in parameter_columns {
+            let (direct1, direct2) = if i < 7 { (d1[i], d2[i]) } else { (0.0, 0.0) };
+            *o1 = direct1 + f10 * a + f11 * b + f12 * c;
+            *o2 = direct2 + f21 * b + f22 * c;
+        }
+        let state_columns = ds1[np..]
+            .iter_mut()
+            .zip(&mut ds2[np..])
+            .zip(&s0[np..])
+            .zip(&s1[np..])
+            .zip(&s2[np..]);
+        for ((((o1, o2), a), b), c) in state_columns {
+            *o1 = 0.0 + f10 * a + f11 * b + f12 * c;
+            *o2 = 0.0 + f21 * b + f22 * c;
         }
         true
     }
