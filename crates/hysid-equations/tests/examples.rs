@@ -7,11 +7,12 @@ mod common;
 use common::{assert_rows_close, example, fd_output, fd_rhs, Arg, Rng};
 use hysid_equations::{EquationModel, TimeDomain};
 
-const EXAMPLES: [&str; 4] = [
+const EXAMPLES: [&str; 5] = [
     "bouc_wen.toml",
     "actuator_fixed.toml",
     "duffing.toml",
     "cascaded_tanks.toml",
+    "backlash_first_order.toml",
 ];
 
 fn load(name: &str) -> EquationModel {
@@ -25,6 +26,7 @@ fn every_example_parses_with_its_declared_shape() {
         ("actuator_fixed.toml", 3, 1, 1, 7),
         ("duffing.toml", 2, 1, 1, 4),
         ("cascaded_tanks.toml", 2, 1, 1, 7),
+        ("backlash_first_order.toml", 2, 1, 1, 3),
     ];
     for (name, n, m, ny, p) in shapes {
         let model = load(name);
@@ -33,7 +35,12 @@ fn every_example_parses_with_its_declared_shape() {
         assert_eq!(model.outputs().len(), ny, "{name}");
         assert_eq!(model.parameters().len(), p, "{name}");
         assert_eq!(model.initial().len(), n, "{name}");
-        assert_eq!(model.time_domain(), TimeDomain::Continuous);
+        let time = if name == "backlash_first_order.toml" {
+            TimeDomain::Discrete
+        } else {
+            TimeDomain::Continuous
+        };
+        assert_eq!(model.time_domain(), time, "{name}");
         assert_eq!(model.source(), example(name));
     }
 }
@@ -94,6 +101,11 @@ fn point(name: &str, rng: &mut Rng, m: &EquationModel) -> (f64, Vec<f64>, Vec<f6
                 vec![rng.uniform(-1.0, 1.0)],
             )
         }
+        "backlash_first_order.toml" => (
+            // z anywhere around u: inside the play band and clamped on either side.
+            vec![rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)],
+            vec![rng.uniform(-1.0, 1.0)],
+        ),
         _ => {
             // Half the points with the upper tank overflowing (x1 above x1max = 10), and
             // the lower one in and above the sensor range.
