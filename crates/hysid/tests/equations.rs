@@ -195,10 +195,12 @@ fn sensitivities_equal_the_built_in_models() {
     }
 }
 
-/// The cascaded tanks below overflow: 3 V ± 0.5 V on the pump, 512 samples of 4 s.
+/// The cascaded tanks through all their regimes: 3.5 V ± 3.2 V on the pump (below its dead
+/// zone u0 = 0.5 V at the troughs, overflowing the upper tank at the crests), 512 samples
+/// of 4 s.
 fn tanks_case() -> (IdData, Vec<f64>) {
     let u: Vec<f64> = (0..512)
-        .map(|k| 3.0 + 0.5 * (std::f64::consts::TAU * k as f64 / 128.0).sin())
+        .map(|k| 3.5 + 3.2 * (std::f64::consts::TAU * k as f64 / 128.0).sin())
         .collect();
     (
         IdData::siso(4.0, "u", u, "y", vec![0.0; 512]).unwrap(),
@@ -300,6 +302,9 @@ fn sensitivities_of_every_example_match_finite_differences() {
     let (bw, bw_x0) = bouc_wen_case();
     let (act, act_x0) = actuator_case();
     let (tanks, tanks_x0) = tanks_case();
+    let upper = velocities(&example("cascaded_tanks"), &tanks, &tanks_x0, 0);
+    let brim = upper.iter().filter(|&&x1| x1 > 10.0).count();
+    assert!(brim > 10, "the upper tank must overflow: {brim} samples");
     let cases = [
         ("duffing", duffing_input(1), vec![0.1, 0.0]),
         ("bouc_wen", bw, bw_x0),
@@ -424,9 +429,10 @@ fn duffing_parameters_are_recovered() {
 }
 
 /// Cascaded tanks: fitted on the estimation record (initial levels estimated), simulated on
-/// the validation record from the same initial state; the validation RMSE this reaches,
-/// 0.515 V (published: best linear approximation 0.75 V, best black-box 0.34 V, grey-box
-/// with overflow 0.18 V — this file's overflow level and sensor limit are fixed at 10 V).
+/// the validation record from the same initial state, as the benchmark prescribes; the
+/// validation RMSE this reaches, 0.338 V (published: best linear approximation 0.75 V, best
+/// black-box 0.34 V, grey-box with overflow 0.18 V). The pump's dead zone u0 (fitted
+/// 0.79 V) and the estimated overflow level are what bring it down from 0.515 V.
 #[test]
 fn cascaded_tanks_validation_rmse() {
     let est = csv("data/cascaded-tanks/estimation.csv", "u_V", "y_V");
@@ -476,7 +482,7 @@ fn cascaded_tanks_validation_rmse() {
         "cascaded tanks: estimation RMSE {:.4} V, validation RMSE {rmse:.4} V, θ = {values:?}",
         fit.fit.mse[0][0].sqrt()
     );
-    assert!(rmse < 0.53, "validation RMSE {rmse} V");
+    assert!((rmse - 0.3384).abs() < 0.005, "validation RMSE {rmse} V");
 }
 
 /// A fitted equation model saved to JSON comes back equal and simulates the same outputs.
