@@ -21,7 +21,8 @@ fn json(path: &Path) -> serde_json::Value {
 
 /// Fit with multi-start, sensitivity table, residual tests, plots, report and model file;
 /// the saved model embeds the equations and `hysid simulate` reproduces the validation
-/// RMSE that the library test reaches (0.515 V).
+/// RMSE that the library test reaches (0.338 V; published: BLA 0.75 V, best black-box
+/// 0.34 V, grey-box with overflow 0.18 V).
 #[test]
 fn equation_file_fit_saves_a_self_contained_model() {
     let dir = TempDir::new().unwrap();
@@ -52,7 +53,7 @@ fn equation_file_fit_saves_a_self_contained_model() {
         .as_str()
         .unwrap()
         .contains("name = \"cascaded_tanks\""));
-    assert_eq!(saved["parameters"].as_array().unwrap().len(), 7);
+    assert_eq!(saved["parameters"].as_array().unwrap().len(), 9);
     assert_eq!(saved["initial_state"].as_array().unwrap().len(), 2);
     let r = json(&report);
     assert_eq!(r["model"]["kind"], "equations");
@@ -68,7 +69,7 @@ fn equation_file_fit_saves_a_self_contained_model() {
         .assert()
         .success();
     let rmse = json(&sim)["fit"]["rmse"].as_f64().unwrap();
-    assert!(rmse < 0.53, "validation RMSE {rmse} V");
+    assert!((rmse - 0.3384).abs() < 0.005, "validation RMSE {rmse} V");
 }
 
 /// Runs `cmd` expecting failure: one line on stderr, no panic; returns it.

@@ -85,6 +85,36 @@
 //! may be called like the state it measures (`y = "y"`). An expression may also be
 //! written as a bare TOML number (`x = 0`).
 //!
+//! **Discrete time.** With `time = "discrete"` the entry `x = "…"` of `[equations]` is
+//! x\[k+1\] as a function of x\[k\], u\[k\], θ and t = t_k; the Jacobians are those of
+//! this map, so hysid propagates sensitivities by the chain rule
+//! S\[k+1\] = (∂f/∂x)·S\[k\] + ∂f/∂θ. A value used by several next states (a "new" value
+//! within the step) is written once in `[let]`:
+//!
+//! ```
+//! let model = hysid_equations::EquationModel::parse(r#"
+//! [model]
+//! time = "discrete"
+//! states = ["z", "x"]
+//! inputs = ["u"]
+//! outputs = ["y"]
+//! [parameters]
+//! r = 0.2
+//! a = 0.9
+//! b = 0.1
+//! [let]
+//! played = "max(u - r, min(u + r, z))"
+//! [equations]
+//! z = "played"
+//! x = "a*x + b*played"
+//! [output]
+//! y = "x"
+//! "#).unwrap();
+//! let mut next = [0.0; 2];
+//! model.rhs(0.0, &[0.0, 1.0], &[1.0], &[0.2, 0.9, 0.1], &mut next);
+//! assert_eq!(next, [0.8, 0.9 + 0.1 * 0.8]); // the play is dragged up to u − r
+//! ```
+//!
 //! **Time.** `t` may appear in `[let]` and `[equations]`. It is refused in `[output]`
 //! (directly or through a `[let]` quantity that uses it): outputs are h(x, u, θ), as in
 //! hysid's state-space models, so [`EquationModel::output`] takes no time.

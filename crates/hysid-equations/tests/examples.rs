@@ -7,11 +7,12 @@ mod common;
 use common::{assert_rows_close, example, fd_output, fd_rhs, Arg, Rng};
 use hysid_equations::{EquationModel, TimeDomain};
 
-const EXAMPLES: [&str; 4] = [
+const EXAMPLES: [&str; 5] = [
     "bouc_wen.toml",
     "actuator_fixed.toml",
     "duffing.toml",
     "cascaded_tanks.toml",
+    "backlash_first_order.toml",
 ];
 
 fn load(name: &str) -> EquationModel {
@@ -24,7 +25,8 @@ fn every_example_parses_with_its_declared_shape() {
         ("bouc_wen.toml", 3, 1, 1, 7),
         ("actuator_fixed.toml", 3, 1, 1, 7),
         ("duffing.toml", 2, 1, 1, 4),
-        ("cascaded_tanks.toml", 2, 1, 1, 7),
+        ("cascaded_tanks.toml", 2, 1, 1, 9),
+        ("backlash_first_order.toml", 2, 1, 1, 3),
     ];
     for (name, n, m, ny, p) in shapes {
         let model = load(name);
@@ -33,7 +35,12 @@ fn every_example_parses_with_its_declared_shape() {
         assert_eq!(model.outputs().len(), ny, "{name}");
         assert_eq!(model.parameters().len(), p, "{name}");
         assert_eq!(model.initial().len(), n, "{name}");
-        assert_eq!(model.time_domain(), TimeDomain::Continuous);
+        let time = if name == "backlash_first_order.toml" {
+            TimeDomain::Discrete
+        } else {
+            TimeDomain::Continuous
+        };
+        assert_eq!(model.time_domain(), time, "{name}");
         assert_eq!(model.source(), example(name));
     }
 }
@@ -94,6 +101,11 @@ fn point(name: &str, rng: &mut Rng, m: &EquationModel) -> (f64, Vec<f64>, Vec<f6
                 vec![rng.uniform(-1.0, 1.0)],
             )
         }
+        "backlash_first_order.toml" => (
+            // z anywhere around u: inside the play band and clamped on either side.
+            vec![rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)],
+            vec![rng.uniform(-1.0, 1.0)],
+        ),
         _ => {
             // Half the points with the upper tank overflowing (x1 above x1max = 10), and
             // the lower one in and above the sensor range.
@@ -345,25 +357,32 @@ fn actuator_fixed_equals_the_built_in_model_away_from_rest() {
 }
 
 #[test]
-fn cascaded_tanks_overflow_holds_the_upper_level() {
+fn cascaded_tanks_overflow_and_pump_dead_zone() {
     let m = load("cascaded_tanks.toml");
     let th = m.parameter_values();
+    let (k1, k2, k3, k4, k5, x1max, kw, u0) =
+        (th[0], th[1], th[2], th[3], th[4], th[5], th[6], th[8]);
     let mut dx = [0.0; 2];
-    // Full upper tank and a strong pump: the level stays, k5 of the excess reaches tank 2.
-    let (x1, x2, u) = (10.0, 4.0, 6.0);
+    // Above the brim: the overflow kw·(x1 − x1max) leaves the upper tank, k5 of it reaches
+    // the lower one.
+    let (x1, x2, u) = (x1max + 0.5, 4.0, 6.0);
     m.rhs(0.0, &[x1, x2], &[u], &th, &mut dx);
-    let (k1, k2, k3, k4, k5) = (th[0], th[1], th[2], th[3], th[4]);
-    let excess = k4 * u - k1 * x1.sqrt();
-    assert!(excess > 0.0);
-    assert_eq!(dx[0], 0.0);
+    let q = kw * 0.5;
     approx::assert_relative_eq!(
-        dx[1],
-        k2 * x1.sqrt() + k5 * excess - k3 * x2.sqrt(),
+        dx[0],
+        k4 * (u - u0) - k1 * x1.sqrt() - q,
         max_relative = 1e-14
     );
-    // Below the brim the Torricelli law alone.
+    approx::assert_relative_eq!(
+        dx[1],
+        k2 * x1.sqrt() + k5 * q - k3 * x2.sqrt(),
+        max_relative = 1e-14
+    );
+    // Below the brim the Torricelli law alone; below the dead zone no inflow.
     m.rhs(0.0, &[4.0, x2], &[u], &th, &mut dx);
-    approx::assert_relative_eq!(dx[0], k4 * u - k1 * 2.0, max_relative = 1e-14);
+    approx::assert_relative_eq!(dx[0], k4 * (u - u0) - k1 * 2.0, max_relative = 1e-14);
+    m.rhs(0.0, &[4.0, x2], &[u0 / 2.0], &th, &mut dx);
+    approx::assert_relative_eq!(dx[0], -k1 * 2.0, max_relative = 1e-14);
     // The sensor saturates at 10 V.
     let mut y = [0.0];
     m.output(&[4.0, 11.0], &[u], &th, &mut y);

@@ -2,7 +2,9 @@
 //! with forward sensitivities (RK4 × 4, band-limited input, the six free parameters) of the
 //! Bouc–Wen oscillator on the benchmark's training record (40 960 samples), once with the
 //! hand-written `BoucWen` and once with `examples/equations/bouc_wen.toml` evaluated from
-//! its compiled tape.
+//! its compiled tape; and a discrete-time equation file
+//! (`examples/equations/backlash_first_order.toml`, the recursion with its chain-rule
+//! sensitivities, three free parameters) on a 40 960-sample multisine.
 //!
 //! Run with `cargo bench -p hysid --bench equations`.
 
@@ -68,5 +70,39 @@ fn sensitivities(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, sensitivities);
+/// The discrete-time backlash file: one recursion with sensitivities to (r, a, b).
+fn discrete(c: &mut Criterion) {
+    let n = 40_960;
+    let u = hysid::numerics::signal::multisine(n, 1, 100.0, 0.2, 5.0, 1.0, 1).unwrap();
+    let data = IdData::siso(0.01, "u", u, "y", vec![0.0; n]).unwrap();
+    let file =
+        EquationStateSpace::load(&root().join("examples/equations/backlash_first_order.toml"))
+            .unwrap();
+    let gb = GreyBox::new(
+        Arc::new(file),
+        &data,
+        Simulation::default(),
+        InitialStates::at_rest(2, 1),
+    )
+    .unwrap();
+    let theta = gb.parameters().values();
+    let free: Vec<usize> = (0..3).collect();
+    let mut group =
+        c.benchmark_group("Discrete-time equation file with sensitivities, 40960 samples");
+    group.sample_size(20);
+    group.bench_function("backlash_first_order", |b| {
+        b.iter(|| {
+            let mut last = 0.0;
+            gb.simulate_sensitivities(black_box(&theta), &data, 0, &free, &mut |_, y, s| {
+                last += y[0] + s[0];
+            })
+            .unwrap()
+            .unwrap();
+            black_box(last)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, sensitivities, discrete);
 criterion_main!(benches);

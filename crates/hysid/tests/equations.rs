@@ -195,10 +195,12 @@ fn sensitivities_equal_the_built_in_models() {
     }
 }
 
-/// The cascaded tanks below overflow: 3 V ± 0.5 V on the pump, 512 samples of 4 s.
+/// The cascaded tanks through all their regimes: 3.5 V ± 3.2 V on the pump (below its dead
+/// zone u0 = 0.5 V at the troughs, overflowing the upper tank at the crests), 512 samples
+/// of 4 s.
 fn tanks_case() -> (IdData, Vec<f64>) {
     let u: Vec<f64> = (0..512)
-        .map(|k| 3.0 + 0.5 * (std::f64::consts::TAU * k as f64 / 128.0).sin())
+        .map(|k| 3.5 + 3.2 * (std::f64::consts::TAU * k as f64 / 128.0).sin())
         .collect();
     (
         IdData::siso(4.0, "u", u, "y", vec![0.0; 512]).unwrap(),
@@ -212,18 +214,103 @@ fn duffing_input(seed: u64) -> IdData {
     IdData::siso(0.05, "u", u, "y", vec![0.0; 2048]).unwrap()
 }
 
-/// Every example's forward sensitivities equal central differences of its simulation to
-/// 1e-6 of each column's largest value (parameters and initial states; the actuator 1e-5).
+/// ∂y/∂θᵢ of the simulation `sim` at θ by Ridders' extrapolation of central differences
+/// (C.J.F. Ridders, "Accurate computation of F′(x) and F′(x)F″(x)", Advances in Engineering
+/// Software 4(2), 1982): D(h) = (y(θ + h eᵢ) − y(θ − h eᵢ))/2h for h = h₀, h₀/1.4, h₀/1.4², …
+/// is extrapolated to h → 0 in a Neville tableau (D(h) = D + c₂h² + c₄h⁴ + …, so each
+/// column cancels one more power), and the entry whose change from its neighbours is the
+/// smallest is kept. This picks the step per parameter: large enough that the rounding
+/// error ε·|y|/h stays small even for a column that is tiny against |y|/|θ|, small enough
+/// for the truncation error, without hand tuning. Returns the derivative and the
+/// tableau's error estimate (largest absolute change).
+fn ridders(sim: &dyn Fn(&[f64]) -> Vec<f64>, theta: &[f64], i: usize, h0: f64) -> (Vec<f64>, f64) {
+    const SHRINK: f64 = 1.4;
+    const LEVELS: usize = 10;
+    let central = |h: f64| {
+        let (mut hi, mut lo) = (theta.to_vec(), theta.to_vec());
+        hi[i] += h;
+        lo[i] -= h;
+        let (a, b) = (sim(&hi), sim(&lo));
+        a.iter()
+            .zip(&b)
+            .map(|(p, q)| (p - q) / (2.0 * h))
+            .collect::<Vec<f64>>()
+    };
+    let gap = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
+    };
+    let mut h = h0;
+    // tableau[j]: the row of the previous step size, extrapolated j times.
+    let mut previous: Vec<Vec<f64>> = vec![central(h)];
+    let (mut best, mut error) = (previous[0].clone(), f64::INFINITY);
+    for _ in 1..LEVELS {
+        h /= SHRINK;
+        let mut row = vec![central(h)];
+        let mut factor = SHRINK * SHRINK;
+        for j in 1..=previous.len() {
+            let next: Vec<f64> = row[j - 1]
+                .iter()
+                .zip(&previous[j - 1])
+                .map(|(a, b)| (a * factor - b) / (factor - 1.0))
+                .collect();
+            factor *= SHRINK * SHRINK;
+            let change = gap(&next, &row[j - 1]).max(gap(&next, &previous[j - 1]));
+            if change <= error {
+                error = change;
+                best = next.clone();
+            }
+            row.push(next);
+        }
+        let last = previous.len();
+        // Higher orders stopped helping: rounding has taken over.
+        if gap(&row[last], &previous[last - 1]) >= 2.0 * error {
+            break;
+        }
+        previous = row;
+    }
+    (best, error)
+}
+
+/// The reference derivative of column `i`: Ridders' extrapolation from first steps of
+/// 10⁻², 10⁻³, 10⁻⁴ and 10⁻⁵ of max(|θᵢ|, 0.01), whichever estimates the smallest error.
+/// Several are tried because y(θ) is only piecewise smooth: a large step can cross a kink
+/// of a non-smooth model (Bouc–Wen's |ẏ| and |z| switch at a stage of another RK4 step), or
+/// leave the region where the curvature is moderate (the actuator's inertia column), and the
+/// tableau then reports a large error, while a small step suffers rounding on a column
+/// that is tiny against |y|/|θ|.
+fn fd_reference(sim: &dyn Fn(&[f64]) -> Vec<f64>, theta: &[f64], i: usize) -> (Vec<f64>, f64) {
+    let scale = theta[i].abs().max(1e-2);
+    [1e-2, 1e-3, 1e-4, 1e-5]
+        .iter()
+        .map(|h| ridders(sim, theta, i, h * scale))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .expect("four steps")
+}
+
+/// Every example's forward sensitivities (parameters and initial states) equal the
+/// derivative of the same simulation by extrapolated central differences
+/// ([`fd_reference`]) to 1e-6, column by column in the max norm: ‖S_fd − S‖∞ ≤ 1e-6·‖S‖∞
+/// for each parameter column. Plain central differences at one step do not reach this on
+/// the actuator: its test record drives the motor quasi-statically, so the output hardly
+/// depends on the inertia J (J·∂y/∂J ≈ 1e-5 of |y|) — at a relative step of 1e-6 the
+/// rounding error ε·|y|/h is 1e-5 of that column, at 1e-4 the truncation error is 3e-3 of
+/// it. The exact sensitivities were right; the reference was not accurate enough.
 #[test]
 fn sensitivities_of_every_example_match_finite_differences() {
     let (bw, bw_x0) = bouc_wen_case();
     let (act, act_x0) = actuator_case();
     let (tanks, tanks_x0) = tanks_case();
+    let upper = velocities(&example("cascaded_tanks"), &tanks, &tanks_x0, 0);
+    let brim = upper.iter().filter(|&&x1| x1 > 10.0).count();
+    assert!(brim > 10, "the upper tank must overflow: {brim} samples");
     let cases = [
         ("duffing", duffing_input(1), vec![0.1, 0.0]),
         ("bouc_wen", bw, bw_x0),
         ("actuator_fixed", act, act_x0),
         ("cascaded_tanks", tanks, tanks_x0),
+        ("backlash_first_order", backlash_record(3), vec![0.05, 0.0]),
     ];
     for (name, data, x0) in cases {
         let model = Arc::new(example(name));
@@ -235,25 +322,27 @@ fn sensitivities_of_every_example_match_finite_differences() {
         let free = free_of(&gb);
         let (_, analytic) = sensitivities(&gb, &data, &theta, &free);
         let n = data.n_samples();
+        let sim = |th: &[f64]| {
+            let mut y = vec![vec![0.0; n]];
+            gb.simulate(th, &data, 0, &mut y).unwrap();
+            y.remove(0)
+        };
         let mut fd = vec![vec![0.0; free.len()]; n];
         for (c, &i) in free.iter().enumerate() {
-            // A step well above rounding (also for initial states at 0).
-            let h = 1e-6 * theta[i].abs().max(1e-2);
-            let (mut hi, mut lo) = (theta.clone(), theta.clone());
-            hi[i] += h;
-            lo[i] -= h;
-            let (mut yh, mut yl) = (vec![vec![0.0; n]], vec![vec![0.0; n]]);
-            gb.simulate(&hi, &data, 0, &mut yh).unwrap();
-            gb.simulate(&lo, &data, 0, &mut yl).unwrap();
-            for k in 0..n {
-                fd[k][c] = (yh[0][k] - yl[0][k]) / (2.0 * h);
+            let (column, estimate) = fd_reference(&sim, &theta, i);
+            let size = analytic.iter().fold(0.0f64, |m, r| m.max(r[c].abs()));
+            // The reference must itself be good to a fifth of the tolerance.
+            assert!(
+                estimate <= 2e-7 * size,
+                "{name} column {c}: reference error {estimate:e} of {size:e}"
+            );
+            for (row, v) in fd.iter_mut().zip(column) {
+                row[c] = v;
             }
         }
         let worst = worst_relative(&fd, &analytic);
-        // The actuator's hysteresis state is stiff (α|x2| ≈ 225 /s) and its Coulomb term
-        // discontinuous: its central differences are good to 5.3e-6, not 1e-6.
-        let tolerance = if name == "actuator_fixed" { 1e-5 } else { 1e-6 };
-        assert!(worst <= tolerance, "{name}: {worst:e}");
+        println!("{name}: worst column difference to extrapolated differences {worst:.1e}");
+        assert!(worst <= 1e-6, "{name}: {worst:e}");
     }
 }
 
@@ -340,9 +429,10 @@ fn duffing_parameters_are_recovered() {
 }
 
 /// Cascaded tanks: fitted on the estimation record (initial levels estimated), simulated on
-/// the validation record from the same initial state; the validation RMSE this reaches,
-/// 0.515 V (published: best linear approximation 0.75 V, best black-box 0.34 V, grey-box
-/// with overflow 0.18 V — this file's overflow level and sensor limit are fixed at 10 V).
+/// the validation record from the same initial state, as the benchmark prescribes; the
+/// validation RMSE this reaches, 0.338 V (published: best linear approximation 0.75 V, best
+/// black-box 0.34 V, grey-box with overflow 0.18 V). The pump's dead zone u0 (fitted
+/// 0.79 V) and the estimated overflow level are what bring it down from 0.515 V.
 #[test]
 fn cascaded_tanks_validation_rmse() {
     let est = csv("data/cascaded-tanks/estimation.csv", "u_V", "y_V");
@@ -392,7 +482,7 @@ fn cascaded_tanks_validation_rmse() {
         "cascaded tanks: estimation RMSE {:.4} V, validation RMSE {rmse:.4} V, θ = {values:?}",
         fit.fit.mse[0][0].sqrt()
     );
-    assert!(rmse < 0.53, "validation RMSE {rmse} V");
+    assert!((rmse - 0.3384).abs() < 0.005, "validation RMSE {rmse} V");
 }
 
 /// A fitted equation model saved to JSON comes back equal and simulates the same outputs.
@@ -430,6 +520,84 @@ fn saved_equation_models_round_trip() {
         e.contains("line ") && e.contains("unknown name 'cc'"),
         "{e}"
     );
+}
+
+/// The discrete-time backlash example's true parameters (r, a, b).
+const BACKLASH: [f64; 3] = [0.2, 0.9, 0.1];
+
+/// A record for the discrete backlash model: a 0.2–5 Hz multisine of RMS 1 rad at 100 Hz
+/// (reversals of every size, so the play engages and releases), 1024 samples, with the
+/// output simulated at [`BACKLASH`] from rest.
+fn backlash_record(seed: u64) -> IdData {
+    let u = multisine(1024, 1, 100.0, 0.2, 5.0, 1.0, seed).unwrap();
+    let input = IdData::siso(0.01, "u", u.clone(), "y", vec![0.0; 1024]).unwrap();
+    let gb = GreyBox::new(
+        Arc::new(example("backlash_first_order")),
+        &input,
+        Simulation::default(),
+        InitialStates::at_rest(2, 1),
+    )
+    .unwrap();
+    let mut theta = BACKLASH.to_vec();
+    theta.extend([0.0, 0.0]);
+    let mut y = vec![vec![0.0; 1024]];
+    gb.simulate(&theta, &input, 0, &mut y).unwrap();
+    IdData::siso(0.01, "u", u, "y", y.remove(0)).unwrap()
+}
+
+/// The discrete-time file runs its recursion: the simulated output equals the recursion
+/// written out by hand, whatever the integrator; fitted from 30 % off (all three parameters
+/// free, noise-free), the parameters come back to 1e-8; the saved fit simulates the same.
+#[test]
+fn discrete_backlash_round_trip() {
+    let data = backlash_record(7);
+    let u = data.experiment(0).input(0);
+    let (r, a, b) = (BACKLASH[0], BACKLASH[1], BACKLASH[2]);
+    let (mut z, mut x) = (0.0f64, 0.0f64);
+    for (k, y) in data.experiment(0).output(0).iter().enumerate() {
+        assert!((y - x).abs() <= 1e-15, "sample {k}: {y} against {x}");
+        z = (u[k] - r).max((u[k] + r).min(z));
+        x = a * x + b * z;
+    }
+    let model = example("backlash_first_order");
+    let mut start = model.parameters();
+    start.set_values(&[r * 1.3, a * 0.9, b * 1.3]);
+    let fit = GreyBoxEstimation {
+        simulation: rk4(1, InputInterpolation::ZeroOrderHold),
+        ..Default::default()
+    }
+    .estimate(
+        Arc::new(model.clone()),
+        &data,
+        &start,
+        InitialStates::of_equations(&model, 1, &[]),
+        &mut |_| Control::Continue,
+    )
+    .unwrap();
+    let got = fit.fit.parameters.values();
+    println!("backlash round trip: {got:?}");
+    for (e, t) in got.iter().zip(BACKLASH) {
+        assert!(((e - t) / t).abs() < 1e-8, "{got:?}");
+    }
+    let fitted = FittedModel::Equations {
+        equations: model.source().to_string(),
+        parameters: {
+            let mut ps = model.parameters();
+            ps.set_values(&got[..3]);
+            ps
+        },
+        std: vec![0.0; 3],
+        simulation: rk4(1, InputInterpolation::ZeroOrderHold),
+        initial_state: vec![0.0, 0.0],
+    };
+    let json = serde_json::to_string(&fitted.to_file()).unwrap();
+    let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
+    let y = back.simulate(&[u], data.ts(), None).unwrap();
+    let worst = y[0]
+        .iter()
+        .zip(data.experiment(0).output(0))
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    assert!(worst < 1e-9, "saved model: {worst:e}");
 }
 
 /// The equation file of Bouc–Wen, fitted to the benchmark's training record with the

@@ -186,8 +186,11 @@ impl OutputErrorModel for GreyBox {
         free: &[usize],
         sink: &mut SensitivitySink<'_>,
     ) -> Option<Result<()>> {
-        let Integrator::Rk4 { substeps } = self.sim.integrator else {
-            return None;
+        let substeps = match self.sim.integrator {
+            Integrator::Rk4 { substeps } => substeps,
+            // A discrete-time model runs its recursion whatever the integrator.
+            _ if self.model.discrete_time() => 1,
+            _ => return None,
         };
         let p = self.n_model_params();
         let nx = self.model.states().len();

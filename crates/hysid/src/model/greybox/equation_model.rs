@@ -22,8 +22,16 @@
 //!   while the applied force is below Fc);
 //! * no second-order layout ([`StateSpaceModel::mechanical_dofs`] is None), so Newmark
 //!   integration is refused: use RK4 (or the adaptive integrator);
-//! * discrete-time files (`time = "discrete"`) are **refused** with an error: the
-//!   simulation path integrates ẋ = f, and a map x\[k+1\] = f(x\[k\]) is not a derivative.
+//!
+//! A discrete-time file (`[model] time = "discrete"`) gives next states instead,
+//!
+//! ```text
+//! x[k+1] = f(t_k, x[k], u[k], θ)        y[k] = h(x[k], u[k], θ)
+//! ```
+//!
+//! and is simulated by this recursion, with the sensitivities of its chain rule
+//! S\[k+1\] = f_x·S\[k\] + f_θ ([`super::discrete`]); the integrator and the input
+//! interpolation do not apply to it.
 
 use super::StateSpaceModel;
 use crate::data::Channel;
@@ -37,8 +45,9 @@ use std::path::Path;
 /// The model kind of equation-file models in saved models and reports.
 pub const EQUATIONS_KIND: &str = "equations";
 
-/// A continuous-time grey-box model read from an equation file (see the module docs):
-/// ẋ = f(t, x, u, θ), y = h(x, u, θ), with analytic Jacobians from the compiled tape.
+/// A grey-box model read from an equation file (see the module docs): ẋ = f(t, x, u, θ)
+/// (or x\[k+1\] = f(t_k, x\[k\], u\[k\], θ) in discrete time), y = h(x, u, θ), with
+/// analytic Jacobians from the compiled tape.
 ///
 /// ```
 /// use hysid::model::greybox::equation_model::EquationStateSpace;
@@ -101,8 +110,8 @@ impl EquationStateSpace {
     /// Parses, checks and compiles the equation-file text `text`; `origin` names where it
     /// came from in error messages (a path, or "saved model").
     ///
-    /// Errors: any language error (with line and column), a discrete-time file, or a
-    /// parameter whose bounds are empty (lower = upper).
+    /// Errors: any language error (with line and column), or a parameter whose bounds are
+    /// empty (lower = upper).
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
         let model = EquationModel::parse(text).map_err(|e| located(origin, e))?;
         Self::new(model, origin)
@@ -119,12 +128,6 @@ impl EquationStateSpace {
 
     /// Wraps a compiled model (see [`Self::parse`] for what is refused).
     pub fn new(model: EquationModel, origin: &str) -> Result<Self> {
-        if model.time_domain() == TimeDomain::Discrete {
-            return Err(Error::Config(format!(
-                "{origin}: model '{}' is discrete-time (time = \"discrete\"); grey-box estimation integrates continuous-time models only: write its [equations] as derivatives",
-                model.name()
-            )));
-        }
         let channel = |name: &String| {
             Channel::new(name.clone()).with_unit(model.unit(name).unwrap_or_default())
         };
@@ -198,6 +201,11 @@ impl StateSpaceModel for EquationStateSpace {
 
     fn parameters(&self) -> ParameterSet {
         self.parameters.clone()
+    }
+
+    /// True for a `time = "discrete"` file.
+    fn discrete_time(&self) -> bool {
+        self.model.time_domain() == TimeDomain::Discrete
     }
 
     #[inline]
@@ -284,9 +292,15 @@ mod tests {
     }
 
     #[test]
-    fn discrete_time_files_are_refused() {
+    fn discrete_time_files_give_next_states() {
         let text = DECAY.replace("[model]\n", "[model]\ntime = \"discrete\"\n");
-        let e = EquationStateSpace::parse(&text, "d.toml").unwrap_err();
-        assert!(e.to_string().contains("discrete-time"), "{e}");
+        let m = EquationStateSpace::parse(&text, "d.toml").unwrap();
+        assert!(m.discrete_time());
+        assert!(!EquationStateSpace::parse(DECAY, "c.toml")
+            .unwrap()
+            .discrete_time());
+        let mut next = [0.0];
+        m.rhs(0.0, &[3.0], &[1.0], &[2.0], &mut next);
+        assert_eq!(next[0], -5.0);
     }
 }

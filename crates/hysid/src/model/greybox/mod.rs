@@ -17,11 +17,14 @@
 //!   input interpolation between samples.
 //! * [`stick_slip`]: RK4 steps that integrate Coulomb friction as stick–slip.
 //! * [`sensitivity`]: the right-hand side of the forward sensitivity equations.
+//! * [`discrete`]: discrete-time models (x\[k+1\] = f(…), [`StateSpaceModel::discrete_time`]),
+//!   simulated by their recursion, with its exact sensitivities.
 //!
 //! Binding a model to data and estimating its parameters is the identify layer's
 //! ([`crate::identify::greybox`]).
 //! * [`models`]: the built-in models (Bouc–Wen oscillator, rigid body with friction).
 
+pub mod discrete;
 pub mod equation_model;
 pub mod models;
 pub mod sensitivity;
@@ -80,6 +83,14 @@ pub trait StateSpaceModel: Sync + Send {
         _hx: &mut [f64],
         _htheta: &mut [f64],
     ) -> bool {
+        false
+    }
+
+    /// True for a discrete-time model: [`rhs`](Self::rhs) then gives the next state
+    /// x\[k+1\] = f(t_k, x\[k\], u\[k\], θ) instead of ẋ, its Jacobians are those of this
+    /// map, and simulation runs the recursion whatever the integrator ([`discrete`]).
+    /// False (the default): continuous time.
+    fn discrete_time(&self) -> bool {
         false
     }
 

@@ -231,7 +231,8 @@ pub fn band_limited_upsample(x: &[f64], factor: usize) -> Vec<f64> {
 
 /// Simulates `model` over the samples of `input` with sample time `ts` from the initial
 /// state `x0`, calling `on_sample(k, x(t_k))` at every sample. Errors with
-/// [`Error::Diverged`] at the first sample where the state is not finite.
+/// [`Error::Diverged`] at the first sample where the state is not finite. A discrete-time
+/// model runs its recursion instead, `integrator` unused ([`super::discrete`]).
 pub fn simulate(
     model: &dyn StateSpaceModel,
     theta: &[f64],
@@ -241,6 +242,9 @@ pub fn simulate(
     integrator: Integrator,
     mut on_sample: impl FnMut(usize, &[f64]),
 ) -> Result<()> {
+    if model.discrete_time() {
+        return super::discrete::simulate(model, theta, x0, input, ts, on_sample);
+    }
     let n = input.len();
     let mut x = x0.to_vec();
     let mut stepper = Stepper::new(model, theta, input, ts, integrator)?;
@@ -597,7 +601,9 @@ impl<'a> Stepper<'a> {
 /// Simulates with RK4 and the forward sensitivities S = ∂x/∂p for the parameters listed in
 /// `params` (indices into θ) followed by the initial states listed in `initial` (indices into
 /// x). Calls `on_sample(k, x(t_k), S(t_k))` with S row-major n × q. Needs the model's
-/// analytic Jacobians; returns Ok(false) without simulating when it has none.
+/// analytic Jacobians; returns Ok(false) without simulating when it has none. A
+/// discrete-time model runs its recursion and its chain rule instead, `substeps` unused
+/// ([`super::discrete`]).
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_sensitivities(
     model: &dyn StateSpaceModel,
@@ -610,6 +616,11 @@ pub fn simulate_sensitivities(
     initial: &[usize],
     mut on_sample: impl FnMut(usize, &[f64], &[f64]),
 ) -> Result<bool> {
+    if model.discrete_time() {
+        return super::discrete::simulate_sensitivities(
+            model, theta, x0, input, ts, params, initial, on_sample,
+        );
+    }
     let n = x0.len();
     let n_samples = input.len();
     let p = theta.len();
