@@ -98,8 +98,8 @@ pub struct ActuatorConstants {
     /// (0, 1e12].
     #[arg(long, default_value_t = 1.867e-3, value_parser = crate::options::positive)]
     pub gear_ratio: f64,
-    /// Saddle mass m [kg] (known; the paper's actuator: 1.2). Range (0, 1e12].
-    #[arg(long, default_value_t = 1.2, value_parser = crate::options::positive)]
+    /// Saddle mass m [kg] (known; the paper's actuator: 1.2). Range [0, 1e6].
+    #[arg(long, default_value_t = 1.2, value_parser = crate::options::nonnegative)]
     pub saddle_mass: f64,
 }
 
