@@ -10,7 +10,8 @@ directory holding copies of the inputs it needs, with a timeout, and is classifi
 
     panic      exit 101 or "panicked" on stderr
     signal     killed by a signal (SIGABRT from a failed allocation, SIGSEGV, ...)
-    nonfinite  exit 0 with NaN/inf in stdout or in a file it wrote
+    nonfinite  exit 0 with NaN/inf in stdout or in a file it wrote (printed bounds such as
+               "[0, inf]" are settings, not results, and are left out)
     stray      a failing run left a file behind (temporaries included) or changed an input
     multiline  a failing run printed other than exactly one line on stderr
     unbounded  still running at the timeout
@@ -41,14 +42,15 @@ import time
 
 # --- The table ------------------------------------------------------------------------
 
-# Options whose names are changing: one place to update.
+# Output options by role: one place to update when one is renamed (the old spellings are
+# still accepted with a deprecation warning, which would count as a second stderr line).
 FLAG = {
-    "plots": "--out",  # plot directory of demo/identify/greybox/benchmark (→ --plots)
-    "sim_csv": "--out",  # simulate's output CSV (→ --csv)
-    "model_out": "--model",  # identify's model file output (→ --model-out)
+    "plots": "--plots",  # plot directory of demo/identify/greybox/benchmark
+    "sim_csv": "--csv",  # simulate's output CSV
+    "model_out": "--model-out",  # identify's model file output
     "greybox_model_out": "--model-out",
-    "rig_dir": "--out",  # actuator rig's data directory
-    "gen_csv": "--out",  # generate's CSV
+    "rig_dir": "--data-out",  # actuator rig's data directory
+    "gen_csv": "--csv",  # generate's CSV
 }
 
 # Bad values for every numeric option.
@@ -184,6 +186,14 @@ PLACEHOLDER_KIND = {"cascade": "csv", "bw": "csv", "rb": "csv", "model": "model"
 MEMORY_KIB = 4 * 1024 * 1024
 
 NONFINITE = re.compile(rb"(?<![A-Za-z_])(-?nan|NaN|-?inf|-?Inf|-?Infinity|inf%)(?![A-Za-z_])")
+# Parameter bounds are printed as intervals, "[0, inf]" or "(-inf, 5)": an infinite bound is
+# a setting, not a result, and is left out before the search for non-finite results.
+BOUNDS = re.compile(rb"[\[(][^\[\]()\n]*,[^\[\]()\n]*[\])]")
+
+
+def nonfinite_result(text):
+    """The first non-finite number of `text` outside printed bounds, or None."""
+    return NONFINITE.search(BOUNDS.sub(b"", text))
 
 # --- Fixtures -------------------------------------------------------------------------
 
@@ -193,12 +203,13 @@ def make_fixtures(binary, root):
     fx = {}
     run = lambda args: subprocess.run([binary] + args, cwd=root, capture_output=True,
                                       timeout=300, check=True)
-    run(["generate", "voros", "--example", "1", "--samples", "400", "--out", "cascade.csv"])
+    run(["generate", "voros", "--example", "1", "--samples", "400", FLAG["gen_csv"],
+         "cascade.csv"])
     fx["cascade"] = os.path.join(root, "cascade.csv")
     run(["benchmark", "bouc-wen", "generate", "--samples", "3000", "--periods", "1",
-         "--out", "bw.csv"])
+         FLAG["gen_csv"], "bw.csv"])
     fx["bw"] = os.path.join(root, "bw.csv")
-    run(["actuator", "rig", "--out", "rig"])
+    run(["actuator", "rig", FLAG["rig_dir"], "rig"])
     fx["rig"] = os.path.join(root, "rig")
     # A rigid body with viscous and Coulomb friction: M q'' + Fv q' + Fc sgn q' = u.
     ts, m, fv, fc = 1e-3, 2.0, 5.0, 1.0
@@ -446,7 +457,7 @@ def classify(proc, before, after, work):
     if rc == 101 or "panicked" in err:
         return "panic", rc, err.strip()[-400:]
     if rc == 0:
-        bad = NONFINITE.search(proc.stdout)
+        bad = nonfinite_result(proc.stdout)
         where = "stdout" if bad else None
         if not bad:
             for name, digest in after.items():
@@ -454,7 +465,7 @@ def classify(proc, before, after, work):
                     continue
                 try:
                     with open(os.path.join(work, name), "rb") as f:
-                        bad = NONFINITE.search(f.read(50_000_000))
+                        bad = nonfinite_result(f.read(50_000_000))
                 except OSError:
                     continue
                 if bad:

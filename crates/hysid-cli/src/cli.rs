@@ -10,6 +10,25 @@ pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+    #[command(flatten)]
+    pub run: RunArgs,
+}
+
+/// Options of every command: progress, time and work limits.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Print no progress on stderr (errors and warnings still go there).
+    #[arg(long, short, global = true)]
+    pub quiet: bool,
+    /// Stop the long searches (multi-start, bootstrap, the global grid, grey-box fits) after
+    /// this many seconds with the best result so far; the report's search.termination is then
+    /// `time_limit` and a warning line is printed (exit 0). Range (0, 1e7].
+    #[arg(long = "time-limit", global = true, value_parser = crate::options::seconds)]
+    pub time_limit: Option<f64>,
+    /// Run a request whose estimated work exceeds the budget of 1e10 model evaluations
+    /// (sample-steps); without it such a request is refused before it starts.
+    #[arg(long = "allow-long", global = true)]
+    pub allow_long: bool,
 }
 
 /// The subcommands.
@@ -56,12 +75,12 @@ pub enum Actuator {
 #[derive(Debug, Args)]
 pub struct RigSettings {
     /// Play width of an unmodelled backlash in the flexibility [rad] (0: none; the real
-    /// actuator has one, e.g. 0.003).
-    #[arg(long, default_value_t = 0.0)]
+    /// actuator has one, e.g. 0.003). Range [0, 1e6].
+    #[arg(long, default_value_t = 0.0, value_parser = crate::options::nonnegative)]
     pub backlash: f64,
     /// Measurement noise as a multiple of the documented levels (one 16-bit count:
-    /// 2.77e-5 rad on the angle, 4.40e-5 N·m on the torque); 0 for none.
-    #[arg(long, default_value_t = 1.0)]
+    /// 2.77e-5 rad on the angle, 4.40e-5 N·m on the torque); 0 for none. Range [0, 1e6].
+    #[arg(long, default_value_t = 1.0, value_parser = crate::options::nonnegative)]
     pub noise: f64,
     /// Seed of the noise.
     #[arg(long, default_value_t = 0)]
@@ -75,11 +94,12 @@ pub struct RigSettings {
 /// The actuator's known constants.
 #[derive(Debug, Args)]
 pub struct ActuatorConstants {
-    /// Gear ratio r of the screw [m/rad] (known; the paper's actuator: 1.867e-3).
-    #[arg(long, default_value_t = 1.867e-3)]
+    /// Gear ratio r of the screw [m/rad] (known; the paper's actuator: 1.867e-3). Range
+    /// (0, 1e12].
+    #[arg(long, default_value_t = 1.867e-3, value_parser = crate::options::positive)]
     pub gear_ratio: f64,
-    /// Saddle mass m [kg] (known; the paper's actuator: 1.2).
-    #[arg(long, default_value_t = 1.2)]
+    /// Saddle mass m [kg] (known; the paper's actuator: 1.2). Range [0, 1e6].
+    #[arg(long, default_value_t = 1.2, value_parser = crate::options::nonnegative)]
     pub saddle_mass: f64,
 }
 
@@ -102,22 +122,23 @@ pub struct ThreeStepArgs {
     #[arg(long)]
     pub remove_mean: bool,
     /// Cut-off of the zero-phase 4th-order Butterworth pre-filter [Hz] (the paper: 100).
-    #[arg(long, default_value_t = 100.0)]
+    /// Range (0, 1e12], below the Nyquist frequency of the data.
+    #[arg(long, default_value_t = 100.0, value_parser = crate::options::positive)]
     pub cutoff: f64,
     /// Step 2 leaves out samples within this fraction of a loop's peak-to-peak torsion from
-    /// a reversal, where the motor sticks and the friction torque is unknown.
-    #[arg(long, default_value_t = 0.05)]
+    /// a reversal, where the motor sticks and the friction torque is unknown. Range [0, 0.5).
+    #[arg(long, default_value_t = 0.05, value_parser = crate::options::margin)]
     pub reversal_margin: f64,
     /// Fit step 3 (and score Table II) on the unfiltered records; the paper pre-filters
     /// them, which biases a nonlinear model slightly (see the README).
     #[arg(long)]
     pub unfiltered_step3: bool,
-    /// Maximum iterations of each step-3 fit (the paper: 30).
-    #[arg(long, default_value_t = 30)]
+    /// Maximum iterations of each step-3 fit (the paper: 30). Range 1..=10000.
+    #[arg(long, default_value_t = 30, value_parser = crate::options::count::<1, 10_000>)]
     pub max_iterations: usize,
     /// Stop a step-3 fit when the expected relative improvement falls below this (the
-    /// paper: 0.01 %).
-    #[arg(long, default_value_t = 1e-4)]
+    /// paper: 0.01 %). Range [1e-15, 1).
+    #[arg(long, default_value_t = 1e-4, value_parser = crate::options::tolerance)]
     pub tolerance: f64,
 }
 
@@ -164,8 +185,8 @@ pub struct RigidBodyLsArgs {
     /// Column of the drive signal u (force = gain·u).
     #[arg(long)]
     pub input: String,
-    /// Drive gain g [force per unit of u] (EMPS: 35.15065188 N/V).
-    #[arg(long, default_value_t = 1.0)]
+    /// Drive gain g [force per unit of u] (EMPS: 35.15065188 N/V). Range ±[1e-9, 1e9].
+    #[arg(long, default_value_t = 1.0, value_parser = crate::options::gain, allow_negative_numbers = true)]
     pub gain: f64,
     /// Estimate a constant force offset.
     #[arg(long)]
@@ -174,17 +195,20 @@ pub struct RigidBodyLsArgs {
     /// estimate on each.
     #[arg(long)]
     pub validate: Vec<PathBuf>,
-    /// Cut-off of the zero-phase Butterworth position filter [Hz].
-    #[arg(long, default_value_t = 100.0)]
+    /// Cut-off of the zero-phase Butterworth position filter [Hz]. Range (0, 1e12], below
+    /// the Nyquist frequency of the data.
+    #[arg(long, default_value_t = 100.0, value_parser = crate::options::positive)]
     pub cutoff: f64,
-    /// Order of the Butterworth filter.
-    #[arg(long, default_value_t = 4)]
+    /// Order of the Butterworth filter. Range 1..=12.
+    #[arg(long, default_value_t = 4, value_parser = crate::options::count::<1, 12>)]
     pub order: usize,
-    /// Decimation factor of the regression ("parallel decimation"; 1 for none).
-    #[arg(long, default_value_t = 10)]
+    /// Decimation factor of the regression ("parallel decimation"; 1 for none). Range
+    /// 1..=10000.
+    #[arg(long, default_value_t = 10, value_parser = crate::options::count::<1, 10_000>)]
     pub decimate: usize,
-    /// Samples dropped at each end (filter transients), at the original rate.
-    #[arg(long, default_value_t = 50)]
+    /// Samples dropped at each end (filter transients), at the original rate. Range
+    /// 0..=100000000, fewer than half the record.
+    #[arg(long, default_value_t = 50, value_parser = crate::options::count::<0, 100_000_000>)]
     pub border: usize,
     /// Write the JSON report here.
     #[arg(long)]
@@ -255,8 +279,9 @@ pub struct SimulationArgs {
     /// Integrator.
     #[arg(long, value_enum, default_value_t = IntegratorArg::Rk4)]
     pub integrator: IntegratorArg,
-    /// Integration steps per sample.
-    #[arg(long, default_value_t = 10)]
+    /// Integration steps per sample. Range 1..=1000 (memory and work checked against the
+    /// record's length).
+    #[arg(long, default_value_t = 10, value_parser = crate::options::count::<1, 1000>)]
     pub substeps: usize,
     /// Input between samples.
     #[arg(long, value_enum, default_value_t = InterpolationArg::Zoh)]
@@ -287,17 +312,18 @@ pub enum InterpolationArg {
 #[derive(Debug, Args)]
 pub struct SearchArgs {
     /// Number of starting points (drawn inside the bounds; the first is the given start).
-    #[arg(long, default_value_t = 1)]
+    /// Range 1..=100000 (work checked against the record's length).
+    #[arg(long, default_value_t = 1, value_parser = crate::options::count::<1, 100_000>)]
     pub starts: usize,
     /// Seed of the random starts.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Maximum iterations of the final fit (Gunnar et al. 2006 use 30).
-    #[arg(long, default_value_t = 100)]
+    /// Maximum iterations of the final fit (Gunnar et al. 2006 use 30). Range 1..=100000.
+    #[arg(long, default_value_t = 100, value_parser = crate::options::count::<1, 100_000>)]
     pub max_iterations: usize,
     /// Stop when the expected relative improvement falls below this (Gunnar et al. 2006:
-    /// 1e-4, i.e. 0.01 %).
-    #[arg(long, default_value_t = 1e-10)]
+    /// 1e-4, i.e. 0.01 %). Range [1e-15, 1).
+    #[arg(long, default_value_t = 1e-10, value_parser = crate::options::tolerance)]
     pub tolerance: f64,
 }
 
@@ -325,8 +351,8 @@ pub struct BoucWenArgs {
     /// (steady state of a periodic test signal) instead of simulating from rest.
     #[arg(long)]
     pub steady_state: bool,
-    /// Start from the benchmark's nominal parameters times this factor.
-    #[arg(long, default_value_t = 1.0)]
+    /// Start from the benchmark's nominal parameters times this factor. Range [1e-6, 1e6].
+    #[arg(long, default_value_t = 1.0, value_parser = crate::options::factor)]
     pub start_factor: f64,
     /// Initial value, NAME=VALUE (repeatable; overrides the nominal start).
     #[arg(long)]
@@ -347,15 +373,16 @@ pub struct BoucWenArgs {
 /// Search settings of the benchmark fit.
 #[derive(Debug, Args)]
 pub struct BenchmarkSearchArgs {
-    /// Number of starting points.
-    #[arg(long, default_value_t = 8)]
+    /// Number of starting points. Range 1..=100000 (work checked against the record's
+    /// length).
+    #[arg(long, default_value_t = 8, value_parser = crate::options::count::<1, 100_000>)]
     pub starts: usize,
     /// Seed of the random starts.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// RK4 steps per sample (750 Hz × 4 = 3 kHz; the training record's residual is its noise
-    /// from 2 on).
-    #[arg(long, default_value_t = 4)]
+    /// from 2 on). Range 1..=1000 (memory and work checked against the record's length).
+    #[arg(long, default_value_t = 4, value_parser = crate::options::count::<1, 1000>)]
     pub substeps: usize,
 }
 
@@ -372,17 +399,19 @@ pub struct BoucWenGenerateArgs {
     /// multisine (8192 samples per period, 5–150 Hz, RMS 50 N) or sweep (40 sin(2π(18t + t²/12))).
     #[arg(long, value_enum, default_value_t = SignalArg::Multisine)]
     pub signal: SignalArg,
-    /// Multisine periods to simulate and write (from rest).
-    #[arg(long, default_value_t = 2)]
+    /// Multisine periods to simulate and write (from rest). Range 1..=10000 (memory
+    /// checked).
+    #[arg(long, default_value_t = 2, value_parser = crate::options::count::<1, 10_000>)]
     pub periods: usize,
-    /// Sweep samples.
-    #[arg(long, default_value_t = 153_000)]
+    /// Sweep samples. Range 2..=100000000 (memory checked).
+    #[arg(long, default_value_t = 153_000, value_parser = crate::options::count::<2, 100_000_000>)]
     pub samples: usize,
     /// Seed of the multisine phases.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// RMS of white Gaussian output noise to add (the training records use 8e-6 m).
-    #[arg(long, default_value_t = 0.0)]
+    /// RMS of white Gaussian output noise to add (the training records use 8e-6 m). Range
+    /// [0, 1e6].
+    #[arg(long, default_value_t = 0.0, value_parser = crate::options::nonnegative)]
     pub noise: f64,
     /// The CSV file to write.
     #[arg(long)]
@@ -412,7 +441,8 @@ pub struct GenerateVorosArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub example: u8,
     /// Number of samples (the amplitude schedule repeats); default the example's own length.
-    #[arg(long)]
+    /// Range 2..=100000000 (memory checked).
+    #[arg(long, value_parser = crate::options::count::<2, 100_000_000>)]
     pub samples: Option<usize>,
     /// Leave the output noise out.
     #[arg(long)]
@@ -474,8 +504,9 @@ pub struct VorosArgs {
     /// How the standard deviations are obtained.
     #[arg(long, value_enum, default_value_t = UncertaintyArg::Bootstrap)]
     pub uncertainty: UncertaintyArg,
-    /// Bootstrap replicates (with --uncertainty bootstrap).
-    #[arg(long, default_value_t = 30)]
+    /// Bootstrap replicates (with --uncertainty bootstrap). Range 1..=100000 (work checked
+    /// against the record's length).
+    #[arg(long, default_value_t = 30, value_parser = crate::options::count::<1, 100_000>)]
     pub replicates: usize,
 }
 
@@ -512,8 +543,8 @@ pub struct DataArgs {
     /// Output column (one per --input).
     #[arg(long, required = true)]
     pub output: Vec<String>,
-    /// Sample time; otherwise from the time column, else 1.
-    #[arg(long)]
+    /// Sample time [s]; otherwise from the time column, else 1. Range (0, 1e12].
+    #[arg(long, value_parser = crate::options::positive)]
     pub ts: Option<f64>,
     /// Time column (default: a column named t, time, t_s or time_s, if any).
     #[arg(long)]
@@ -542,20 +573,21 @@ pub struct CascadeArgs {
     /// Hysteresis form: ch4 (saturated, 4 parameters) or ch6.
     #[arg(long)]
     pub hysteresis: String,
-    /// Order n of A(q⁻¹).
-    #[arg(long)]
+    /// Order n of A(q⁻¹). Range 0..=50.
+    #[arg(long, value_parser = crate::options::count::<0, 50>)]
     pub na: usize,
-    /// Number m of B coefficients (b1 = 1 included).
-    #[arg(long)]
+    /// Number m of B coefficients (b1 = 1 included). Range 1..=50.
+    #[arg(long, value_parser = crate::options::count::<1, 50>)]
     pub nb: usize,
-    /// Input delay k ≥ 1 of the linear block.
-    #[arg(long)]
+    /// Input delay k of the linear block. Range 1..=100000, shorter than the record.
+    #[arg(long, value_parser = crate::options::count::<1, 100_000>)]
     pub delay: usize,
     /// How the standard deviations are obtained.
     #[arg(long, value_enum, default_value_t = UncertaintyArg::Asymptotic)]
     pub uncertainty: UncertaintyArg,
-    /// Bootstrap replicates (with --uncertainty bootstrap).
-    #[arg(long, default_value_t = 30)]
+    /// Bootstrap replicates (with --uncertainty bootstrap). Range 1..=100000 (work checked
+    /// against the record's length).
+    #[arg(long, default_value_t = 30, value_parser = crate::options::count::<1, 100_000>)]
     pub replicates: usize,
     /// Seed of the bootstrap.
     #[arg(long, default_value_t = 0)]
@@ -604,8 +636,8 @@ pub struct SimulateArgs {
     /// Measured output column, for fit % and RMSE.
     #[arg(long)]
     pub output: Option<String>,
-    /// Sample time; otherwise from the time column, else 1.
-    #[arg(long)]
+    /// Sample time [s]; otherwise from the time column, else 1. Range (0, 1e12].
+    #[arg(long, value_parser = crate::options::positive)]
     pub ts: Option<f64>,
     /// Time column (default: a column named t, time, t_s or time_s, if any).
     #[arg(long)]

@@ -5,10 +5,12 @@
 //! code says its class: 0 success, 1 bad input or data, 2 usage, 3 numerical failure, 4 I/O
 //! (the table is in [`exit`]).
 
+mod budget;
 mod cli;
 mod commands;
 mod deprecated;
 mod exit;
+mod options;
 mod output;
 mod plot;
 mod progress;
@@ -26,8 +28,15 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return parser_exit(&e),
     };
+    progress::init(cli.run.quiet, cli.run.time_limit);
+    budget::init(cli.run.allow_long);
     match commands::run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(()) => {
+            if let Some(warning) = progress::time_limit_warning() {
+                eprintln!("{warning}");
+            }
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {}", exit::one_line(&e));
             exit::classify(&e).exit_code()

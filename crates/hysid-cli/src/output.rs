@@ -7,6 +7,8 @@ use std::path::Path;
 
 /// Writes `value` as pretty JSON to `path` atomically.
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    // serde_json would write NaN and ±inf as null: refuse them (a numerical failure).
+    hysid::io::atomic::ensure_finite(value)?;
     let text = serde_json::to_string_pretty(value).context("serialising the report")?;
     write_atomic(path, text.as_bytes())
 }
@@ -14,7 +16,8 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
 /// Writes the report as pretty JSON to `path` atomically, refused when a number in it is
 /// not finite.
 pub fn write_report(path: &Path, report: &hysid::report::Report) -> Result<()> {
-    let text = report.to_json()?;
+    // A search stopped by --time-limit says so in the report.
+    let text = crate::progress::mark_report(report).to_json()?;
     write_atomic(path, text.as_bytes()).context("writing the JSON report")
 }
 

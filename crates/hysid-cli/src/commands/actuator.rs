@@ -233,8 +233,9 @@ fn rig_from(settings: &RigSettings, constants: &ActuatorConstants) -> Result<Rig
 
 /// Simulates and writes the data sets and rig.json; returns the data-set files.
 fn write_rig(rig: &Rig, dir: &Path) -> Result<Vec<PathBuf>> {
-    ensure_dir(dir)?;
+    // Simulate first: a rig that fails leaves no directory behind.
     let records = rig.records()?;
+    ensure_dir(dir)?;
     let files = records
         .iter()
         .map(|r| r.write(dir))

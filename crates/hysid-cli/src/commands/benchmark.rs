@@ -125,8 +125,16 @@ fn fit_training(args: &BoucWenArgs, data: &IdData) -> Result<(GreyBoxFit, Simula
         seed: args.search.seed,
         ..GreyBoxEstimation::default()
     };
+    crate::budget::check(
+        "the Bouc–Wen fit",
+        estimation.work_estimate(data.n_samples(), 1, 3, params.free_indices().len() + 3),
+    )?;
     let fit = {
         let progress = FitProgress::new("fitting Bouc–Wen");
+        let estimation = GreyBoxEstimation {
+            observer: progress.observer(),
+            ..estimation
+        };
         let mut callback = progress.callback();
         estimation.estimate(
             Arc::new(BoucWen),
@@ -228,6 +236,15 @@ const UP: usize = 20;
 /// β = ¼) at 15 kHz, low-pass filtering and decimation back to 750 Hz.
 fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
     preflight(&[Some(&args.csv)], &[])?;
+    let samples = match args.signal {
+        SignalArg::Multisine => args.periods.saturating_mul(8192),
+        SignalArg::Sweep => args.samples,
+    };
+    // The simulation runs at UP times the rate, on the band-limited input.
+    crate::budget::check(
+        "the test-signal simulation",
+        hysid::identify::budget::simulation(samples.saturating_mul(UP), 1, 1, 3, 0, true),
+    )?;
     let (u, u_fine) = match args.signal {
         SignalArg::Multisine => {
             anyhow::ensure!(args.periods >= 1, "--periods must be at least 1");

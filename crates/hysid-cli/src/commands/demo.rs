@@ -50,8 +50,13 @@ pub fn voros(args: &VorosArgs) -> Result<()> {
             )
         }
     );
+    crate::budget::check(
+        "the cascade identification",
+        id.work_estimate(data.n_samples()),
+    )?;
     let fit = {
         let progress = FitProgress::new("identifying");
+        id.observer = progress.observer();
         let mut callback = progress.callback();
         id.estimate(&data, &mut callback)?
     };

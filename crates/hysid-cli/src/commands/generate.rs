@@ -12,6 +12,10 @@ pub fn voros(args: &GenerateVorosArgs) -> Result<()> {
     preflight(&[Some(&args.csv)], &[])?;
     if let Some(n) = args.samples {
         anyhow::ensure!(n >= 2, "--samples must be at least 2, got {n}");
+        crate::budget::check(
+            "the generated record",
+            hysid::identify::budget::simulation(n, 1, 1, 2, 0, false),
+        )?;
         ex = ex.extended(n);
     }
     let data = ex.generate(args.seed, !args.noise_free)?;

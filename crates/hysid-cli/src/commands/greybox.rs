@@ -56,8 +56,23 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         seed: args.search.seed,
         ..GreyBoxEstimation::default()
     };
+    let estimated_states = initial.estimated.iter().filter(|e| **e).count();
+    let free = params.free_indices().len() + estimated_states * data.n_experiments();
+    crate::budget::check(
+        "the grey-box fit",
+        estimation.work_estimate(
+            data.n_samples(),
+            model.inputs().len(),
+            model.states().len(),
+            free,
+        ),
+    )?;
     let fit = {
         let progress = FitProgress::new("fitting");
+        let estimation = GreyBoxEstimation {
+            observer: progress.observer(),
+            ..estimation
+        };
         let mut callback = progress.callback();
         estimation.estimate(model.clone(), &data, &params, initial, &mut callback)?
     };
@@ -114,6 +129,9 @@ pub fn configure(
     init: &[String],
     bounds: &[String],
 ) -> Result<ParameterSet> {
+    if let Some(name) = fix.iter().find(|n| free.contains(n)) {
+        bail!("--fix {name} and --free {name}: a parameter is either fixed or free; give it to one of them");
+    }
     for name in fix {
         params.by_name_mut(name)?.fixed = true;
     }
@@ -124,7 +142,11 @@ pub fn configure(
         let (name, value) = spec
             .split_once('=')
             .with_context(|| format!("--init {spec}: write NAME=VALUE"))?;
-        params.by_name_mut(name.trim())?.value = number(value, "--init", spec)?;
+        let value = number(value, "--init", spec)?;
+        if !value.is_finite() {
+            bail!("--init {spec}: the initial value must be finite");
+        }
+        params.by_name_mut(name.trim())?.value = value;
     }
     for spec in bounds {
         let (name, range) = spec
@@ -133,9 +155,19 @@ pub fn configure(
         let (lo, hi) = range
             .split_once(':')
             .with_context(|| format!("--bounds {spec}: write NAME=LO:HI"))?;
+        let (lo, hi) = (number(lo, "--bounds", spec)?, number(hi, "--bounds", spec)?);
         let p = params.by_name_mut(name.trim())?;
-        p.min = number(lo, "--bounds", spec)?;
-        p.max = number(hi, "--bounds", spec)?;
+        // The model's own bounds are its physics (a positive mass): narrow them, never widen.
+        if lo < p.min || hi > p.max {
+            bail!(
+                "--bounds {spec}: the model needs {} within [{}, {}]; give bounds inside that range",
+                p.name,
+                p.min,
+                p.max
+            );
+        }
+        p.min = lo;
+        p.max = hi;
     }
     Ok(params)
 }
@@ -144,9 +176,10 @@ fn number(text: &str, option: &str, spec: &str) -> Result<f64> {
     match text.trim() {
         "inf" | "+inf" => Ok(f64::INFINITY),
         "-inf" => Ok(f64::NEG_INFINITY),
-        t => t
-            .parse()
-            .with_context(|| format!("{option} {spec}: '{t}' is not a number")),
+        t => match t.parse::<f64>() {
+            Ok(v) if !v.is_nan() => Ok(v),
+            _ => bail!("{option} {spec}: '{t}' is not a number"),
+        },
     }
 }
 

@@ -75,8 +75,13 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
     let mut id = CascadeIdentification::new(form, args.na, args.nb, args.delay);
     id.uncertainty = uncertainty(args.uncertainty, args.replicates);
     id.bootstrap_seed = args.seed;
+    crate::budget::check(
+        "the cascade identification",
+        id.work_estimate(data.n_samples()),
+    )?;
     let fit = {
         let progress = FitProgress::new("identifying cascade");
+        id.observer = progress.observer();
         let mut callback = progress.callback();
         id.estimate(&data, &mut callback)?
     };

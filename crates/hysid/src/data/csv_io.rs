@@ -431,10 +431,11 @@ fn check_table(path: &Path, headers: &[&str], columns: &[&[f64]]) -> Result<()> 
                 one_line(headers[0])
             )));
         }
+        // A table being written holds results: a non-finite one is a numerical failure,
+        // not bad data.
         if let Some(index) = column.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                channel: one_line(header).into_owned(),
-                index,
+            return Err(Error::NonFiniteResult {
+                key: format!("{}[{index}]", one_line(header)),
                 value: column[index],
             });
         }

@@ -228,6 +228,15 @@ impl Rig {
             (warmup * fs).round() as usize,
             (length * fs).round() as usize,
         );
+        if let Some(index) = torque.iter().chain(&angle).position(|v| !v.is_finite()) {
+            return Err(Error::Diverged {
+                index: index % torque.len().max(1),
+                reason: format!(
+                    "the rig's simulation of data set {set} left the finite range with these \
+                     settings; check the true parameters, the backlash and the constants"
+                ),
+            });
+        }
         let (torque, angle) = self.add_noise(set, torque, angle)?;
         Ok(RigRecord {
             set,
@@ -243,6 +252,19 @@ impl Rig {
             return Err(Error::Config(
                 "the rig needs 7 finite true parameters (J, Fv, Fc, k1, k2, alpha, A)".into(),
             ));
+        }
+        // The physics: positive inertia, non-negative friction and hysteresis rate.
+        for (p, &value) in ActuatorFixed.parameters().iter().zip(&self.truth) {
+            if !(p.min..=p.max).contains(&value) {
+                return Err(Error::InvalidParameter {
+                    name: p.name.clone(),
+                    value,
+                    reason: format!(
+                        "the actuator's true {} must lie in [{}, {}]",
+                        p.name, p.min, p.max
+                    ),
+                });
+            }
         }
         if self.fs.is_nan()
             || self.fs <= 0.0
@@ -416,7 +438,9 @@ impl Plant {
         x[..4].copy_from_slice(&s);
         let x1 = x[0] - x[2] / r;
         let half = 0.5 * self.backlash;
-        let new_d = d.clamp(x1 - half, x1 + half);
+        // max/min, not clamp: a diverged state (NaN) must reach the finite check of the
+        // records, not panic here.
+        let new_d = d.max(x1 - half).min(x1 + half);
         let delta = new_d - d;
         if delta != 0.0 {
             let target = th[6] / th[5] * delta.signum();

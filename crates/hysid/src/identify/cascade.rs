@@ -23,9 +23,7 @@
 use super::bootstrap::{parametric_bootstrap, Bootstrap};
 use super::cascade_pass::{simulate_into, stream_sensitivities};
 use super::global::{GlobalSearch, GridCandidate};
-use super::hysteresis::{
-    bounded_parameter, check_excitation, check_finite, max_increment, rate_error,
-};
+use super::hysteresis::{alpha_max, bounded_parameter, check_excitation, check_finite, rate_error};
 use super::key_term::{KeyTermFit, KeyTermSeparation};
 use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel, SensitivitySink};
 use super::switching::{
@@ -37,8 +35,10 @@ use crate::data::{Experiment, IdData};
 use crate::model::ParameterSet;
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade};
 use crate::numerics::levenberg_marquardt::{Control, IterationRecord, LmConfig};
+use crate::numerics::Observer;
 use crate::{Error, Result};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// The cascade structure (form and orders) as an output-error model: input channel 0 is x,
@@ -146,6 +146,10 @@ pub struct CascadeIdentification {
     pub bootstrap_seed: u64,
     /// Settings of the output-error fits.
     pub lm: LmConfig,
+    /// Sees "grid" (once the grid is scored) and "bootstrap replicate k/N";
+    /// [`Control::Stop`] skips the remaining bootstrap replicates (with fewer than two done,
+    /// the asymptotic standard deviations stand).
+    pub observer: Observer,
 }
 
 /// How one starting candidate fared in the local refinement.
@@ -225,6 +229,7 @@ impl CascadeIdentification {
             bootstrap_seed: 0,
             grid: GlobalSearch::new(form, na, nb, delay),
             lm: LmConfig::default(),
+            observer: Observer::none(),
         }
     }
 
@@ -249,6 +254,7 @@ impl CascadeIdentification {
             window.experiment(0).output(0),
         );
         let grid = self.grid.search(x, y)?;
+        self.observer.report("grid", 1, 1);
         // The paper's iteration and the grid candidates' refinement are independent: run them
         // side by side, then refine the iteration's result (candidates keep their order).
         let (key_term, mut candidates) = rayon::join(
@@ -282,12 +288,17 @@ impl CascadeIdentification {
         let d_index = self.structure.form.n_params() - 1;
         let (output_error, threshold) = place_threshold(&self.make(), data, switched.fit, d_index)?;
         let model = self.structure.cascade(&output_error.parameters.values())?;
-        if model.hysteresis.alpha() >= (1.0 - 1e-9) / max_increment(data) {
+        let alpha = model.hysteresis.alpha();
+        if !(alpha > 0.0 && alpha <= alpha_max(data)) {
             return Err(rate_error(data, model.hysteresis.alpha()));
         }
         let bootstrap = match self.uncertainty {
             Uncertainty::Asymptotic => None,
-            Uncertainty::Bootstrap(n) => Some(self.run_bootstrap(data, &output_error, n)?),
+            Uncertainty::Bootstrap(n) => match self.run_bootstrap(data, &output_error, n) {
+                // A time limit that left fewer than two replicates: the asymptotic ones stand.
+                Err(_) if self.observer.should_stop("bootstrap replicate") => None,
+                other => Some(other?),
+            },
         };
         Ok(CascadeFit {
             model,
@@ -317,7 +328,12 @@ impl CascadeIdentification {
             ));
         }
         check_excitation(data, s.n_params())?;
-        let needed = 3 * s.n_params() + s.na + s.delay + s.nb + 10;
+        // Saturating: the orders and the delay come from the user and may be huge.
+        let needed = (3 * s.n_params())
+            .saturating_add(s.na)
+            .saturating_add(s.delay)
+            .saturating_add(s.nb)
+            .saturating_add(10);
         if data.experiment(0).len() < needed {
             return Err(Error::TooFewSamples {
                 samples: data.experiment(0).len(),
@@ -452,6 +468,7 @@ impl CascadeIdentification {
         // global refit lets the bootstrap see that.
         let point = CascadeIdentification {
             uncertainty: Uncertainty::Asymptotic,
+            observer: Observer::none(),
             ..self.clone()
         };
         // A refit that does worse on its replicate than the estimate it was generated from has
@@ -464,18 +481,18 @@ impl CascadeIdentification {
         } else {
             self.scan
         };
+        let done = AtomicUsize::new(0);
         let refit = |replicate: &IdData| -> Result<Vec<f64>> {
-            let reference = true_cost(&self.structure, replicate, &start)?;
-            if let Ok(global) = point.estimate(replicate, &mut |_| Control::Continue) {
-                if global.output_error.report.cost <= reference {
-                    return Ok(global.model.params());
-                }
+            if self.observer.should_stop("bootstrap replicate") {
+                return Err(Error::Config(
+                    "replicate skipped at the caller's request".into(),
+                ));
             }
-            Ok(self
-                .fit(replicate, &start, scan, &mut |_| Control::Continue)?
-                .fit
-                .parameters
-                .values())
+            let refitted = self.refit_replicate(&point, replicate, &start, scan);
+            let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
+            self.observer
+                .report("bootstrap replicate", finished, replicates);
+            refitted
         };
         let sigma = [fit.covariance.sigma2.sqrt()];
         parametric_bootstrap(
@@ -486,6 +503,28 @@ impl CascadeIdentification {
             self.bootstrap_seed,
             &refit,
         )
+    }
+
+    /// One bootstrap replicate identified again: globally, or locally from `start` when
+    /// the global refit does worse than `start` itself.
+    fn refit_replicate(
+        &self,
+        point: &CascadeIdentification,
+        replicate: &IdData,
+        start: &[f64],
+        scan: usize,
+    ) -> Result<Vec<f64>> {
+        let reference = true_cost(&self.structure, replicate, start)?;
+        if let Ok(global) = point.estimate(replicate, &mut |_| Control::Continue) {
+            if global.output_error.report.cost <= reference {
+                return Ok(global.model.params());
+            }
+        }
+        Ok(self
+            .fit(replicate, start, scan, &mut |_| Control::Continue)?
+            .fit
+            .parameters
+            .values())
     }
 
     /// Builds the structure with a given frozen switching.

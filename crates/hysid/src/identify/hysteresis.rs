@@ -161,7 +161,7 @@ pub fn hysteresis_sensitivities(
 pub(crate) fn bounded_parameter(name: &str, value: f64, data: &IdData) -> Parameter {
     let p = Parameter::new(name, value);
     match name {
-        "alpha" => p.bounds(f64::MIN_POSITIVE, 1.0 / max_increment(data)),
+        "alpha" => p.bounds(f64::MIN_POSITIVE, alpha_max(data)),
         "d" => {
             let max_x = max_abs_input(data);
             p.bounds(1e-9 * max_x, max_x)
@@ -197,6 +197,12 @@ fn diverged(index: usize) -> Error {
         index,
         reason: "the simulated output is not finite".into(),
     }
+}
+
+/// The largest admissible α: (1 − 10⁻⁹)/max|Δx|, inside the rate limit α·|Δx(t)| < 1 of the
+/// discrete recursion with a margin for rounding, so an estimate on the bound is valid.
+pub(crate) fn alpha_max(data: &IdData) -> f64 {
+    (1.0 - 1e-9) / max_increment(data)
 }
 
 /// Largest |Δx| over all experiments' input channel 0.
@@ -298,7 +304,7 @@ impl HysteresisIdentification {
             initial: self.initial,
             switching,
         };
-        let alpha_max = 1.0 / max_increment(data);
+        let alpha_max = alpha_max(data);
         let mut start = separated.model.params();
         start[0] = start[0].min(alpha_max);
         let mut params = bounded_hysteresis_parameters(self.form, &start, data);
@@ -315,7 +321,7 @@ impl HysteresisIdentification {
         let d_index = self.form.n_params() - 1;
         let (output_error, threshold) = place_threshold(&structure, data, switched.fit, d_index)?;
         let model = ColemanHodgdon::from_params(self.form, &output_error.parameters.values())?;
-        if model.alpha() >= alpha_max * (1.0 - 1e-9) {
+        if !(model.alpha() > 0.0 && model.alpha() <= alpha_max) {
             return Err(rate_error(data, model.alpha()));
         }
         Ok(HysteresisFit {

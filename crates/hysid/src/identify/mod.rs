@@ -6,6 +6,7 @@
 //!   [`OutputErrorModel`] (the generic layer over the Levenberg–Marquardt engine).
 //! * [`multistart`]: several starts inside the bounds, fitted in parallel, the best kept.
 //! * [`bootstrap`]: parametric bootstrap standard deviations where the curvature misleads.
+//! * [`budget`]: memory and work estimates of the recipes, made before large allocations.
 //! * [`hysteresis`]: the Coleman–Hodgdon hysteresis alone, from measured input and output.
 //! * [`key_term`]: the iterative key-term-separation method of Vörös (2015) for the cascade.
 //! * [`global`]: the (α, d) grid stage that makes the cascade fit independent of the start.
@@ -22,6 +23,7 @@
 
 pub mod actuator;
 pub mod bootstrap;
+pub mod budget;
 pub mod cascade;
 pub mod cascade_pass;
 pub mod global;

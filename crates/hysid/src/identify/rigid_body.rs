@@ -109,6 +109,12 @@ impl RigidBodyLs {
         let ls: LsSolution = least_squares(&w, &force, &name_refs)?;
         let values: Vec<f64> = ls.theta.iter().copied().collect();
         let std = ls.std();
+        if let Some((name, value)) = names.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
+            return Err(Error::NonFiniteResult {
+                key: name.clone(),
+                value: *value,
+            });
+        }
         Ok(RigidBodyEstimate {
             relative_std_percent: values
                 .iter()
@@ -154,6 +160,14 @@ impl RigidBodyLs {
                 u.len()
             )));
         }
+        if !(self.gain.is_normal() && self.gain.abs() <= 1e9) {
+            return Err(Error::InvalidParameter {
+                name: "gain".into(),
+                value: self.gain,
+                reason: "the drive gain must be finite, non-zero and at most 1e9 in magnitude"
+                    .into(),
+            });
+        }
         let nyquist = 0.5 / ts;
         if !(self.cutoff_hz > 0.0 && self.cutoff_hz < nyquist) {
             return Err(Error::Config(format!(
@@ -161,7 +175,12 @@ impl RigidBodyLs {
                 self.cutoff_hz
             )));
         }
-        let needed = 2 * self.border + 20 * self.decimation.max(1) + 30;
+        // Saturating: border and decimation come from the user and may be huge.
+        let needed = self
+            .border
+            .saturating_mul(2)
+            .saturating_add(self.decimation.max(1).saturating_mul(20))
+            .saturating_add(30);
         if q.len() < needed {
             return Err(Error::TooFewSamples {
                 samples: q.len(),
@@ -200,7 +219,22 @@ impl RigidBodyLs {
         let cut = self.border / r;
         let rows = force.len().saturating_sub(2 * cut);
         let w = DMatrix::from_fn(rows, decimated.len(), |i, j| decimated[j][i + cut]);
-        Ok((w, force[cut..cut + rows].to_vec()))
+        let force = force[cut..cut + rows].to_vec();
+        // A sample near the floating-point limit (1e308) overflows g·u, the filter or the
+        // derivatives: the regression would be NaN.
+        if let Some(k) = force.iter().position(|f| !f.is_finite()) {
+            return Err(Error::InvalidData(format!(
+                "the force g·u overflows at regression row {k}; scale the input or the gain down"
+            )));
+        }
+        if w.iter().any(|v| !v.is_finite()) {
+            return Err(Error::InvalidData(
+                "the filtered position or its derivatives overflow (a sample near the \
+                 floating-point limit?); scale the position data down"
+                    .into(),
+            ));
+        }
+        Ok((w, force))
     }
 
     /// Coulomb friction is only separable from a constant force when the motion reverses.

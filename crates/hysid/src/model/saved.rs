@@ -507,6 +507,19 @@ impl FittedModel {
         let mut std = Vec::new();
         for i in 0..parameters.len() {
             let e = record(file, &parameters.get(i).name.clone())?;
+            // The model's own bounds are its physics (a positive mass, non-negative
+            // friction): a file's wider bounds do not admit a value outside them.
+            let own = parameters.get(i);
+            if !(own.min..=own.max).contains(&e.value) {
+                return Err(Error::InvalidParameter {
+                    name: own.name.clone(),
+                    value: e.value,
+                    reason: format!(
+                        "the {kind} model needs {} in [{}, {}]",
+                        own.name, own.min, own.max
+                    ),
+                });
+            }
             *parameters.get_mut(i) = e.parameter();
             std.push(e.std_or_nan());
         }

@@ -14,6 +14,7 @@
 //! * [`integrate`]: the classical RK4 step shared by every fixed-step simulation.
 //! * [`metrics`]: fit %, RMSE, NRMSE, FPE and AIC.
 //! * [`termination`]: why an iterative method stopped.
+//! * [`progress`]: progress of the phases of a recipe, reported to an observer.
 
 pub mod integrate;
 pub mod least_squares;
@@ -21,11 +22,13 @@ pub mod levenberg_marquardt;
 pub mod metrics;
 pub mod nelder_mead;
 pub mod nnls;
+pub mod progress;
 pub mod signal;
 pub mod termination;
 
 pub use least_squares::{least_squares, LsSolution};
 pub use levenberg_marquardt::{Control, Covariance, IterationRecord, LmConfig, LmReport};
+pub use progress::{Observer, Progress};
 pub use termination::Termination;
 
 /// sgn with sgn(0) = 0 (friction and hysteresis laws use it).

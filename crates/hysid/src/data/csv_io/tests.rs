@@ -472,7 +472,7 @@ fn write_rejects_inconsistent_columns() {
         &[&[1.0, 2.0], &[1.0, f64::NAN]],
     ));
     assert!(
-        matches!(error, Error::NonFinite { ref channel, index: 1, .. } if channel == "b"),
+        matches!(error, Error::NonFiniteResult { ref key, .. } if key == "b[1]"),
         "{error:?}"
     );
     // Nothing was written.

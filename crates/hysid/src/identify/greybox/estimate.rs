@@ -11,8 +11,9 @@ use crate::identify::{OutputError, OutputErrorFit};
 use crate::model::greybox::{Simulation, StateSpaceModel};
 use crate::model::saved::FittedModel;
 use crate::model::ParameterSet;
-use crate::numerics::{Control, IterationRecord, LmConfig};
+use crate::numerics::{Control, IterationRecord, LmConfig, Observer};
 use crate::{Error, Result};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -33,6 +34,9 @@ pub struct GreyBoxEstimation {
     pub screening_iterations: usize,
     /// Leading samples of each experiment used for screening (None: all).
     pub screening_samples: Option<usize>,
+    /// Sees "start k/N" after each screening fit; [`Control::Stop`] skips the remaining
+    /// starts (each is then only evaluated where it was drawn), keeping the best so far.
+    pub observer: Observer,
 }
 
 impl Default for GreyBoxEstimation {
@@ -45,6 +49,7 @@ impl Default for GreyBoxEstimation {
             seed: 0,
             screening_iterations: 10,
             screening_samples: Some(16_384),
+            observer: Observer::none(),
         }
     }
 }
@@ -143,8 +148,21 @@ impl GreyBoxEstimation {
             skip: 0,
         };
         let starts = draw_starts(params, self.starts, self.seed);
+        let total = starts.len();
+        let done = AtomicUsize::new(0);
         let fit = |p: &ParameterSet| {
-            estimator.estimate(&structure, &screen_data, p, &mut |_| Control::Continue)
+            let observer = &self.observer;
+            let mut stop_when_asked = |_: &IterationRecord| {
+                if observer.should_stop("start") {
+                    Control::Stop
+                } else {
+                    Control::Continue
+                }
+            };
+            let result = estimator.estimate(&structure, &screen_data, p, &mut stop_when_asked);
+            let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
+            observer.report("start", finished, total);
+            result
         };
         let (best, outcomes) = best_of(&starts, &fit)?;
         Ok((best.parameters, outcomes))

@@ -66,8 +66,13 @@ impl StateSpaceModel for RigidBody {
             Parameter::new("M", 1.0)
                 .unit("kg")
                 .bounds(1e-12, f64::INFINITY),
-            Parameter::new("Fv", 0.0).unit("N*s/m"),
-            Parameter::new("Fc", 0.0).unit("N"),
+            // Friction dissipates: Fv ≥ 0, Fc ≥ 0.
+            Parameter::new("Fv", 0.0)
+                .unit("N*s/m")
+                .bounds(0.0, f64::INFINITY),
+            Parameter::new("Fc", 0.0)
+                .unit("N")
+                .bounds(0.0, f64::INFINITY),
             Parameter::new("offset", 0.0).unit("N"),
             Parameter::new("gain", 1.0).fixed(true),
         ])

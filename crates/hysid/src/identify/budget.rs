@@ -1,0 +1,213 @@
+//! Resource estimates of the recipes, made before any large allocation.
+//!
+//! A recipe's cost is dominated by simulations of the model over the record. For a record of
+//! N samples, s integration sub-steps per sample, n states and p free parameters, one
+//! simulation with forward sensitivities performs N·s steps and holds
+//!
+//! ```text
+//!     bytes       ≈ 8 · N · (s·c + n·(1 + p) + p + 4)        (c input channels)
+//!     evaluations = N · s                                    (model steps)
+//! ```
+//!
+//! the first term being the input interpolated at the sub-steps (band-limited interpolation
+//! keeps the whole upsampled record, 16 bytes per complex point), the second the states and
+//! their sensitivities, the third the Jacobian of the residuals (Ljung, *System
+//! Identification*, 2nd ed., 1999, §10.2). A Levenberg–Marquardt fit of I iterations performs
+//! at most about I·(1 + p) such simulations; a multi-start of S starts and a bootstrap of R
+//! replicates multiply the work, not the memory (the searches keep one result per start).
+//!
+//! The figures are upper estimates to a factor of a few: they exist to refuse, before it
+//! starts, a request that cannot finish (a 13 GB allocation, 10¹² model steps), not to
+//! predict run times. All arithmetic saturates at `u64::MAX`, so an absurd request gives an
+//! absurd but finite figure instead of an overflow.
+
+use super::cascade::CascadeIdentification;
+use super::greybox::GreyBoxEstimation;
+use super::Uncertainty;
+use crate::model::greybox::{InputInterpolation, Integrator};
+
+/// Memory and work of a request.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Work {
+    /// Peak bytes the request allocates at once.
+    pub bytes: u64,
+    /// Model steps (sample × sub-step evaluations of the model equations) in total.
+    pub evaluations: u64,
+}
+
+/// `a · b`, saturating at `u64::MAX`.
+fn mul(a: u64, b: u64) -> u64 {
+    a.saturating_mul(b)
+}
+
+/// A `usize` as `u64`, saturating (a `usize` wider than 64 bits is not a target).
+fn wide(n: usize) -> u64 {
+    u64::try_from(n).unwrap_or(u64::MAX)
+}
+
+/// Memory and work of one model simulation over `samples` samples with `substeps` steps per
+/// sample, `inputs` input channels, `states` states and `parameters` sensitivities
+/// (0 for a plain simulation); `band_limited` when the input is upsampled over the whole
+/// record at once.
+pub fn simulation(
+    samples: usize,
+    substeps: usize,
+    inputs: usize,
+    states: usize,
+    parameters: usize,
+    band_limited: bool,
+) -> Work {
+    let (n, s) = (wide(samples), wide(substeps.max(1)));
+    let c = wide(inputs.max(1));
+    // Complex spectrum and real upsampled copy: 16 + 8 bytes per point.
+    let input = if band_limited { mul(mul(s, c), 3) } else { c };
+    let state = mul(wide(states), wide(parameters).saturating_add(1));
+    let per_sample = input
+        .saturating_add(state)
+        .saturating_add(wide(parameters))
+        .saturating_add(4);
+    Work {
+        bytes: mul(mul(n, per_sample), 8),
+        evaluations: mul(n, s),
+    }
+}
+
+impl Work {
+    /// The same memory, the work repeated `times` times.
+    pub fn repeated(self, times: u64) -> Work {
+        Work {
+            bytes: self.bytes,
+            evaluations: mul(self.evaluations, times),
+        }
+    }
+}
+
+impl GreyBoxEstimation {
+    /// Memory and work of [`GreyBoxEstimation::estimate`] on `samples` samples (summed over
+    /// the experiments) of a model with `inputs` input channels, `states` states and
+    /// `parameters` free parameters: the screening fits of every start plus the final fit.
+    pub fn work_estimate(
+        &self,
+        samples: usize,
+        inputs: usize,
+        states: usize,
+        parameters: usize,
+    ) -> Work {
+        let (substeps, steps_factor) = match self.simulation.integrator {
+            Integrator::Rk4 { substeps } => (substeps, 4),
+            Integrator::Newmark { substeps } => (substeps, 1),
+            // Dormand–Prince: six stages a step, a few steps a sample for smooth models.
+            Integrator::Adaptive { .. } => (4, 6),
+        };
+        let band_limited = matches!(
+            self.simulation.interpolation,
+            InputInterpolation::BandLimited
+        );
+        let one = simulation(samples, substeps, inputs, states, parameters, band_limited)
+            .repeated(steps_factor);
+        let per_fit = wide(parameters).saturating_add(1);
+        let final_fit = mul(wide(self.lm.max_iterations).saturating_add(1), per_fit);
+        let screening = if self.starts > 1 {
+            let screened = self
+                .screening_samples
+                .map_or(wide(samples), |m| wide(m).min(wide(samples)));
+            let fraction = screened.max(1);
+            mul(
+                mul(
+                    wide(self.starts),
+                    wide(self.screening_iterations).saturating_add(1),
+                ),
+                per_fit,
+            )
+            .saturating_mul(fraction)
+                / wide(samples).max(1)
+        } else {
+            0
+        };
+        one.repeated(final_fit.saturating_add(screening))
+    }
+}
+
+impl CascadeIdentification {
+    /// Memory and work of [`CascadeIdentification::estimate`] on `samples` samples: the
+    /// (α, d) grid of equation-error regressions on the window, the local refinements and
+    /// the final fit, all repeated for every bootstrap replicate.
+    pub fn work_estimate(&self, samples: usize) -> Work {
+        let p = wide(self.structure.n_params());
+        let window = wide(self.window.max(100)).min(wide(samples));
+        let grid = mul(
+            mul(wide(self.grid.alpha_points), wide(self.grid.d_points)),
+            mul(window, p),
+        );
+        let fits = mul(
+            wide(self.lm.max_iterations).saturating_add(1),
+            p.saturating_add(1),
+        );
+        let refine = mul(mul(wide(self.grid.refine).saturating_add(1), fits), window);
+        let final_fit = mul(
+            mul(fits, wide(samples)),
+            wide(2 * self.scan.min(1 << 20) + 1),
+        );
+        let once = grid.saturating_add(refine).saturating_add(final_fit);
+        let replicates = match self.uncertainty {
+            Uncertainty::Asymptotic => 0,
+            Uncertainty::Bootstrap(r) => wide(r),
+        };
+        Work {
+            bytes: mul(mul(wide(samples), p.saturating_add(4)), 16),
+            evaluations: mul(once, replicates.saturating_add(1)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::coleman_hodgdon::ChForm;
+    use crate::model::greybox::Simulation;
+
+    #[test]
+    fn a_simulation_counts_its_steps_and_states() {
+        // 1000 samples, 4 sub-steps, 1 input, 2 states, 3 parameters, zero-order hold:
+        // 8 · 1000 · (1 + 2·4 + 3 + 4) bytes, 4000 steps.
+        let w = simulation(1000, 4, 1, 2, 3, false);
+        assert_eq!(w.bytes, 8 * 1000 * 16);
+        assert_eq!(w.evaluations, 4000);
+        // Band-limited: 3 · s · c more words per sample.
+        let b = simulation(1000, 4, 1, 2, 3, true);
+        assert_eq!(b.bytes, 8 * 1000 * (12 + 8 + 3 + 4));
+    }
+
+    #[test]
+    fn absurd_requests_saturate_instead_of_overflowing() {
+        let w = simulation(usize::MAX, usize::MAX, 1, 7, 7, true);
+        assert_eq!(w.bytes, u64::MAX);
+        assert_eq!(w.evaluations, u64::MAX);
+    }
+
+    #[test]
+    fn the_bouc_wen_benchmark_at_10000_substeps_needs_gigabytes() {
+        // The issue's case: 40 960 samples, band-limited input, 10 000 sub-steps.
+        let est = GreyBoxEstimation {
+            simulation: Simulation {
+                integrator: Integrator::Rk4 { substeps: 10_000 },
+                interpolation: InputInterpolation::BandLimited,
+            },
+            ..GreyBoxEstimation::default()
+        };
+        let w = est.work_estimate(40_960, 1, 3, 5);
+        assert!(w.bytes > 9_000_000_000, "{}", w.bytes);
+        let small = GreyBoxEstimation::default().work_estimate(40_960, 1, 3, 5);
+        assert!(small.bytes < 100_000_000, "{}", small.bytes);
+    }
+
+    #[test]
+    fn bootstrap_replicates_multiply_the_cascade_work() {
+        let mut id = CascadeIdentification::new(ChForm::Saturated4, 2, 2, 1);
+        let once = id.work_estimate(2000);
+        id.uncertainty = Uncertainty::Bootstrap(9);
+        let ten = id.work_estimate(2000);
+        assert_eq!(ten.evaluations, once.evaluations * 10);
+        assert_eq!(ten.bytes, once.bytes);
+    }
+}
