@@ -133,9 +133,7 @@ def identify_many(
         )
         client = Client(cluster)
     try:
-        futures = client.map(
-            _guarded, [fit] * len(records), range(len(records)), records, pure=False
-        )
+        futures = client.map(_guarded, [fit] * len(records), range(len(records)), records, pure=False)
         results = client.gather(futures)
     finally:
         if own:
