@@ -116,7 +116,7 @@ fn identify_cascade(
         id.uncertainty = uncertainty;
         id.bootstrap_seed = seed;
         let fit = id.estimate(&data, &mut quiet())?;
-        let extra = json!({"input": "x", "output": "y"});
+        let extra = json!({"input": ["x"], "output": ["y"]});
         report::cascade_report("identify cascade", &fit, &data, source(), extra)?.to_json()
     })
 }

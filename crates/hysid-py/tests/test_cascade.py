@@ -144,3 +144,24 @@ def test_record_objects_accepted(example1):
     a = hysid.identify_cascade(Record(x, y, 1.0), na=2, nb=2, delay=1)
     b = hysid.identify_cascade(x, y, na=2, nb=2, delay=1)
     assert a.parameters == b.parameters
+
+
+def timeless(report):
+    """A report without its wall-clock figure and the data's names (a file vs numpy arrays)."""
+    report = json.loads(json.dumps(report))
+    report["search"].pop("elapsed_s", None)
+    report["data"].pop("source", None)
+    for e in report["fit"]["per_experiment"]:
+        e.pop("experiment", None)
+    return report
+
+
+@pytest.mark.skipif(not os.environ.get("HYSID_CLI"), reason="set HYSID_CLI to a hysid binary to compare live")
+def test_cascade_report_equals_live_cli(example1, tmp_path):
+    """The library's report builder (hysid::report::cascade_report) gives the CLI's report."""
+    path = tmp_path / "r.json"
+    args = ["identify", "cascade", "--data", str(DATA / "example1.csv"), "--input", "x", "--output", "y"]
+    args += ["--hysteresis", "ch4", "--na", "2", "--nb", "2", "--delay", "1", "--json", str(path)]
+    subprocess.run([os.environ["HYSID_CLI"], *args], check=True, capture_output=True)
+    r = hysid.identify_cascade(*example1, hysteresis="ch4", na=2, nb=2, delay=1)
+    assert timeless(r.report()) == timeless(json.loads(path.read_text()))
