@@ -94,3 +94,63 @@ pub fn rigid_body_report(
         ..Report::new("rigid-body ls")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn estimate() -> RigidBodyEstimate {
+        RigidBodyEstimate {
+            names: vec!["M".into(), "Fv".into(), "Fc".into()],
+            values: vec![1.5, 20.0, 3.0],
+            std: vec![0.01, 0.2, 0.03],
+            relative_std_percent: vec![0.67, 1.0, 1.0],
+            relative_error_percent: 2.5,
+            condition_number: 4.0,
+            condition_number_unscaled: 40.0,
+            equations: 1000,
+        }
+    }
+
+    /// The estimates go into the built-in model by name; the gain is fixed at the given
+    /// value and the offset, not estimated, fixed.
+    #[test]
+    fn model_holds_the_estimates_and_fixes_the_rest() {
+        let file = rigid_body_model(&estimate(), 35.15).to_file();
+        let p = |name: &str| file.parameters.iter().find(|p| p.name == name).unwrap();
+        assert_eq!(file.kind, "rigid_body");
+        assert_eq!(
+            (p("M").value, p("M").std, p("M").fixed),
+            (1.5, Some(0.01), false)
+        );
+        assert_eq!((p("Fc").value, p("Fc").std), (3.0, Some(0.03)));
+        assert_eq!(
+            (p("gain").value, p("gain").fixed, p("gain").std),
+            (35.15, true, None)
+        );
+        assert!(p("offset").fixed);
+    }
+
+    #[test]
+    fn report_lists_settings_and_records() {
+        let ls = RigidBodyLs::default();
+        let records =
+            vec![json!({"file": "a.csv", "role": "estimation", "relative_error_percent": 2.5})];
+        let r = rigid_body_report(
+            &estimate(),
+            &ls,
+            "a.csv".into(),
+            4000,
+            0.1,
+            records,
+            json!({"position": "q"}),
+        );
+        assert_eq!(r.command, "rigid-body ls");
+        assert_eq!(r.details["relative_std_percent"]["Fv"], 1.0);
+        assert_eq!(r.details["settings"]["cutoff_hz"], 100.0);
+        assert_eq!(r.details["settings"]["position"], "q");
+        assert_eq!(r.details["condition_number"], 40.0);
+        assert_eq!(r.data.as_ref().map(|d| d.samples), Some(4000));
+        assert!(r.to_json().is_ok());
+    }
+}
