@@ -15,9 +15,8 @@ import argparse
 import math
 import time
 
-import numpy as np
-
 import hysid
+import numpy as np
 from hysid.fleet import Failure, identify_many
 
 FS = 750.0
@@ -29,16 +28,29 @@ def actuator_model(values):
     """A built-in Bouc–Wen model file with the given parameter values."""
     defaults, _, _ = hysid._hysid.model_parameters("bouc-wen")
     params = [
-        {"name": n, "value": values[n], "std": None, "unit": unit, "fixed": f,
-         "lower": None if math.isinf(lo) else lo, "upper": None if math.isinf(hi) else hi}
+        {
+            "name": n,
+            "value": values[n],
+            "std": None,
+            "unit": unit,
+            "fixed": f,
+            "lower": None if math.isinf(lo) else lo,
+            "upper": None if math.isinf(hi) else hi,
+        }
         for (n, _, lo, hi, f, unit) in defaults
     ]
-    return hysid.Model({
-        "schema": "hysid.model/1", "kind": "bouc_wen", "parameters": params,
-        "hysteresis": None, "delay": None, "initial_output": None,
-        "simulation": {"integrator": "rk4", "substeps": 2, "interpolation": "zero_order_hold"},
-        "initial_state": [0.0, 0.0, 0.0],
-    })
+    return hysid.Model(
+        {
+            "schema": "hysid.model/1",
+            "kind": "bouc_wen",
+            "parameters": params,
+            "hysteresis": None,
+            "delay": None,
+            "initial_output": None,
+            "simulation": {"integrator": "rk4", "substeps": 2, "interpolation": "zero_order_hold"},
+            "initial_state": [0.0, 0.0, 0.0],
+        }
+    )
 
 
 def make_fleet(n, seed=2026):

@@ -82,7 +82,7 @@ pub fn to_py(py: Python<'_>, e: hysid::Error) -> PyErr {
         | E::Csv { .. }
         | E::MissingColumn { .. }
         | E::NotNumeric { .. } => "DataError",
-        E::InvalidParameter { .. } | E::Config(_) => "ConfigError",
+        E::InvalidParameter { .. } | E::Config(_) | E::Equations(_) => "ConfigError",
         E::ModelFile { .. } | E::Io { .. } => "ModelFileError",
         _ => "NumericalError",
     };

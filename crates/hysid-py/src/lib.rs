@@ -19,7 +19,10 @@
 
 use pyo3::prelude::*;
 
+pub mod actuator;
+pub mod equations;
 pub mod errors;
+pub mod pool;
 pub mod recipes;
 pub mod user_model;
 
@@ -29,6 +32,9 @@ fn _hysid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     recipes::register(m)?;
     user_model::register(m)?;
+    pool::register(m)?;
+    actuator::register(m)?;
+    equations::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

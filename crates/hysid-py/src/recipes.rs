@@ -1,15 +1,17 @@
 //! The library recipes behind `hysid.identify_cascade`, `identify_hysteresis`,
 //! `greybox_fit` (built-in models), `benchmark_bouc_wen`, `rigid_body_ls`, and model
 //! simulation, loading and saving. Each returns JSON text (`hysid.report/1` for a fit,
-//! `hysid.model/1` for a model) and runs with the GIL released.
+//! `hysid.model/1` for a model) and runs with the GIL released, its parallel work on
+//! `threads` workers ([`crate::pool`]).
 //!
-//! The `details` of each report are assembled here as the CLI assembles them (the same
-//! keys), until the library offers them itself.
+//! The reports are the library's (`hysid::report::cascade_report`, `greybox_report`, …),
+//! the ones the CLI writes.
 
 use crate::errors::{guard, run};
+use crate::pool::run_on;
 use hysid::data::{Channel, Experiment, IdData};
-use hysid::identify::cascade::{CascadeFit, CascadeIdentification};
-use hysid::identify::greybox::{GreyBoxEstimation, GreyBoxFit, InitialStates};
+use hysid::identify::cascade::CascadeIdentification;
+use hysid::identify::greybox::{GreyBoxEstimation, InitialStates};
 use hysid::identify::hysteresis::{HysteresisIdentification, InitialOutput};
 use hysid::identify::rigid_body::RigidBodyLs;
 use hysid::identify::Uncertainty;
@@ -17,7 +19,7 @@ use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, 
 use hysid::model::saved::{FittedModel, ModelFile};
 use hysid::model::{ChForm, Parameter, ParameterSet};
 use hysid::numerics::{metrics, Control, IterationRecord};
-use hysid::report::{Report, SearchSummary, UncertaintySummary, ValidationEntry};
+use hysid::report::{self, ValidationEntry};
 use hysid::{Error, Result};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -71,13 +73,14 @@ pub fn id_data(ts: f64, u: Vec<Vec<f64>>, y: Vec<Vec<f64>>) -> Result<IdData> {
     IdData::new(ts, inputs, outputs, vec![experiment])
 }
 
-fn source() -> Vec<String> {
+/// The `data.source` of a report on numpy arrays.
+pub fn source() -> Vec<String> {
     vec!["python (numpy arrays)".into()]
 }
 
 /// Identifies a Coleman–Hodgdon hysteresis + linear-block cascade (Vörös 2015).
 #[pyfunction]
-#[pyo3(signature = (x, y, hysteresis, na, nb, delay, ts, uncertainty, replicates, seed))]
+#[pyo3(signature = (x, y, hysteresis, na, nb, delay, ts, uncertainty, replicates, seed, threads=0))]
 #[allow(clippy::too_many_arguments)]
 fn identify_cascade(
     py: Python<'_>,
@@ -91,6 +94,7 @@ fn identify_cascade(
     uncertainty: &str,
     replicates: usize,
     seed: u64,
+    threads: usize,
 ) -> PyResult<String> {
     let (x, y) = (samples(&x), samples(&y));
     let hysteresis = hysteresis.to_string();
@@ -105,63 +109,21 @@ fn identify_cascade(
             ))
         }
     };
-    run(py, move || {
+    run_on(py, threads, move || {
         let form = ChForm::parse(&hysteresis)?;
         let data = id_data(ts, vec![x], vec![y])?;
         let mut id = CascadeIdentification::new(form, na, nb, delay);
         id.uncertainty = uncertainty;
         id.bootstrap_seed = seed;
         let fit = id.estimate(&data, &mut quiet())?;
-        cascade_report(&fit, &data, uncertainty)?.to_json()
+        let extra = json!({"input": ["x"], "output": ["y"]});
+        report::cascade_report("identify cascade", &fit, &data, source(), extra)?.to_json()
     })
-}
-
-/// The report of a cascade fit (the CLI's `identify cascade` details).
-fn cascade_report(fit: &CascadeFit, data: &IdData, uncertainty: Uncertainty) -> Result<Report> {
-    let oe = &fit.output_error;
-    let fitted = FittedModel::Cascade {
-        model: fit.model.clone(),
-        std: fit.std(),
-    };
-    let key_term = fit.key_term.as_ref().map(|k| {
-        json!({
-            "termination": k.termination.to_string(),
-            "iterations": k.history.len().saturating_sub(1),
-            "history": k.history,
-            "equation_error": k.costs,
-        })
-    });
-    let details = json!({
-        "admissibility": fit.model.hysteresis.admissibility(),
-        "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
-        "threshold": fit.threshold,
-        "switching_consistent": fit.switching_consistent,
-        "fit_percent_per_experiment": oe.fit_percent,
-        "key_term_iteration": key_term,
-        "output_error_history": oe.report.history,
-        "candidates": fit.candidates.iter().map(|c| json!({"origin": c.origin, "cost": c.cost, "start": c.start, "refined": c.refined})).collect::<Vec<_>>(),
-        "asymptotic_std": oe.std(),
-        "bootstrap": fit.bootstrap.as_ref().map(|b| json!({"replicates": b.replicates.len(), "failed": b.failed, "std": b.std})),
-    });
-    let summary = match (uncertainty, &fit.bootstrap) {
-        (Uncertainty::Bootstrap(n), Some(b)) => UncertaintySummary::bootstrap(n, b.failed),
-        _ => UncertaintySummary::asymptotic(),
-    };
-    Ok(Report::of_output_error(
-        "identify cascade",
-        data,
-        source(),
-        fitted.to_file(),
-        oe,
-        fit.elapsed_s,
-        summary,
-    )?
-    .with_details(details))
 }
 
 /// Identifies a Coleman–Hodgdon hysteresis alone (separated regression, then output error).
 #[pyfunction]
-#[pyo3(signature = (x, y, hysteresis, ts, initial_output))]
+#[pyo3(signature = (x, y, hysteresis, ts, initial_output, threads=0))]
 fn identify_hysteresis(
     py: Python<'_>,
     x: PyReadonlyArray1<'_, f64>,
@@ -169,6 +131,7 @@ fn identify_hysteresis(
     hysteresis: &str,
     ts: f64,
     initial_output: &str,
+    threads: usize,
 ) -> PyResult<String> {
     let (x, y) = (samples(&x), samples(&y));
     let hysteresis = hysteresis.to_string();
@@ -183,39 +146,13 @@ fn identify_hysteresis(
             ))
         }
     };
-    run(py, move || {
+    run_on(py, threads, move || {
         let form = ChForm::parse(&hysteresis)?;
         let data = id_data(ts, vec![x], vec![y])?;
         let mut id = HysteresisIdentification::new(form);
         id.initial = initial;
         let fit = id.estimate(&data, &mut quiet())?;
-        let oe = &fit.output_error;
-        let fitted = FittedModel::Hysteresis {
-            model: fit.model.clone(),
-            initial,
-            std: fit.std(),
-        };
-        let details = json!({
-            "fit_percent_per_experiment": oe.fit_percent,
-            "admissibility": fit.model.admissibility(),
-            "threshold": fit.threshold,
-            "separated_regression": {
-                "d_history": fit.separated.d_history,
-                "termination": fit.separated.termination.to_string(),
-            },
-            "output_error_history": oe.report.history,
-        });
-        Report::of_output_error(
-            "identify hysteresis",
-            &data,
-            source(),
-            fitted.to_file(),
-            oe,
-            fit.elapsed_s,
-            UncertaintySummary::asymptotic(),
-        )?
-        .with_details(details)
-        .to_json()
+        report::hysteresis_report(&fit, &data, source(), initial)?.to_json()
     })
 }
 
@@ -298,68 +235,9 @@ pub fn estimation(sim: Simulation, starts: usize, seed: u64) -> GreyBoxEstimatio
     }
 }
 
-/// The model file of a fitted grey-box model: its own parameters, their std, the first
-/// experiment's initial state.
-pub fn fitted_greybox(
-    kind: &str,
-    n_params: usize,
-    n_states: usize,
-    fit: &GreyBoxFit,
-    sim: Simulation,
-) -> Result<FittedModel> {
-    let all = &fit.fit.parameters;
-    let parameters = ParameterSet::new(all.iter().take(n_params).cloned().collect())?;
-    let values = all.values();
-    Ok(FittedModel::GreyBox {
-        kind: kind.to_string(),
-        parameters,
-        std: fit.fit.std()[..n_params].to_vec(),
-        simulation: sim,
-        initial_state: values[n_params..n_params + n_states].to_vec(),
-    })
-}
-
-/// The report of a grey-box fit (the CLI's `greybox fit` details, without the residual
-/// analysis and sensitivity table).
-pub fn greybox_report(
-    command: &str,
-    fit: &GreyBoxFit,
-    data: &IdData,
-    model: ModelFile,
-    extra: serde_json::Value,
-) -> Result<Report> {
-    let oe = &fit.fit;
-    let n = oe.parameters.len();
-    let correlation: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| oe.covariance.correlation[(i, j)]).collect())
-        .collect();
-    let mut details = json!({
-        "fit_percent_per_experiment": oe.fit_percent,
-        "mse_per_experiment": oe.mse,
-        "function_evaluations": oe.report.function_evaluations,
-        "rejected_trials": oe.report.rejected_trials,
-        "correlation": correlation,
-        "history": oe.report.history,
-        "starts": fit.starts,
-    });
-    if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
-        obj.extend(more);
-    }
-    Ok(Report::of_output_error(
-        command,
-        data,
-        source(),
-        model,
-        oe,
-        fit.elapsed_s,
-        UncertaintySummary::asymptotic(),
-    )?
-    .with_details(details))
-}
-
 /// Output-error fit of a built-in grey-box model (`bouc-wen`, `rigid-body`, …).
 #[pyfunction]
-#[pyo3(signature = (kind, u, y, ts, params, starts, seed, integrator, substeps, interpolation))]
+#[pyo3(signature = (kind, u, y, ts, params, starts, seed, integrator, substeps, interpolation, threads=0))]
 #[allow(clippy::too_many_arguments)]
 fn greybox_fit(
     py: Python<'_>,
@@ -373,6 +251,7 @@ fn greybox_fit(
     integrator: &str,
     substeps: usize,
     interpolation: &str,
+    threads: usize,
 ) -> PyResult<String> {
     let u: Vec<Vec<f64>> = u.iter().map(samples).collect();
     let y: Vec<Vec<f64>> = y.iter().map(samples).collect();
@@ -381,7 +260,7 @@ fn greybox_fit(
         integrator.to_string(),
         interpolation.to_string(),
     );
-    run(py, move || {
+    run_on(py, threads, move || {
         let model: Arc<dyn StateSpaceModel> = Arc::from(models::by_kind(&kind)?);
         let sim = simulation(&integrator, substeps, &interpolation)?;
         let data = id_data(ts, u, y)?;
@@ -394,15 +273,24 @@ fn greybox_fit(
             InitialStates::at_rest(n_states, 1),
             &mut quiet(),
         )?;
-        let fitted = fitted_greybox(model.kind(), params.len(), n_states, &fit, sim)?;
-        greybox_report("greybox fit", &fit, &data, fitted.to_file(), json!({}))?.to_json()
+        let fitted = fit.fitted_model(model.as_ref(), sim);
+        let extra = json!({"residual_analysis": report::greybox_residuals(&fit, &data), "sensitivity": null});
+        report::greybox_report(
+            "greybox fit",
+            &fit,
+            &data,
+            source(),
+            fitted.to_file(),
+            extra,
+        )?
+        .to_json()
     })
 }
 
 /// The Bouc–Wen benchmark of Noël & Schoukens (2016): fit on the training record, e_RMS
 /// (the RMS simulation error) on each test record.
 #[pyfunction]
-#[pyo3(signature = (u, y, ts, params, tests, steady_state, starts, seed, substeps))]
+#[pyo3(signature = (u, y, ts, params, tests, steady_state, starts, seed, substeps, threads=0))]
 #[allow(clippy::too_many_arguments)]
 fn benchmark_bouc_wen(
     py: Python<'_>,
@@ -415,13 +303,14 @@ fn benchmark_bouc_wen(
     starts: usize,
     seed: u64,
     substeps: usize,
+    threads: usize,
 ) -> PyResult<String> {
     let (u, y) = (samples(&u), samples(&y));
     let tests: Vec<(Vec<f64>, Vec<f64>, f64, String)> = tests
         .iter()
         .map(|(u, y, ts, name)| (samples(u), samples(y), *ts, name.clone()))
         .collect();
-    run(py, move || {
+    run_on(py, threads, move || {
         let sim = Simulation {
             integrator: Integrator::Rk4 {
                 substeps: substeps.max(1),
@@ -438,19 +327,20 @@ fn benchmark_bouc_wen(
             InitialStates::at_rest(3, 1),
             &mut quiet(),
         )?;
-        let fitted = fitted_greybox(model.kind(), params.len(), 3, &fit, sim)?;
+        let fitted = fit.fitted_model(&model, sim);
         let validation = tests
             .iter()
             .map(|(u, y, ts, name)| score(&fitted, u, y, *ts, name, steady_state))
             .collect::<Result<Vec<_>>>()?;
-        let extra = json!({
-            "training_e_rms": fit.fit.mse[0][0].sqrt(),
-            "tests": validation.iter().map(|t| json!({"file": t.source, "e_rms": t.e_rms, "fit_percent": t.fit_percent, "samples": t.samples})).collect::<Vec<_>>(),
-        });
-        let mut report =
-            greybox_report("benchmark bouc-wen", &fit, &data, fitted.to_file(), extra)?;
-        report.validation = validation;
-        report.to_json()
+        report::bouc_wen_benchmark_report(
+            &fit,
+            &data,
+            source(),
+            fitted.to_file(),
+            validation,
+            steady_state,
+        )?
+        .to_json()
     })
 }
 
@@ -484,7 +374,7 @@ fn score(
 /// Rigid-body least squares (the paper's step 1): filtered position, velocity and
 /// acceleration, force = g·u regressed on inertia, viscous and Coulomb friction.
 #[pyfunction]
-#[pyo3(signature = (q, u, ts, gain, offset, cutoff_hz, order, decimation, border, inertia_name))]
+#[pyo3(signature = (q, u, ts, gain, offset, cutoff_hz, order, decimation, border, inertia_name, threads=0))]
 #[allow(clippy::too_many_arguments)]
 fn rigid_body_ls(
     py: Python<'_>,
@@ -498,11 +388,13 @@ fn rigid_body_ls(
     decimation: usize,
     border: usize,
     inertia_name: String,
+    threads: usize,
 ) -> PyResult<String> {
     let (q, u) = (samples(&q), samples(&u));
-    run(py, move || {
+    run_on(py, threads, move || {
         let clock = std::time::Instant::now();
-        let data = id_data(ts, vec![u.clone()], vec![q.clone()])?;
+        // Checks the record (finite, equal lengths, enough samples) as for every recipe.
+        id_data(ts, vec![u.clone()], vec![q.clone()])?;
         let ls = RigidBodyLs {
             inertia_name,
             gain,
@@ -513,27 +405,23 @@ fn rigid_body_ls(
             border,
         };
         let e = ls.estimate(&q, &u, ts)?;
-        let records = (0..e.names.len())
-            .map(|i| json!({"name": e.names[i], "value": e.values[i], "std": e.std[i], "unit": "", "fixed": false, "lower": null, "upper": null}))
-            .collect::<Vec<_>>();
-        let model: ModelFile = serde_json::from_value(json!({
-            "schema": "hysid.model/1", "kind": "rigid_body_ls", "parameters": records,
-            "hysteresis": null, "delay": null, "initial_output": null, "simulation": null, "initial_state": null,
-        }))
-        .map_err(|err| Error::Config(format!("rigid-body model record: {err}")))?;
-        let mut report = Report::new("rigid-body ls");
-        report.data = Some(hysid::report::DataSummary::of(&data, source()));
-        report.model = Some(model);
-        report.search = Some(SearchSummary::direct(clock.elapsed().as_secs_f64()));
-        report.uncertainty = Some(UncertaintySummary::least_squares());
-        report.details = json!({
+        let records = vec![json!({
+            "file": source()[0],
+            "role": "estimation",
             "relative_error_percent": e.relative_error_percent,
-            "relative_std_percent": e.relative_std_percent,
-            "condition_number": e.condition_number_unscaled,
-            "condition_number_scaled": e.condition_number,
-            "equations": e.equations,
-        });
-        report.to_json()
+        })];
+        let settings = json!({"position": "q", "input": "u"});
+        let elapsed = clock.elapsed().as_secs_f64();
+        report::rigid_body_report(
+            &e,
+            &ls,
+            source().remove(0),
+            q.len(),
+            elapsed,
+            records,
+            settings,
+        )
+        .to_json()
     })
 }
 

@@ -25,8 +25,7 @@
 
 use crate::errors::{named, CallbackError, InternalError};
 use crate::recipes::{
-    estimation, fitted_greybox, greybox_report, id_data, parameter_set, quiet, samples, simulation,
-    ParamTuple,
+    estimation, id_data, parameter_set, quiet, samples, simulation, source, ParamTuple,
 };
 use hysid::data::Channel;
 use hysid::identify::greybox::InitialStates;
@@ -267,13 +266,15 @@ fn greybox_fit_user(
             initial,
             &mut quiet(),
         )?;
-        let fitted = fitted_greybox("python", m.params.len(), n, &fit, sim)?;
-        greybox_report(
+        let fitted = fit.fitted_model(m.as_ref(), sim);
+        let extra = json!({"model": "python callbacks", "residual_analysis": hysid::report::greybox_residuals(&fit, &data)});
+        hysid::report::greybox_report(
             "greybox fit",
             &fit,
             &data,
+            source(),
             fitted.to_file(),
-            json!({"model": "python callbacks"}),
+            extra,
         )?
         .to_json()
     })

@@ -1,13 +1,11 @@
 """Shared fixtures: the Bouc–Wen truth, simulated records, the Example-1 record."""
-import json
+
 import math
-import os
 import pathlib
 
+import hysid
 import numpy as np
 import pytest
-
-import hysid
 
 HERE = pathlib.Path(__file__).parent
 DATA = HERE / "data"
@@ -21,16 +19,35 @@ def bouc_wen_model(values=BW_TRUTH, substeps=2, interpolation="zoh"):
     """A built-in Bouc–Wen model file with the given parameter values."""
     defaults, _, _ = hysid._hysid.model_parameters("bouc-wen")
     params = [
-        {"name": n, "value": values[n], "std": None, "unit": unit, "fixed": f,
-         "lower": None if math.isinf(lo) else lo, "upper": None if math.isinf(hi) else hi}
+        {
+            "name": n,
+            "value": values[n],
+            "std": None,
+            "unit": unit,
+            "fixed": f,
+            "lower": None if math.isinf(lo) else lo,
+            "upper": None if math.isinf(hi) else hi,
+        }
         for (n, _, lo, hi, f, unit) in defaults
     ]
-    return hysid.Model({
-        "schema": "hysid.model/1", "kind": "bouc_wen", "parameters": params,
-        "hysteresis": None, "delay": None, "initial_output": None,
-        "simulation": {"integrator": "rk4", "substeps": substeps, "interpolation": {"zoh": "zero_order_hold", "band-limited": "band_limited"}.get(interpolation, interpolation)},
-        "initial_state": [0.0, 0.0, 0.0],
-    })
+    return hysid.Model(
+        {
+            "schema": "hysid.model/1",
+            "kind": "bouc_wen",
+            "parameters": params,
+            "hysteresis": None,
+            "delay": None,
+            "initial_output": None,
+            "simulation": {
+                "integrator": "rk4",
+                "substeps": substeps,
+                "interpolation": {"zoh": "zero_order_hold", "band-limited": "band_limited"}.get(
+                    interpolation, interpolation
+                ),
+            },
+            "initial_state": [0.0, 0.0, 0.0],
+        }
+    )
 
 
 def excitation(n, seed, amplitude=50.0):

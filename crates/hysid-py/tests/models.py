@@ -1,10 +1,10 @@
 """A Bouc–Wen oscillator written as Python functions (module level, so it pickles):
 m ÿ + c ẏ + k y + z = u,  ż = α ẏ − β_γ |ẏ| sgn(z) |z|^ν − β_δ ẏ |z|^ν  (Noël & Schoukens 2016)."""
+
 import math
 
-import numpy as np
-
 import hysid
+import numpy as np
 
 
 def bw_rhs(t, x, u, p):
@@ -20,8 +20,9 @@ def bw_output(t, x, u, p):
 
 
 def bouc_wen_python(start):
-    params = [hysid.Parameter(n, v, fixed=(n == "nu"), lower=1e-9 if n == "mL" else -math.inf)
-              for n, v in start.items()]
+    params = [
+        hysid.Parameter(n, v, fixed=(n == "nu"), lower=1e-9 if n == "mL" else -math.inf) for n, v in start.items()
+    ]
     return hysid.GreyBoxModel(["y", "v", "z"], params, bw_rhs, bw_output)
 
 

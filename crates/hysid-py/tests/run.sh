@@ -11,4 +11,6 @@ python3 -m venv "$venv"
 # The Rust build reuses CARGO_TARGET_DIR when it is set (CI: the workspace's target/).
 "$venv/bin/python" -m pip install -q "$here[test]"
 cd "$here"
+"$venv/bin/ruff" format --check python tests examples
+"$venv/bin/ruff" check python tests examples
 "$venv/bin/python" -m pytest -q -rs -s tests "$@"

@@ -2,14 +2,14 @@
 (`hysid benchmark bouc-wen --train train_multisine_5periods.csv`, in
 data/bouc_wen_cli_figures.json). Needs the project's shared data (beside the clone, or
 HYSID_SHARED=path/to/shared)."""
+
 import json
 import os
 import pathlib
 
+import hysid
 import numpy as np
 import pytest
-
-import hysid
 from conftest import DATA
 
 
@@ -33,5 +33,7 @@ def test_benchmark_reproduces_cli():
         assert abs(r.parameters[name].value - value) <= 1e-12 * abs(value), name
     assert abs(r.fit_percent - cli["fit_percent"]) < 1e-9
     assert abs(r.report()["details"]["training_e_rms"] - cli["training_e_rms"]) < 1e-15
-    print(f"\nBouc–Wen benchmark: training e_RMS {cli['training_e_rms']:.4e} m, fit {r.fit_percent:.2f} %, "
-          f"fit time {r.elapsed_s:.2f} s")
+    print(
+        f"\nBouc–Wen benchmark: training e_RMS {cli['training_e_rms']:.4e} m, fit {r.fit_percent:.2f} %, "
+        f"fit time {r.elapsed_s:.2f} s"
+    )

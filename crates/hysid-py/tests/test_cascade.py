@@ -1,13 +1,12 @@
 """identify_cascade / identify_hysteresis: equality with the CLI, round trips, models."""
+
 import json
 import os
-import shutil
 import subprocess
 
+import hysid
 import numpy as np
 import pytest
-
-import hysid
 from conftest import DATA, rel_err
 
 #: Example 1's truth (Vörös 2015 cascade as the project reconstructs it).
@@ -37,9 +36,31 @@ def test_cascade_equals_cli_to_1e12(example1):
 @pytest.mark.skipif(not os.environ.get("HYSID_CLI"), reason="set HYSID_CLI to a hysid binary to compare live")
 def test_cascade_equals_live_cli(example1, tmp_path):
     model = tmp_path / "m.json"
-    subprocess.run([os.environ["HYSID_CLI"], "identify", "cascade", "--data", str(DATA / "example1.csv"),
-                    "--input", "x", "--output", "y", "--hysteresis", "ch4", "--na", "2", "--nb", "2",
-                    "--delay", "1", "--model", str(model)], check=True, capture_output=True)
+    subprocess.run(
+        [
+            os.environ["HYSID_CLI"],
+            "identify",
+            "cascade",
+            "--data",
+            str(DATA / "example1.csv"),
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch4",
+            "--na",
+            "2",
+            "--nb",
+            "2",
+            "--delay",
+            "1",
+            "--model",
+            str(model),
+        ],
+        check=True,
+        capture_output=True,
+    )
     cli = hysid.load_model(model)
     r = hysid.identify_cascade(*example1, hysteresis="ch4", na=2, nb=2, delay=1)
     for n, p in cli.parameters.items():
@@ -88,9 +109,18 @@ def test_hysteresis_round_trip(example1):
     """The cascade's hysteresis simulated alone, then identified alone."""
     x, _ = example1
     r = hysid.identify_cascade(*example1, hysteresis="ch4", na=2, nb=2, delay=1)
-    hfile = {"schema": "hysid.model/1", "kind": "coleman_hodgdon", "hysteresis": "ch4",
-             "initial_output": "zero", "delay": None, "simulation": None, "initial_state": None,
-             "parameters": [dict(p, std=None) for p in r.model.file["parameters"] if p["name"] not in ("a1", "a2", "b1", "b2")]}
+    hfile = {
+        "schema": "hysid.model/1",
+        "kind": "coleman_hodgdon",
+        "hysteresis": "ch4",
+        "initial_output": "zero",
+        "delay": None,
+        "simulation": None,
+        "initial_state": None,
+        "parameters": [
+            dict(p, std=None) for p in r.model.file["parameters"] if p["name"] not in ("a1", "a2", "b1", "b2")
+        ],
+    }
     v = hysid.Model(hfile).simulate(x, ts=1.0)
     h = hysid.identify_hysteresis(x, v, hysteresis="ch4", initial_output="zero")
     for rec in hfile["parameters"]:
@@ -114,3 +144,24 @@ def test_record_objects_accepted(example1):
     a = hysid.identify_cascade(Record(x, y, 1.0), na=2, nb=2, delay=1)
     b = hysid.identify_cascade(x, y, na=2, nb=2, delay=1)
     assert a.parameters == b.parameters
+
+
+def timeless(report):
+    """A report without its wall-clock figure and the data's names (a file vs numpy arrays)."""
+    report = json.loads(json.dumps(report))
+    report["search"].pop("elapsed_s", None)
+    report["data"].pop("source", None)
+    for e in report["fit"]["per_experiment"]:
+        e.pop("experiment", None)
+    return report
+
+
+@pytest.mark.skipif(not os.environ.get("HYSID_CLI"), reason="set HYSID_CLI to a hysid binary to compare live")
+def test_cascade_report_equals_live_cli(example1, tmp_path):
+    """The library's report builder (hysid::report::cascade_report) gives the CLI's report."""
+    path = tmp_path / "r.json"
+    args = ["identify", "cascade", "--data", str(DATA / "example1.csv"), "--input", "x", "--output", "y"]
+    args += ["--hysteresis", "ch4", "--na", "2", "--nb", "2", "--delay", "1", "--json", str(path)]
+    subprocess.run([os.environ["HYSID_CLI"], *args], check=True, capture_output=True)
+    r = hysid.identify_cascade(*example1, hysteresis="ch4", na=2, nb=2, delay=1)
+    assert timeless(r.report()) == timeless(json.loads(path.read_text()))

@@ -1,10 +1,10 @@
 """Bad input raises a Python exception with a clear one-line message, never a crash."""
-import numpy as np
-import pytest
 
 import hysid
+import numpy as np
+import pytest
 from conftest import BW_TRUTH, FS
-from models import bouc_wen_python, bw_output, bw_rhs, raising_rhs, wrong_shape_late
+from models import bouc_wen_python, bw_output, raising_rhs, wrong_shape_late
 
 X = np.sin(np.linspace(0, 20, 300)) * 3
 
@@ -68,8 +68,7 @@ def test_callback_raises_at_construction():
 
 def test_callback_wrong_shape_at_construction():
     with pytest.raises(hysid.CallbackError, match=r"returned shape \(2,\); it must return \(3,\)"):
-        hysid.GreyBoxModel(["y", "v", "z"], [hysid.Parameter("k", 1.0)],
-                           lambda t, x, u, p: np.zeros(2), bw_output)
+        hysid.GreyBoxModel(["y", "v", "z"], [hysid.Parameter("k", 1.0)], lambda t, x, u, p: np.zeros(2), bw_output)
 
 
 def _user(rhs):

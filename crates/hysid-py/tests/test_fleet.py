@@ -1,10 +1,9 @@
 """hysid.fleet.identify_many on a 2-worker LocalCluster."""
+
 import time
 
 import numpy as np
 import pytest
-
-import hysid
 from hysid.fleet import Failure, identify_many
 from models import cascade_fit
 
@@ -13,8 +12,7 @@ distributed = pytest.importorskip("dask.distributed")
 
 @pytest.fixture(scope="module")
 def client():
-    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                       dashboard_address=None)
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
     c = distributed.Client(cluster)
     yield c
     c.close()
@@ -50,6 +48,8 @@ def test_identify_many_100_records_timing(client, example1):
     t0 = time.perf_counter()
     fleet = identify_many(recs, cascade_fit, client=client)
     t_dask = time.perf_counter() - t0
-    print(f"\n100 cascade fits: loop {t_loop:.2f} s, Dask 2-worker LocalCluster {t_dask:.2f} s, "
-          f"speed-up {t_loop / t_dask:.2f}x")
+    print(
+        f"\n100 cascade fits: loop {t_loop:.2f} s, Dask 2-worker LocalCluster {t_dask:.2f} s, "
+        f"speed-up {t_loop / t_dask:.2f}x"
+    )
     assert fleet.results == loop

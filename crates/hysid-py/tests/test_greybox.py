@@ -1,11 +1,11 @@
 """greybox_fit: built-in models, user models as Python functions, benchmark_bouc_wen,
 rigid_body_ls."""
+
 import time
 
+import hysid
 import numpy as np
 import pytest
-
-import hysid
 from conftest import BW_TRUTH, FS, bouc_wen_model, excitation, rel_err
 from models import bouc_wen_python
 
@@ -35,11 +35,14 @@ def test_user_model_recovers_parameters(short_record):
     user = hysid.greybox_fit(bouc_wen_python(START), u, y, ts=1 / FS, substeps=1)
     t_user = time.perf_counter() - t0
     t0 = time.perf_counter()
-    builtin = hysid.greybox_fit("bouc-wen", u, y, ts=1 / FS, substeps=1,
-                                init={k: v for k, v in START.items() if k != "nu"})
+    builtin = hysid.greybox_fit(
+        "bouc-wen", u, y, ts=1 / FS, substeps=1, init={k: v for k, v in START.items() if k != "nu"}
+    )
     t_builtin = time.perf_counter() - t0
-    print(f"\nuser-defined Bouc–Wen fit {t_user:.2f} s, built-in {t_builtin:.3f} s "
-          f"({t_user / t_builtin:.0f}x), {len(u)} samples")
+    print(
+        f"\nuser-defined Bouc–Wen fit {t_user:.2f} s, built-in {t_builtin:.3f} s "
+        f"({t_user / t_builtin:.0f}x), {len(u)} samples"
+    )
     for n, v in BW_TRUTH.items():
         assert rel_err(user.parameters[n].value, v) < 1e-4, n
         assert rel_err(builtin.parameters[n].value, v) < 1e-4, n

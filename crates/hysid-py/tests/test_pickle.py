@@ -1,9 +1,9 @@
 """Results and models pickle and round-trip exactly."""
+
 import pickle
 
-import numpy as np
-
 import hysid
+import numpy as np
 from conftest import FS
 from models import bouc_wen_python
 from test_greybox import START, short_record  # noqa: F401

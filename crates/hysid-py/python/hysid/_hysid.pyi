@@ -1,5 +1,6 @@
 """Type stubs of the extension module hysid._hysid (the low-level layer; use the functions
 of the hysid package). Every fit returns the hysid.report/1 report as JSON text."""
+
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -19,14 +20,118 @@ _Array = npt.NDArray[np.float64]
 _Param = Tuple[str, float, float, float, bool, str]
 _Spec = Tuple[object, object, List[str], int, int, List[_Param], List[float]]
 
-def identify_cascade(x: _Array, y: _Array, hysteresis: str, na: int, nb: int, delay: int, ts: float, uncertainty: str, replicates: int, seed: int) -> str: ...
-def identify_hysteresis(x: _Array, y: _Array, hysteresis: str, ts: float, initial_output: str) -> str: ...
+def identify_cascade(
+    x: _Array,
+    y: _Array,
+    hysteresis: str,
+    na: int,
+    nb: int,
+    delay: int,
+    ts: float,
+    uncertainty: str,
+    replicates: int,
+    seed: int,
+    threads: int = 0,
+) -> str: ...
+def identify_hysteresis(
+    x: _Array, y: _Array, hysteresis: str, ts: float, initial_output: str, threads: int = 0
+) -> str: ...
 def model_parameters(kind: str) -> Tuple[List[_Param], List[str], int]: ...
-def greybox_fit(kind: str, u: Sequence[_Array], y: Sequence[_Array], ts: float, params: Sequence[_Param], starts: int, seed: int, integrator: str, substeps: int, interpolation: str) -> str: ...
-def greybox_fit_user(spec: _Spec, u: Sequence[_Array], y: Sequence[_Array], ts: float, starts: int, seed: int, integrator: str, substeps: int, interpolation: str) -> str: ...
-def benchmark_bouc_wen(u: _Array, y: _Array, ts: float, params: Sequence[_Param], tests: Sequence[Tuple[_Array, _Array, float, str]], steady_state: bool, starts: int, seed: int, substeps: int) -> str: ...
-def rigid_body_ls(q: _Array, u: _Array, ts: float, gain: float, offset: bool, cutoff_hz: float, order: int, decimation: int, border: int, inertia_name: str) -> str: ...
-def simulate_model(model_json: str, inputs: Sequence[_Array], ts: float, y0: Optional[float] = None) -> List[_Array]: ...
-def simulate_user(spec: _Spec, inputs: Sequence[_Array], ts: float, integrator: str, substeps: int, interpolation: str) -> List[_Array]: ...
+def greybox_fit(
+    kind: str,
+    u: Sequence[_Array],
+    y: Sequence[_Array],
+    ts: float,
+    params: Sequence[_Param],
+    starts: int,
+    seed: int,
+    integrator: str,
+    substeps: int,
+    interpolation: str,
+    threads: int = 0,
+) -> str: ...
+def greybox_fit_user(
+    spec: _Spec,
+    u: Sequence[_Array],
+    y: Sequence[_Array],
+    ts: float,
+    starts: int,
+    seed: int,
+    integrator: str,
+    substeps: int,
+    interpolation: str,
+) -> str: ...
+def benchmark_bouc_wen(
+    u: _Array,
+    y: _Array,
+    ts: float,
+    params: Sequence[_Param],
+    tests: Sequence[Tuple[_Array, _Array, float, str]],
+    steady_state: bool,
+    starts: int,
+    seed: int,
+    substeps: int,
+    threads: int = 0,
+) -> str: ...
+def rigid_body_ls(
+    q: _Array,
+    u: _Array,
+    ts: float,
+    gain: float,
+    offset: bool,
+    cutoff_hz: float,
+    order: int,
+    decimation: int,
+    border: int,
+    inertia_name: str,
+    threads: int = 0,
+) -> str: ...
+def simulate_model(
+    model_json: str, inputs: Sequence[_Array], ts: float, y0: Optional[float] = None
+) -> List[_Array]: ...
+def simulate_user(
+    spec: _Spec, inputs: Sequence[_Array], ts: float, integrator: str, substeps: int, interpolation: str
+) -> List[_Array]: ...
 def load_model(path: str) -> str: ...
 def check_model(model_json: str) -> str: ...
+def set_num_threads(n: int) -> None: ...
+def get_num_threads() -> int: ...
+def equation_info(
+    text: str, origin: str
+) -> Tuple[str, List[_Param], List[str], List[str], List[str], List[float], List[bool]]: ...
+def equation_model_file(
+    text: str, params: Sequence[_Param], x0: Sequence[float], integrator: str, substeps: int, interpolation: str
+) -> str: ...
+def greybox_fit_equations(
+    text: str,
+    u: Sequence[_Array],
+    y: Sequence[_Array],
+    ts: float,
+    params: Sequence[_Param],
+    starts: int,
+    seed: int,
+    integrator: str,
+    substeps: int,
+    interpolation: str,
+    threads: int = 0,
+) -> str: ...
+def actuator_parameter_names() -> List[str]: ...
+def actuator_rig_truth() -> List[float]: ...
+def actuator_read_data_sets(dir: str) -> List[Tuple[_Array, _Array, float]]: ...
+def actuator_rig(
+    truth: Optional[Sequence[float]], backlash: float, noise: float, seed: int, gear_ratio: float, saddle_mass: float
+) -> List[Tuple[int, bool, float, _Array, _Array]]: ...
+def actuator_three_steps(
+    sets: Sequence[Tuple[_Array, _Array, float]],
+    source: str,
+    truth: Optional[Sequence[float]],
+    gear_ratio: float,
+    saddle_mass: float,
+    cutoff_hz: float,
+    remove_mean: bool,
+    reversal_margin: float,
+    unfiltered_step3: bool,
+    max_iterations: int,
+    tolerance: float,
+    threads: int = 0,
+) -> str: ...

@@ -14,7 +14,10 @@ installed there) and pass ``Client("tcp://HOST:8786")``: the same code runs unch
 a ``functools.partial`` of one), and hysid's results pickle exactly.
 
 Each hysid fit releases the GIL, so a worker with several threads runs several fits at
-once; with Python-callback models (:class:`hysid.GreyBoxModel`) use worker processes
+once: give those fits ``threads=1`` (or call ``hysid.set_num_threads(1)`` in the worker),
+else they share one pool of all cores and gain nothing. The default cluster here has
+single-threaded worker processes, and a fit there may use all cores of its machine. With
+Python-callback models (:class:`hysid.GreyBoxModel`) use worker processes
 (``threads_per_worker=1``), since those callbacks need the GIL.
 """
 
@@ -133,9 +136,7 @@ def identify_many(
         )
         client = Client(cluster)
     try:
-        futures = client.map(
-            _guarded, [fit] * len(records), range(len(records)), records, pure=False
-        )
+        futures = client.map(_guarded, [fit] * len(records), range(len(records)), records, pure=False)
         results = client.gather(futures)
     finally:
         if own:

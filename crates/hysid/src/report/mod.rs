@@ -23,6 +23,13 @@
 //! FPE and AIC are Akaike's (Ljung, *System Identification*, 2nd ed., 1999, §16.4).
 
 pub mod actuator;
+pub mod cascade;
+pub mod greybox;
+pub mod rigid_body;
+
+pub use cascade::{cascade_report, hysteresis_report};
+pub use greybox::{bouc_wen_benchmark_report, greybox_report, greybox_residuals};
+pub use rigid_body::{rigid_body_model, rigid_body_report};
 
 use crate::data::IdData;
 use crate::identify::OutputErrorFit;
