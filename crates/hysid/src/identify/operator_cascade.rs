@@ -301,13 +301,29 @@ impl OperatorCascadeIdentification {
         Ok((a, b, theta, sse))
     }
 
+    /// The start's cascade; an unstable A from the equation error (a misfitting Γ₀ can give
+    /// one) has its poles pulled radially inside the unit circle, aᵢ ← aᵢ ρⁱ with
+    /// ρ = 0.95/(spectral radius), because output error cannot start from a diverging
+    /// simulation.
     fn cascade(
         &self,
         operator: CascadeOperator,
         a: Vec<f64>,
         b: Vec<f64>,
     ) -> Result<OperatorCascade> {
-        OperatorCascade::new(operator, LinearBlock::new(a, b, self.delay)?)
+        let mut linear = LinearBlock::new(a, b, self.delay)?;
+        let radius = linear.spectral_radius();
+        if radius >= 0.99 {
+            let rho = 0.95 / radius;
+            let a = linear
+                .a()
+                .iter()
+                .zip(1..)
+                .map(|(ai, i)| ai * rho.powi(i))
+                .collect();
+            linear = LinearBlock::new(a, linear.b().to_vec(), self.delay)?;
+        }
+        OperatorCascade::new(operator, linear)
     }
 
     fn pi_start(&self, u: &[f64], y: &[f64], n: usize) -> Result<OperatorCascade> {

@@ -143,3 +143,24 @@ fn bad_settings_are_refused() {
     let flat = data(&vec![1.0; 200], (0..200).map(|k| k as f64).collect());
     assert!(id.estimate(&flat, &mut |_| Control::Continue).is_err());
 }
+
+#[test]
+fn a_misfitting_family_still_starts_from_a_stable_block() {
+    // Bouc–Wen fitted to a PI cascade: the ARX start on Γ₀[u] may be unstable; it is pulled
+    // inside the unit circle so that output error can start.
+    let u = input(1500);
+    let grid = threshold_grid(&u, 4).unwrap();
+    let op = PrandtlIshlinskii::new(
+        0.9,
+        vec![0.5, 0.3, 0.25, 0.2],
+        grid,
+        0.4,
+        Orientation::default(),
+    )
+    .unwrap();
+    let truth = OperatorCascade::new(CascadeOperator::Pi(op), block()).unwrap();
+    let y = truth.simulate(&u).unwrap().y;
+    let f = fit(CascadeFamily::BoucWen, &data(&u, y));
+    assert!(f.start.linear.spectral_radius() < 0.99);
+    assert!(f.fit_percent > 90.0, "{}", f.fit_percent);
+}
