@@ -255,11 +255,7 @@ impl OperatorCascadeIdentification {
 
     /// Equation-error least squares of y on past y and the lagged basis signals; returns
     /// (a, b with b1 = 1, θ) from the rank-one factorisation, and the residual sum of squares.
-    fn rank_one(
-        &self,
-        y: &[f64],
-        basis: &[Vec<f64>],
-    ) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, f64)> {
+    fn rank_one(&self, y: &[f64], basis: &[Vec<f64>]) -> Result<RankOne> {
         let (na, nb, k) = (self.na, self.nb, self.delay);
         let l = basis.len();
         let mut columns: Vec<Vec<f64>> = (1..=na).map(|i| lagged(y, i, -1.0)).collect();
@@ -298,7 +294,7 @@ impl OperatorCascadeIdentification {
         }
         let b: Vec<f64> = u1.iter().map(|v| v / u1[0]).collect();
         let theta: Vec<f64> = vt.row(best).iter().map(|v| sigma * u1[0] * v).collect();
-        Ok((a, b, theta, sse))
+        Ok(RankOne { a, b, theta, sse })
     }
 
     /// The start's cascade; an unstable A from the equation error (a misfitting Γ₀ can give
@@ -331,7 +327,7 @@ impl OperatorCascadeIdentification {
         let mut basis = vec![u.to_vec()];
         basis.extend(grid.iter().map(|&r| play(u, r)));
         basis.push(vec![1.0; u.len()]);
-        let (a, b, theta, _) = self.rank_one(y, &basis)?;
+        let RankOne { a, b, theta, .. } = self.rank_one(y, &basis)?;
         let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
         let (a0, weights) = monotone_weights(theta[0], &theta[1..=n]);
         let op = PrandtlIshlinskii::new(a0, weights, grid, theta[n + 1], o)?;
@@ -343,7 +339,7 @@ impl OperatorCascadeIdentification {
         let mut basis = vec![u.to_vec()];
         basis.extend(widths.iter().map(|&d| stop(u, d)));
         basis.push(vec![1.0; u.len()]);
-        let (a, b, theta, _) = self.rank_one(y, &basis)?;
+        let RankOne { a, b, theta, .. } = self.rank_one(y, &basis)?;
         let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
         let k: Vec<f64> = theta[1..=n].iter().map(|v| v.max(0.0)).collect();
         let op = MaxwellSlip::new(theta[0].max(0.0), k, widths, theta[n + 1], o)?;
@@ -359,17 +355,17 @@ impl OperatorCascadeIdentification {
         let (lo, hi) = range(u);
         let step = (hi - lo) / (2.0 * points as f64);
         let ones = vec![1.0; u.len()];
-        let mut best: Option<(f64, f64, Vec<f64>, Vec<f64>, Vec<f64>)> = None;
+        let mut best: Option<(f64, RankOne)> = None;
         for i in 0..points {
             let r = i as f64 * step;
-            let Ok((a, b, theta, sse)) = self.rank_one(y, &[play(u, r), ones.clone()]) else {
+            let Ok(fit) = self.rank_one(y, &[play(u, r), ones.clone()]) else {
                 continue;
             };
-            if best.as_ref().is_none_or(|bst| sse < bst.0) {
-                best = Some((sse, r, a, b, theta));
+            if best.as_ref().is_none_or(|(_, b)| fit.sse < b.sse) {
+                best = Some((r, fit));
             }
         }
-        let (_, r, a, b, theta) = best.ok_or_else(|| Error::NotExciting {
+        let (r, RankOne { a, b, theta, .. }) = best.ok_or_else(|| Error::NotExciting {
             channel: "u".into(),
             reason: "no backlash width gives a regular cascade regression; check the columns"
                 .into(),
@@ -434,10 +430,19 @@ impl OperatorCascadeIdentification {
         };
         let v = op.as_operator().simulate(u)?;
         // With the single basis signal v₀ the factorisation returns b/b1 and θ = b1.
-        let (a, b, theta, _) = self.rank_one(y, &[v])?;
+        let RankOne { a, b, theta, .. } = self.rank_one(y, &[v])?;
         let op = op.scaled(theta[0]).unwrap_or(op);
         self.cascade(op, a, b)
     }
+}
+
+/// The rank-one factorisation of the over-parameterised regression: A, B (b1 = 1), the
+/// operator's linear parameters θ and the equation error's residual sum of squares.
+struct RankOne {
+    a: Vec<f64>,
+    b: Vec<f64>,
+    theta: Vec<f64>,
+    sse: f64,
 }
 
 /// (θ, orientation): θ negated with the decreasing orientation when its slope is negative.
@@ -485,7 +490,7 @@ fn range(x: &[f64]) -> (f64, f64) {
 /// The families' threshold grid rᵢ = i·(max u − min u)/(2(n + 1)), i = 1 … n.
 pub fn threshold_grid(u: &[f64], n: usize) -> Result<Vec<f64>> {
     let (lo, hi) = range(u);
-    if n == 0 || !(hi > lo) {
+    if n == 0 || hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return Err(Error::NotExciting {
             channel: "u".into(),
             reason: format!("a grid of {n} thresholds needs n >= 1 and an input that varies"),

@@ -553,13 +553,11 @@ mod tests {
             let comp = c.compensate(&r).unwrap();
             assert!(comp.clipped.is_empty());
             let scale = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for t in 2..r.len() {
+            for (t, (p, rt)) in comp.predicted.iter().zip(&r).enumerate().skip(2) {
                 assert!(
-                    (comp.predicted[t] - r[t]).abs() <= tol * scale,
-                    "{} t = {t}: {} vs {}",
-                    c.operator.family(),
-                    comp.predicted[t],
-                    r[t]
+                    (p - rt).abs() <= tol * scale,
+                    "{} t = {t}: {p} vs {rt}",
+                    c.operator.family()
                 );
             }
             assert_eq!(comp.predicted[..2], [0.0, 0.0]);
@@ -574,8 +572,8 @@ mod tests {
             OperatorCascade::new(CascadeOperator::BoucWen(bw), second_order(vec![1.0])).unwrap();
         let comp = c.compensate(&r).unwrap();
         assert!(comp.clipped.is_empty(), "{:?}", comp.clipped.len());
-        for t in 2..r.len() {
-            assert!((comp.predicted[t] - r[t]).abs() <= 1e-6, "t = {t}");
+        for (t, (p, rt)) in comp.predicted.iter().zip(&r).enumerate().skip(2) {
+            assert!((p - rt).abs() <= 1e-6, "t = {t}");
         }
     }
 
