@@ -523,7 +523,8 @@ pub enum UncertaintyArg {
 /// Identification commands.
 #[derive(Debug, Subcommand)]
 pub enum Identify {
-    /// Coleman–Hodgdon hysteresis followed by a linear block (Vörös 2015).
+    /// A hysteresis (Coleman–Hodgdon ch4/ch6 or any operator family) followed by a linear
+    /// block (Vörös 2015).
     Cascade(CascadeArgs),
     /// Coleman–Hodgdon hysteresis alone, its input and output both measured.
     Hysteresis(HysteresisArgs),
@@ -570,9 +571,17 @@ pub struct OutputArgs {
 pub struct CascadeArgs {
     #[command(flatten)]
     pub data: DataArgs,
-    /// Hysteresis form: ch4 (saturated, 4 parameters) or ch6.
+    /// Hysteresis: ch4 (saturated Coleman–Hodgdon, 4 parameters), ch6, or an operator family:
+    /// pi, gpi, preisach, jiles-atherton, bouc-wen, duhem, dahl, maxwell-slip, backlash.
     #[arg(long)]
     pub hysteresis: String,
+    /// Operator families: number of thresholds of pi and gpi, elements of maxwell-slip (10).
+    /// Range 1..=200.
+    #[arg(long, value_parser = crate::options::count::<1, 200>)]
+    pub thresholds: Option<usize>,
+    /// Operator family preisach: intervals of the Preisach grid (10). Range 1..=100.
+    #[arg(long, value_parser = crate::options::count::<1, 100>)]
+    pub levels: Option<usize>,
     /// Order n of A(q⁻¹). Range 0..=50.
     #[arg(long, value_parser = crate::options::count::<0, 50>)]
     pub na: usize,

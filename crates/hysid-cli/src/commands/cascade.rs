@@ -16,6 +16,12 @@ use hysid::report::UncertaintySummary;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
+/// True for the Coleman–Hodgdon forms (`ch4`, `ch6`) of the paper-1 pipeline; every other
+/// name is an operator family (`commands/operator_cascade.rs`).
+pub fn is_coleman_hodgdon(name: &str) -> bool {
+    matches!(name.trim().to_ascii_lowercase().as_str(), "ch4" | "ch6")
+}
+
 /// The estimator setting for a command-line choice.
 pub fn uncertainty(arg: UncertaintyArg, replicates: usize) -> Uncertainty {
     match arg {

@@ -69,6 +69,9 @@ fn rename(data: IdData, inputs: &[Channel], outputs: &[Channel], k: usize) -> Re
 
 /// `hysid identify cascade`.
 pub fn cascade(args: &CascadeArgs) -> Result<()> {
+    if !super::cascade::is_coleman_hodgdon(&args.hysteresis) {
+        return super::operator_cascade::identify(args);
+    }
     let form = ChForm::parse(&args.hysteresis)?;
     preflight_outputs(&args.output)?;
     let data = load(&args.data)?;
@@ -258,7 +261,7 @@ fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()
 }
 
 /// Writes the report and the model file when asked for.
-fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<()> {
+pub(super) fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<()> {
     if let Some(path) = &output.json {
         write_report(path, report)?;
         println!("  report: {}", path.display());
@@ -271,7 +274,7 @@ fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<(
 }
 
 /// Checks the report, model and plot destinations before the fit.
-fn preflight_outputs(output: &OutputArgs) -> Result<()> {
+pub(super) fn preflight_outputs(output: &OutputArgs) -> Result<()> {
     crate::output::preflight(
         &[output.json.as_deref(), output.model_out.as_deref()],
         &[output.plots.as_deref()],

@@ -7,6 +7,7 @@ mod demo;
 mod generate;
 mod greybox;
 mod identify;
+mod operator_cascade;
 mod present;
 mod rigid_body;
 mod simulate;

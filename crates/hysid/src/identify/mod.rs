@@ -19,6 +19,8 @@
 //!   multi-start (MATLAB's `nlgreyest`).
 //! * [`actuator`]: the three-step identification of Gunnar et al. (2006).
 //! * [`operators`]: identification of the hysteresis operator families from the data alone.
+//! * [`operator_cascade`]: any operator family followed by a linear block (global start,
+//!   output error).
 //! * [`validate`]: residual analysis and the one-at-a-time sensitivity table.
 
 pub mod actuator;
@@ -32,6 +34,7 @@ pub mod grid_regression;
 pub mod hysteresis;
 pub mod key_term;
 pub mod multistart;
+pub mod operator_cascade;
 pub mod operators;
 pub mod output_error;
 pub mod rigid_body;

@@ -7,6 +7,7 @@
 //!   functions, 4- and 6-parameter forms.
 //! * [`LinearBlock`]: A(q⁻¹) y = B(q⁻¹) v with delay.
 //! * [`HysteresisCascade`]: the two in series (Vörös 2015).
+//! * [`OperatorCascade`]: any operator family of [`operators`] followed by a linear block.
 //! * [`greybox`]: continuous-time state-space models ([`greybox::StateSpaceModel`]), the
 //!   built-in ones (Bouc–Wen oscillator, rigid body, the actuator of Gunnar et al. 2006),
 //!   their integrators and forward sensitivities.
@@ -16,6 +17,7 @@ mod cascade;
 pub mod coleman_hodgdon;
 pub mod greybox;
 mod linear;
+pub mod operator_cascade;
 pub mod operators;
 mod parameters;
 pub mod saved;
@@ -24,4 +26,5 @@ mod saved_equations;
 pub use cascade::{CascadeOutput, HysteresisCascade};
 pub use coleman_hodgdon::{Admissibility, ChForm, ColemanHodgdon};
 pub use linear::LinearBlock;
+pub use operator_cascade::{CascadeCompensation, CascadeOperator, OperatorCascade};
 pub use parameters::{Parameter, ParameterSet};

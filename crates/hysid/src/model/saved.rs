@@ -22,6 +22,7 @@
 //! |---|---|---|
 //! | `coleman_hodgdon` | `hysteresis` (`ch4`/`ch6`), `initial_output` (`measured`/`zero`) | α, m₁, c₁, d (ch6: and m₂, c₂) |
 //! | `ch_cascade` | `hysteresis`, `delay` | hysteresis, then b₁ (fixed at 1) … b_m, a₁ … a_n |
+//! | `operator_cascade` | `operator` (the family and its structure: thresholds, grid, orientation, …), `delay` | the operator's (prefixed `op_` where they collide with a₁…, b₁…), then a₁ … a_n, b₁ (fixed at 1) … b_m |
 //! | `bouc_wen`, `rigid_body`, `actuator_fixed`, `actuator_free` | `simulation`, `initial_state` | the grey-box model's |
 //! | `equations` | `equations` (the equation file's text), `simulation`, `initial_state` | the file's `[parameters]` |
 //!
@@ -33,6 +34,7 @@ use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::saved_equations::{equations_from_file, simulate_outputs};
+use crate::model::{CascadeOperator, OperatorCascade};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -123,6 +125,10 @@ pub struct ModelFile {
     /// self-contained.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub equations: Option<String>,
+    /// The operator of an `operator_cascade`: `{"family": …, "operator": {…}}` with its
+    /// structure (thresholds, grid, orientation, …); its values are read from `parameters`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub operator: Option<serde_json::Value>,
 }
 
 /// The simulation settings in a model file.
@@ -238,6 +244,14 @@ pub enum FittedModel {
         /// Its initial state.
         initial_state: Vec<f64>,
     },
+    /// Any hysteresis operator followed by a linear block.
+    OperatorCascade {
+        /// The model.
+        model: OperatorCascade,
+        /// Standard deviations in [`OperatorCascade::parameters`] order (NaN where not
+        /// estimated).
+        std: Vec<f64>,
+    },
     /// A grey-box model written as equations (`hysid-equations`).
     Equations {
         /// The equation file's text.
@@ -304,6 +318,7 @@ impl FittedModel {
                 Ok(vec![simulate_switched(model, x, v0, None)])
             }
             FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::OperatorCascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
             FittedModel::GreyBox {
                 kind,
                 parameters,
@@ -375,6 +390,7 @@ impl FittedModel {
             simulation: None,
             initial_state: None,
             equations: None,
+            operator: None,
         };
         match self {
             FittedModel::Hysteresis {
@@ -390,6 +406,19 @@ impl FittedModel {
                 hysteresis: Some(model.hysteresis.form()),
                 delay: Some(model.linear.delay()),
                 ..empty("ch_cascade", cascade_records(model, std))
+            },
+            FittedModel::OperatorCascade { model, std } => ModelFile {
+                delay: Some(model.linear.delay()),
+                operator: serde_json::to_value(&model.operator).ok(),
+                ..empty(
+                    OPERATOR_CASCADE_KIND,
+                    model
+                        .parameters()
+                        .iter()
+                        .zip(std)
+                        .map(|(p, s)| ParameterRecord::of(p, *s))
+                        .collect(),
+                )
             },
             FittedModel::GreyBox {
                 kind,
@@ -448,6 +477,7 @@ impl FittedModel {
         match file.kind.as_str() {
             "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
             EQUATIONS_KIND => equations_from_file(file),
+            OPERATOR_CASCADE_KIND => operator_cascade_from_file(file),
             kind => Self::grey_box_from_file(kind, file),
         }
     }
@@ -574,6 +604,46 @@ impl FittedModel {
     }
 }
 
+/// The kind of [`FittedModel::OperatorCascade`].
+pub const OPERATOR_CASCADE_KIND: &str = "operator_cascade";
+
+/// An operator cascade from its file: the structure from `operator`, every value from
+/// `parameters` (validated by the family's constructor).
+fn operator_cascade_from_file(file: &ModelFile) -> Result<FittedModel> {
+    let structure = file.operator.clone().ok_or_else(|| {
+        Error::Config("an operator_cascade model needs \"operator\" (family and structure)".into())
+    })?;
+    let operator: CascadeOperator = serde_json::from_value(structure)
+        .map_err(|e| Error::Config(format!("the operator of the operator_cascade model: {e}")))?;
+    let delay = file
+        .delay
+        .ok_or_else(|| Error::Config("an operator_cascade model needs \"delay\"".into()))?;
+    let b = coefficients(file, 'b')?;
+    let a = coefficients(file, 'a')?;
+    if b.is_empty() || b[0].value != 1.0 {
+        return Err(Error::Config(
+            "an operator_cascade model needs b1 = 1 (the gain sits in the operator)".into(),
+        ));
+    }
+    let linear = LinearBlock::new(
+        a.iter().map(|e| e.value).collect(),
+        b.iter().map(|e| e.value).collect(),
+        delay,
+    )?;
+    let template = OperatorCascade::new(operator, linear)?;
+    let mut values = Vec::new();
+    let mut std = Vec::new();
+    for name in template.parameters().names() {
+        let e = record(file, &name)?;
+        values.push(e.value);
+        std.push(e.std_or_nan());
+    }
+    Ok(FittedModel::OperatorCascade {
+        model: template.with_values(&values)?,
+        std,
+    })
+}
+
 fn hysteresis_records(model: &ColemanHodgdon, std: &[f64]) -> Vec<ParameterRecord> {
     model
         .form()
@@ -631,8 +701,9 @@ fn coefficients(file: &ModelFile, letter: char) -> Result<Vec<ParameterRecord>> 
     for (i, (k, _)) in found.iter().enumerate() {
         if *k != i + 1 {
             return Err(Error::Config(format!(
-                "coefficient {letter}{} is missing from the ch_cascade model",
-                i + 1
+                "coefficient {letter}{} is missing from the {} model",
+                i + 1,
+                file.kind
             )));
         }
     }
@@ -659,6 +730,41 @@ mod tests {
         );
         let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
         assert_eq!(back, fitted);
+    }
+
+    #[test]
+    fn operator_cascade_round_trips_through_json() {
+        use crate::model::operators::{Orientation, Preisach};
+        let w: Vec<f64> = (0..10).map(|k| 0.05 + 0.01 * k as f64).collect();
+        let op = Preisach::new(-2.0, 2.0, 4, w, 0.3, 0.1, Orientation::default()).unwrap();
+        let linear = LinearBlock::new(vec![-0.5], vec![1.0, 0.3], 1).unwrap();
+        let model = OperatorCascade::new(CascadeOperator::Preisach(op), linear).unwrap();
+        let std: Vec<f64> = (0..model.parameters().len())
+            .map(|i| 0.01 * i as f64)
+            .collect();
+        let fitted = FittedModel::OperatorCascade { model, std };
+        let json = serde_json::to_string(&fitted.to_file()).unwrap();
+        assert!(
+            json.contains("\"kind\":\"operator_cascade\"")
+                && json.contains("\"family\":\"preisach\"")
+        );
+        let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
+        let u: Vec<f64> = (0..300).map(|k| 2.0 * (k as f64 * 0.05).sin()).collect();
+        let (a, b) = (
+            fitted.simulate(&[&u], 1.0, None).unwrap(),
+            back.simulate(&[&u], 1.0, None).unwrap(),
+        );
+        let d = a[0]
+            .iter()
+            .zip(&b[0])
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        assert!(d < 1e-12, "{d} {:?}", &json);
+        let bad = json.replace(
+            "\"name\":\"b1\",\"value\":1.0",
+            "\"name\":\"b1\",\"value\":2.0",
+        );
+        assert!(FittedModel::from_file(&serde_json::from_str(&bad).unwrap()).is_err());
     }
 
     #[test]
