@@ -413,17 +413,12 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 }
 
-/// Accumulates JᵀJ, Jᵀr and Σr² row by row. Each row updates the upper triangle of a block's
-/// partial sums (p(p+1)/2 + p multiply-adds over contiguous slices, which the compiler
-/// vectorises); every [`BLOCK_ROWS`] rows the partial sums are added to the totals, which
-/// keeps the rounding of a 10⁶-row sum at the level of a 512-row one. Σr² is summed row by
-/// row in order, so it equals the sum of squares of the same residuals computed elsewhere.
+/// Accumulates JᵀJ, Jᵀr and Σr² row by row, in blocks so the rank-k update runs through a
+/// matrix product instead of a scalar double loop per sample.
 struct Accumulator {
-    p: usize,
+    block: DMatrix<f64>,
+    residuals: DVector<f64>,
     rows: usize,
-    /// Partial sums of the current block: upper triangle of JᵀJ, row-major p × p.
-    block_jtj: Vec<f64>,
-    block_jtr: Vec<f64>,
     jtj: DMatrix<f64>,
     jtr: DVector<f64>,
     cost: f64,
@@ -434,10 +429,9 @@ const BLOCK_ROWS: usize = 512;
 impl Accumulator {
     fn new(p: usize) -> Self {
         Self {
-            p,
+            block: DMatrix::zeros(BLOCK_ROWS, p),
+            residuals: DVector::zeros(BLOCK_ROWS),
             rows: 0,
-            block_jtj: vec![0.0; p * p],
-            block_jtr: vec![0.0; p],
             jtj: DMatrix::zeros(p, p),
             jtr: DVector::zeros(p),
             cost: 0.0,
@@ -446,14 +440,10 @@ impl Accumulator {
 
     #[inline]
     fn add(&mut self, row: &[f64], r: f64) {
-        let p = self.p;
-        for (a, (&ja, g)) in row.iter().zip(&mut self.block_jtr).enumerate() {
-            let upper = &mut self.block_jtj[a * p + a..(a + 1) * p];
-            for (h, &jb) in upper.iter_mut().zip(&row[a..]) {
-                *h += ja * jb;
-            }
-            *g += ja * r;
+        for (k, v) in row.iter().enumerate() {
+            self.block[(self.rows, k)] = *v;
         }
+        self.residuals[self.rows] = r;
         self.cost += r * r;
         self.rows += 1;
         if self.rows == BLOCK_ROWS {
@@ -465,19 +455,15 @@ impl Accumulator {
         if self.rows == 0 {
             return;
         }
-        let p = self.p;
-        for a in 0..p {
-            for b in a..p {
-                self.jtj[(a, b)] += std::mem::take(&mut self.block_jtj[a * p + b]);
-            }
-            self.jtr[a] += std::mem::take(&mut self.block_jtr[a]);
-        }
+        let j = self.block.rows(0, self.rows);
+        let r = self.residuals.rows(0, self.rows);
+        self.jtj.gemm_tr(1.0, &j, &j, 1.0);
+        self.jtr.gemv_tr(1.0, &j, &r, 1.0);
         self.rows = 0;
     }
 
     fn finish(mut self) -> NormalEquations {
         self.flush();
-        self.jtj.fill_lower_triangle_with_upper_triangle();
         NormalEquations {
             jtj: self.jtj,
             jtr: self.jtr,
