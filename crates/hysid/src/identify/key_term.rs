@@ -108,8 +108,10 @@ impl KeyTermSeparation {
         let mut costs = Vec::new();
         let mut hysteresis = initial.clone();
         let mut termination = Termination::MaxIterations;
+        // The internal variable v̂ of the current hysteresis estimate; each iteration's check
+        // of the new estimate simulates the next one.
+        let mut v = hysteresis.simulate_unchecked(x, 0.0);
         for _ in 0..self.max_iterations {
-            let v = hysteresis.simulate_unchecked(x, 0.0);
             let (phi, target) = self.rows(x, y, &v, hysteresis.d());
             let ls = least_squares(&phi, &target, &[])?;
             costs.push(ls.residual_ss);
@@ -138,14 +140,17 @@ impl KeyTermSeparation {
                 .collect();
             let change = relative_change(&theta, &relaxed);
             match ColemanHodgdon::from_params(self.form, &relaxed[..nh]) {
-                Ok(h) if h.simulate_unchecked(x, 0.0).iter().all(|v| v.is_finite()) => {
-                    hysteresis = h
-                }
-                Ok(_) => {
-                    termination = Termination::Diverged {
-                        reason: "the hysteresis simulation blew up (alpha*|dx| far above 1)".into(),
-                    };
-                    break;
+                Ok(h) => {
+                    let next = h.simulate_unchecked(x, 0.0);
+                    if !next.iter().all(|v| v.is_finite()) {
+                        termination = Termination::Diverged {
+                            reason: "the hysteresis simulation blew up (alpha*|dx| far above 1)"
+                                .into(),
+                        };
+                        break;
+                    }
+                    hysteresis = h;
+                    v = next;
                 }
                 Err(e) => {
                     termination = Termination::Diverged {

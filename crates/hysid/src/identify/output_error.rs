@@ -29,6 +29,7 @@ use crate::numerics::metrics;
 use crate::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
+use std::sync::Mutex;
 
 /// Receives one sample of simulated outputs and their sensitivities:
 /// `(t, ŷ(t) [n_y], ∂ŷ(t)/∂θ_free [n_y × n_free, row-major])`.
@@ -254,6 +255,10 @@ pub struct OutputErrorProblem<'a> {
     skip: usize,
     n_residuals: usize,
     data_scale: f64,
+    /// The last simulation behind [`residuals`](LeastSquaresProblem::residuals) and its θ:
+    /// the fit statistics at the final point (the last accepted trial) reuse it instead of
+    /// simulating a long record once more.
+    last: Mutex<Option<(Vec<f64>, Simulations)>>,
     speculation: Option<Speculation>,
 }
 
@@ -276,6 +281,9 @@ struct Speculation {
     without: std::sync::atomic::AtomicUsize,
     disabled: std::sync::atomic::AtomicBool,
 }
+
+/// Simulated outputs `[experiment][output][t]`.
+type Simulations = Vec<Vec<Vec<f64>>>;
 
 impl<'a> OutputErrorProblem<'a> {
     /// Checks that the data suit the model and precomputes the residual layout.
@@ -317,6 +325,7 @@ impl<'a> OutputErrorProblem<'a> {
             skip,
             n_residuals,
             data_scale,
+            last: Mutex::new(None),
             speculation: None,
         })
     }
@@ -453,6 +462,9 @@ impl<'a> OutputErrorProblem<'a> {
 
     /// Simulated outputs of every experiment, `[experiment][output][t]`.
     pub fn simulate_all(&self, theta: &[f64]) -> Result<Vec<Vec<Vec<f64>>>> {
+        if let Some(sims) = self.take_last(theta) {
+            return Ok(sims);
+        }
         (0..self.data.n_experiments())
             .into_par_iter()
             .map(|e| {
@@ -462,6 +474,19 @@ impl<'a> OutputErrorProblem<'a> {
                 Ok(y)
             })
             .collect()
+    }
+
+    /// The kept simulation when it was made at exactly `theta` (the same θ simulates to the
+    /// same outputs, bit for bit).
+    fn take_last(&self, theta: &[f64]) -> Option<Simulations> {
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        match last.take() {
+            Some((at, sims)) if at == theta => Some(sims),
+            other => {
+                *last = other;
+                None
+            }
+        }
     }
 
     /// Streams one experiment's sensitivities into normal equations, and its residuals into
@@ -544,6 +569,7 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
                 }
             }
         }
+        *self.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((theta.to_vec(), sims));
         Ok(())
     }
 
@@ -559,6 +585,11 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
             if !spec.disabled.load(std::sync::atomic::Ordering::Relaxed) {
                 spec.with_sensitivities
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                if spec.split && spec.free == free {
+                    // The start: the engine asks for the normal equations first.
+                    let mut r = vec![0.0; self.n_residuals];
+                    return self.residuals_with_normal_equations(theta, free, true, &mut r);
+                }
             }
         }
         let parts: Vec<Option<Result<NormalEquations>>> = (0..self.data.n_experiments())

@@ -281,6 +281,9 @@ struct State<'a> {
     upper: Vec<f64>,
     theta: Vec<f64>,
     residuals: Vec<f64>,
+    /// The residuals of trial points (reused from step to step: a long record's buffer is
+    /// megabytes, page-faulted afresh if allocated per step).
+    trial: Vec<f64>,
     system: NormalEquations,
     initial_cost: f64,
     lambda: f64,
@@ -312,24 +315,16 @@ impl<'a> State<'a> {
         config: &'a LmConfig,
     ) -> Result<Self> {
         let mut residuals = vec![0.0; problem.n_residuals()];
-        problem
-            .residuals(theta0, &mut residuals)
-            .map_err(|e| match e {
-                Error::Diverged { index, reason } => Error::Diverged {
-                    index,
-                    reason: format!(
-                        "the model cannot be simulated from its initial parameters ({reason})"
-                    ),
-                },
-                other => other,
-            })?;
-        if let Some(i) = residuals.iter().position(|r| !r.is_finite()) {
-            return Err(Error::Diverged {
-                index: i,
-                reason:
-                    "the model cannot be simulated from its initial parameters (non-finite output)"
-                        .into(),
-            });
+        // Analytic normal equations carry the cost S(θ₀): the residuals themselves are then
+        // needed only as a buffer, and computing them would cost one more simulation per fit.
+        let analytic = problem.normal_equations(theta0, free);
+        if analytic.is_none() {
+            problem
+                .residuals(theta0, &mut residuals)
+                .map_err(initial_error)?;
+            if let Some(i) = residuals.iter().position(|r| !r.is_finite()) {
+                return Err(non_finite_start(i));
+            }
         }
         let mut state = Self {
             problem,
@@ -338,6 +333,7 @@ impl<'a> State<'a> {
             lower: lower.to_vec(),
             upper: upper.to_vec(),
             theta: theta0.to_vec(),
+            trial: vec![0.0; residuals.len()],
             residuals,
             system: NormalEquations {
                 jtj: DMatrix::zeros(0, 0),
@@ -348,13 +344,28 @@ impl<'a> State<'a> {
             lambda: 0.0,
             nu: 2.0,
             iterations: 0,
-            fevals: 1,
-            plain_evals: 1,
+            fevals: 0,
+            plain_evals: 0,
             sensitivity_evals: 0,
             rejected: 0,
             history: Vec::new(),
         };
-        state.system = state.normal_equations()?;
+        state.system = match analytic {
+            Some(system) => {
+                state.fevals += 1;
+                state.sensitivity_evals += 1;
+                let system = system.map_err(initial_error)?;
+                if !system.cost.is_finite() {
+                    return Err(non_finite_start(0));
+                }
+                system
+            }
+            None => {
+                state.fevals += 1;
+                state.plain_evals += 1;
+                state.normal_equations()?
+            }
+        };
         state.initial_cost = state.system.cost;
         // D = diag(JᵀJ) carries the scale, so λ itself is dimensionless.
         state.lambda = config.initial_damping;
@@ -435,8 +446,15 @@ impl<'a> State<'a> {
     /// Tries damped steps with growing λ until one decreases S; recomputes the normal
     /// equations at the new point.
     fn damped_step(&mut self) -> StepOutcome {
+        let mut trial = std::mem::take(&mut self.trial);
+        let outcome = self.damped_step_with(&mut trial);
+        self.trial = trial;
+        outcome
+    }
+
+    /// [`damped_step`](Self::damped_step) with `trial` as the buffer of trial residuals.
+    fn damped_step_with(&mut self, trial: &mut Vec<f64>) -> StepOutcome {
         const MAX_FAILURES: usize = 60;
-        let mut trial = vec![0.0; self.residuals.len()];
         for _ in 0..MAX_FAILURES {
             let Some(candidate) = self.candidate() else {
                 self.grow_damping();
@@ -456,7 +474,7 @@ impl<'a> State<'a> {
             let predicted = self.predicted_decrease(&candidate);
             self.fevals += 1;
             self.plain_evals += 1;
-            let cost = match self.problem.residuals(&candidate, &mut trial) {
+            let cost = match self.problem.residuals(&candidate, trial) {
                 Ok(()) if trial.iter().all(|r| r.is_finite()) => {
                     trial.iter().map(|r| r * r).sum::<f64>()
                 }
@@ -472,7 +490,7 @@ impl<'a> State<'a> {
                 // Evaluate the new point's normal equations before committing, so that a
                 // failure there is a rejected step, not an abort.
                 let saved = std::mem::replace(&mut self.theta, candidate);
-                std::mem::swap(&mut self.residuals, &mut trial);
+                std::mem::swap(&mut self.residuals, trial);
                 match self.normal_equations() {
                     Ok(system) => {
                         self.system = system;
@@ -485,7 +503,7 @@ impl<'a> State<'a> {
                     }
                     Err(_) => {
                         self.theta = saved;
-                        std::mem::swap(&mut self.residuals, &mut trial);
+                        std::mem::swap(&mut self.residuals, trial);
                         self.rejected += 1;
                     }
                 }
@@ -635,6 +653,26 @@ impl<'a> State<'a> {
             jtj: self.system.jtj,
             elapsed_s,
         }
+    }
+}
+
+/// The error of a model that cannot be evaluated at its initial parameters, said so.
+fn initial_error(e: Error) -> Error {
+    match e {
+        Error::Diverged { index, reason } => Error::Diverged {
+            index,
+            reason: format!("the model cannot be simulated from its initial parameters ({reason})"),
+        },
+        other => other,
+    }
+}
+
+/// A non-finite residual at the initial parameters (sample `index`).
+fn non_finite_start(index: usize) -> Error {
+    Error::Diverged {
+        index,
+        reason: "the model cannot be simulated from its initial parameters (non-finite output)"
+            .into(),
     }
 }
 
