@@ -10,7 +10,6 @@ mod commands;
 mod deprecated;
 mod exit;
 mod output;
-mod plot;
 mod progress;
 mod report;
 

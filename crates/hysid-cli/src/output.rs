@@ -86,3 +86,19 @@ fn writable_file(path: &Path) -> Result<&Path> {
     }
     Ok(dir)
 }
+
+/// Writes the plots into `dir` (created when missing); returns the files written.
+pub fn write_figures(
+    dir: &Path,
+    figures: &[hysid::report::plot::Svg],
+) -> Result<Vec<std::path::PathBuf>> {
+    ensure_dir(dir)?;
+    figures
+        .iter()
+        .map(|f| {
+            let path = dir.join(&f.name);
+            write_atomic(&path, f.svg.as_bytes())?;
+            Ok(path)
+        })
+        .collect()
+}

@@ -5,11 +5,11 @@
 use crate::cli::{
     ActuatorConstants, ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs,
 };
-use crate::output::{ensure_dir, preflight, write_atomic, write_json, write_model, write_report};
-use crate::plot::{convergence, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
+use crate::output::{
+    ensure_dir, preflight, write_atomic, write_figures, write_json, write_model, write_report,
+};
 use anyhow::{bail, Context, Result};
 use hysid::experiments::actuator_rig::Rig;
-use hysid::identify::actuator::loops::{ascending, descending};
 use hysid::identify::actuator::{
     read_data_sets, ActuatorIdentification, Record, ThreeSteps, PARAMETERS,
 };
@@ -17,6 +17,7 @@ use hysid::model::greybox::models::ActuatorFixed;
 use hysid::model::greybox::Simulation;
 use hysid::numerics::LmConfig;
 use hysid::report::actuator::three_steps_report;
+use hysid::report::plot::actuator_figures;
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
@@ -145,7 +146,7 @@ fn publish(
     if let Some(dir) = outputs.plots {
         ensure_dir(dir)?;
         write_atomic(&dir.join("tables.md"), markdown.as_bytes())?;
-        let files = figures(dir, id, truth, records)?;
+        let files = write_figures(dir, &actuator_figures(id, truth, records[&6].ts)?)?;
         println!("  tables and {} plots in {}", files.len(), dir.display());
     }
     if let Some(path) = outputs.json {
@@ -281,181 +282,4 @@ fn rig_truth(dir: &Path) -> Result<Option<Vec<f64>>> {
         })
         .collect::<Result<Vec<f64>>>()
         .map(Some)
-}
-
-/// Figure 2 (the loops of step 2), figure 4 (torque against torsion, measured and simulated
-/// by m67), the compare plots of sets 6–8 and the convergence of m67.
-fn figures(
-    dir: &Path,
-    id: &ActuatorIdentification,
-    truth: Option<&[f64]>,
-    records: &BTreeMap<usize, Record>,
-) -> Result<Vec<PathBuf>> {
-    let mut files = vec![dir.join("fig2_loops.svg")];
-    loops_figure(&files[0], id)?;
-    let path = dir.join("fig4_torque_torsion.svg");
-    torque_torsion_figure(&path, id)?;
-    files.push(path);
-    let path = dir.join("compare.svg");
-    compare_figure(&path, id, records)?;
-    files.push(path);
-    let m67 = &id.step3["m67"].fit.report.history;
-    if !m67.is_empty() {
-        let path = dir.join("m67_convergence.svg");
-        let names: Vec<String> = PARAMETERS.iter().map(|p| p.to_string()).collect();
-        let mut history: Vec<Vec<f64>> = vec![id.m0.clone()];
-        history.extend(m67.iter().map(|r| r.theta[..PARAMETERS.len()].to_vec()));
-        convergence(
-            &path,
-            "m67: estimates per iteration (0 = m0)",
-            &names,
-            &history,
-            truth,
-        )?;
-        files.push(path);
-    }
-    Ok(files)
-}
-
-fn loops_figure(path: &Path, id: &ActuatorIdentification) -> Result<()> {
-    let [k1, k2, alpha, a] = id.step2.values;
-    let labels: Vec<String> = id
-        .step2
-        .loops
-        .iter()
-        .map(|l| format!("set {} (Q = {:.3} rad)", l.set, l.q))
-        .collect();
-    let curves: Vec<(Vec<f64>, Vec<f64>)> = id
-        .step2
-        .loops
-        .iter()
-        .map(|l| {
-            let n = 200;
-            let up = (0..=n).map(|i| -l.q + 2.0 * l.q * i as f64 / n as f64);
-            let down = (0..=n).map(|i| l.q - 2.0 * l.q * i as f64 / n as f64);
-            let x: Vec<f64> = up.clone().chain(down.clone()).collect();
-            let y: Vec<f64> = up
-                .map(|x| k1 * x + k2 * x.powi(3) + ascending(a, alpha, l.q, x))
-                .chain(down.map(|x| k1 * x + k2 * x.powi(3) + descending(a, alpha, l.q, x)))
-                .collect();
-            (x, y)
-        })
-        .collect();
-    let mut fig = Figure::new(
-        "Figure 2: steady-state loops (points) and the step-2 model (lines)",
-        "torsion x1 [rad]",
-        "τn [N·m]",
-    );
-    for ((l, label), (x, y)) in id.step2.loops.iter().zip(&labels).zip(&curves) {
-        fig = fig
-            .with(Series::new(
-                label.as_str(),
-                thin(&l.x1, 400),
-                thin(&l.tau_n, 400),
-                Style::Points,
-            ))
-            .with(Series::new("", x.as_slice(), y.as_slice(), Style::Line));
-    }
-    plot(path, &fig)
-}
-
-fn torque_torsion_figure(path: &Path, id: &ActuatorIdentification) -> Result<()> {
-    let titles = ["data set 6", "data set 7", "data set 8"];
-    let panels: Vec<Figure> = id
-        .validation
-        .experiments()
-        .iter()
-        .zip(&id.simulated["m67"])
-        .zip(titles)
-        .map(|((exp, sim), title)| {
-            let tau = thin(exp.input(0), PLOT_POINTS);
-            let fig = Figure::new(title, "torsion x1 [rad]", "torque τ [N·m]").with(Series::new(
-                "measured",
-                thin(exp.output(0), PLOT_POINTS),
-                tau.clone(),
-                Style::Line,
-            ));
-            if sim.is_empty() {
-                fig
-            } else {
-                fig.with(Series::new(
-                    "simulated (m67)",
-                    thin(sim, PLOT_POINTS),
-                    tau,
-                    Style::DashedLine,
-                ))
-            }
-        })
-        .collect();
-    plot_panels(
-        path,
-        "Figure 4: torque against torsion, measured and simulated",
-        &panels,
-        3,
-    )
-}
-
-fn compare_figure(
-    path: &Path,
-    id: &ActuatorIdentification,
-    records: &BTreeMap<usize, Record>,
-) -> Result<()> {
-    let ts = records[&6].ts;
-    let titles: Vec<String> = (6..=8)
-        .map(|set| {
-            let f = &id.fit_table;
-            format!(
-                "data set {set}: fit m0 {:.1} %, m67 {:.1} %",
-                f["m0"][set - 6],
-                f["m67"][set - 6]
-            )
-        })
-        .collect();
-    let times: Vec<Vec<f64>> = id
-        .validation
-        .experiments()
-        .iter()
-        .map(|e| (0..e.len()).map(|k| k as f64 * ts).collect())
-        .collect();
-    let panels: Vec<Figure> = (0..3)
-        .map(|e| {
-            let exp = &id.validation.experiments()[e];
-            let t = thin(&times[e], PLOT_POINTS);
-            let mut fig = Figure::new(&titles[e], "t [s]", "torsion x1 [rad]").with(Series::new(
-                "measured",
-                t.clone(),
-                thin(exp.output(0), PLOT_POINTS),
-                Style::Line,
-            ));
-            for name in ["m0", "m67"] {
-                let sim = &id.simulated[name][e];
-                if !sim.is_empty() {
-                    fig = fig.with(Series::new(
-                        name,
-                        t.clone(),
-                        thin(sim, PLOT_POINTS),
-                        Style::DashedLine,
-                    ));
-                }
-            }
-            fig
-        })
-        .collect();
-    plot_panels_sized(
-        path,
-        "Measured and simulated torsion (MATLAB compare)",
-        &panels,
-        1,
-        (1400, 1050),
-    )
-}
-
-/// Points per plotted series: enough for the eye at 1 kHz records, and SVG files of a few
-/// hundred kilobytes.
-const PLOT_POINTS: usize = 2500;
-
-/// Every k-th sample, k chosen to keep at most `max` of them.
-fn thin(x: &[f64], max: usize) -> Vec<f64> {
-    let step = x.len().div_ceil(max.max(1)).max(1);
-    x.iter().step_by(step).copied().collect()
 }

@@ -3,8 +3,7 @@
 use super::present::{print_fit, print_residuals, print_sensitivity, report};
 use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
 use crate::commands::identify::load;
-use crate::output::{ensure_dir, preflight, write_model, write_report};
-use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
+use crate::output::{preflight, write_figures, write_model, write_report};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
 use hysid::data::IdData;
@@ -14,6 +13,7 @@ use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, StateSpaceModel};
 use hysid::model::ParameterSet;
 use hysid::numerics::LmConfig;
+use hysid::report::plot::greybox_figures;
 use serde_json::json;
 use std::path::Path;
 use std::sync::Arc;
@@ -76,7 +76,7 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
             model.clone(),
             &data,
             estimation.simulation,
-            initial_from(&fit, model.as_ref(), &data),
+            fit.initial_states(model.as_ref(), data.n_experiments()),
         )?;
         let rows = sensitivity_table(&structure, &data, &fit.fit.parameters, 0.2)?;
         print_sensitivity(&rows);
@@ -172,19 +172,6 @@ fn initial_states(
     Ok(initial)
 }
 
-/// The fitted initial states, fixed (for re-simulation).
-fn initial_from(fit: &GreyBoxFit, model: &dyn StateSpaceModel, data: &IdData) -> InitialStates {
-    let n = model.states().len();
-    let p = model.parameters().len();
-    let v = fit.fit.parameters.values();
-    InitialStates {
-        values: (0..data.n_experiments())
-            .map(|e| v[p + e * n..p + (e + 1) * n].to_vec())
-            .collect(),
-        estimated: vec![false; n],
-    }
-}
-
 /// The command line's simulation settings.
 pub fn simulation(args: &SimulationArgs) -> Simulation {
     let substeps = args.substeps.max(1);
@@ -208,57 +195,6 @@ pub fn plots(
     data: &IdData,
     residuals: &[ResidualAnalysis],
 ) -> Result<()> {
-    ensure_dir(dir)?;
-    let exp = data.experiment(0);
-    let t: Vec<f64> = (0..exp.len()).map(|k| k as f64 * data.ts()).collect();
-    let y_name = data.output_channels()[0].to_string();
-    let title = format!(
-        "Output: measured and simulated (fit {:.2} %)",
-        fit.fit.fit_percent[0][0]
-    );
-    let output = Figure::new(&title, "t [s]", &y_name)
-        .with(Series::line("measured", &t, exp.output(0)))
-        .with(Series::dashed("simulated", &t, &fit.fit.simulated[0][0]));
-    plot(&dir.join("output.svg"), &output)?;
-    let a = &residuals[0];
-    let lags: Vec<f64> = (0..=a.max_lag).map(|l| l as f64).collect();
-    let cross_lags: Vec<f64> = (-(a.max_lag as i64)..=a.max_lag as i64)
-        .map(|l| l as f64)
-        .collect();
-    let auto = Figure::new("Residual auto-correlation", "lag", "r")
-        .with(Series::new(
-            "r_e",
-            lags.as_slice(),
-            a.autocorrelation.as_slice(),
-            Style::Points,
-        ))
-        .with(hline("99 %", (0.0, a.max_lag as f64), a.band))
-        .with(hline("-99 %", (0.0, a.max_lag as f64), -a.band));
-    let cross = Figure::new("Input-residual cross-correlation", "lag", "r")
-        .with(Series::new(
-            "r_eu",
-            cross_lags.as_slice(),
-            a.cross_correlation[0].as_slice(),
-            Style::Points,
-        ))
-        .with(hline(
-            "99 %",
-            (-(a.max_lag as f64), a.max_lag as f64),
-            a.band,
-        ))
-        .with(hline(
-            "-99 %",
-            (-(a.max_lag as f64), a.max_lag as f64),
-            -a.band,
-        ));
-    plot_panels(
-        &dir.join("residuals.svg"),
-        "Residual analysis (experiment 1)",
-        &[auto, cross],
-        2,
-    )?;
-    let cost: Vec<f64> = fit.fit.report.history.iter().map(|r| r.cost).collect();
-    let convergence = Figure::new("Criterion per iteration", "iteration", "sum of squares")
-        .with(Series::indexed("S", &cost, Style::Line));
-    plot(&dir.join("convergence.svg"), &convergence)
+    write_figures(dir, &greybox_figures(fit, data, residuals)?)?;
+    Ok(())
 }

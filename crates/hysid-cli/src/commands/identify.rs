@@ -2,8 +2,7 @@
 
 use super::cascade::{fitted, plots, print_summary, report, rows, uncertainty};
 use crate::cli::{CascadeArgs, DataArgs, HysteresisArgs, InitialArg, OutputArgs};
-use crate::output::{ensure_dir, write_model, write_report};
-use crate::plot::{plot, Figure, Series, Style};
+use crate::output::{write_figures, write_model, write_report};
 use crate::progress::FitProgress;
 use crate::report::{figures, of_output_error, print_table, Report, Row};
 use anyhow::Result;
@@ -12,10 +11,10 @@ use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::hysteresis::{HysteresisFit, HysteresisIdentification, InitialOutput};
 use hysid::model::saved::FittedModel;
 use hysid::model::ChForm;
+use hysid::report::plot::hysteresis_figures;
 use hysid::report::UncertaintySummary;
 use hysid::Error;
 use serde_json::json;
-use std::path::Path;
 
 /// Reads the input and output columns of a CSV file: one experiment per --input/--output
 /// pair.
@@ -166,7 +165,7 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
         );
     }
     if let Some(dir) = &args.output.plots {
-        hysteresis_plots(dir, &fit, &data)?;
+        write_figures(dir, &hysteresis_figures(&fit, &data)?)?;
         println!("  plots: {}", dir.display());
     }
     let fitted = FittedModel::Hysteresis {
@@ -208,48 +207,6 @@ fn hysteresis_report(
         UncertaintySummary::asymptotic(),
         details,
     )?)
-}
-
-fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()> {
-    ensure_dir(dir)?;
-    let x_name = data.input_channels()[0].to_string();
-    let y_name = data.output_channels()[0].to_string();
-    let mut loops = Figure::new(
-        "Hysteresis: measured and simulated output against input",
-        &x_name,
-        &y_name,
-    );
-    let labels: Vec<(String, String)> = (0..data.n_experiments())
-        .map(|e| {
-            (
-                format!("measured {}", e + 1),
-                format!("simulated {}", e + 1),
-            )
-        })
-        .collect();
-    for (e, exp) in data.experiments().iter().enumerate() {
-        loops = loops
-            .with(Series::points(&labels[e].0, exp.input(0), exp.output(0)))
-            .with(Series::dashed(
-                &labels[e].1,
-                exp.input(0),
-                &fit.output_error.simulated[e][0],
-            ));
-    }
-    plot(&dir.join("loops.svg"), &loops)?;
-    let exp = data.experiment(0);
-    let title = format!(
-        "Output: measured and simulated (fit {:.2} %)",
-        fit.output_error.fit_percent[0][0]
-    );
-    let output = Figure::new(&title, "sample", &y_name)
-        .with(Series::indexed("measured", exp.output(0), Style::Line))
-        .with(Series::indexed(
-            "simulated",
-            &fit.output_error.simulated[0][0],
-            Style::DashedLine,
-        ));
-    plot(&dir.join("output.svg"), &output)
 }
 
 /// Writes the report and the model file when asked for.

@@ -23,6 +23,7 @@
 //! FPE and AIC are Akaike's (Ljung, *System Identification*, 2nd ed., 1999, §16.4).
 
 pub mod actuator;
+pub mod plot;
 
 use crate::data::IdData;
 use crate::identify::OutputErrorFit;
@@ -314,6 +315,11 @@ pub struct ValidationEntry {
 }
 
 impl ValidationEntry {
+    /// The entry of a scored Bouc–Wen benchmark test record (fit %, RMSE and e_RMS).
+    pub fn of_benchmark(test: &crate::identify::bouc_wen_benchmark::BenchmarkTest) -> Result<Self> {
+        Self::of(test.source.clone(), &test.y, &test.yhat, Some(test.e_rms))
+    }
+
     /// The figures of simulated `yhat` against measured `y` from `source`.
     pub fn of(source: String, y: &[f64], yhat: &[f64], e_rms: Option<f64>) -> Result<Self> {
         let entry = Self {
