@@ -5,9 +5,7 @@
 use crate::cli::{
     ActuatorConstants, ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs,
 };
-use crate::output::{
-    ensure_dir, preflight, write_atomic, write_figures, write_json, write_model, write_report,
-};
+use crate::output::{write_figures, Outputs};
 use anyhow::{bail, Context, Result};
 use hysid::experiments::actuator_rig::Rig;
 use hysid::identify::actuator::{
@@ -21,17 +19,19 @@ use hysid::report::plot::actuator_figures;
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-/// Writes the eight data sets of the virtual rig.
+/// Writes the eight data sets of the virtual rig (all or nothing: an existing directory is
+/// replaced only once every file of the new one is written).
 pub fn rig(args: &RigArgs) -> Result<()> {
     let rig = rig_from(&args.rig, &args.constants)?;
-    preflight(&[], &[Some(&args.data_out)])?;
-    let files = write_rig(&rig, &args.data_out)?;
+    let mut out = Outputs::new(&[], None, None, None)?;
+    let dir = out.dir_at(&args.data_out)?;
+    let files = write_rig(&rig, &dir.tmp)?;
+    out.finish(None, None)?;
     println!(
-        "virtual actuator rig (Gunnar et al. 2006): {} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
-        files.len(),
+        "virtual actuator rig (Gunnar et al. 2006): {files} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
         args.data_out.display(),
         rig.backlash,
         rig.angle_noise,
@@ -43,48 +43,38 @@ pub fn rig(args: &RigArgs) -> Result<()> {
 
 /// The three steps on a data directory.
 pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
-    preflight(
-        &[args.json.as_deref(), args.model_out.as_deref()],
-        &[args.plots.as_deref()],
+    let out = Outputs::new(
+        &[args.data.as_path()],
+        args.json.as_deref(),
+        args.model_out.as_deref(),
+        args.plots.as_deref(),
     )?;
     let records = read_data_sets(&args.data)?;
     let truth = rig_truth(&args.data)?;
     let clock = Instant::now();
     let steps = three_steps(&args.steps, &args.constants);
     let id = run(&steps, &records)?;
-    let outputs = Outputs {
-        plots: args.plots.as_deref(),
-        json: args.json.as_deref(),
-        model_out: args.model_out.as_deref(),
-        sources: vec![args.data.display().to_string()],
-        simulation: steps.simulation,
-    };
+    let sources = vec![args.data.display().to_string()];
     publish(
         &id,
         truth.as_deref(),
         &records,
-        &outputs,
+        out,
+        (sources, steps.simulation),
         json!({ "elapsed_s": clock.elapsed().as_secs_f64() }),
     )
-}
-
-/// Where the results of the three steps go.
-struct Outputs<'a> {
-    plots: Option<&'a Path>,
-    json: Option<&'a Path>,
-    model_out: Option<&'a Path>,
-    sources: Vec<String>,
-    simulation: Simulation,
 }
 
 /// The rig and the three steps on the default settings.
 pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     let clock = Instant::now();
     let rig = rig_from(&args.rig, &args.constants)?;
-    preflight(&[args.json.as_deref()], &[Some(&args.plots)])?;
+    let plots = args.plots.join("actuator");
+    let mut out = Outputs::new(&[], args.json.as_deref(), None, Some(&plots))?;
     let data_dir = args.plots.join("actuator-data");
-    write_rig(&rig, &data_dir)?;
-    let records = read_data_sets(&data_dir)?;
+    let staged = out.dir_at(&data_dir)?;
+    write_rig(&rig, &staged.tmp)?;
+    let records = read_data_sets(&staged.tmp)?;
     println!(
         "Virtual actuator rig (Gunnar et al. 2006): backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {}; data in {}",
         rig.backlash,
@@ -95,19 +85,13 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     );
     let steps = three_steps(&args.steps, &args.constants);
     let id = run(&steps, &records)?;
-    let plots = args.plots.join("actuator");
-    let outputs = Outputs {
-        plots: Some(&plots),
-        json: args.json.as_deref(),
-        model_out: None,
-        sources: vec![data_dir.display().to_string()],
-        simulation: steps.simulation,
-    };
+    let sources = vec![data_dir.display().to_string()];
     publish(
         &id,
         Some(&rig.truth),
         &records,
-        &outputs,
+        out,
+        (sources, steps.simulation),
         json!({ "rig": rig_json(&rig) }),
     )?;
     println!("  total time {:.1} s", clock.elapsed().as_secs_f64());
@@ -126,15 +110,16 @@ fn run(steps: &ThreeSteps, records: &BTreeMap<usize, Record>) -> Result<Actuator
     Ok(id)
 }
 
-/// Prints the tables; writes Markdown, plots and JSON.
+/// Prints the tables; writes Markdown and plots, the report and the m67 model (read from
+/// `sources`, simulated with `simulation`), all in one transaction.
 fn publish(
     id: &ActuatorIdentification,
     truth: Option<&[f64]>,
     records: &BTreeMap<usize, Record>,
-    outputs: &Outputs,
+    out: Outputs,
+    (sources, simulation): (Vec<String>, Simulation),
     details: serde_json::Value,
 ) -> Result<()> {
-    let simulation = outputs.simulation;
     let markdown = id.markdown(truth);
     println!("\n{markdown}");
     for (name, fit) in &id.step3 {
@@ -143,30 +128,24 @@ fn publish(
             fit.fit.report.iterations, fit.fit.report.termination, fit.elapsed_s
         );
     }
-    if let Some(dir) = outputs.plots {
-        ensure_dir(dir)?;
-        write_atomic(&dir.join("tables.md"), markdown.as_bytes())?;
-        let files = write_figures(dir, &actuator_figures(id, truth, records[&6].ts)?)?;
-        println!("  tables and {} plots in {}", files.len(), dir.display());
+    if let Some(dir) = &out.plots {
+        std::fs::write(dir.tmp.join("tables.md"), &markdown)
+            .with_context(|| format!("cannot write {}", dir.target.join("tables.md").display()))?;
+        write_figures(&dir.tmp, &actuator_figures(id, truth, records[&6].ts)?)?;
     }
-    if let Some(path) = outputs.json {
-        let mut report = three_steps_report(id, truth, outputs.sources.clone(), simulation)?;
+    let report = if out.json.is_some() {
+        let mut report = three_steps_report(id, truth, sources, simulation)?;
         if let (Some(obj), serde_json::Value::Object(more)) =
             (report.details.as_object_mut(), details)
         {
             obj.extend(more);
         }
-        write_report(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = outputs.model_out {
-        write_model(
-            path,
-            &id.step3["m67"].fitted_model(&ActuatorFixed, simulation),
-        )?;
-        println!("  model (m67): {}", path.display());
-    }
-    Ok(())
+        Some(report)
+    } else {
+        None
+    };
+    let m67 = id.step3["m67"].fitted_model(&ActuatorFixed, simulation);
+    out.finish(report.as_ref(), Some(&m67))
 }
 
 fn three_steps(args: &ThreeStepArgs, constants: &ActuatorConstants) -> ThreeSteps {
@@ -232,16 +211,17 @@ fn rig_from(settings: &RigSettings, constants: &ActuatorConstants) -> Result<Rig
     })
 }
 
-/// Simulates and writes the data sets and rig.json; returns the data-set files.
-fn write_rig(rig: &Rig, dir: &Path) -> Result<Vec<PathBuf>> {
-    ensure_dir(dir)?;
+/// Simulates and writes the data sets and rig.json into `dir` (a staged directory);
+/// returns the number of data sets.
+fn write_rig(rig: &Rig, dir: &Path) -> Result<usize> {
     let records = rig.records()?;
-    let files = records
-        .iter()
-        .map(|r| r.write(dir))
-        .collect::<hysid::Result<Vec<_>>>()?;
-    write_json(&dir.join("rig.json"), &rig_json(rig))?;
-    Ok(files)
+    for r in &records {
+        r.write(dir)?;
+    }
+    let path = dir.join("rig.json");
+    let text = serde_json::to_string_pretty(&rig_json(rig))?;
+    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(records.len())
 }
 
 fn rig_json(rig: &Rig) -> serde_json::Value {

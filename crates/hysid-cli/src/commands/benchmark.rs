@@ -3,10 +3,10 @@
 //! Fits the Bouc–Wen oscillator on a training record and scores test records by e_RMS in
 //! simulation mode (docs/benchmarks.md §1); `generate` makes test signals by the official recipe.
 
-use super::greybox::{configure, plots};
+use super::greybox::configure;
 use super::present::{print_fit, print_residuals, report};
 use crate::cli::{BoucWenArgs, BoucWenGenerate, BoucWenGenerateArgs, SignalArg};
-use crate::output::{preflight, write_figures, write_model, write_report};
+use crate::output::{write_figures, Outputs};
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
 use hysid::data::{write_csv, IdData};
@@ -14,7 +14,7 @@ use hysid::identify::bouc_wen_benchmark::{
     generate as generate_record, record_spec, BenchmarkTest, BoucWenBenchmark, TestSignal,
     PUBLISHED,
 };
-use hysid::report::plot::benchmark_test_figures;
+use hysid::report::plot::{benchmark_test_figures, greybox_figures};
 use hysid::report::ValidationEntry;
 use serde_json::json;
 use std::path::Path;
@@ -24,15 +24,19 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
     if let Some(BoucWenGenerate::Generate(g)) = &args.generate {
         return generate(g);
     }
-    preflight(
-        &[args.json.as_deref(), args.model_out.as_deref()],
-        &[args.plots.as_deref()],
-    )?;
     let Some(train) = &args.train else {
         bail!(
             "give the training record with --train FILE (columns t_s, u_N, y_m), or use `generate`"
         );
     };
+    let mut inputs = vec![train.as_path()];
+    inputs.extend(args.test.iter().map(|p| p.as_path()));
+    let out = Outputs::new(
+        &inputs,
+        args.json.as_deref(),
+        args.model_out.as_deref(),
+        args.plots.as_deref(),
+    )?;
     let data = record(train)?;
     let tests = args
         .test
@@ -67,12 +71,11 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
         result.training_e_rms
     );
     print_tests(&result.tests);
-    if let Some(dir) = &args.plots {
-        plots(dir, fit, &data, &residuals)?;
-        write_figures(dir, &benchmark_test_figures(&result.tests)?)?;
-        println!("  plots: {}", dir.display());
+    if let Some(dir) = &out.plots {
+        write_figures(&dir.tmp, &greybox_figures(fit, &data, &residuals)?)?;
+        write_figures(&dir.tmp, &benchmark_test_figures(&result.tests)?)?;
     }
-    if let Some(path) = &args.json {
+    let report = if out.json.is_some() {
         let extra = json!({
             "training_e_rms": result.training_e_rms,
             "steady_state": args.steady_state,
@@ -93,14 +96,11 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
             .iter()
             .map(ValidationEntry::of_benchmark)
             .collect::<hysid::Result<_>>()?;
-        write_report(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = &args.model_out {
-        write_model(path, &result.model)?;
-        println!("  model: {}", path.display());
-    }
-    Ok(())
+        Some(report)
+    } else {
+        None
+    };
+    out.finish(report.as_ref(), Some(&result.model))
 }
 
 /// e_RMS per test record, and the published figures for comparison.
@@ -135,7 +135,8 @@ fn record(path: &Path) -> Result<IdData> {
 /// Simulates a test signal by the official recipe: the input at 15 kHz, Newmark (γ = ½,
 /// β = ¼) at 15 kHz, low-pass filtering and decimation back to 750 Hz.
 fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
-    preflight(&[Some(&args.csv)], &[])?;
+    let mut out = Outputs::new(&[], None, None, None)?;
+    let csv = out.file_at(&args.csv)?;
     let signal = match args.signal {
         SignalArg::Multisine => {
             anyhow::ensure!(args.periods >= 1, "--periods must be at least 1");
@@ -152,10 +153,11 @@ fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
     };
     let record = generate_record(signal, args.noise, args.seed)?;
     write_csv(
-        &args.csv,
+        &csv.tmp,
         &["t_s", "u_N", "y_m"],
         &[&record.t, &record.u, &record.y],
     )?;
+    out.finish(None, None)?;
     println!(
         "Bouc–Wen {} test signal, {} samples at 750 Hz (Newmark at 15 kHz, decimated) -> {}",
         match args.signal {

@@ -2,18 +2,14 @@
 //! `identify cascade`).
 
 use crate::cli::UncertaintyArg;
-use crate::output::write_figures;
 use crate::report::{figures, of_output_error, Report, Row};
 use anyhow::Result;
 use hysid::data::IdData;
 use hysid::identify::cascade::CascadeFit;
 use hysid::identify::Uncertainty;
 use hysid::model::saved::FittedModel;
-use hysid::model::HysteresisCascade;
-use hysid::report::plot::cascade_figures;
 use hysid::report::UncertaintySummary;
 use serde_json::json;
-use std::path::{Path, PathBuf};
 
 /// The estimator setting for a command-line choice.
 pub fn uncertainty(arg: UncertaintyArg, replicates: usize) -> Uncertainty {
@@ -138,15 +134,4 @@ pub fn print_summary(fit: &CascadeFit, report: &Report) {
             "  note: re-classifying the samples by the final d did not lower the criterion; the best classification is kept"
         );
     }
-}
-
-/// Writes the cascade plots into `dir`; returns the files written.
-pub fn plots(
-    dir: &Path,
-    fit: &CascadeFit,
-    x: &[f64],
-    y: &[f64],
-    truth: Option<&HysteresisCascade>,
-) -> Result<Vec<PathBuf>> {
-    write_figures(dir, &cascade_figures(fit, x, y, truth)?)
 }

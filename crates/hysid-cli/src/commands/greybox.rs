@@ -3,19 +3,18 @@
 use super::present::{print_fit, print_residuals, print_sensitivity, report};
 use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
 use crate::commands::identify::load;
-use crate::output::{preflight, write_figures, write_model, write_report};
+use crate::output::Outputs;
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
 use hysid::data::IdData;
-use hysid::identify::greybox::{GreyBoxEstimation, GreyBoxFit, InitialStates};
-use hysid::identify::validate::{sensitivity_table, ResidualAnalysis};
+use hysid::identify::greybox::{GreyBoxEstimation, InitialStates};
+use hysid::identify::validate::sensitivity_table;
 use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, StateSpaceModel};
 use hysid::model::ParameterSet;
 use hysid::numerics::LmConfig;
 use hysid::report::plot::greybox_figures;
 use serde_json::json;
-use std::path::Path;
 use std::sync::Arc;
 
 /// Runs `hysid greybox fit`.
@@ -29,9 +28,13 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         (Some(eq), _) => eq.clone(),
         (None, name) => Arc::from(models::by_kind(name.as_deref().unwrap_or_default())?),
     };
-    preflight(
-        &[args.json.as_deref(), args.model_out.as_deref()],
-        &[args.plots.as_deref()],
+    let mut inputs = vec![args.data.data.as_path()];
+    inputs.extend(args.model_file.as_deref());
+    let out = Outputs::new(
+        &inputs,
+        args.json.as_deref(),
+        args.model_out.as_deref(),
+        args.plots.as_deref(),
     )?;
     let data = load(&args.data)?;
     let params = configure(
@@ -88,22 +91,11 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     if let Some(eq) = &equations {
         fitted = fitted.with_equations(eq.source());
     }
-    if let Some(dir) = &args.plots {
-        plots(dir, &fit, &data, &residuals)?;
-        println!("  plots: {}", dir.display());
-    }
+    out.figures(|| greybox_figures(&fit, &data, &residuals))?;
     let extra = json!({"residual_analysis": residuals, "sensitivity": sensitivity});
     let sources = vec![args.data.data.display().to_string()];
     let report = report("greybox fit", &fit, &data, sources, fitted.to_file(), extra)?;
-    if let Some(path) = &args.json {
-        write_report(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = &args.model_out {
-        write_model(path, &fitted)?;
-        println!("  model: {}", path.display());
-    }
-    Ok(())
+    out.finish(Some(&report), Some(&fitted))
 }
 
 /// `params` with the command line's fixes, frees, initial values and bounds applied.
@@ -186,15 +178,4 @@ pub fn simulation(args: &SimulationArgs) -> Simulation {
             InterpolationArg::BandLimited => InputInterpolation::BandLimited,
         },
     }
-}
-
-/// Measured against simulated output, residual correlations, convergence.
-pub fn plots(
-    dir: &Path,
-    fit: &GreyBoxFit,
-    data: &IdData,
-    residuals: &[ResidualAnalysis],
-) -> Result<()> {
-    write_figures(dir, &greybox_figures(fit, data, residuals)?)?;
-    Ok(())
 }

@@ -1,8 +1,8 @@
 //! `hysid identify cascade` and `hysid identify hysteresis`.
 
-use super::cascade::{fitted, plots, print_summary, report, rows, uncertainty};
+use super::cascade::{fitted, print_summary, report, rows, uncertainty};
 use crate::cli::{CascadeArgs, DataArgs, HysteresisArgs, InitialArg, OutputArgs};
-use crate::output::{write_figures, write_model, write_report};
+use crate::output::Outputs;
 use crate::progress::FitProgress;
 use crate::report::{figures, of_output_error, print_table, Report, Row};
 use anyhow::Result;
@@ -11,7 +11,7 @@ use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::hysteresis::{HysteresisFit, HysteresisIdentification, InitialOutput};
 use hysid::model::saved::FittedModel;
 use hysid::model::ChForm;
-use hysid::report::plot::hysteresis_figures;
+use hysid::report::plot::{cascade_figures, hysteresis_figures};
 use hysid::report::UncertaintySummary;
 use hysid::Error;
 use serde_json::json;
@@ -69,7 +69,7 @@ fn rename(data: IdData, inputs: &[Channel], outputs: &[Channel], k: usize) -> Re
 /// `hysid identify cascade`.
 pub fn cascade(args: &CascadeArgs) -> Result<()> {
     let form = ChForm::parse(&args.hysteresis)?;
-    preflight_outputs(&args.output)?;
+    let out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
     let mut id = CascadeIdentification::new(form, args.na, args.nb, args.delay);
     id.uncertainty = uncertainty(args.uncertainty, args.replicates);
@@ -100,17 +100,14 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         extra,
     )?;
     print_summary(&fit, &report);
-    if let Some(dir) = &args.output.plots {
-        let files = plots(dir, &fit, x, y, None)?;
-        println!("  plots: {} files in {}", files.len(), dir.display());
-    }
-    finish(&args.output, &report, &fitted(&fit))
+    out.figures(|| cascade_figures(&fit, x, y, None))?;
+    out.finish(Some(&report), Some(&fitted(&fit)))
 }
 
 /// `hysid identify hysteresis`.
 pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
     let form = ChForm::parse(&args.hysteresis)?;
-    preflight_outputs(&args.output)?;
+    let out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
     let mut id = HysteresisIdentification::new(form);
     id.initial = match args.initial_output {
@@ -164,16 +161,13 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
             adm.violations.join("; ")
         );
     }
-    if let Some(dir) = &args.output.plots {
-        write_figures(dir, &hysteresis_figures(&fit, &data)?)?;
-        println!("  plots: {}", dir.display());
-    }
+    out.figures(|| hysteresis_figures(&fit, &data))?;
     let fitted = FittedModel::Hysteresis {
         model: fit.model.clone(),
         initial: id.initial,
         std,
     };
-    finish(&args.output, &report, &fitted)
+    out.finish(Some(&report), Some(&fitted))
 }
 
 fn hysteresis_report(
@@ -209,23 +203,13 @@ fn hysteresis_report(
     )?)
 }
 
-/// Writes the report and the model file when asked for.
-fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<()> {
-    if let Some(path) = &output.json {
-        write_report(path, report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = &output.model_out {
-        write_model(path, model)?;
-        println!("  model: {}", path.display());
-    }
-    Ok(())
-}
-
-/// Checks the report, model and plot destinations before the fit.
-fn preflight_outputs(output: &OutputArgs) -> Result<()> {
-    crate::output::preflight(
-        &[output.json.as_deref(), output.model_out.as_deref()],
-        &[output.plots.as_deref()],
+/// Registers the report, model and plot destinations before the fit (refused when one is
+/// the data file or cannot be written).
+fn register(data: &DataArgs, output: &OutputArgs) -> Result<Outputs> {
+    Outputs::new(
+        &[data.data.as_path()],
+        output.json.as_deref(),
+        output.model_out.as_deref(),
+        output.plots.as_deref(),
     )
 }
