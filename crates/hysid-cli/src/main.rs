@@ -12,7 +12,6 @@ mod deprecated;
 mod exit;
 mod options;
 mod output;
-mod plot;
 mod progress;
 mod report;
 

@@ -1,29 +1,127 @@
-//! Writing result files: never a half-written file (temporary file, then rename).
+//! Writing result files through the library's one atomic writer,
+//! [`hysid::io::atomic::OutputSet`]: every output of a run is registered before any work
+//! (refused when it equals an input, is given twice or cannot be written), written to a
+//! temporary, and renamed into place together with the others at the end — or not at all.
 
 use anyhow::{Context, Result};
-use serde::Serialize;
-use std::fs;
-use std::path::Path;
+use hysid::io::atomic::OutputSet;
+use hysid::model::saved::FittedModel;
+use hysid::report::plot::Svg;
+use hysid::report::Report;
+use std::path::{Path, PathBuf};
 
-/// Writes `value` as pretty JSON to `path` atomically.
-pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
-    // serde_json would write NaN and ±inf as null: refuse them (a numerical failure).
-    hysid::io::atomic::ensure_finite(value)?;
-    let text = serde_json::to_string_pretty(value).context("serialising the report")?;
-    write_atomic(path, text.as_bytes())
+/// One registered output: where it will appear and the temporary to write now.
+#[derive(Clone, Debug)]
+pub struct Staged {
+    /// The path the user asked for.
+    pub target: PathBuf,
+    /// The temporary file or directory to write (renamed to `target` by the commit).
+    pub tmp: PathBuf,
 }
 
-/// Writes the report as pretty JSON to `path` atomically, refused when a number in it is
-/// not finite.
-pub fn write_report(path: &Path, report: &hysid::report::Report) -> Result<()> {
+/// The outputs of one command: the report (`--json`), the saved model (`--model-out`), the
+/// plot directory (`--plots`) and any further file or directory, as one transaction.
+pub struct Outputs {
+    set: OutputSet,
+    /// The report, when asked for.
+    pub json: Option<Staged>,
+    /// The saved-model file, when asked for.
+    pub model_out: Option<Staged>,
+    /// The plot directory, when asked for.
+    pub plots: Option<Staged>,
+}
+
+impl Outputs {
+    /// Registers the usual outputs of a command, refusing any that equals one of `inputs`.
+    pub fn new(
+        inputs: &[&Path],
+        json: Option<&Path>,
+        model_out: Option<&Path>,
+        plots: Option<&Path>,
+    ) -> Result<Self> {
+        let mut out = Self {
+            set: OutputSet::new(inputs)?,
+            json: None,
+            model_out: None,
+            plots: None,
+        };
+        out.json = out.file(json)?;
+        out.model_out = out.file(model_out)?;
+        out.plots = out.dir(plots)?;
+        Ok(out)
+    }
+
+    /// Registers a further output file, when one was asked for.
+    pub fn file(&mut self, path: Option<&Path>) -> Result<Option<Staged>> {
+        path.map(|p| self.file_at(p)).transpose()
+    }
+
+    /// Registers the output file `path`.
+    pub fn file_at(&mut self, path: &Path) -> Result<Staged> {
+        Ok(Staged {
+            target: path.to_path_buf(),
+            tmp: self.set.file(path)?,
+        })
+    }
+
+    /// Registers a further output directory, when one was asked for.
+    pub fn dir(&mut self, path: Option<&Path>) -> Result<Option<Staged>> {
+        path.map(|p| self.dir_at(p)).transpose()
+    }
+
+    /// Registers the output directory `path`.
+    pub fn dir_at(&mut self, path: &Path) -> Result<Staged> {
+        Ok(Staged {
+            target: path.to_path_buf(),
+            tmp: self.set.dir(path)?,
+        })
+    }
+
+    /// Writes the plots into the plot directory, when one was asked for.
+    pub fn figures(&self, figures: impl FnOnce() -> hysid::Result<Vec<Svg>>) -> Result<()> {
+        if let Some(dir) = &self.plots {
+            write_figures(&dir.tmp, &figures()?)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the report and the model file when asked for, renames every output into
+    /// place and says where they are.
+    pub fn finish(self, report: Option<&Report>, model: Option<&FittedModel>) -> Result<()> {
+        if let (Some(out), Some(report)) = (&self.json, report) {
+            write_report(out, report)?;
+        }
+        if let (Some(out), Some(model)) = (&self.model_out, model) {
+            write_model(out, model)?;
+        }
+        let (json, model_out, plots) = (
+            self.json.clone(),
+            self.model_out.clone(),
+            self.plots.clone(),
+        );
+        self.set.commit()?;
+        if let Some(dir) = plots {
+            println!("  plots: {}", dir.target.display());
+        }
+        if let Some(out) = json.filter(|_| report.is_some()) {
+            println!("  report: {}", out.target.display());
+        }
+        if let Some(out) = model_out.filter(|_| model.is_some()) {
+            println!("  model: {}", out.target.display());
+        }
+        Ok(())
+    }
+}
+
+/// Writes the report as pretty JSON, refused when a number in it is not finite.
+pub fn write_report(out: &Staged, report: &Report) -> Result<()> {
     // A search stopped by --time-limit says so in the report.
     let text = crate::progress::mark_report(report).to_json()?;
-    write_atomic(path, text.as_bytes()).context("writing the JSON report")
+    write_text(out, &text).context("writing the JSON report")
 }
 
-/// Writes the saved-model file of `model` to `path` atomically, refused when a parameter is
-/// not finite.
-pub fn write_model(path: &Path, model: &hysid::model::saved::FittedModel) -> Result<()> {
+/// Writes the saved-model file of `model`, refused when a parameter is not finite.
+pub fn write_model(out: &Staged, model: &FittedModel) -> Result<()> {
     let file = model.to_file();
     if let Some(p) = file.parameters.iter().find(|p| !p.value.is_finite()) {
         anyhow::bail!(
@@ -31,61 +129,23 @@ pub fn write_model(path: &Path, model: &hysid::model::saved::FittedModel) -> Res
             p.name
         );
     }
-    write_json(path, &file).context("writing the model file")
+    let text = serde_json::to_string_pretty(&file).context("serialising the model file")?;
+    write_text(out, &text).context("writing the model file")
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same directory.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = writable_file(path)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    fs::write(&tmp, bytes).with_context(|| format!("cannot write {}", tmp.display()))?;
-    fs::rename(&tmp, path).map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        anyhow::anyhow!("cannot write {}: {e}", path.display())
-    })
-}
-
-/// Creates the plot directory (and its parents).
-pub fn ensure_dir(dir: &Path) -> Result<()> {
-    fs::create_dir_all(dir).with_context(|| format!("cannot create directory {}", dir.display()))
-}
-
-/// Checks, before any work, that every result file can be written where asked (its
-/// directory exists and the path is not a directory) and creates the plot directories, so
-/// that a long fit never ends in "cannot write".
-pub fn preflight(files: &[Option<&Path>], dirs: &[Option<&Path>]) -> Result<()> {
-    for path in files.iter().flatten() {
-        writable_file(path)?;
-    }
-    for dir in dirs.iter().flatten() {
-        ensure_dir(dir)?;
+/// Writes the plots into `dir`, a staged directory or a directory inside one.
+pub fn write_figures(dir: &Path, figures: &[Svg]) -> Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create directory {}", dir.display()))?;
+    for f in figures {
+        let path = dir.join(&f.name);
+        std::fs::write(&path, &f.svg)
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(())
 }
 
-/// The directory `path` would be written into, when it exists and `path` is not itself a
-/// directory.
-fn writable_file(path: &Path) -> Result<&Path> {
-    if path.is_dir() {
-        anyhow::bail!(
-            "cannot write {}: it is a directory; give a file name",
-            path.display()
-        );
-    }
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        anyhow::bail!(
-            "cannot write {}: directory {} does not exist; create it or choose another path",
-            path.display(),
-            dir.display()
-        );
-    }
-    Ok(dir)
+/// Writes `text` to the temporary of `out`.
+pub fn write_text(out: &Staged, text: &str) -> Result<()> {
+    std::fs::write(&out.tmp, text).with_context(|| format!("cannot write {}", out.target.display()))
 }

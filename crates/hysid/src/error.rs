@@ -124,6 +124,11 @@ pub enum Error {
     #[error("invalid configuration: {0}")]
     Config(String),
 
+    /// A plot could not be laid out (an internal failure of the plot layout, never of the
+    /// data).
+    #[error("plot: {0}")]
+    Plot(String),
+
     /// A least-squares problem is singular or numerically rank deficient.
     #[error("singular regression: {0}")]
     Singular(String),

@@ -5,11 +5,9 @@
 use crate::cli::{
     ActuatorConstants, ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs,
 };
-use crate::output::{ensure_dir, preflight, write_atomic, write_json, write_model, write_report};
-use crate::plot::{convergence, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
+use crate::output::{write_figures, Outputs};
 use anyhow::{bail, Context, Result};
 use hysid::experiments::actuator_rig::Rig;
-use hysid::identify::actuator::loops::{ascending, descending};
 use hysid::identify::actuator::{
     read_data_sets, ActuatorIdentification, Record, ThreeSteps, PARAMETERS,
 };
@@ -17,20 +15,23 @@ use hysid::model::greybox::models::ActuatorFixed;
 use hysid::model::greybox::Simulation;
 use hysid::numerics::LmConfig;
 use hysid::report::actuator::three_steps_report;
+use hysid::report::plot::actuator_figures;
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-/// Writes the eight data sets of the virtual rig.
+/// Writes the eight data sets of the virtual rig (all or nothing: an existing directory is
+/// replaced only once every file of the new one is written).
 pub fn rig(args: &RigArgs) -> Result<()> {
     let rig = rig_from(&args.rig, &args.constants)?;
-    preflight(&[], &[Some(&args.data_out)])?;
-    let files = write_rig(&rig, &args.data_out)?;
+    let mut out = Outputs::new(&[], None, None, None)?;
+    let dir = out.dir_at(&args.data_out)?;
+    let files = write_rig(&rig, &dir.tmp)?;
+    out.finish(None, None)?;
     println!(
-        "virtual actuator rig (Gunnar et al. 2006): {} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
-        files.len(),
+        "virtual actuator rig (Gunnar et al. 2006): {files} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
         args.data_out.display(),
         rig.backlash,
         rig.angle_noise,
@@ -42,48 +43,38 @@ pub fn rig(args: &RigArgs) -> Result<()> {
 
 /// The three steps on a data directory.
 pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
-    preflight(
-        &[args.json.as_deref(), args.model_out.as_deref()],
-        &[args.plots.as_deref()],
+    let out = Outputs::new(
+        &[args.data.as_path()],
+        args.json.as_deref(),
+        args.model_out.as_deref(),
+        args.plots.as_deref(),
     )?;
     let records = read_data_sets(&args.data)?;
     let truth = rig_truth(&args.data)?;
     let clock = Instant::now();
     let steps = three_steps(&args.steps, &args.constants);
     let id = run(&steps, &records)?;
-    let outputs = Outputs {
-        plots: args.plots.as_deref(),
-        json: args.json.as_deref(),
-        model_out: args.model_out.as_deref(),
-        sources: vec![args.data.display().to_string()],
-        simulation: steps.simulation,
-    };
+    let sources = vec![args.data.display().to_string()];
     publish(
         &id,
         truth.as_deref(),
         &records,
-        &outputs,
+        out,
+        (sources, steps.simulation),
         json!({ "elapsed_s": clock.elapsed().as_secs_f64() }),
     )
-}
-
-/// Where the results of the three steps go.
-struct Outputs<'a> {
-    plots: Option<&'a Path>,
-    json: Option<&'a Path>,
-    model_out: Option<&'a Path>,
-    sources: Vec<String>,
-    simulation: Simulation,
 }
 
 /// The rig and the three steps on the default settings.
 pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     let clock = Instant::now();
     let rig = rig_from(&args.rig, &args.constants)?;
-    preflight(&[args.json.as_deref()], &[Some(&args.plots)])?;
+    let plots = args.plots.join("actuator");
+    let mut out = Outputs::new(&[], args.json.as_deref(), None, Some(&plots))?;
     let data_dir = args.plots.join("actuator-data");
-    write_rig(&rig, &data_dir)?;
-    let records = read_data_sets(&data_dir)?;
+    let staged = out.dir_at(&data_dir)?;
+    write_rig(&rig, &staged.tmp)?;
+    let records = read_data_sets(&staged.tmp)?;
     println!(
         "Virtual actuator rig (Gunnar et al. 2006): backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {}; data in {}",
         rig.backlash,
@@ -94,19 +85,13 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     );
     let steps = three_steps(&args.steps, &args.constants);
     let id = run(&steps, &records)?;
-    let plots = args.plots.join("actuator");
-    let outputs = Outputs {
-        plots: Some(&plots),
-        json: args.json.as_deref(),
-        model_out: None,
-        sources: vec![data_dir.display().to_string()],
-        simulation: steps.simulation,
-    };
+    let sources = vec![data_dir.display().to_string()];
     publish(
         &id,
         Some(&rig.truth),
         &records,
-        &outputs,
+        out,
+        (sources, steps.simulation),
         json!({ "rig": rig_json(&rig) }),
     )?;
     println!("  total time {:.1} s", clock.elapsed().as_secs_f64());
@@ -125,15 +110,16 @@ fn run(steps: &ThreeSteps, records: &BTreeMap<usize, Record>) -> Result<Actuator
     Ok(id)
 }
 
-/// Prints the tables; writes Markdown, plots and JSON.
+/// Prints the tables; writes Markdown and plots, the report and the m67 model (read from
+/// `sources`, simulated with `simulation`), all in one transaction.
 fn publish(
     id: &ActuatorIdentification,
     truth: Option<&[f64]>,
     records: &BTreeMap<usize, Record>,
-    outputs: &Outputs,
+    out: Outputs,
+    (sources, simulation): (Vec<String>, Simulation),
     details: serde_json::Value,
 ) -> Result<()> {
-    let simulation = outputs.simulation;
     let markdown = id.markdown(truth);
     println!("\n{markdown}");
     for (name, fit) in &id.step3 {
@@ -142,30 +128,24 @@ fn publish(
             fit.fit.report.iterations, fit.fit.report.termination, fit.elapsed_s
         );
     }
-    if let Some(dir) = outputs.plots {
-        ensure_dir(dir)?;
-        write_atomic(&dir.join("tables.md"), markdown.as_bytes())?;
-        let files = figures(dir, id, truth, records)?;
-        println!("  tables and {} plots in {}", files.len(), dir.display());
+    if let Some(dir) = &out.plots {
+        std::fs::write(dir.tmp.join("tables.md"), &markdown)
+            .with_context(|| format!("cannot write {}", dir.target.join("tables.md").display()))?;
+        write_figures(&dir.tmp, &actuator_figures(id, truth, records[&6].ts)?)?;
     }
-    if let Some(path) = outputs.json {
-        let mut report = three_steps_report(id, truth, outputs.sources.clone(), simulation)?;
+    let report = if out.json.is_some() {
+        let mut report = three_steps_report(id, truth, sources, simulation)?;
         if let (Some(obj), serde_json::Value::Object(more)) =
             (report.details.as_object_mut(), details)
         {
             obj.extend(more);
         }
-        write_report(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = outputs.model_out {
-        write_model(
-            path,
-            &id.step3["m67"].fitted_model(&ActuatorFixed, simulation),
-        )?;
-        println!("  model (m67): {}", path.display());
-    }
-    Ok(())
+        Some(report)
+    } else {
+        None
+    };
+    let m67 = id.step3["m67"].fitted_model(&ActuatorFixed, simulation);
+    out.finish(report.as_ref(), Some(&m67))
 }
 
 fn three_steps(args: &ThreeStepArgs, constants: &ActuatorConstants) -> ThreeSteps {
@@ -231,17 +211,19 @@ fn rig_from(settings: &RigSettings, constants: &ActuatorConstants) -> Result<Rig
     })
 }
 
-/// Simulates and writes the data sets and rig.json; returns the data-set files.
-fn write_rig(rig: &Rig, dir: &Path) -> Result<Vec<PathBuf>> {
-    // Simulate first: a rig that fails leaves no directory behind.
+/// Simulates and writes the data sets and rig.json into `dir` (a staged directory);
+/// returns the number of data sets.
+fn write_rig(rig: &Rig, dir: &Path) -> Result<usize> {
     let records = rig.records()?;
-    ensure_dir(dir)?;
-    let files = records
-        .iter()
-        .map(|r| r.write(dir))
-        .collect::<hysid::Result<Vec<_>>>()?;
-    write_json(&dir.join("rig.json"), &rig_json(rig))?;
-    Ok(files)
+    for r in &records {
+        r.write(dir)?;
+    }
+    let path = dir.join("rig.json");
+    let json = rig_json(rig);
+    hysid::io::atomic::ensure_finite(&json)?;
+    let text = serde_json::to_string_pretty(&json)?;
+    std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(records.len())
 }
 
 fn rig_json(rig: &Rig) -> serde_json::Value {
@@ -282,181 +264,4 @@ fn rig_truth(dir: &Path) -> Result<Option<Vec<f64>>> {
         })
         .collect::<Result<Vec<f64>>>()
         .map(Some)
-}
-
-/// Figure 2 (the loops of step 2), figure 4 (torque against torsion, measured and simulated
-/// by m67), the compare plots of sets 6–8 and the convergence of m67.
-fn figures(
-    dir: &Path,
-    id: &ActuatorIdentification,
-    truth: Option<&[f64]>,
-    records: &BTreeMap<usize, Record>,
-) -> Result<Vec<PathBuf>> {
-    let mut files = vec![dir.join("fig2_loops.svg")];
-    loops_figure(&files[0], id)?;
-    let path = dir.join("fig4_torque_torsion.svg");
-    torque_torsion_figure(&path, id)?;
-    files.push(path);
-    let path = dir.join("compare.svg");
-    compare_figure(&path, id, records)?;
-    files.push(path);
-    let m67 = &id.step3["m67"].fit.report.history;
-    if !m67.is_empty() {
-        let path = dir.join("m67_convergence.svg");
-        let names: Vec<String> = PARAMETERS.iter().map(|p| p.to_string()).collect();
-        let mut history: Vec<Vec<f64>> = vec![id.m0.clone()];
-        history.extend(m67.iter().map(|r| r.theta[..PARAMETERS.len()].to_vec()));
-        convergence(
-            &path,
-            "m67: estimates per iteration (0 = m0)",
-            &names,
-            &history,
-            truth,
-        )?;
-        files.push(path);
-    }
-    Ok(files)
-}
-
-fn loops_figure(path: &Path, id: &ActuatorIdentification) -> Result<()> {
-    let [k1, k2, alpha, a] = id.step2.values;
-    let labels: Vec<String> = id
-        .step2
-        .loops
-        .iter()
-        .map(|l| format!("set {} (Q = {:.3} rad)", l.set, l.q))
-        .collect();
-    let curves: Vec<(Vec<f64>, Vec<f64>)> = id
-        .step2
-        .loops
-        .iter()
-        .map(|l| {
-            let n = 200;
-            let up = (0..=n).map(|i| -l.q + 2.0 * l.q * i as f64 / n as f64);
-            let down = (0..=n).map(|i| l.q - 2.0 * l.q * i as f64 / n as f64);
-            let x: Vec<f64> = up.clone().chain(down.clone()).collect();
-            let y: Vec<f64> = up
-                .map(|x| k1 * x + k2 * x.powi(3) + ascending(a, alpha, l.q, x))
-                .chain(down.map(|x| k1 * x + k2 * x.powi(3) + descending(a, alpha, l.q, x)))
-                .collect();
-            (x, y)
-        })
-        .collect();
-    let mut fig = Figure::new(
-        "Figure 2: steady-state loops (points) and the step-2 model (lines)",
-        "torsion x1 [rad]",
-        "τn [N·m]",
-    );
-    for ((l, label), (x, y)) in id.step2.loops.iter().zip(&labels).zip(&curves) {
-        fig = fig
-            .with(Series::new(
-                label.as_str(),
-                thin(&l.x1, 400),
-                thin(&l.tau_n, 400),
-                Style::Points,
-            ))
-            .with(Series::new("", x.as_slice(), y.as_slice(), Style::Line));
-    }
-    plot(path, &fig)
-}
-
-fn torque_torsion_figure(path: &Path, id: &ActuatorIdentification) -> Result<()> {
-    let titles = ["data set 6", "data set 7", "data set 8"];
-    let panels: Vec<Figure> = id
-        .validation
-        .experiments()
-        .iter()
-        .zip(&id.simulated["m67"])
-        .zip(titles)
-        .map(|((exp, sim), title)| {
-            let tau = thin(exp.input(0), PLOT_POINTS);
-            let fig = Figure::new(title, "torsion x1 [rad]", "torque τ [N·m]").with(Series::new(
-                "measured",
-                thin(exp.output(0), PLOT_POINTS),
-                tau.clone(),
-                Style::Line,
-            ));
-            if sim.is_empty() {
-                fig
-            } else {
-                fig.with(Series::new(
-                    "simulated (m67)",
-                    thin(sim, PLOT_POINTS),
-                    tau,
-                    Style::DashedLine,
-                ))
-            }
-        })
-        .collect();
-    plot_panels(
-        path,
-        "Figure 4: torque against torsion, measured and simulated",
-        &panels,
-        3,
-    )
-}
-
-fn compare_figure(
-    path: &Path,
-    id: &ActuatorIdentification,
-    records: &BTreeMap<usize, Record>,
-) -> Result<()> {
-    let ts = records[&6].ts;
-    let titles: Vec<String> = (6..=8)
-        .map(|set| {
-            let f = &id.fit_table;
-            format!(
-                "data set {set}: fit m0 {:.1} %, m67 {:.1} %",
-                f["m0"][set - 6],
-                f["m67"][set - 6]
-            )
-        })
-        .collect();
-    let times: Vec<Vec<f64>> = id
-        .validation
-        .experiments()
-        .iter()
-        .map(|e| (0..e.len()).map(|k| k as f64 * ts).collect())
-        .collect();
-    let panels: Vec<Figure> = (0..3)
-        .map(|e| {
-            let exp = &id.validation.experiments()[e];
-            let t = thin(&times[e], PLOT_POINTS);
-            let mut fig = Figure::new(&titles[e], "t [s]", "torsion x1 [rad]").with(Series::new(
-                "measured",
-                t.clone(),
-                thin(exp.output(0), PLOT_POINTS),
-                Style::Line,
-            ));
-            for name in ["m0", "m67"] {
-                let sim = &id.simulated[name][e];
-                if !sim.is_empty() {
-                    fig = fig.with(Series::new(
-                        name,
-                        t.clone(),
-                        thin(sim, PLOT_POINTS),
-                        Style::DashedLine,
-                    ));
-                }
-            }
-            fig
-        })
-        .collect();
-    plot_panels_sized(
-        path,
-        "Measured and simulated torsion (MATLAB compare)",
-        &panels,
-        1,
-        (1400, 1050),
-    )
-}
-
-/// Points per plotted series: enough for the eye at 1 kHz records, and SVG files of a few
-/// hundred kilobytes.
-const PLOT_POINTS: usize = 2500;
-
-/// Every k-th sample, k chosen to keep at most `max` of them.
-fn thin(x: &[f64], max: usize) -> Vec<f64> {
-    let step = x.len().div_ceil(max.max(1)).max(1);
-    x.iter().step_by(step).copied().collect()
 }

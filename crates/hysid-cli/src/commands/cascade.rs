@@ -2,19 +2,14 @@
 //! `identify cascade`).
 
 use crate::cli::UncertaintyArg;
-use crate::output::ensure_dir;
-use crate::plot::{convergence, plot, Figure, Series, Style};
 use crate::report::{figures, of_output_error, Report, Row};
 use anyhow::Result;
 use hysid::data::IdData;
 use hysid::identify::cascade::CascadeFit;
 use hysid::identify::Uncertainty;
 use hysid::model::saved::FittedModel;
-use hysid::model::HysteresisCascade;
-use hysid::numerics::metrics;
 use hysid::report::UncertaintySummary;
 use serde_json::json;
-use std::path::{Path, PathBuf};
 
 /// True for the Coleman–Hodgdon forms (`ch4`, `ch6`) of the paper-1 pipeline; every other
 /// name is an operator family (`commands/operator_cascade.rs`).
@@ -145,71 +140,4 @@ pub fn print_summary(fit: &CascadeFit, report: &Report) {
             "  note: re-classifying the samples by the final d did not lower the criterion; the best classification is kept"
         );
     }
-}
-
-/// Writes the cascade plots into `dir`; returns the files written.
-pub fn plots(
-    dir: &Path,
-    fit: &CascadeFit,
-    x: &[f64],
-    y: &[f64],
-    truth: Option<&HysteresisCascade>,
-) -> Result<Vec<PathBuf>> {
-    ensure_dir(dir)?;
-    let mut files = Vec::new();
-    let v_est = fit.model.hysteresis.simulate_unchecked(x, 0.0);
-    let v_true = truth.map(|t| t.hysteresis.simulate_unchecked(x, 0.0));
-    // Hysteresis loops (paper Figs. 4 and 8).
-    let mut loops = Figure::new(
-        "Hysteresis loops: v against x",
-        "x (hysteresis input)",
-        "v (hysteresis output)",
-    );
-    if let Some(v) = &v_true {
-        loops = loops.with(Series::line("true", x, v));
-    }
-    loops = loops.with(Series::dashed("identified", x, &v_est));
-    files.push(save(dir, "loops.svg", |p| plot(p, &loops))?);
-    // Input (paper Figs. 5 and 9).
-    let input = Figure::new("Input x", "sample", "x").with(Series::indexed("x", x, Style::Line));
-    files.push(save(dir, "input.svg", |p| plot(p, &input))?);
-    // Measured against simulated output.
-    let yhat = &fit.output_error.simulated[0][0];
-    let title = format!(
-        "Output: measured and simulated (fit {:.2} %)",
-        metrics::fit_percent(y, yhat)
-    );
-    let output = Figure::new(&title, "sample", "y")
-        .with(Series::indexed("measured", y, Style::Line))
-        .with(Series::indexed("simulated", yhat, Style::DashedLine));
-    files.push(save(dir, "output.svg", |p| plot(p, &output))?);
-    // Parameter estimates per iteration (paper Figs. 6–7 and 10–11).
-    let names = fit.output_error.parameters.names();
-    let truth_params = truth.map(|t| t.params());
-    if let Some(k) = fit.key_term.as_ref().filter(|k| k.history.len() > 1) {
-        let title = "Paper iteration (key-term separation): estimates per iteration";
-        files.push(save(dir, "paper_iteration.svg", |p| {
-            convergence(p, title, &names, &k.history, truth_params.as_deref())
-        })?);
-    }
-    let lm: Vec<Vec<f64>> = fit
-        .output_error
-        .report
-        .history
-        .iter()
-        .map(|r| r.theta.clone())
-        .collect();
-    if !lm.is_empty() {
-        let title = "Output-error fit: estimates per iteration";
-        files.push(save(dir, "output_error_iterations.svg", |p| {
-            convergence(p, title, &names, &lm, truth_params.as_deref())
-        })?);
-    }
-    Ok(files)
-}
-
-fn save(dir: &Path, name: &str, draw: impl FnOnce(&Path) -> Result<()>) -> Result<PathBuf> {
-    let path = dir.join(name);
-    draw(&path)?;
-    Ok(path)
 }

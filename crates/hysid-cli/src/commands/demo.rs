@@ -1,19 +1,22 @@
 //! `hysid demo voros`: the project's cascade examples end to end.
 
-use super::cascade::{plots, print_summary, report, rows, uncertainty};
+use super::cascade::{print_summary, report, rows, uncertainty};
 use crate::cli::{UncertaintyArg, VorosArgs};
-use crate::output::{preflight, write_report};
+use crate::output::Outputs;
 use crate::progress::FitProgress;
 use crate::report::print_table;
 use anyhow::Result;
 use hysid::experiments::voros::{CascadeExample, EXAMPLE_SNR};
 use hysid::identify::cascade::CascadeIdentification;
+use hysid::report::plot::cascade_figures;
 use serde_json::json;
 
 /// Generates Example 1 or 2, identifies it and reports against the truth.
 pub fn voros(args: &VorosArgs) -> Result<()> {
     let ex = CascadeExample::number(args.example)?;
-    preflight(&[args.json.as_deref()], &[Some(&args.plots)])?;
+    // The plots go into their own subdirectory, so other demos' plots beside it stay.
+    let dir = args.plots.join(format!("voros-example{}", args.example));
+    let out = Outputs::new(&[], args.json.as_deref(), None, Some(&dir))?;
     let generated = ex.generate(args.seed, !args.noise_free)?;
     let data = generated.id_data()?;
     let truth = &ex.truth;
@@ -74,12 +77,6 @@ pub fn voros(args: &VorosArgs) -> Result<()> {
     let source = vec![format!("built-in: project Example {}", args.example)];
     let report = report("demo voros", &fit, &data, source, id.uncertainty, extra)?;
     print_summary(&fit, &report);
-    let dir = args.plots.join(format!("voros-example{}", args.example));
-    let files = plots(&dir, &fit, &generated.x, &generated.y, Some(truth))?;
-    println!("  plots: {} files in {}", files.len(), dir.display());
-    if let Some(path) = &args.json {
-        write_report(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    Ok(())
+    out.figures(|| cascade_figures(&fit, &generated.x, &generated.y, Some(truth)))?;
+    out.finish(Some(&report), None)
 }

@@ -1,7 +1,7 @@
 //! `hysid generate voros`: the examples' data as CSV.
 
 use crate::cli::GenerateVorosArgs;
-use crate::output::preflight;
+use crate::output::Outputs;
 use anyhow::Result;
 use hysid::data::write_csv;
 use hysid::experiments::voros::CascadeExample;
@@ -9,7 +9,8 @@ use hysid::experiments::voros::CascadeExample;
 /// Writes columns t, x, y of Example 1 or 2 (optionally extended to `--samples`).
 pub fn voros(args: &GenerateVorosArgs) -> Result<()> {
     let mut ex = CascadeExample::number(args.example)?;
-    preflight(&[Some(&args.csv)], &[])?;
+    let mut out = Outputs::new(&[], None, None, None)?;
+    let csv = out.file_at(&args.csv)?;
     if let Some(n) = args.samples {
         anyhow::ensure!(n >= 2, "--samples must be at least 2, got {n}");
         crate::budget::check(
@@ -20,7 +21,8 @@ pub fn voros(args: &GenerateVorosArgs) -> Result<()> {
     }
     let data = ex.generate(args.seed, !args.noise_free)?;
     let t: Vec<f64> = (0..data.x.len()).map(|k| k as f64).collect();
-    write_csv(&args.csv, &["t", "x", "y"], &[&t, &data.x, &data.y])?;
+    write_csv(&csv.tmp, &["t", "x", "y"], &[&t, &data.x, &data.y])?;
+    out.finish(None, None)?;
     println!(
         "Example {} data: {} samples, seed {}, {} -> {}",
         args.example,

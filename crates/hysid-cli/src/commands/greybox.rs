@@ -3,19 +3,18 @@
 use super::present::{print_fit, print_residuals, print_sensitivity, report};
 use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
 use crate::commands::identify::load;
-use crate::output::{ensure_dir, preflight, write_model, write_report};
-use crate::plot::{hline, plot, plot_panels, Figure, Series, Style};
+use crate::output::Outputs;
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
 use hysid::data::IdData;
-use hysid::identify::greybox::{GreyBoxEstimation, GreyBoxFit, InitialStates};
-use hysid::identify::validate::{sensitivity_table, ResidualAnalysis};
+use hysid::identify::greybox::{GreyBoxEstimation, InitialStates};
+use hysid::identify::validate::sensitivity_table;
 use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, StateSpaceModel};
 use hysid::model::ParameterSet;
 use hysid::numerics::LmConfig;
+use hysid::report::plot::greybox_figures;
 use serde_json::json;
-use std::path::Path;
 use std::sync::Arc;
 
 /// Runs `hysid greybox fit`.
@@ -29,9 +28,13 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         (Some(eq), _) => eq.clone(),
         (None, name) => Arc::from(models::by_kind(name.as_deref().unwrap_or_default())?),
     };
-    preflight(
-        &[args.json.as_deref(), args.model_out.as_deref()],
-        &[args.plots.as_deref()],
+    let mut inputs = vec![args.data.data.as_path()];
+    inputs.extend(args.model_file.as_deref());
+    let out = Outputs::new(
+        &inputs,
+        args.json.as_deref(),
+        args.model_out.as_deref(),
+        args.plots.as_deref(),
     )?;
     let data = load(&args.data)?;
     let params = configure(
@@ -91,7 +94,7 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
             model.clone(),
             &data,
             estimation.simulation,
-            initial_from(&fit, model.as_ref(), &data),
+            fit.initial_states(model.as_ref(), data.n_experiments()),
         )?;
         let rows = sensitivity_table(&structure, &data, &fit.fit.parameters, 0.2)?;
         print_sensitivity(&rows);
@@ -103,22 +106,11 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     if let Some(eq) = &equations {
         fitted = fitted.with_equations(eq.source());
     }
-    if let Some(dir) = &args.plots {
-        plots(dir, &fit, &data, &residuals)?;
-        println!("  plots: {}", dir.display());
-    }
+    out.figures(|| greybox_figures(&fit, &data, &residuals))?;
     let extra = json!({"residual_analysis": residuals, "sensitivity": sensitivity});
     let sources = vec![args.data.data.display().to_string()];
     let report = report("greybox fit", &fit, &data, sources, fitted.to_file(), extra)?;
-    if let Some(path) = &args.json {
-        write_report(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = &args.model_out {
-        write_model(path, &fitted)?;
-        println!("  model: {}", path.display());
-    }
-    Ok(())
+    out.finish(Some(&report), Some(&fitted))
 }
 
 /// `params` with the command line's fixes, frees, initial values and bounds applied.
@@ -205,19 +197,6 @@ fn initial_states(
     Ok(initial)
 }
 
-/// The fitted initial states, fixed (for re-simulation).
-fn initial_from(fit: &GreyBoxFit, model: &dyn StateSpaceModel, data: &IdData) -> InitialStates {
-    let n = model.states().len();
-    let p = model.parameters().len();
-    let v = fit.fit.parameters.values();
-    InitialStates {
-        values: (0..data.n_experiments())
-            .map(|e| v[p + e * n..p + (e + 1) * n].to_vec())
-            .collect(),
-        estimated: vec![false; n],
-    }
-}
-
 /// The command line's simulation settings.
 pub fn simulation(args: &SimulationArgs) -> Simulation {
     let substeps = args.substeps.max(1);
@@ -232,66 +211,4 @@ pub fn simulation(args: &SimulationArgs) -> Simulation {
             InterpolationArg::BandLimited => InputInterpolation::BandLimited,
         },
     }
-}
-
-/// Measured against simulated output, residual correlations, convergence.
-pub fn plots(
-    dir: &Path,
-    fit: &GreyBoxFit,
-    data: &IdData,
-    residuals: &[ResidualAnalysis],
-) -> Result<()> {
-    ensure_dir(dir)?;
-    let exp = data.experiment(0);
-    let t: Vec<f64> = (0..exp.len()).map(|k| k as f64 * data.ts()).collect();
-    let y_name = data.output_channels()[0].to_string();
-    let title = format!(
-        "Output: measured and simulated (fit {:.2} %)",
-        fit.fit.fit_percent[0][0]
-    );
-    let output = Figure::new(&title, "t [s]", &y_name)
-        .with(Series::line("measured", &t, exp.output(0)))
-        .with(Series::dashed("simulated", &t, &fit.fit.simulated[0][0]));
-    plot(&dir.join("output.svg"), &output)?;
-    let a = &residuals[0];
-    let lags: Vec<f64> = (0..=a.max_lag).map(|l| l as f64).collect();
-    let cross_lags: Vec<f64> = (-(a.max_lag as i64)..=a.max_lag as i64)
-        .map(|l| l as f64)
-        .collect();
-    let auto = Figure::new("Residual auto-correlation", "lag", "r")
-        .with(Series::new(
-            "r_e",
-            lags.as_slice(),
-            a.autocorrelation.as_slice(),
-            Style::Points,
-        ))
-        .with(hline("99 %", (0.0, a.max_lag as f64), a.band))
-        .with(hline("-99 %", (0.0, a.max_lag as f64), -a.band));
-    let cross = Figure::new("Input-residual cross-correlation", "lag", "r")
-        .with(Series::new(
-            "r_eu",
-            cross_lags.as_slice(),
-            a.cross_correlation[0].as_slice(),
-            Style::Points,
-        ))
-        .with(hline(
-            "99 %",
-            (-(a.max_lag as f64), a.max_lag as f64),
-            a.band,
-        ))
-        .with(hline(
-            "-99 %",
-            (-(a.max_lag as f64), a.max_lag as f64),
-            -a.band,
-        ));
-    plot_panels(
-        &dir.join("residuals.svg"),
-        "Residual analysis (experiment 1)",
-        &[auto, cross],
-        2,
-    )?;
-    let cost: Vec<f64> = fit.fit.report.history.iter().map(|r| r.cost).collect();
-    let convergence = Figure::new("Criterion per iteration", "iteration", "sum of squares")
-        .with(Series::indexed("S", &cost, Style::Line));
-    plot(&dir.join("convergence.svg"), &convergence)
 }

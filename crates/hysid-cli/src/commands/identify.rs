@@ -1,9 +1,8 @@
 //! `hysid identify cascade` and `hysid identify hysteresis`.
 
-use super::cascade::{fitted, plots, print_summary, report, rows, uncertainty};
+use super::cascade::{fitted, print_summary, report, rows, uncertainty};
 use crate::cli::{CascadeArgs, DataArgs, HysteresisArgs, InitialArg, OutputArgs};
-use crate::output::{ensure_dir, write_model, write_report};
-use crate::plot::{plot, Figure, Series, Style};
+use crate::output::Outputs;
 use crate::progress::FitProgress;
 use crate::report::{figures, of_output_error, print_table, Report, Row};
 use anyhow::Result;
@@ -12,10 +11,10 @@ use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::hysteresis::{HysteresisFit, HysteresisIdentification, InitialOutput};
 use hysid::model::saved::FittedModel;
 use hysid::model::ChForm;
+use hysid::report::plot::{cascade_figures, hysteresis_figures};
 use hysid::report::UncertaintySummary;
 use hysid::Error;
 use serde_json::json;
-use std::path::Path;
 
 /// Reads the input and output columns of a CSV file: one experiment per --input/--output
 /// pair.
@@ -73,7 +72,7 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         return super::operator_cascade::identify(args);
     }
     let form = ChForm::parse(&args.hysteresis)?;
-    preflight_outputs(&args.output)?;
+    let out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
     let mut id = CascadeIdentification::new(form, args.na, args.nb, args.delay);
     id.uncertainty = uncertainty(args.uncertainty, args.replicates);
@@ -109,17 +108,14 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         extra,
     )?;
     print_summary(&fit, &report);
-    if let Some(dir) = &args.output.plots {
-        let files = plots(dir, &fit, x, y, None)?;
-        println!("  plots: {} files in {}", files.len(), dir.display());
-    }
-    finish(&args.output, &report, &fitted(&fit))
+    out.figures(|| cascade_figures(&fit, x, y, None))?;
+    out.finish(Some(&report), Some(&fitted(&fit)))
 }
 
 /// `hysid identify hysteresis`.
 pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
     let form = ChForm::parse(&args.hysteresis)?;
-    preflight_outputs(&args.output)?;
+    let out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
     let mut id = HysteresisIdentification::new(form);
     id.initial = match args.initial_output {
@@ -173,16 +169,13 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
             adm.violations.join("; ")
         );
     }
-    if let Some(dir) = &args.output.plots {
-        hysteresis_plots(dir, &fit, &data)?;
-        println!("  plots: {}", dir.display());
-    }
+    out.figures(|| hysteresis_figures(&fit, &data))?;
     let fitted = FittedModel::Hysteresis {
         model: fit.model.clone(),
         initial: id.initial,
         std,
     };
-    finish(&args.output, &report, &fitted)
+    out.finish(Some(&report), Some(&fitted))
 }
 
 fn hysteresis_report(
@@ -218,65 +211,13 @@ fn hysteresis_report(
     )?)
 }
 
-fn hysteresis_plots(dir: &Path, fit: &HysteresisFit, data: &IdData) -> Result<()> {
-    ensure_dir(dir)?;
-    let x_name = data.input_channels()[0].to_string();
-    let y_name = data.output_channels()[0].to_string();
-    let mut loops = Figure::new(
-        "Hysteresis: measured and simulated output against input",
-        &x_name,
-        &y_name,
-    );
-    let labels: Vec<(String, String)> = (0..data.n_experiments())
-        .map(|e| {
-            (
-                format!("measured {}", e + 1),
-                format!("simulated {}", e + 1),
-            )
-        })
-        .collect();
-    for (e, exp) in data.experiments().iter().enumerate() {
-        loops = loops
-            .with(Series::points(&labels[e].0, exp.input(0), exp.output(0)))
-            .with(Series::dashed(
-                &labels[e].1,
-                exp.input(0),
-                &fit.output_error.simulated[e][0],
-            ));
-    }
-    plot(&dir.join("loops.svg"), &loops)?;
-    let exp = data.experiment(0);
-    let title = format!(
-        "Output: measured and simulated (fit {:.2} %)",
-        fit.output_error.fit_percent[0][0]
-    );
-    let output = Figure::new(&title, "sample", &y_name)
-        .with(Series::indexed("measured", exp.output(0), Style::Line))
-        .with(Series::indexed(
-            "simulated",
-            &fit.output_error.simulated[0][0],
-            Style::DashedLine,
-        ));
-    plot(&dir.join("output.svg"), &output)
-}
-
-/// Writes the report and the model file when asked for.
-pub(super) fn finish(output: &OutputArgs, report: &Report, model: &FittedModel) -> Result<()> {
-    if let Some(path) = &output.json {
-        write_report(path, report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = &output.model_out {
-        write_model(path, model)?;
-        println!("  model: {}", path.display());
-    }
-    Ok(())
-}
-
-/// Checks the report, model and plot destinations before the fit.
-pub(super) fn preflight_outputs(output: &OutputArgs) -> Result<()> {
-    crate::output::preflight(
-        &[output.json.as_deref(), output.model_out.as_deref()],
-        &[output.plots.as_deref()],
+/// Registers the report, model and plot destinations before the fit (refused when one is
+/// the data file or cannot be written).
+pub(super) fn register(data: &DataArgs, output: &OutputArgs) -> Result<Outputs> {
+    Outputs::new(
+        &[data.data.as_path()],
+        output.json.as_deref(),
+        output.model_out.as_deref(),
+        output.plots.as_deref(),
     )
 }

@@ -2,10 +2,8 @@
 //! operator followed by a linear block); `ch4`/`ch6` keep the paper-1 pipeline of
 //! `identify.rs`.
 
-use super::identify::{finish, load, preflight_outputs};
+use super::identify::{load, register};
 use crate::cli::{CascadeArgs, UncertaintyArg};
-use crate::output::ensure_dir;
-use crate::plot::{plot, Figure, Series, Style};
 use crate::progress::FitProgress;
 use crate::report::{figures, of_output_error, print_table, Row};
 use anyhow::Result;
@@ -13,9 +11,9 @@ use hysid::identify::operator_cascade::{
     CascadeFamily, OperatorCascadeFit, OperatorCascadeIdentification,
 };
 use hysid::model::saved::FittedModel;
+use hysid::report::plot::operator_cascade_figures;
 use hysid::report::UncertaintySummary;
 use serde_json::json;
-use std::path::{Path, PathBuf};
 
 /// The family named on the command line with its structure options (the lead unifies this
 /// parser with the `Family` enum of `identify operator` at merge).
@@ -61,7 +59,7 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
         "--uncertainty bootstrap is available for ch4 and ch6; operator cascades report \
          asymptotic standard deviations (use --uncertainty asymptotic)"
     );
-    preflight_outputs(&args.output)?;
+    let out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
     let id = OperatorCascadeIdentification::new(family, args.na, args.nb, args.delay);
     let fit = {
@@ -119,11 +117,8 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
             fit.model.linear.spectral_radius()
         );
     }
-    if let Some(dir) = &args.output.plots {
-        let files = plots(dir, &fit, u, y)?;
-        println!("  plots: {} files in {}", files.len(), dir.display());
-    }
-    finish(&args.output, &report, &model)
+    out.figures(|| operator_cascade_figures(&fit, u, y))?;
+    out.finish(Some(&report), Some(&model))
 }
 
 /// Table rows: estimate ± std with the global start as the initial value.
@@ -142,29 +137,4 @@ fn rows(fit: &OperatorCascadeFit) -> Vec<Row> {
             std: std[i],
         })
         .collect()
-}
-
-/// The operator's loop (v against u) and the measured and simulated outputs.
-fn plots(dir: &Path, fit: &OperatorCascadeFit, u: &[f64], y: &[f64]) -> Result<Vec<PathBuf>> {
-    ensure_dir(dir)?;
-    let v = fit.model.simulate(u)?.v;
-    let loops = Figure::new(
-        "Identified operator: v against u",
-        "u (input)",
-        "v (operator output)",
-    )
-    .with(Series::line("identified", u, &v));
-    let loops_path = dir.join("loops.svg");
-    plot(&loops_path, &loops)?;
-    let yhat = &fit.output_error.simulated[0][0];
-    let title = format!(
-        "Output: measured and simulated (fit {:.2} %)",
-        fit.fit_percent
-    );
-    let output = Figure::new(&title, "sample", "y")
-        .with(Series::indexed("measured", y, Style::Line))
-        .with(Series::indexed("simulated", yhat, Style::DashedLine));
-    let output_path = dir.join("output.svg");
-    plot(&output_path, &output)?;
-    Ok(vec![loops_path, output_path])
 }

@@ -62,12 +62,7 @@ pub fn print_fit(title: &str, fit: &GreyBoxFit) {
         oe.report.residual_evaluations, oe.report.sensitivity_evaluations
     );
     if fit.starts.len() > 1 {
-        let good = fit
-            .starts
-            .iter()
-            .map(|s| s.cost)
-            .fold(f64::INFINITY, f64::min);
-        let near = fit.starts.iter().filter(|s| s.cost <= 1.01 * good).count();
+        let near = fit.starts_near_best(0.01);
         println!(
             "  multi-start: {} starts screened, {near} reached the best screened criterion",
             fit.starts.len()

@@ -2,7 +2,7 @@
 //! 1 of Gunnar et al. 2006; the reference method of the EMPS benchmark, Janot et al. 2019).
 
 use crate::cli::RigidBodyLsArgs;
-use crate::output::{preflight, write_model, write_report};
+use crate::output::Outputs;
 use anyhow::{Context, Result};
 use hysid::data::{CsvSpec, IdData};
 use hysid::identify::rigid_body::{RigidBodyEstimate, RigidBodyLs};
@@ -15,7 +15,14 @@ use std::path::Path;
 
 /// Estimates on one record; relative errors on every validation record.
 pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
-    preflight(&[args.json.as_deref(), args.model_out.as_deref()], &[])?;
+    let mut inputs = vec![args.data.as_path()];
+    inputs.extend(args.validate.iter().map(|p| p.as_path()));
+    let out = Outputs::new(
+        &inputs,
+        args.json.as_deref(),
+        args.model_out.as_deref(),
+        None,
+    )?;
     let clock = std::time::Instant::now();
     let ls = RigidBodyLs {
         inertia_name: "M".into(),
@@ -55,15 +62,7 @@ pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
         q.len(),
         clock.elapsed().as_secs_f64(),
     );
-    if let Some(path) = &args.json {
-        write_report(path, &report)?;
-        println!("  report: {}", path.display());
-    }
-    if let Some(path) = &args.model_out {
-        write_model(path, &fitted(&estimate, args))?;
-        println!("  model: {}", path.display());
-    }
-    Ok(())
+    out.finish(Some(&report), Some(&fitted(&estimate, args)))
 }
 
 /// The settings, the estimates with their standard deviations, the fit and the condition.

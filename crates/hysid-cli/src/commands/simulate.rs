@@ -1,9 +1,9 @@
 //! `hysid simulate`: run a saved model (or the model of a report) on new input data.
 
 use crate::cli::SimulateArgs;
+use crate::output::Outputs;
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
-use hysid::io::atomic::OutputSet;
 use hysid::model::saved::FittedModel;
 use hysid::report::{DataSummary, FitSummary, Report};
 
@@ -11,9 +11,13 @@ use hysid::report::{DataSummary, FitSummary, Report};
 /// The outputs are one transaction: written to temporaries, renamed into place together at
 /// the end, and never an input file.
 pub fn run(args: &SimulateArgs) -> Result<()> {
-    let mut files = OutputSet::new(&[args.model.as_path(), args.data.as_path()])?;
-    let csv_tmp = args.csv.as_deref().map(|p| files.file(p)).transpose()?;
-    let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
+    let mut out = Outputs::new(
+        &[args.model.as_path(), args.data.as_path()],
+        args.json.as_deref(),
+        None,
+        None,
+    )?;
+    let csv = out.file(args.csv.as_deref())?;
     let model = FittedModel::load(&args.model)?;
     let spec = CsvSpec {
         inputs: args.input.clone(),
@@ -49,7 +53,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         )?);
     }
     report.model = Some(file);
-    if let Some(path) = &csv_tmp {
+    if let Some(csv) = &csv {
         let mut headers: Vec<&str> = args.input.iter().map(String::as_str).collect();
         headers.push("simulated");
         let mut cols: Vec<&[f64]> = inputs.clone();
@@ -58,13 +62,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
             headers.push(name.as_str());
             cols.push(y);
         }
-        write_csv(path, &headers, &cols)?;
+        write_csv(&csv.tmp, &headers, &cols)?;
     }
-    if let Some(path) = &json_tmp {
-        let text = report.to_json()?;
-        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    files.commit()?;
     println!(
         "Simulated {kind} on {} ({} samples)",
         args.data.display(),
@@ -76,8 +75,5 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     if let Some(path) = &args.csv {
         println!("  simulated output: {}", path.display());
     }
-    if let Some(path) = &args.json {
-        println!("  report: {}", path.display());
-    }
-    Ok(())
+    out.finish(Some(&report), None)
 }

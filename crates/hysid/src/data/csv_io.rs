@@ -11,15 +11,15 @@
 //! file without blank lines or multi-line quoted cells, that is the line number minus two.
 
 use std::fmt::Write as _;
-use std::fs::{self, File};
+use std::fs::File;
 use std::io;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use csv::{ByteRecord, ErrorKind, ReaderBuilder};
 
 use super::{one_line, Channel, Experiment, IdData};
 use crate::error::{Error, Result};
+use crate::io::atomic::OutputSet;
 
 /// Names (compared case-insensitively) recognised as a time column when the spec names none.
 pub(super) const TIME_COLUMN_NAMES: [&str; 4] = ["t", "time", "t_s", "time_s"];
@@ -169,8 +169,9 @@ pub fn read_columns(path: &Path, names: &[&str]) -> Result<(Vec<String>, Vec<Vec
     Ok((table.header, columns))
 }
 
-/// Writes `columns` under `headers` as a CSV file, replacing `path` atomically: the data go
-/// to a temporary file in the same directory, which is renamed over `path` once complete.
+/// Writes `columns` under `headers` as a CSV file, replacing `path` atomically through the
+/// library's one writer, [`crate::io::atomic::OutputSet`]: the data go to a temporary file
+/// in the same directory, which is renamed over `path` once complete.
 ///
 /// Values are written in full precision (shortest text that reads back to the same `f64`;
 /// scientific notation for very large or small magnitudes), so reading them back is
@@ -184,9 +185,11 @@ pub fn write_csv(path: &Path, headers: &[&str], columns: &[&[f64]]) -> Result<()
         path: path.to_path_buf(),
         source,
     };
-    let (temp, file) = TempFile::create_beside(path).map_err(io_error)?;
+    let mut output = OutputSet::new(&[])?;
+    let temp = output.file(path)?;
+    let file = File::create(&temp).map_err(io_error)?;
     write_table(file, headers, columns).map_err(io_error)?;
-    temp.persist(path).map_err(io_error)
+    output.commit()
 }
 
 /// A CSV file opened for reading, positioned after its header.
@@ -472,58 +475,6 @@ fn push_f64(out: &mut String, value: f64) {
         write!(out, "{value:e}")
     };
     written.expect("writing to a String cannot fail");
-}
-
-/// A temporary file that is deleted when dropped unless it was renamed into place.
-struct TempFile {
-    path: PathBuf,
-    persisted: bool,
-}
-
-impl TempFile {
-    /// Creates a new, uniquely named hidden file in the directory of `target`.
-    fn create_beside(target: &Path) -> io::Result<(Self, File)> {
-        static COUNTER: AtomicU64 = AtomicU64::new(0);
-        let file_name = target
-            .file_name()
-            .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "not a file name"))?;
-        let dir = match target.parent() {
-            Some(dir) if !dir.as_os_str().is_empty() => dir,
-            _ => Path::new("."),
-        };
-        let unique = format!(
-            "{}-{}",
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed)
-        );
-        let mut name = std::ffi::OsString::from(".");
-        name.push(file_name);
-        name.push(format!(".{unique}.tmp"));
-        let path = dir.join(name);
-        let file = File::options().write(true).create_new(true).open(&path)?;
-        Ok((
-            Self {
-                path,
-                persisted: false,
-            },
-            file,
-        ))
-    }
-
-    fn persist(mut self, target: &Path) -> io::Result<()> {
-        fs::rename(&self.path, target)?;
-        self.persisted = true;
-        Ok(())
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        if !self.persisted {
-            // Best effort: the write already failed, and that error is the one to report.
-            let _ = fs::remove_file(&self.path);
-        }
-    }
 }
 
 mod float;

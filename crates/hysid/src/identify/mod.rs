@@ -18,6 +18,8 @@
 //! * [`greybox`]: output-error estimation of continuous-time grey-box models with
 //!   multi-start (MATLAB's `nlgreyest`).
 //! * [`actuator`]: the three-step identification of Gunnar et al. (2006).
+//! * [`bouc_wen_benchmark`]: the hysteretic benchmark of Noël & Schoukens (2016): fit, e_RMS
+//!   scores and test-record generation.
 //! * [`operators`]: identification of the hysteresis operator families from the data alone.
 //! * [`operator_cascade`]: any operator family followed by a linear block (global start,
 //!   output error).
@@ -25,6 +27,7 @@
 
 pub mod actuator;
 pub mod bootstrap;
+pub mod bouc_wen_benchmark;
 pub mod budget;
 pub mod cascade;
 pub mod cascade_pass;

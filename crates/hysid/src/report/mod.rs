@@ -25,6 +25,7 @@
 pub mod actuator;
 pub mod cascade;
 pub mod greybox;
+pub mod plot;
 pub mod rigid_body;
 
 pub use cascade::{cascade_report, hysteresis_report};
@@ -322,6 +323,11 @@ pub struct ValidationEntry {
 }
 
 impl ValidationEntry {
+    /// The entry of a scored Bouc–Wen benchmark test record (fit %, RMSE and e_RMS).
+    pub fn of_benchmark(test: &crate::identify::bouc_wen_benchmark::BenchmarkTest) -> Result<Self> {
+        Self::of(test.source.clone(), &test.y, &test.yhat, Some(test.e_rms))
+    }
+
     /// The figures of simulated `yhat` against measured `y` from `source`.
     pub fn of(source: String, y: &[f64], yhat: &[f64], e_rms: Option<f64>) -> Result<Self> {
         let entry = Self {

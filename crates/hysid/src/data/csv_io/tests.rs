@@ -1,3 +1,5 @@
+use std::fs;
+
 use tempfile::TempDir;
 
 use super::*;
@@ -480,12 +482,15 @@ fn write_rejects_inconsistent_columns() {
 }
 
 #[test]
-fn write_into_missing_directory_is_io_error() {
+fn write_into_missing_directory_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("absent").join("out.csv");
+    // Refused when the output is registered with the one writer (io::atomic::OutputSet).
     let error = err(write_csv(&path, &["x"], &[&[1.0]]));
-    assert!(matches!(error, Error::Io { .. }), "{error:?}");
-    assert!(error.to_string().contains("out.csv"), "{error}");
+    let message = error.to_string();
+    assert!(message.contains("out.csv"), "{message}");
+    assert!(message.contains("does not exist"), "{message}");
+    assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
 #[test]

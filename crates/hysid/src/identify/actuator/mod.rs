@@ -102,6 +102,24 @@ pub struct LoopFit {
     pub loops: Vec<Loop>,
 }
 
+impl LoopFit {
+    /// The step-2 model's steady-state loop for the torsion amplitude `q`: x1 from −Q to Q
+    /// and back in `2 (points + 1)` samples, and τn = k1 x1 + k2 x1³ + Cu(x1) on the way up,
+    /// + Cd(x1) on the way down (Gunnar et al. 2006 eq. (10); [`loops`]).
+    pub fn model_loop(&self, q: f64, points: usize) -> (Vec<f64>, Vec<f64>) {
+        let [k1, k2, alpha, a] = self.values;
+        let n = points.max(1);
+        let up = (0..=n).map(|i| -q + 2.0 * q * i as f64 / n as f64);
+        let down = (0..=n).map(|i| q - 2.0 * q * i as f64 / n as f64);
+        let x: Vec<f64> = up.clone().chain(down.clone()).collect();
+        let tau: Vec<f64> = up
+            .map(|x| k1 * x + k2 * x.powi(3) + ascending(a, alpha, q, x))
+            .chain(down.map(|x| k1 * x + k2 * x.powi(3) + descending(a, alpha, q, x)))
+            .collect();
+        (x, tau)
+    }
+}
+
 /// One steady-state loop of step 2.
 #[derive(Clone, Debug, Serialize)]
 pub struct Loop {
@@ -489,4 +507,31 @@ fn linear_part(loops: &[Loop], alpha: f64) -> Option<(Vec<f64>, Vec<f64>, f64)> 
     let ls = least_squares(&phi, &y, &["k1", "k2", "A"]).ok()?;
     let std = ls.std();
     Some((ls.theta.iter().copied().collect(), std, ls.residual_ss))
+}
+
+#[cfg(test)]
+mod model_loop_tests {
+    use super::*;
+
+    #[test]
+    fn the_model_loop_closes_at_its_turning_points() {
+        let (k1, k2, alpha, a, q) = (30.0, 5.0e3, 40.0, 900.0, 0.05);
+        let fit = LoopFit {
+            values: [k1, k2, alpha, a],
+            std: [0.0; 4],
+            rms: 0.0,
+            loops: Vec::new(),
+        };
+        let (x, tau) = fit.model_loop(q, 200);
+        assert_eq!(x.len(), 402);
+        // Cu(±Q) = ±(A/α)·tanh(αQ): the branches meet at the turning points.
+        let top = k1 * q + k2 * q.powi(3) + (a / alpha) * (alpha * q).tanh();
+        assert!(
+            (tau[200] - top).abs() < 1e-9 * top.abs(),
+            "{} {top}",
+            tau[200]
+        );
+        assert!((tau[201] - top).abs() < 1e-9 * top.abs());
+        assert!((tau[0] + top).abs() < 1e-9 * top.abs());
+    }
 }

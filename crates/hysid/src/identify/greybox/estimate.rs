@@ -81,6 +81,35 @@ impl GreyBoxFit {
             initial_state: values[p..p + n].to_vec(),
         }
     }
+
+    /// The fitted initial states of the `experiments` experiments, fixed (for
+    /// re-simulation): the estimate holds the model's own parameters first, then n states
+    /// per experiment.
+    pub fn initial_states(&self, model: &dyn StateSpaceModel, experiments: usize) -> InitialStates {
+        let n = model.states().len();
+        let p = model.parameters().len();
+        let v = self.fit.parameters.values();
+        InitialStates {
+            values: (0..experiments)
+                .map(|e| v[p + e * n..p + (e + 1) * n].to_vec())
+                .collect(),
+            estimated: vec![false; n],
+        }
+    }
+
+    /// How many multi-start starts reached a screened criterion within the relative
+    /// `tolerance` of the best one (e.g. 0.01: within 1 %).
+    pub fn starts_near_best(&self, tolerance: f64) -> usize {
+        let best = self
+            .starts
+            .iter()
+            .map(|s| s.cost)
+            .fold(f64::INFINITY, f64::min);
+        self.starts
+            .iter()
+            .filter(|s| s.cost <= (1.0 + tolerance) * best)
+            .count()
+    }
 }
 
 impl GreyBoxEstimation {

@@ -1,18 +1,10 @@
-// Renders every kind of plot into a temporary directory and checks the SVG.
+// Renders every kind of plot and checks the SVG text.
 
-use std::fs;
-use std::path::{Path, PathBuf};
+use super::{hline, render, render_panels, render_panels_sized, Figure, Series, Style};
 
-use super::{hline, plot, plot_panels, plot_panels_sized, Figure, Series, Style};
-
-fn tmp() -> tempfile::TempDir {
-    tempfile::tempdir().expect("tempdir")
-}
-
-/// Reads the SVG at `path`, checks it is a complete document with the given
-/// texts, and that no temporary file was left behind. Returns its size.
-fn check_svg(path: &Path, texts: &[&str]) -> usize {
-    let svg = fs::read_to_string(path).expect("plot file exists");
+/// Checks that `svg` is a complete document with the given texts and no non-finite number.
+/// Returns its size.
+fn check_svg(svg: &str, texts: &[&str]) -> usize {
     assert!(
         svg.starts_with("<svg") || svg.starts_with("<?xml"),
         "bad start"
@@ -25,9 +17,6 @@ fn check_svg(path: &Path, texts: &[&str]) -> usize {
         !svg.contains("NaN") && !svg.contains("inf"),
         "non-finite leaked"
     );
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    assert!(!PathBuf::from(tmp).exists(), "temporary file left behind");
     svg.len()
 }
 
@@ -37,17 +26,15 @@ fn time(n: usize, dt: f64) -> Vec<f64> {
 
 #[test]
 fn single_panel_time_plot() {
-    let dir = tmp();
     let t = time(2_000, 0.01);
     let y: Vec<f64> = t.iter().map(|t| (t * 2.0).sin()).collect();
     let yh: Vec<f64> = t.iter().map(|t| 0.95 * (t * 2.0 + 0.05).sin()).collect();
     let fig = Figure::new("Output, fit 93.2 %", "time [s]", "force [N]")
         .with(Series::line("measured", &t, &y))
         .with(Series::dashed("simulated", &t, &yh));
-    let path = dir.path().join("time.svg");
-    plot(&path, &fig).unwrap();
+    let svg = render(&fig).unwrap();
     check_svg(
-        &path,
+        &svg,
         &[
             "Output, fit 93.2 %",
             "time [s]",
@@ -60,7 +47,6 @@ fn single_panel_time_plot() {
 
 #[test]
 fn hysteresis_loops() {
-    let dir = tmp();
     let mut figs_x = Vec::new();
     let mut figs_y = Vec::new();
     for amp in [0.5, 1.0, 1.5] {
@@ -77,10 +63,9 @@ fn hysteresis_loops() {
         fig.series
             .push(Series::line(labels[i], &figs_x[i], &figs_y[i]));
     }
-    let path = dir.path().join("loops.svg");
-    plot(&path, &fig).unwrap();
+    let svg = render(&fig).unwrap();
     check_svg(
-        &path,
+        &svg,
         &[
             "Hysteresis loops",
             "displacement [mm]",
@@ -92,7 +77,6 @@ fn hysteresis_loops() {
 
 #[test]
 fn six_panel_parameter_grid() {
-    let dir = tmp();
     let it = time(50, 1.0);
     let names = [
         "k [N/m]",
@@ -118,16 +102,14 @@ fn six_panel_parameter_grid() {
                 .with(hline("true value", (0.0, 49.0), truth[i]))
         })
         .collect();
-    let path = dir.path().join("params.svg");
-    plot_panels(&path, "Parameter convergence", &panels, 2).unwrap();
+    let svg = render_panels("Parameter convergence", &panels, 2).unwrap();
     let mut texts = vec!["Parameter convergence", "iteration", "true value"];
     texts.extend(names);
-    check_svg(&path, &texts);
+    check_svg(&svg, &texts);
 }
 
 #[test]
 fn million_points_are_decimated() {
-    let dir = tmp();
     let n = 1_000_000;
     let x: Vec<f64> = (0..n).map(|i| i as f64).collect();
     // Noise plus a slow sine: the worst case for a naive polyline.
@@ -137,56 +119,46 @@ fn million_points_are_decimated() {
     let fig = Figure::new("Input signal", "sample index [-]", "voltage [V]")
         .with(Series::line("u", &x, &y))
         .with(Series::dashed("u (dashed copy)", &x, &y));
-    let path = dir.path().join("big.svg");
-    plot(&path, &fig).unwrap();
-    let size = check_svg(&path, &["Input signal", "sample index [-]", "voltage [V]"]);
+    let svg = render(&fig).unwrap();
+    let size = check_svg(&svg, &["Input signal", "sample index [-]", "voltage [V]"]);
     eprintln!("10^6-point plot (line + dashed): {size} bytes");
     assert!(size < 1_000_000, "SVG too large: {size} bytes");
 
     let fig = Figure::new("Scatter", "x [-]", "y [-]").with(Series::points("p", &x, &y));
-    let path = dir.path().join("big_points.svg");
-    plot(&path, &fig).unwrap();
-    let size = check_svg(&path, &["Scatter"]);
+    let svg = render(&fig).unwrap();
+    let size = check_svg(&svg, &["Scatter"]);
     eprintln!("10^6-point scatter: {size} bytes");
     assert!(size < 1_000_000, "SVG too large: {size} bytes");
 }
 
 #[test]
 fn indexed_series() {
-    let dir = tmp();
     let u: Vec<f64> = (0..3000).map(|i| ((i / 100) % 2) as f64).collect();
     let fig =
         Figure::new("Input", "sample [-]", "u [V]").with(Series::indexed("u", &u, Style::Line));
-    let path = dir.path().join("input.svg");
-    plot(&path, &fig).unwrap();
-    check_svg(&path, &["Input", "sample [-]", "u [V]"]);
+    let svg = render(&fig).unwrap();
+    check_svg(&svg, &["Input", "sample [-]", "u [V]"]);
 }
 
 #[test]
 fn empty_series_and_figures() {
-    let dir = tmp();
     let fig = Figure::new("Empty", "time [s]", "y [m]").with(Series::line("nothing", &[], &[]));
-    let path = dir.path().join("empty.svg");
-    plot(&path, &fig).unwrap();
-    check_svg(&path, &["Empty", "time [s]", "y [m]", "nothing", "no data"]);
+    let svg = render(&fig).unwrap();
+    check_svg(&svg, &["Empty", "time [s]", "y [m]", "nothing", "no data"]);
 
     let bare = Figure::new("", "", "");
-    let path = dir.path().join("bare.svg");
-    plot(&path, &bare).unwrap();
-    check_svg(&path, &[]);
+    let svg = render(&bare).unwrap();
+    check_svg(&svg, &[]);
 
-    let path = dir.path().join("no_panels.svg");
-    plot_panels(&path, "No panels", &[], 2).unwrap();
-    check_svg(&path, &["No panels"]);
+    let svg = render_panels("No panels", &[], 2).unwrap();
+    check_svg(&svg, &["No panels"]);
 
-    let path = dir.path().join("zero_cols.svg");
-    plot_panels(&path, "Zero columns", &[fig.clone(), bare], 0).unwrap();
-    check_svg(&path, &["Zero columns", "Empty"]);
+    let svg = render_panels("Zero columns", &[fig.clone(), bare], 0).unwrap();
+    check_svg(&svg, &["Zero columns", "Empty"]);
 }
 
 #[test]
 fn nan_and_infinite_values_are_skipped() {
-    let dir = tmp();
     let t = time(100, 0.1);
     let mut y: Vec<f64> = t.iter().map(|t| t.cos()).collect();
     y[10] = f64::NAN;
@@ -198,73 +170,59 @@ fn nan_and_infinite_values_are_skipped() {
         .with(Series::line("gappy", &t, &y))
         .with(Series::dashed("all missing", &t, &all_nan))
         .with(Series::points("mismatched lengths", &t, &short));
-    let path = dir.path().join("nan.svg");
-    plot(&path, &fig).unwrap();
+    let svg = render(&fig).unwrap();
     check_svg(
-        &path,
+        &svg,
         &["With gaps", "time [s]", "y [m]", "gappy", "all missing"],
     );
 }
 
 #[test]
 fn constant_and_extreme_series() {
-    let dir = tmp();
     let t = time(100, 1.0);
     let c = vec![3.7; 100];
     let z = vec![0.0; 100];
     let fig = Figure::new("Constant", "time [s]", "y [m]")
         .with(Series::line("c", &t, &c))
         .with(Series::line("zero", &t, &z));
-    let path = dir.path().join("const.svg");
-    plot(&path, &fig).unwrap();
-    check_svg(&path, &["Constant", "time [s]", "y [m]"]);
+    let svg = render(&fig).unwrap();
+    check_svg(&svg, &["Constant", "time [s]", "y [m]"]);
 
     let one = Figure::new("Single point", "x", "y").with(Series::points("p", &[1.0], &[2.0]));
-    let path = dir.path().join("one.svg");
-    plot(&path, &one).unwrap();
-    check_svg(&path, &["Single point"]);
+    let svg = render(&one).unwrap();
+    check_svg(&svg, &["Single point"]);
 
     let huge = [-f64::MAX, 0.0, f64::MAX];
     let tiny = [1e-300, 2e-300, 3e-300];
     let fig = Figure::new("Extremes", "x", "y")
         .with(Series::line("huge", &huge, &huge))
         .with(Series::line("tiny", &tiny, &tiny));
-    let path = dir.path().join("extreme.svg");
-    plot(&path, &fig).unwrap();
-    check_svg(&path, &["Extremes"]);
+    let svg = render(&fig).unwrap();
+    check_svg(&svg, &["Extremes"]);
     let fig = Figure::new("Tiny", "x", "y").with(Series::line("tiny", &tiny, &tiny));
-    plot(&path, &fig).unwrap();
-    check_svg(&path, &["Tiny"]);
+    let svg = render(&fig).unwrap();
+    check_svg(&svg, &["Tiny"]);
 }
 
 #[test]
 fn odd_sizes_and_paths() {
-    let dir = tmp();
     let mut fig = Figure::new("Small", "x", "y").with(Series::line("a", &[0.0, 1.0], &[0.0, 1.0]));
     fig.size = (0, 0);
-    let path = dir.path().join("small.svg");
-    plot(&path, &fig).unwrap();
-    check_svg(&path, &["Small"]);
-    // Overwriting an existing plot is fine.
-    plot(&path, &fig).unwrap();
-    plot_panels_sized(&path, "Grid", &[fig.clone()], 3, (1, 1)).unwrap();
-    check_svg(&path, &["Grid", "Small"]);
-    // A missing directory is an error, not a panic.
-    let bad = dir.path().join("missing/dir/plot.svg");
-    assert!(plot(&bad, &fig).is_err());
+    let svg = render(&fig).unwrap();
+    check_svg(&svg, &["Small"]);
+    let svg = render_panels_sized("Grid", &[fig.clone()], 3, (1, 1)).unwrap();
+    check_svg(&svg, &["Grid", "Small"]);
 }
 
 #[test]
 fn many_panels_in_a_tiny_canvas() {
-    let dir = tmp();
     let x = [0.0, 1.0, 2.0];
     let panels: Vec<Figure> = (0..50)
         .map(|_| Figure::new("p", "x", "y").with(Series::line("a", &x, &x)))
         .collect();
-    let path = dir.path().join("crowded.svg");
     // Either a drawing or a clean error is fine; a panic is not.
-    let r = plot_panels_sized(&path, "Crowded", &panels, 1, (200, 150));
+    let r = render_panels_sized("Crowded", &panels, 1, (200, 150));
     eprintln!("crowded grid: {r:?}");
-    let _ = plot_panels(&path, "Many", &panels, 7);
-    check_svg(&path, &["Many"]);
+    let svg = render_panels("Many", &panels, 7).unwrap();
+    check_svg(&svg, &["Many"]);
 }
