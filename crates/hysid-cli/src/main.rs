@@ -6,6 +6,7 @@
 //! (the table is in [`exit`]).
 
 mod cli;
+mod cli_zoo;
 mod commands;
 mod deprecated;
 mod exit;

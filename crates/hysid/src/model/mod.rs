@@ -14,6 +14,7 @@
 
 mod cascade;
 pub mod coleman_hodgdon;
+pub mod compensate;
 pub mod greybox;
 mod linear;
 pub mod operators;
