@@ -113,7 +113,7 @@ fn print_table(rows: &[CompareRow]) {
             r.parameters
                 .map_or(format!("{:>9}", "-"), |p| format!("{p:>9}")),
             num(r.aic, 14, 1),
-            num(r.fit_time_s, 12, 3),
+            num(r.fit_time_s, 12, 4),
         );
     }
 }

@@ -327,14 +327,9 @@ fn boxed<M>(
 /// at the measured first sample.
 fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<FittedModel>> {
     let started = Instant::now();
-    if u.len() != y.len() {
-        return Err(Error::InvalidData(format!(
-            "{}: input has {} samples, output {}; give equally long signals",
-            form.short_name(),
-            u.len(),
-            y.len()
-        )));
-    }
+    // Equal lengths, enough samples, an input that reverses (a loop, not a curve) — the
+    // recipe itself accepts a monotone input, on which d and the loop are not identifiable.
+    super::differential_fit::check_record(form.short_name(), u, y, form.n_params())?;
     let data = IdData::siso(1.0, "u", u.to_vec(), "y", y.to_vec())?;
     let id = HysteresisIdentification::new(form);
     let fit = id.estimate(&data, &mut |_| Control::Continue)?;
