@@ -59,6 +59,11 @@ pub enum Command {
     /// Rigid bodies with friction: inverse-dynamics least squares.
     #[command(subcommand, name = "rigid-body")]
     RigidBody(RigidBody),
+    /// Fit several hysteresis families to one record and rank them by validation fit %.
+    Compare(crate::cli_zoo::CompareArgs),
+    /// The input that makes a fitted hysteresis model follow a reference (feed-forward
+    /// compensation by the model's inverse).
+    Compensate(crate::cli_zoo::CompensateArgs),
 }
 
 /// Actuator commands.
@@ -528,6 +533,9 @@ pub enum Identify {
     Cascade(CascadeArgs),
     /// Coleman–Hodgdon hysteresis alone, its input and output both measured.
     Hysteresis(HysteresisArgs),
+    /// A hysteresis operator of one family (PI, Preisach, Jiles–Atherton, Bouc–Wen, …) from
+    /// its measured input and output.
+    Operator(crate::cli_zoo::OperatorArgs),
 }
 
 /// Where the data come from.

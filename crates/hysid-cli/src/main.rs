@@ -7,6 +7,7 @@
 
 mod budget;
 mod cli;
+mod cli_zoo;
 mod commands;
 mod deprecated;
 mod exit;

@@ -166,6 +166,15 @@ pub enum Error {
         /// The number found.
         value: f64,
     },
+
+    /// A model of this kind cannot be inverted (no compensator can be computed from it).
+    #[error("not invertible: model kind '{kind}': {reason}")]
+    NotInvertible {
+        /// The model kind (`ch_cascade`, `bouc_wen`, …).
+        kind: String,
+        /// Why, and what to use instead.
+        reason: String,
+    },
 }
 
 /// An equation-file model (`hysid-equations`) is invalid: parse, name or bound error at

@@ -3,14 +3,18 @@
 mod actuator;
 mod benchmark;
 mod cascade;
+mod compare;
+mod compensate;
 mod demo;
 mod generate;
 mod greybox;
 mod identify;
+mod operator;
 mod operator_cascade;
 mod present;
 mod rigid_body;
 mod simulate;
+mod zoo;
 
 use crate::cli::{Actuator, Benchmark, Cli, Command, Demo, Generate, Greybox, Identify, RigidBody};
 use anyhow::Result;
@@ -29,5 +33,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Actuator(Actuator::Rig(args)) => actuator::rig(&args),
         Command::Actuator(Actuator::Identify(args)) => actuator::identify(&args),
         Command::RigidBody(RigidBody::Ls(args)) => rigid_body::ls(&args),
+        Command::Identify(Identify::Operator(args)) => operator::run(&args),
+        Command::Compare(args) => compare::run(&args),
+        Command::Compensate(args) => compensate::run(&args),
     }
 }

@@ -15,6 +15,7 @@
 
 mod cascade;
 pub mod coleman_hodgdon;
+pub mod compensate;
 pub mod greybox;
 mod linear;
 pub mod operator_cascade;

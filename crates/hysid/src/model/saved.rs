@@ -25,6 +25,7 @@
 //! | `operator_cascade` | `operator` (the family and its structure: thresholds, grid, orientation, …), `delay` | the operator's (prefixed `op_` where they collide with a₁…, b₁…), then a₁ … a_n, b₁ (fixed at 1) … b_m |
 //! | `bouc_wen`, `rigid_body`, `actuator_fixed`, `actuator_free` | `simulation`, `initial_state` | the grey-box model's |
 //! | `equations` | `equations` (the equation file's text), `simulation`, `initial_state` | the file's `[parameters]` |
+//! | `operator` | `family` (`pi`, `gpi`, `preisach`, `jiles-atherton`, `bouc-wen`, `duhem`, `dahl`, `maxwell-slip`, `backlash`), `operator` (the operator's full structure: thresholds, weights, grid, orientation, initial state) | the family's, named as in the literature |
 //!
 //! `simulation` saves the integrator faithfully: `{"integrator": "rk4", "substeps": 10,
 //! "interpolation": "zero_order_hold"}`, `newmark` with `substeps`, or `dopri5` with `rtol`
@@ -33,6 +34,7 @@
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
+use crate::model::operators::OperatorModel;
 use crate::model::saved_equations::{equations_from_file, simulate_outputs};
 use crate::model::{CascadeOperator, OperatorCascade};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
@@ -41,6 +43,9 @@ use crate::{Error, Result};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// The kind of a saved hysteresis operator (see the module docs).
+pub const OPERATOR_KIND: &str = "operator";
 
 /// The schema tag of a saved model.
 pub const MODEL_SCHEMA: &str = "hysid.model/1";
@@ -125,8 +130,14 @@ pub struct ModelFile {
     /// self-contained.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub equations: Option<String>,
-    /// The operator of an `operator_cascade`: `{"family": …, "operator": {…}}` with its
-    /// structure (thresholds, grid, orientation, …); its values are read from `parameters`.
+    /// The operator family (kind `operator`): `pi`, `gpi`, `preisach`, `jiles-atherton`,
+    /// `bouc-wen`, `duhem`, `dahl`, `maxwell-slip` or `backlash`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family: Option<String>,
+    /// The operator's full structure: for kind `operator` its thresholds, weights, grids,
+    /// orientation and initial state, as the family defines them; for kind
+    /// `operator_cascade` `{"family": …, "operator": {…}}` with the structure, whose values
+    /// are read from `parameters`. Checked on reading.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub operator: Option<serde_json::Value>,
 }
@@ -265,6 +276,15 @@ pub enum FittedModel {
         /// Its initial state.
         initial_state: Vec<f64>,
     },
+    /// A hysteresis operator of one of the families of [`crate::model::operators`].
+    Operator {
+        /// The family's name (`pi`, `preisach`, …; equal to `model.family()`).
+        family: &'static str,
+        /// The operator.
+        model: OperatorModel,
+        /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
+        std: Vec<f64>,
+    },
 }
 
 impl FittedModel {
@@ -319,6 +339,9 @@ impl FittedModel {
             }
             FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
             FittedModel::OperatorCascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::Operator { model, .. } => {
+                Ok(vec![model.as_operator().simulate(first()?)?])
+            }
             FittedModel::GreyBox {
                 kind,
                 parameters,
@@ -390,6 +413,7 @@ impl FittedModel {
             simulation: None,
             initial_state: None,
             equations: None,
+            family: None,
             operator: None,
         };
         match self {
@@ -457,6 +481,31 @@ impl FittedModel {
                         .collect(),
                 )
             },
+            FittedModel::Operator { family, model, std } => ModelFile {
+                family: Some(family.to_string()),
+                // The structure of a constructed operator is always representable; a failure
+                // would only drop it, and reading the file back then says so.
+                operator: model.structure().ok(),
+                ..empty(
+                    OPERATOR_KIND,
+                    model
+                        .as_operator()
+                        .parameters()
+                        .iter()
+                        .zip(std)
+                        .map(|(p, s)| ParameterRecord::of(p, *s))
+                        .collect(),
+                )
+            },
+        }
+    }
+
+    /// The fitted model of an operator with standard deviations `std` (NaN: none).
+    pub fn operator(model: OperatorModel, std: Vec<f64>) -> Self {
+        FittedModel::Operator {
+            family: model.family(),
+            model,
+            std,
         }
     }
 
@@ -478,6 +527,7 @@ impl FittedModel {
             "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
             EQUATIONS_KIND => equations_from_file(file),
             OPERATOR_CASCADE_KIND => operator_cascade_from_file(file),
+            OPERATOR_KIND => Self::operator_from_file(file),
             kind => Self::grey_box_from_file(kind, file),
         }
     }
@@ -527,10 +577,25 @@ impl FittedModel {
         })
     }
 
+    fn operator_from_file(file: &ModelFile) -> Result<Self> {
+        let (Some(family), Some(structure)) = (&file.family, &file.operator) else {
+            return Err(Error::Config(
+                "an operator model needs \"family\" and \"operator\"; save the model again".into(),
+            ));
+        };
+        let model = OperatorModel::from_structure(family, structure)?;
+        let names = model.as_operator().parameters();
+        let mut std = Vec::with_capacity(names.len());
+        for p in names.iter() {
+            std.push(record(file, &p.name)?.std_or_nan());
+        }
+        Ok(Self::operator(model, std))
+    }
+
     fn grey_box_from_file(kind: &str, file: &ModelFile) -> Result<Self> {
         let model = models::by_kind(kind).map_err(|_| {
             Error::Config(format!(
-                "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed, actuator_free and equations"
+                "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed, actuator_free, equations, operator and operator_cascade"
             ))
         })?;
         let mut parameters = model.parameters();

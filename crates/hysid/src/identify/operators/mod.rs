@@ -20,11 +20,16 @@ use crate::model::ParameterSet;
 use crate::numerics::Termination;
 use serde::Serialize;
 
+pub use compare::{compare, CompareOptions, CompareRow, Comparison, Split};
+pub use family::{fit_operator, Family, FamilyOptions, FittedOperator};
+
 pub mod backlash;
 pub mod bouc_wen;
+pub mod compare;
 pub mod dahl;
 pub mod differential_fit;
 pub mod duhem;
+pub mod family;
 pub mod gpi;
 pub mod jiles_atherton;
 mod linear_support;

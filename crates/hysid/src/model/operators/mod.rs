@@ -43,6 +43,7 @@ use crate::model::ParameterSet;
 use crate::Result;
 use serde::{Deserialize, Serialize};
 
+pub mod any;
 pub(crate) mod backlash;
 pub mod bouc_wen;
 pub mod dahl;
@@ -55,6 +56,7 @@ pub(crate) mod maxwell_slip;
 pub(crate) mod pi;
 pub(crate) mod preisach;
 
+pub use any::{OperatorModel, OPERATOR_FAMILIES};
 pub use backlash::Backlash;
 pub use bouc_wen::BoucWen;
 pub use dahl::Dahl;

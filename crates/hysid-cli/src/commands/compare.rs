@@ -1,0 +1,189 @@
+//! `hysid compare`: several hysteresis families fitted to one record, ranked by validation
+//! fit %.
+
+use super::zoo::{family_options, load, loops, write_text};
+use crate::cli_zoo::CompareArgs;
+use anyhow::{Context, Result};
+use hysid::identify::operators::{compare, CompareOptions, CompareRow, Comparison, Family};
+use hysid::io::atomic::OutputSet;
+use hysid::report::{DataSummary, Report, ValidationEntry};
+use serde_json::json;
+use std::path::Path;
+
+/// Fits the families, prints the ranked table, writes the report, best model and plot.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let families = Family::parse_list(&args.families).context("--families")?;
+    let options = CompareOptions {
+        families,
+        family: family_options(&args.options)?,
+        ..CompareOptions::default()
+    };
+    let mut inputs = vec![args.data.data.as_path()];
+    inputs.extend(args.validate.as_deref());
+    let mut files = OutputSet::new(&inputs)?;
+    let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
+    let model_tmp = args
+        .model_out
+        .as_deref()
+        .map(|p| files.file(p))
+        .transpose()?;
+    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
+    let data = load(&args.data, &args.data.data)?;
+    let validation = args
+        .validate
+        .as_deref()
+        .map(|p| load(&args.data, p))
+        .transpose()?;
+    let exp = data.experiment(0);
+    let held_out = validation
+        .as_ref()
+        .map(|v| (v.experiment(0).input(0), v.experiment(0).output(0)));
+    eprintln!(
+        "comparing {} families on {} samples …",
+        options.families.len(),
+        exp.len()
+    );
+    let comparison = compare(exp.input(0), exp.output(0), held_out, &options)?;
+    println!("Split: {}", comparison.split);
+    print_table(&comparison.rows);
+    for row in comparison.rows.iter().filter(|r| r.error.is_some()) {
+        eprintln!(
+            "warning: {} failed: {}",
+            row.family,
+            row.error.as_deref().unwrap_or("")
+        );
+    }
+    let best = comparison.best();
+    match best {
+        Some(b) => println!(
+            "Best: {} (validation fit {:.3} %)",
+            b.family,
+            b.validation_fit_percent.unwrap_or(f64::NAN)
+        ),
+        None => eprintln!("warning: no family could be fitted to these data"),
+    }
+    let report = report(args, &data, &comparison)?;
+    if let Some(dir) = &plots_tmp {
+        plot_loops(dir, &data, &comparison)?;
+    }
+    if let Some(path) = &json_tmp {
+        write_text(path, &report.to_json()?)?;
+    }
+    if let Some(path) = &model_tmp {
+        let model = best.and_then(|b| b.fitted.as_ref()).ok_or_else(|| {
+            anyhow::anyhow!("--model-out: no family could be fitted, so there is no model to write")
+        })?;
+        write_text(
+            path,
+            &serde_json::to_string_pretty(&model.fit.model.to_file())?,
+        )?;
+    }
+    files.commit()?;
+    for (what, path) in [
+        ("report", &args.json),
+        ("model", &args.model_out),
+        ("plots", &args.plots),
+    ] {
+        if let Some(p) = path {
+            println!("  {what}: {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+fn print_table(rows: &[CompareRow]) {
+    println!(
+        "  {:<16}{:>16}{:>14}{:>9}{:>14}{:>12}",
+        "family", "validation fit %", "RMSE", "#params", "AIC", "fit time s"
+    );
+    let num = |v: Option<f64>, w: usize, p: usize| {
+        v.map_or(format!("{:>w$}", "-"), |x| format!("{x:>w$.p$}"))
+    };
+    for r in rows {
+        if let Some(e) = &r.error {
+            println!("  {:<16}  failed: {}", r.family, first_words(e));
+            continue;
+        }
+        println!(
+            "  {:<16}{}{}{}{}{}",
+            r.family,
+            num(r.validation_fit_percent, 16, 3),
+            r.validation_rmse
+                .map_or(format!("{:>14}", "-"), |x| format!("{x:>14.4e}")),
+            r.parameters
+                .map_or(format!("{:>9}", "-"), |p| format!("{p:>9}")),
+            num(r.aic, 14, 1),
+            num(r.fit_time_s, 12, 4),
+        );
+    }
+}
+
+/// The error cut to one short line for the table (the report keeps it whole).
+fn first_words(e: &str) -> String {
+    let limit = 90;
+    if e.chars().count() <= limit {
+        e.to_string()
+    } else {
+        format!("{}…", e.chars().take(limit).collect::<String>())
+    }
+}
+
+fn report(args: &CompareArgs, data: &hysid::data::IdData, c: &Comparison) -> Result<Report> {
+    let mut sources = vec![args.data.data.display().to_string()];
+    sources.extend(args.validate.iter().map(|p| p.display().to_string()));
+    let mut report = Report::new("compare");
+    report.data = Some(DataSummary::of(data, sources));
+    if let Some(best) = c.best() {
+        if let Some(fitted) = &best.fitted {
+            report.model = Some(fitted.fit.model.to_file());
+        }
+        report.validation.push(ValidationEntry::of(
+            format!("{} ({})", best.family, validation_source(args)),
+            &c.validation_output,
+            &best.validation_simulated,
+            None,
+        )?);
+    }
+    report.details = json!({
+        "split": c.split,
+        "split_text": c.split.to_string(),
+        "best": c.best().map(|b| b.family),
+        "families": c.rows,
+    });
+    Ok(report)
+}
+
+fn validation_source(args: &CompareArgs) -> String {
+    args.validate.as_ref().map_or_else(
+        || format!("{}, validation samples", args.data.data.display()),
+        |p| p.display().to_string(),
+    )
+}
+
+fn plot_loops(dir: &Path, data: &hysid::data::IdData, c: &Comparison) -> Result<()> {
+    let (u, y) = (&c.validation_input, &c.validation_output);
+    let models: Vec<(String, &[f64])> = c
+        .rows
+        .iter()
+        .filter(|r| r.fitted.is_some())
+        .map(|r| {
+            (
+                format!(
+                    "{} ({:.2} %)",
+                    r.family,
+                    r.validation_fit_percent.unwrap_or(f64::NAN)
+                ),
+                r.validation_simulated.as_slice(),
+            )
+        })
+        .collect();
+    let x_label = data.input_channels()[0].to_string();
+    let y_label = data.output_channels()[0].to_string();
+    loops(
+        &dir.join("compare_loops.svg"),
+        "Validation loops: measured and every family",
+        (&x_label, &y_label),
+        (u, y),
+        &models,
+    )
+}

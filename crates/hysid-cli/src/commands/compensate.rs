@@ -1,0 +1,114 @@
+//! `hysid compensate`: the input that makes a fitted hysteresis model follow a reference.
+
+use super::zoo::{signals, write_text};
+use crate::cli_zoo::CompensateArgs;
+use anyhow::{Context, Result};
+use hysid::data::{write_csv, CsvSpec, IdData};
+use hysid::io::atomic::OutputSet;
+use hysid::model::compensate::compensate;
+use hysid::model::saved::FittedModel;
+use hysid::report::{DataSummary, Report};
+use serde_json::json;
+
+/// Clipped ranges printed in the warning before it is cut short (the report lists all).
+const PRINTED_RANGES: usize = 5;
+
+/// Inverts the model along the reference, writes OUT.csv, the report and the plots.
+pub fn run(args: &CompensateArgs) -> Result<()> {
+    let mut files = OutputSet::new(&[args.model.as_path(), args.data.as_path()])?;
+    let csv_tmp = files.file(&args.csv)?;
+    let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
+    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
+    let model = FittedModel::load(&args.model)?;
+    let spec = CsvSpec {
+        inputs: vec![args.reference.clone()],
+        outputs: Vec::new(),
+        time: args.time.clone(),
+        ts: args.ts,
+    };
+    let data = IdData::from_file(&args.data, &spec)
+        .with_context(|| format!("reading {}", args.data.display()))?;
+    let reference = data.experiment(0).input(0);
+    let c = compensate(&model, reference)
+        .with_context(|| format!("compensating with {}", args.model.display()))?;
+    let (rms, max) = c.tracking_error();
+    let ranges = c.clipped_ranges();
+    let file = model.to_file();
+    let family = file.family.clone().unwrap_or_else(|| file.kind.clone());
+    println!(
+        "Compensated {} samples of '{}' with the {family} model",
+        reference.len(),
+        args.reference
+    );
+    println!("  predicted tracking error: RMS {rms:.4e}, max {max:.4e}");
+    if !c.clipped.is_empty() {
+        let shown: Vec<String> = ranges
+            .iter()
+            .take(PRINTED_RANGES)
+            .map(|(a, b)| {
+                if a == b {
+                    format!("{a}")
+                } else {
+                    format!("{a}-{b}")
+                }
+            })
+            .collect();
+        let more = if ranges.len() > PRINTED_RANGES {
+            ", …"
+        } else {
+            ""
+        };
+        eprintln!(
+            "warning: {} of {} reference samples lie outside the model's reachable range and were clipped (samples {}{more}); see the report",
+            c.clipped.len(),
+            reference.len(),
+            shown.join(", ")
+        );
+    }
+    let mut report = Report::new("compensate");
+    report.data = Some(DataSummary::of(
+        &data,
+        vec![args.data.display().to_string()],
+    ));
+    report.model = Some(file);
+    report.details = json!({
+        "reference_column": args.reference,
+        "model_source": args.model.display().to_string(),
+        "tracking_error": { "rms": rms, "max": max },
+        "clipped": {
+            "count": c.clipped.len(),
+            "indices": c.clipped,
+            "ranges": ranges,
+        },
+    });
+    write_csv(
+        &csv_tmp,
+        &["reference", "u", "predicted"],
+        &[reference, &c.u, &c.predicted],
+    )?;
+    if let Some(dir) = &plots_tmp {
+        signals(
+            &dir.join("compensation.svg"),
+            "Compensation: reference and predicted output",
+            "output",
+            &[("reference", reference), ("predicted", &c.predicted)],
+        )?;
+        signals(
+            &dir.join("input.svg"),
+            "Compensating input",
+            "u",
+            &[("u", &c.u)],
+        )?;
+    }
+    if let Some(path) = &json_tmp {
+        write_text(path, &report.to_json()?)?;
+    }
+    files.commit()?;
+    println!("  compensating input: {}", args.csv.display());
+    for (what, path) in [("report", &args.json), ("plots", &args.plots)] {
+        if let Some(p) = path {
+            println!("  {what}: {}", p.display());
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,167 @@
+//! `hysid identify operator`: one hysteresis family fitted to a measured input and output.
+
+use super::zoo::{family_options, load, loops, signals, write_text};
+use crate::cli_zoo::OperatorArgs;
+use crate::report::{print_table, Row};
+use anyhow::{Context, Result};
+use hysid::identify::operators::{fit_operator, Family, FittedOperator};
+use hysid::io::atomic::OutputSet;
+use hysid::report::{
+    DataSummary, FitSummary, Report, SearchSummary, TerminationSummary, UncertaintySummary,
+};
+use serde_json::json;
+
+/// Parameters printed before the table is cut short (a Preisach plane has hundreds).
+const PRINTED_PARAMETERS: usize = 16;
+
+/// Fits the family, prints the parameters and fit, writes the report, model and plots.
+pub fn run(args: &OperatorArgs) -> Result<()> {
+    let family = Family::parse(&args.family).context("--family")?;
+    let options = family_options(&args.options)?;
+    let mut files = OutputSet::new(&[args.data.data.as_path()])?;
+    let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
+    let model_tmp = args
+        .model_out
+        .as_deref()
+        .map(|p| files.file(p))
+        .transpose()?;
+    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
+    let data = load(&args.data, &args.data.data)?;
+    let exp = data.experiment(0);
+    let (u, y) = (exp.input(0), exp.output(0));
+    eprintln!("fitting {family} to {} samples …", u.len());
+    let fitted = fit_operator(family, u, y, &options)
+        .with_context(|| format!("identifying a {family} operator"))?;
+    // The report's fit is the saved model's own simulation, so `hysid simulate` reproduces it.
+    let yhat = fitted
+        .fit
+        .model
+        .simulate(&[u], data.ts(), y.first().copied())?
+        .swap_remove(0);
+    let mut report = Report::new("identify operator");
+    report.data = Some(DataSummary::of(
+        &data,
+        vec![args.data.data.display().to_string()],
+    ));
+    report.fit = Some(FitSummary::of(
+        std::slice::from_ref(&exp.name),
+        &[y],
+        &[&yhat],
+    )?);
+    report.search = Some(search(&fitted));
+    report.uncertainty = Some(if fitted.fit.iterations == 0 {
+        UncertaintySummary::least_squares()
+    } else {
+        UncertaintySummary::asymptotic()
+    });
+    report.model = Some(fitted.fit.model.to_file());
+    report.details = json!({
+        "family": family.name(),
+        "estimated_parameters": fitted.estimated_parameters(),
+        "converged": fitted.fit.termination.converged(),
+        "aic": finite(fitted.fit.aic),
+        "fpe": finite(fitted.fit.fpe),
+    });
+    print_summary(&fitted, &report);
+    if let Some(dir) = &plots_tmp {
+        let title = format!("{family}: measured and simulated loop");
+        let names = (exp_name(&data, true), exp_name(&data, false));
+        loops(
+            &dir.join("loops.svg"),
+            &title,
+            (&names.0, &names.1),
+            (u, y),
+            &[(family.name().to_string(), &yhat)],
+        )?;
+        signals(
+            &dir.join("output.svg"),
+            "Output: measured and simulated",
+            &names.1,
+            &[("measured", y), ("simulated", &yhat)],
+        )?;
+    }
+    if let Some(path) = &json_tmp {
+        write_text(path, &report.to_json()?)?;
+    }
+    if let Some(path) = &model_tmp {
+        let text = serde_json::to_string_pretty(&fitted.fit.model.to_file())?;
+        write_text(path, &text)?;
+    }
+    files.commit()?;
+    for (what, path) in [
+        ("report", &args.json),
+        ("model", &args.model_out),
+        ("plots", &args.plots),
+    ] {
+        if let Some(p) = path {
+            println!("  {what}: {}", p.display());
+        }
+    }
+    Ok(())
+}
+
+fn search(fitted: &FittedOperator) -> SearchSummary {
+    let fit = &fitted.fit;
+    SearchSummary {
+        iterations: fit.iterations,
+        evaluations: fit.evaluations,
+        termination: TerminationSummary::of(&fit.termination),
+        elapsed_s: fit.elapsed_s,
+    }
+}
+
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+fn exp_name(data: &hysid::data::IdData, input: bool) -> String {
+    let channels = if input {
+        data.input_channels()
+    } else {
+        data.output_channels()
+    };
+    channels[0].to_string()
+}
+
+fn print_summary(fitted: &FittedOperator, report: &Report) {
+    let fit = &fitted.fit;
+    println!(
+        "{} operator: {} estimated parameters, {} ({} iterations)",
+        fitted.family,
+        fitted.estimated_parameters(),
+        fit.termination,
+        fit.iterations
+    );
+    let rows: Vec<Row> = fit
+        .parameters
+        .iter()
+        .zip(&fit.std)
+        .take(PRINTED_PARAMETERS)
+        .map(|(p, s)| Row {
+            name: p.name.clone(),
+            truth: None,
+            initial: None,
+            estimate: p.value,
+            std: s.unwrap_or(f64::NAN),
+        })
+        .collect();
+    print_table(&rows);
+    if fit.parameters.len() > PRINTED_PARAMETERS {
+        println!(
+            "  … {} more parameters in the report and the model file",
+            fit.parameters.len() - PRINTED_PARAMETERS
+        );
+    }
+    if let Some(f) = &report.fit {
+        println!(
+            "  fit {:.3} %   RMSE {:.4e}   time {:.3} s",
+            f.fit_percent, f.rmse, fit.elapsed_s
+        );
+    }
+    if !fit.termination.converged() {
+        eprintln!(
+            "warning: the {} fit did not converge ({}); treat its parameters with care",
+            fitted.family, fit.termination
+        );
+    }
+}

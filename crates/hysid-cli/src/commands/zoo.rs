@@ -1,0 +1,94 @@
+//! What `identify operator`, `compare` and `compensate` share: the family options from the
+//! flags, reading a record, and the loop plots (through the plotting module's figure API only).
+
+use crate::cli_zoo::{FamilyArgs, ZooDataArgs};
+use anyhow::{Context, Result};
+use hysid::data::{CsvSpec, IdData};
+use hysid::identify::operators::FamilyOptions;
+use hysid::report::plot::{render, Figure, Series, Style};
+use std::path::Path;
+
+/// The recipes' options from the flags, ranges checked.
+pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
+    let mut options = FamilyOptions {
+        grid: args.grid as usize,
+        lambda: args.lambda,
+        dead_zones: args.dead_zones as usize,
+        ..FamilyOptions::default()
+    };
+    let text = args.thresholds.trim();
+    match text.parse::<usize>() {
+        Ok(n) => options.thresholds = n,
+        Err(_) => {
+            let grid = text
+                .split(',')
+                .map(|s| s.trim().parse::<f64>())
+                .collect::<Result<Vec<f64>, _>>()
+                .map_err(|_| {
+                    anyhow::anyhow!(
+                        "--thresholds '{text}' is neither a count nor a comma-separated list of numbers"
+                    )
+                })?;
+            options.thresholds = grid.len();
+            options.threshold_grid = Some(grid);
+        }
+    }
+    options.validate().with_context(|| {
+        format!(
+            "--thresholds {text} --grid {} --lambda {} --dead-zones {}",
+            args.grid, args.lambda, args.dead_zones
+        )
+    })?;
+    Ok(options)
+}
+
+/// Reads the input and output columns of `path` (one experiment).
+pub fn load(args: &ZooDataArgs, path: &Path) -> Result<IdData> {
+    let spec = CsvSpec {
+        inputs: vec![args.input.clone()],
+        outputs: vec![args.output.clone()],
+        time: args.time.clone(),
+        ts: args.ts,
+    };
+    IdData::from_file(path, &spec).with_context(|| format!("reading {}", path.display()))
+}
+
+/// The measured loop (points) with model loops (dashed) over it, as `dir/name`.
+pub fn loops(
+    path: &Path,
+    title: &str,
+    labels: (&str, &str),
+    measured: (&[f64], &[f64]),
+    models: &[(String, &[f64])],
+) -> Result<()> {
+    let mut figure = Figure::new(title, labels.0, labels.1)
+        .with(Series::points("measured", measured.0, measured.1));
+    for (name, y) in models {
+        figure = figure.with(Series::dashed(name, measured.0, y));
+    }
+    plot(path, &figure)
+}
+
+/// Signals against their sample index, as `path`.
+pub fn signals(path: &Path, title: &str, y_label: &str, series: &[(&str, &[f64])]) -> Result<()> {
+    let mut figure = Figure::new(title, "sample", y_label);
+    for (k, (name, y)) in series.iter().enumerate() {
+        let style = if k == 0 {
+            Style::Line
+        } else {
+            Style::DashedLine
+        };
+        figure = figure.with(Series::indexed(name, y, style));
+    }
+    plot(path, &figure)
+}
+
+/// Renders `figure` as SVG into the staged output `path`.
+fn plot(path: &Path, figure: &Figure) -> Result<()> {
+    write_text(path, &render(figure)?)
+}
+
+/// Writes `text` to the staged output `path`.
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,253 @@
+//! Feed-forward compensation: the input u that makes a fitted model's output follow a
+//! reference r, so that the model's inverse placed before the system cancels its hysteresis.
+//!
+//! * **Operators** (kind `operator`): each family's own inverse
+//!   ([`crate::model::operators::HysteresisOperator::invert`]): the analytic inverse of
+//!   Krejčí & Kuhnen (2001) for PI and Maxwell-slip, Kuhnen's (2003) for the generalised PI, a
+//!   monotone per-sample solve for Preisach and the differential families.
+//! * **Coleman–Hodgdon hysteresis alone** (kind `coleman_hodgdon`, ch4/ch6): the recursion
+//!   y(t) = y(t−1) + α|Δx|(f(x) − y(t−1)) + g(x)Δx (Coleman & Hodgdon 1986) is solved for x(t)
+//!   sample by sample, y(t) = r(t), by bracketing on |Δx| ≤ 1/α (the recursion's own rate
+//!   limit, beyond which it is not a blend of y(t−1) and f(x)). The output starts at the
+//!   reference's first sample (a model starting from the measured output) or at 0, and the
+//!   first input at the value where the anhysteretic f(x) equals it.
+//! * **Operator cascades** (kind `operator_cascade`): the linear block inverted (stable only for
+//!   a minimum-phase B, refused otherwise), then the operator
+//!   ([`crate::model::OperatorCascade::compensate`]); the output follows from the delay k on.
+//! * Other kinds (the Coleman–Hodgdon cascade, grey-box models) give
+//!   [`Error::NotInvertible`].
+//!
+//! A reference sample the model cannot reach (beyond a saturation level, or faster than the
+//! rate limit allows) is clipped to the nearest reachable output and listed in
+//! [`Compensation::clipped`], never silently.
+
+use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
+use crate::model::operators::{solve_monotone, Branch};
+use crate::model::saved::FittedModel;
+use crate::model::ColemanHodgdon;
+use crate::numerics::metrics;
+use crate::{Error, Result};
+use serde::Serialize;
+
+/// The compensating input and what the model predicts for it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Compensation {
+    /// The reference r.
+    pub reference: Vec<f64>,
+    /// The input u that makes the model follow r.
+    pub u: Vec<f64>,
+    /// The model's output for u (equal to r where r is reachable).
+    pub predicted: Vec<f64>,
+    /// Samples where r lay outside the reachable range and was clipped.
+    pub clipped: Vec<usize>,
+    /// The first sample the model can follow: 0 for a hysteresis alone, the linear block's
+    /// delay k for a cascade (its first k outputs do not depend on u).
+    pub settled_from: usize,
+}
+
+impl Compensation {
+    /// The predicted tracking error e = predicted − r: (RMS, max |e|) over the samples from
+    /// [`settled_from`](Self::settled_from) on.
+    pub fn tracking_error(&self) -> (f64, f64) {
+        let from = self.settled_from.min(self.reference.len());
+        let (r, p) = (&self.reference[from..], &self.predicted[from..]);
+        if r.is_empty() {
+            return (0.0, 0.0);
+        }
+        let rms = metrics::rmse(r, p);
+        let max = r
+            .iter()
+            .zip(p)
+            .fold(0.0f64, |m, (r, p)| m.max((p - r).abs()));
+        (rms, max)
+    }
+
+    /// The clipped samples as inclusive index ranges (first, last).
+    pub fn clipped_ranges(&self) -> Vec<(usize, usize)> {
+        let mut ranges: Vec<(usize, usize)> = Vec::new();
+        for &k in &self.clipped {
+            match ranges.last_mut() {
+                Some((_, last)) if *last + 1 == k => *last = k,
+                _ => ranges.push((k, k)),
+            }
+        }
+        ranges
+    }
+}
+
+/// The input that makes `model` follow `reference` (see the module doc).
+pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation> {
+    if reference.is_empty() {
+        return Err(Error::InvalidData("the reference is empty".into()));
+    }
+    if let Some(k) = reference.iter().position(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            channel: "reference".into(),
+            index: k,
+            value: reference[k],
+        });
+    }
+    let mut settled_from = 0;
+    let (u, predicted, clipped) = match model {
+        FittedModel::Operator { model, .. } => {
+            let inv = model.as_operator().invert(reference)?;
+            (inv.u, inv.predicted, inv.clipped)
+        }
+        FittedModel::Hysteresis { model, initial, .. } => {
+            coleman_hodgdon_inverse(model, *initial, reference)
+        }
+        FittedModel::OperatorCascade { model, .. } => {
+            // The linear block is inverted (minimum-phase B only) and the operator after it.
+            let inv = model.compensate(reference)?;
+            settled_from = inv.delay;
+            (inv.u, inv.predicted, inv.clipped)
+        }
+        other => {
+            let kind = other.to_file().kind;
+            return Err(Error::NotInvertible {
+                kind,
+                reason: "compensation inverts hysteresis operators, the Coleman–Hodgdon \
+                         hysteresis alone and operator cascades with a minimum-phase linear \
+                         block; identify one of those"
+                    .into(),
+            });
+        }
+    };
+    Ok(Compensation {
+        reference: reference.to_vec(),
+        u,
+        predicted,
+        clipped,
+        settled_from,
+    })
+}
+
+type Solved = (Vec<f64>, Vec<f64>, Vec<usize>);
+
+/// The per-sample solve of the Coleman–Hodgdon recursion (module doc).
+fn coleman_hodgdon_inverse(ch: &ColemanHodgdon, initial: InitialOutput, r: &[f64]) -> Solved {
+    let y0 = match initial {
+        InitialOutput::Measured => r[0],
+        InitialOutput::Zero => 0.0,
+    };
+    let alpha = ch.alpha();
+    // The largest step the recursion admits; a model with α = 0 has none.
+    let reach = if alpha > 0.0 {
+        1.0 / alpha
+    } else {
+        f64::MAX.sqrt()
+    };
+    let mut x = vec![anhysteretic_inverse(ch, y0, reach)];
+    let mut y_prev = y0;
+    let mut clipped = Vec::new();
+    if (y0 - r[0]).abs() > 1e-12 * (1.0 + r[0].abs()) {
+        clipped.push(0);
+    }
+    for (t, &target) in r.iter().enumerate().skip(1) {
+        let x_prev = x[t - 1];
+        let step = |v: f64| ch.step(y_prev, x_prev, v.clamp(x_prev - reach, x_prev + reach));
+        let branch = Branch {
+            center: x_prev,
+            span: reach,
+            unbounded_below: false,
+            unbounded_above: false,
+        };
+        let (xt, clip) = solve_monotone(step, target, branch);
+        let xt = xt.clamp(x_prev - reach, x_prev + reach);
+        y_prev = ch.step(y_prev, x_prev, xt);
+        // The recursion need not be monotone on every branch of every model: a solve that
+        // missed counts as clipped too.
+        if clip || (y_prev - target).abs() > 1e-9 * (1.0 + target.abs()) {
+            clipped.push(t);
+        }
+        x.push(xt);
+    }
+    let predicted = simulate_switched(ch, &x, y0, None);
+    (x, predicted, clipped)
+}
+
+/// x with f(x) = v for the odd, piecewise-linear material function f, or 0 when f is flat.
+fn anhysteretic_inverse(ch: &ColemanHodgdon, v: f64, reach: f64) -> f64 {
+    let branch = Branch {
+        center: 0.0,
+        span: ch.d().abs().max(1.0).min(reach),
+        unbounded_below: true,
+        unbounded_above: true,
+    };
+    if ch.m1() <= 0.0 {
+        return 0.0;
+    }
+    let (x, _) = solve_monotone(|x| ch.f(x), v, branch);
+    if x.is_finite() {
+        x
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::operators::{OperatorModel, Orientation, PrandtlIshlinskii};
+
+    fn reference(n: usize, amplitude: f64) -> Vec<f64> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64 / n as f64;
+                amplitude * (1.0 - 0.5 * t) * (2.0 * std::f64::consts::PI * 3.0 * t).sin()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn pi_compensation_tracks_to_1e9() {
+        let pi = PrandtlIshlinskii::new(
+            0.6,
+            vec![0.3, 0.2, 0.1],
+            vec![0.1, 0.2, 0.3],
+            0.0,
+            Orientation::default(),
+        )
+        .unwrap();
+        let model = FittedModel::operator(OperatorModel::Pi(pi), vec![f64::NAN; 7]);
+        let c = compensate(&model, &reference(500, 1.0)).unwrap();
+        let (rms, max) = c.tracking_error();
+        assert!(c.clipped.is_empty() && max < 1e-9, "rms {rms} max {max}");
+        let y = model.simulate(&[&c.u], 1.0, None).unwrap();
+        assert_eq!(y[0], c.predicted);
+    }
+
+    #[test]
+    fn coleman_hodgdon_compensation_and_clipping() {
+        let ch = ColemanHodgdon::saturated(0.5, 1.0, 0.3, 3.0).unwrap();
+        let model = FittedModel::Hysteresis {
+            model: ch,
+            initial: InitialOutput::Measured,
+            std: vec![f64::NAN; 4],
+        };
+        let r = reference(800, 1.5);
+        let c = compensate(&model, &r).unwrap();
+        let (_, max) = c.tracking_error();
+        assert!(c.clipped.is_empty() && max < 1e-6, "max {max}");
+        let y = model.simulate(&[&c.u], 1.0, Some(r[0])).unwrap();
+        assert_eq!(y[0], c.predicted);
+        // Beyond the saturated material function's range (|f| ≤ m1·d = 3) the reference is
+        // clipped, counted and listed as ranges.
+        let far: Vec<f64> = r.iter().map(|v| 5.0 * v).collect();
+        let c = compensate(&model, &far).unwrap();
+        assert!(!c.clipped.is_empty());
+        assert!(!c.clipped_ranges().is_empty());
+    }
+
+    #[test]
+    fn a_cascade_is_not_invertible() {
+        let truth = crate::experiments::voros::CascadeExample::example2().truth;
+        let std = vec![f64::NAN; truth.params().len()];
+        let model = FittedModel::Cascade { model: truth, std };
+        let e = compensate(&model, &[0.0, 1.0]).unwrap_err();
+        assert!(matches!(e, Error::NotInvertible { .. }));
+        assert!(e
+            .to_string()
+            .starts_with("not invertible: model kind 'ch_cascade'"));
+    }
+}
