@@ -131,6 +131,33 @@ impl Scratch {
     }
 }
 
+/// The tape of f, ∂f/∂x and the columns ∂f/∂θ\[params\] only, for the parameters a fit
+/// estimates ([`EquationModel::rhs_jacobian_columns`]): the derivatives with respect to the
+/// other parameters, and everything only they read, are not computed.
+#[derive(Clone, Debug)]
+pub struct ColumnTape {
+    params: Vec<usize>,
+    tape: Tape,
+}
+
+impl ColumnTape {
+    /// The parameter indices of the ∂f/∂θ columns, in order.
+    pub fn params(&self) -> &[usize] {
+        &self.params
+    }
+
+    /// Number of instructions.
+    pub fn len(&self) -> usize {
+        self.tape.len()
+    }
+
+    /// True for a tape without instructions (f and its Jacobians are all inputs or
+    /// constants).
+    pub fn is_empty(&self) -> bool {
+        self.tape.len() == 0
+    }
+}
+
 thread_local! {
     static SCRATCH: RefCell<Scratch> = const { RefCell::new(Scratch { regs: Vec::new() }) };
 }
@@ -325,6 +352,51 @@ impl EquationModel {
         check_len(fx, n * n, "fx");
         check_len(ftheta, n * p, "ftheta");
         self.eval(s, &self.tapes.f_jac, t, x, u, theta, &mut [dx, fx, ftheta]);
+    }
+
+    /// The tape computing f, ∂f/∂x and the columns `params` of ∂f/∂θ (see
+    /// [`Self::rhs_jacobian_columns_with`]); None if an index is not below the number of
+    /// parameters.
+    pub fn rhs_jacobian_columns(&self, params: &[usize]) -> Option<ColumnTape> {
+        let (n, p) = (self.states.len(), self.parameters.len());
+        if params.iter().any(|&c| c >= p) {
+            return None;
+        }
+        // Result layout of the full tape: f, then ∂f/∂x row-major, then ∂f/∂θ row-major.
+        let mut keep: Vec<usize> = (0..n + n * n).collect();
+        for i in 0..n {
+            keep.extend(params.iter().map(|&c| n + n * n + i * p + c));
+        }
+        Some(ColumnTape {
+            params: params.to_vec(),
+            tape: self.tapes.f_jac.restrict(&keep),
+        })
+    }
+
+    /// [`Self::rhs_jacobians_with`] from a [`ColumnTape`]: f, ∂f/∂x (n×n) and ∂f/∂θ for its
+    /// columns only (`ftheta` n×k row-major, k = `columns.params().len()`), in one pass; the
+    /// values equal the corresponding entries of [`Self::rhs_jacobians_with`].
+    ///
+    /// # Panics
+    /// As [`Self::rhs_jacobians_with`], with `ftheta` of n·k entries.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rhs_jacobian_columns_with(
+        &self,
+        s: &mut Scratch,
+        columns: &ColumnTape,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        dx: &mut [f64],
+        fx: &mut [f64],
+        ftheta: &mut [f64],
+    ) {
+        let n = self.states.len();
+        check_len(dx, n, "dx");
+        check_len(fx, n * n, "fx");
+        check_len(ftheta, n * columns.params.len(), "ftheta");
+        self.eval(s, &columns.tape, t, x, u, theta, &mut [dx, fx, ftheta]);
     }
 
     /// h with ∂h/∂x (ny×n, row-major) and ∂h/∂θ (ny×p, row-major).

@@ -79,6 +79,47 @@ impl Instr {
         }
     }
 
+    /// The operand registers, for dead-code elimination and renumbering.
+    fn operands_mut(&mut self) -> Vec<&mut u32> {
+        use Instr::*;
+        match self {
+            Neg(a)
+            | Sin(a)
+            | Cos(a)
+            | Tan(a)
+            | Exp(a)
+            | Ln(a)
+            | Sqrt(a)
+            | Abs(a)
+            | Sign(a)
+            | Tanh(a)
+            | Atan(a)
+            | FiniteOr0(a)
+            | Square(a)
+            | Cube(a)
+            | Powi(a, _)
+            | Not(a) => {
+                vec![a]
+            }
+            Add(a, b)
+            | Sub(a, b)
+            | Mul(a, b)
+            | Div(a, b)
+            | Pow(a, b)
+            | Min(a, b)
+            | Max(a, b)
+            | Lt(a, b)
+            | Le(a, b)
+            | Eq(a, b)
+            | Ne(a, b)
+            | And(a, b)
+            | Or(a, b) => {
+                vec![a, b]
+            }
+            Select(c, a, b) => vec![c, a, b],
+        }
+    }
+
     fn power(a: u32, n: i32) -> Instr {
         match n {
             2 => Instr::Square(a),
@@ -167,6 +208,56 @@ impl Tape {
         }
     }
 
+    /// The tape computing only the results at positions `keep` of [`Tape::outputs`] (in
+    /// that order), with the instructions and constants no kept result reads removed: a
+    /// Jacobian tape restricted to some parameter columns. Every `keep` entry must be below
+    /// `outputs().len()`.
+    pub fn restrict(&self, keep: &[usize]) -> Tape {
+        let first = self.inputs + self.consts.len();
+        let mut live = vec![false; self.registers()];
+        for &k in keep {
+            live[self.outputs[k] as usize] = true;
+        }
+        let mut code = self.code.clone();
+        for (k, instr) in code.iter_mut().enumerate().rev() {
+            if live[first + k] {
+                for a in instr.operands_mut() {
+                    live[*a as usize] = true;
+                }
+            }
+        }
+        // New register numbers: inputs stay, then the live constants, then live code.
+        let mut map: Vec<u32> = (0..self.registers() as u32).collect();
+        let mut consts = Vec::new();
+        for (c, &v) in self.consts.iter().enumerate() {
+            if live[self.inputs + c] {
+                map[self.inputs + c] = (self.inputs + consts.len()) as u32;
+                consts.push(v);
+            }
+        }
+        let new_first = self.inputs + consts.len();
+        let mut kept = Vec::new();
+        for (k, mut instr) in code.into_iter().enumerate() {
+            if !live[first + k] {
+                continue;
+            }
+            for a in instr.operands_mut() {
+                *a = map[*a as usize];
+            }
+            map[first + k] = (new_first + kept.len()) as u32;
+            kept.push(instr);
+        }
+        Tape {
+            inputs: self.inputs,
+            consts,
+            code: kept,
+            outputs: keep
+                .iter()
+                .map(|&k| map[self.outputs[k] as usize])
+                .collect(),
+        }
+    }
+
     /// Registers the tape needs.
     pub fn registers(&self) -> usize {
         self.inputs + self.consts.len() + self.code.len()
@@ -204,7 +295,7 @@ impl Tape {
                 Instr::Sub(a, b) => r(a) - r(b),
                 Instr::Mul(a, b) => r(a) * r(b),
                 Instr::Div(a, b) => r(a) / r(b),
-                Instr::Pow(a, b) => r(a).powf(r(b)),
+                Instr::Pow(a, b) => num::pow(r(a), r(b)),
                 Instr::Min(a, b) => num::min(r(a), r(b)),
                 Instr::Max(a, b) => num::max(r(a), r(b)),
                 Instr::Lt(a, b) => num::truth(r(a) < r(b)),
@@ -265,6 +356,28 @@ mod tests {
         let o = tape.outputs();
         assert_eq!(regs[o[0] as usize], 0.75f64.sin());
         assert_eq!(regs[o[1] as usize], 0.75f64.cos());
+    }
+
+    #[test]
+    fn a_restricted_tape_computes_the_kept_results_only() {
+        let mut g = Graph::default();
+        let (x, y) = (g.var(1), g.var(2));
+        let two = g.konst(2.0);
+        let s = g.bin(Fn2::Add, x, y);
+        let sin = g.un(Fn1::Sin, s);
+        let scaled = g.bin(Fn2::Mul, two, y);
+        let exp = g.un(Fn1::Exp, scaled);
+        let tape = Tape::compile(&g, 3, &[sin, exp, s]);
+        let only = tape.restrict(&[2, 0]);
+        assert_eq!((tape.len(), only.len()), (4, 2)); // 2*y and exp(2*y) are dropped
+        assert_eq!(only.registers(), 5); // t, x, y, x+y, sin; the constant 2 is dropped
+        let mut regs = vec![0.0; only.registers()];
+        regs[1] = 0.25;
+        regs[2] = 0.5;
+        only.run(&mut regs);
+        let o = only.outputs();
+        assert_eq!(regs[o[0] as usize], 0.75);
+        assert_eq!(regs[o[1] as usize], 0.75f64.sin());
     }
 
     #[test]

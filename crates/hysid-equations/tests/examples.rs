@@ -403,3 +403,48 @@ fn duffing_is_the_cubic_oscillator() {
         max_relative = 1e-15
     );
 }
+
+/// A tape restricted to some ∂f/∂θ columns gives, bit for bit, the same f, ∂f/∂x and those
+/// columns as the full Jacobian tape, and is shorter when a column is left out.
+#[test]
+fn column_tapes_equal_the_full_jacobian_columns() {
+    let mut rng = Rng::new(0x5eed_0002);
+    for name in EXAMPLES {
+        let m = load(name);
+        let (n, p) = (m.states().len(), m.parameters().len());
+        let all: Vec<usize> = (0..p).collect();
+        let subsets = [all.clone(), (0..p - 1).collect(), vec![p - 1, 0], vec![]];
+        assert!(m.rhs_jacobian_columns(&[p]).is_none(), "{name}");
+        let full_len = m.tape_lengths()[1];
+        assert_eq!(m.rhs_jacobian_columns(&all).unwrap().len(), full_len);
+        let mut s = m.scratch();
+        for cols in &subsets {
+            let tape = m.rhs_jacobian_columns(cols).unwrap();
+            assert!(tape.len() <= full_len, "{name}");
+            assert_eq!(tape.params(), cols.as_slice());
+            for _ in 0..10 {
+                let (t, x, u, th) = point(name, &mut rng, &m);
+                let (mut dx, mut fx, mut ft) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * p]);
+                m.rhs_jacobians(t, &x, &u, &th, &mut dx, &mut fx, &mut ft);
+                let k = cols.len();
+                let (mut dx2, mut fx2, mut ft2) =
+                    (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * k]);
+                m.rhs_jacobian_columns_with(
+                    &mut s, &tape, t, &x, &u, &th, &mut dx2, &mut fx2, &mut ft2,
+                );
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&dx2), bits(&dx), "{name} {cols:?}: f");
+                assert_eq!(bits(&fx2), bits(&fx), "{name} {cols:?}: ∂f/∂x");
+                let want: Vec<f64> = (0..n)
+                    .flat_map(|i| cols.iter().map(move |&c| (i, c)))
+                    .map(|(i, c)| ft[i * p + c])
+                    .collect();
+                assert_eq!(bits(&ft2), bits(&want), "{name} {cols:?}: ∂f/∂θ");
+            }
+        }
+    }
+    // Bouc–Wen without ν: ∂f/∂ν = −(…)·|z|^ν·ln|z| is no longer computed.
+    let m = load("bouc_wen.toml");
+    let six = m.rhs_jacobian_columns(&[0, 1, 2, 3, 4, 5]).unwrap();
+    assert!(six.len() < m.tape_lengths()[1]);
+}

@@ -33,12 +33,12 @@
 //! S\[k+1\] = f_x·S\[k\] + f_θ ([`super::discrete`]); the integrator and the input
 //! interpolation do not apply to it.
 
-use super::StateSpaceModel;
+use super::{sensitivity, JacobianScratch, StateSpaceModel};
 use crate::data::Channel;
 use crate::error::EquationFileError;
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
-use hysid_equations::{EquationError, EquationModel, Scratch, TimeDomain};
+use hysid_equations::{ColumnTape, EquationError, EquationModel, Scratch, TimeDomain};
 use std::cell::RefCell;
 use std::path::Path;
 
@@ -67,6 +67,9 @@ pub struct EquationStateSpace {
     inputs: Vec<Channel>,
     outputs: Vec<Channel>,
     parameters: ParameterSet,
+    /// The Jacobian tape restricted to the free parameters' ∂f/∂θ columns (what a fit
+    /// asks sensitivities for).
+    free_columns: Option<ColumnTape>,
 }
 
 /// Per-thread registers and value buffers, so that the trait's Jacobian methods (which do
@@ -94,6 +97,38 @@ fn with_work<R>(n: usize, f: impl FnOnce(&mut Scratch, &mut [f64]) -> R) -> R {
         // Re-entered on one thread (not done by hysid): stay correct with fresh buffers.
         Err(_) => f(&mut Scratch::new(), &mut vec![0.0; n]),
     })
+}
+
+/// Ṡ = f_x·S + [f_θ, 0] row by row: `fx` n × n, `direct` n × k (the parameter columns),
+/// `s` and `ds` n × q with q ≥ k (the last q − k columns, initial states, have no direct
+/// term). Summed in the order of the default sensitivity right-hand side, so the values
+/// are the same to the bit.
+fn sensitivity_rates(n: usize, fx: &[f64], direct: &[f64], s: &[f64], ds: &mut [f64]) {
+    let (q, k) = (s.len() / n, direct.len() / n);
+    if q == 0 {
+        return;
+    }
+    for (r, (ds_row, fx_row)) in ds.chunks_exact_mut(q).zip(fx.chunks_exact(n)).enumerate() {
+        let mut terms = fx_row.iter().zip(s.chunks_exact(q));
+        // The first product initialises the row (no separate copy of the direct term:
+        // per-row memcpy calls of a few entries cost more than the products).
+        if let Some((&a, s0)) = terms.next() {
+            let (d_head, d_tail) = ds_row.split_at_mut(k);
+            let (s_head, s_tail) = s0.split_at(k);
+            let f_row = &direct[r * k..(r + 1) * k];
+            for ((d, &f), &sj) in d_head.iter_mut().zip(f_row).zip(s_head) {
+                *d = f + a * sj;
+            }
+            for (d, &sj) in d_tail.iter_mut().zip(s_tail) {
+                *d = 0.0 + a * sj;
+            }
+        }
+        for (&a, s_row) in terms {
+            for (d, &sj) in ds_row.iter_mut().zip(s_row) {
+                *d += a * sj;
+            }
+        }
+    }
 }
 
 /// The language's error as hysid's, with where the text came from.
@@ -147,6 +182,7 @@ impl EquationStateSpace {
             .validate()
             .map_err(|e| Error::Config(format!("{origin}: {e}")))?;
         Ok(Self {
+            free_columns: model.rhs_jacobian_columns(&parameters.free_indices()),
             states: model.states().iter().map(channel).collect(),
             inputs: model.inputs().iter().map(channel).collect(),
             outputs: model.outputs().iter().map(channel).collect(),
@@ -235,6 +271,52 @@ impl StateSpaceModel for EquationStateSpace {
         true
     }
 
+    /// ẋ and Ṡ = (∂f/∂x)·S + ∂f/∂θ\[params\] from ONE pass over the Jacobian tape —
+    /// restricted to the free parameters' columns when `params` are exactly those — with
+    /// the registers and Jacobian buffers from `scratch`; the values equal the default's.
+    /// `held` is ignored: equation files have no stick–slip handling (their `rhs_sliding`
+    /// is `rhs`).
+    #[allow(clippy::too_many_arguments)]
+    fn rhs_sensitivities(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        theta: &[f64],
+        held: Option<f64>,
+        params: &[usize],
+        s: &[f64],
+        scratch: &mut JacobianScratch,
+        dx: &mut [f64],
+        ds: &mut [f64],
+    ) -> bool {
+        let (n, p, k) = (x.len(), theta.len(), params.len());
+        let q = s.len() / n.max(1);
+        if n == 0 || k > q || ds.len() != s.len() || params.iter().any(|&c| c >= p) {
+            return sensitivity::default_rhs_sensitivities(
+                self, t, x, u, theta, held, params, s, scratch, dx, ds,
+            );
+        }
+        let (fx, ft, regs) = scratch.split(n, p + k);
+        let (full, direct) = ft.split_at_mut(n * p);
+        match &self.free_columns {
+            Some(columns) if columns.params() == params => self
+                .model
+                .rhs_jacobian_columns_with(regs, columns, t, x, u, theta, dx, fx, direct),
+            _ => {
+                self.model
+                    .rhs_jacobians_with(regs, t, x, u, theta, dx, fx, full);
+                for (row, out) in full.chunks_exact(p).zip(direct.chunks_exact_mut(k.max(1))) {
+                    for (o, &c) in out.iter_mut().zip(params) {
+                        *o = row[c];
+                    }
+                }
+            }
+        }
+        sensitivity_rates(n, fx, direct, s, ds);
+        true
+    }
+
     /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded).
     fn output_jacobians(
         &self,
@@ -274,6 +356,69 @@ mod tests {
         let (mut hx, mut ht) = ([0.0], [0.0]);
         assert!(m.output_jacobians(&[3.0], &[1.0], &[2.0], &mut hx, &mut ht));
         assert_eq!((hx[0], ht[0]), (1.0, 0.0));
+    }
+
+    /// The fused sensitivity right-hand side equals the default one (f, then the Jacobians,
+    /// then the products) to the bit: for the free parameters (restricted tape), for other
+    /// column lists (full tape), with and without initial-state columns.
+    #[test]
+    fn fused_sensitivities_equal_the_default() {
+        let text = include_str!("../../../../../examples/equations/bouc_wen.toml");
+        let m = EquationStateSpace::parse(text, "bouc_wen.toml").unwrap();
+        let free: Vec<usize> = (0..6).collect();
+        assert_eq!(m.parameters().free_indices(), free);
+        let points = [
+            ([1e-3, 0.05, 20.0], 30.0),
+            ([-2e-3, -0.08, -35.0], -12.0),
+            ([4e-4, 0.0, 0.0], 3.0),
+        ];
+        let lists: [(&[usize], usize); 5] = [
+            (&free, 6),
+            (&free, 8),
+            (&[6, 0, 3], 4),
+            (&[0, 1, 2, 3, 4, 5, 6], 7),
+            (&[], 2),
+        ];
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for nu in [1.0, 1.3] {
+            let mut theta = m.parameters().values();
+            theta[6] = nu;
+            for (x, u) in &points {
+                for (params, q) in lists {
+                    let s: Vec<f64> = (0..3 * q).map(|i| (i as f64 * 0.37).sin()).collect();
+                    let mut scratch = JacobianScratch::new(3, 7);
+                    let (mut dx, mut ds) = ([0.0; 3], vec![0.0; 3 * q]);
+                    assert!(m.rhs_sensitivities(
+                        0.1,
+                        x,
+                        &[*u],
+                        &theta,
+                        None,
+                        params,
+                        &s,
+                        &mut scratch,
+                        &mut dx,
+                        &mut ds
+                    ));
+                    let (mut dx0, mut ds0) = ([0.0; 3], vec![0.0; 3 * q]);
+                    assert!(sensitivity::default_rhs_sensitivities(
+                        &m,
+                        0.1,
+                        x,
+                        &[*u],
+                        &theta,
+                        None,
+                        params,
+                        &s,
+                        &mut scratch,
+                        &mut dx0,
+                        &mut ds0
+                    ));
+                    assert_eq!(bits(&dx), bits(&dx0), "ν {nu}, {params:?}");
+                    assert_eq!(bits(&ds), bits(&ds0), "ν {nu}, {params:?}, q {q}");
+                }
+            }
+        }
     }
 
     #[test]

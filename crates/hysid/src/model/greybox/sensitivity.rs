@@ -19,11 +19,13 @@
 use super::StateSpaceModel;
 
 /// Scratch space for ∂f/∂x (n × n) and ∂f/∂θ (n × p) of the default sensitivity right-hand
-/// side, allocated once per simulation.
+/// side, allocated once per simulation; also the registers of models evaluated from an
+/// instruction tape (equation files), so that they need no per-thread look-up per stage.
 #[derive(Clone, Debug, Default)]
 pub struct JacobianScratch {
     fx: Vec<f64>,
     ftheta: Vec<f64>,
+    tape: hysid_equations::Scratch,
 }
 
 impl JacobianScratch {
@@ -32,7 +34,20 @@ impl JacobianScratch {
         Self {
             fx: vec![0.0; n * n],
             ftheta: vec![0.0; n * p],
+            tape: hysid_equations::Scratch::new(),
         }
+    }
+
+    /// ∂f/∂x sized n × n, ∂f/∂θ sized n × p (contents unspecified) and the tape registers,
+    /// for a model's own fused [`StateSpaceModel::rhs_sensitivities`].
+    pub(crate) fn split(
+        &mut self,
+        n: usize,
+        p: usize,
+    ) -> (&mut [f64], &mut [f64], &mut hysid_equations::Scratch) {
+        self.fx.resize(n * n, 0.0);
+        self.ftheta.resize(n * p, 0.0);
+        (&mut self.fx, &mut self.ftheta, &mut self.tape)
     }
 }
 
