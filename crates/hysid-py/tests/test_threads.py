@@ -130,8 +130,10 @@ def test_two_threads_beat_one_after_the_other(example1):
         f"{cores} cores, load {load:.1f})"
     )
     print("\n" + figure)
-    if cores < 2 or load > cores:
-        pytest.skip(f"not asserted (needs >= 2 cores and load <= cores): {figure}")
+    # The one-minute load average includes this suite's own fits (both cores busy: about 2),
+    # so a machine is taken as otherwise idle up to one more than its cores.
+    if cores < 2 or load > cores + 1:
+        pytest.skip(f"not asserted (needs >= 2 cores and load <= cores + 1): {figure}")
     assert speedup >= 1.6, figure
 
 
