@@ -43,6 +43,13 @@ pub fn init(quiet: bool, time_limit_s: Option<f64>) {
     });
 }
 
+/// Prints one line about what the run is doing on stderr, unless `--quiet`.
+pub fn note(message: &str) {
+    if !RUN.get().is_some_and(|run| run.quiet) {
+        eprintln!("{message}");
+    }
+}
+
 /// True once the time limit is reached (and remembered as hit).
 fn over_time() -> bool {
     let Some(run) = RUN.get() else {

@@ -1,15 +1,11 @@
-//! Reporting and plotting a cascade identification (shared by `demo voros` and
+//! Printing a cascade identification (the report is `hysid::report::cascade_report`) (shared by `demo voros` and
 //! `identify cascade`).
 
 use crate::cli::UncertaintyArg;
-use crate::report::{figures, of_output_error, Report, Row};
-use anyhow::Result;
-use hysid::data::IdData;
+use crate::report::{figures, Report, Row};
 use hysid::identify::cascade::CascadeFit;
 use hysid::identify::Uncertainty;
 use hysid::model::saved::FittedModel;
-use hysid::report::UncertaintySummary;
-use serde_json::json;
 
 /// True for the Coleman–Hodgdon forms (`ch4`, `ch6`) of the paper-1 pipeline; every other
 /// name is an operator family (`commands/operator_cascade.rs`).
@@ -49,54 +45,6 @@ pub fn rows(fit: &CascadeFit, truth: Option<&[f64]>, initial: Option<&[f64]>) ->
             std: std[i],
         })
         .collect()
-}
-
-/// The report of a cascade fit on `data` (read from `sources`).
-pub fn report(
-    command: &str,
-    fit: &CascadeFit,
-    data: &IdData,
-    sources: Vec<String>,
-    uncertainty: Uncertainty,
-    extra: serde_json::Value,
-) -> Result<Report> {
-    let oe = &fit.output_error;
-    let key_term = fit.key_term.as_ref().map(|k| {
-        json!({
-            "termination": k.termination.to_string(),
-            "iterations": k.history.len().saturating_sub(1),
-            "history": k.history,
-            "equation_error": k.costs,
-        })
-    });
-    let mut details = json!({
-        "admissibility": fit.model.hysteresis.admissibility(),
-        "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
-        "threshold": fit.threshold,
-        "switching_consistent": fit.switching_consistent,
-        "key_term_iteration": key_term,
-        "output_error_history": oe.report.history,
-        "candidates": fit.candidates.iter().map(|c| json!({"origin": c.origin, "cost": c.cost, "start": c.start, "refined": c.refined})).collect::<Vec<_>>(),
-        "asymptotic_std": oe.std(),
-        "bootstrap": fit.bootstrap.as_ref().map(|b| json!({"replicates": b.replicates.len(), "failed": b.failed, "std": b.std})),
-    });
-    if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
-        obj.extend(more);
-    }
-    let uncertainty = match (&fit.bootstrap, uncertainty) {
-        (Some(b), _) => UncertaintySummary::bootstrap(b.replicates.len(), b.failed),
-        (None, _) => UncertaintySummary::asymptotic(),
-    };
-    Ok(of_output_error(
-        command,
-        oe,
-        data,
-        sources,
-        fitted(fit).to_file(),
-        fit.elapsed_s,
-        uncertainty,
-        details,
-    )?)
 }
 
 /// Prints the lines under the table: the paper's iteration, the final fit, warnings.

@@ -38,11 +38,11 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let held_out = validation
         .as_ref()
         .map(|v| (v.experiment(0).input(0), v.experiment(0).output(0)));
-    eprintln!(
+    crate::progress::note(&format!(
         "comparing {} families on {} samples …",
         options.families.len(),
         exp.len()
-    );
+    ));
     let comparison = compare(exp.input(0), exp.output(0), held_out, &options)?;
     println!("Split: {}", comparison.split);
     print_table(&comparison.rows);

@@ -1,6 +1,6 @@
 //! `hysid demo voros`: the project's cascade examples end to end.
 
-use super::cascade::{print_summary, report, rows, uncertainty};
+use super::cascade::{print_summary, rows, uncertainty};
 use crate::cli::{UncertaintyArg, VorosArgs};
 use crate::output::Outputs;
 use crate::progress::FitProgress;
@@ -8,6 +8,7 @@ use crate::report::print_table;
 use anyhow::Result;
 use hysid::experiments::voros::{CascadeExample, EXAMPLE_SNR};
 use hysid::identify::cascade::CascadeIdentification;
+use hysid::report::cascade_report;
 use hysid::report::plot::cascade_figures;
 use serde_json::json;
 
@@ -75,7 +76,7 @@ pub fn voros(args: &VorosArgs) -> Result<()> {
         "initial_hysteresis": ex.initial.params(),
     });
     let source = vec![format!("built-in: project Example {}", args.example)];
-    let report = report("demo voros", &fit, &data, source, id.uncertainty, extra)?;
+    let report = cascade_report("demo voros", &fit, &data, source, extra)?;
     print_summary(&fit, &report);
     out.figures(|| cascade_figures(&fit, &generated.x, &generated.y, Some(truth)))?;
     out.finish(Some(&report), None)

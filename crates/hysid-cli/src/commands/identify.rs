@@ -1,18 +1,18 @@
 //! `hysid identify cascade` and `hysid identify hysteresis`.
 
-use super::cascade::{fitted, print_summary, report, rows, uncertainty};
+use super::cascade::{fitted, print_summary, rows, uncertainty};
 use crate::cli::{CascadeArgs, DataArgs, HysteresisArgs, InitialArg, OutputArgs};
 use crate::output::Outputs;
 use crate::progress::FitProgress;
-use crate::report::{figures, of_output_error, print_table, Report, Row};
+use crate::report::{figures, print_table, Row};
 use anyhow::Result;
 use hysid::data::{Channel, CsvSpec, Experiment, IdData};
 use hysid::identify::cascade::CascadeIdentification;
-use hysid::identify::hysteresis::{HysteresisFit, HysteresisIdentification, InitialOutput};
+use hysid::identify::hysteresis::{HysteresisIdentification, InitialOutput};
 use hysid::model::saved::FittedModel;
 use hysid::model::ChForm;
 use hysid::report::plot::{cascade_figures, hysteresis_figures};
-use hysid::report::UncertaintySummary;
+use hysid::report::{cascade_report, hysteresis_report};
 use hysid::Error;
 use serde_json::json;
 
@@ -99,12 +99,11 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
     );
     print_table(&rows(&fit, None, None));
     let extra = json!({"input": args.data.input, "output": args.data.output});
-    let report = report(
+    let report = cascade_report(
         "identify cascade",
         &fit,
         &data,
         vec![args.data.data.display().to_string()],
-        id.uncertainty,
         extra,
     )?;
     print_summary(&fit, &report);
@@ -176,39 +175,6 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
         std,
     };
     out.finish(Some(&report), Some(&fitted))
-}
-
-fn hysteresis_report(
-    fit: &HysteresisFit,
-    data: &IdData,
-    sources: Vec<String>,
-    initial: InitialOutput,
-) -> Result<Report> {
-    let oe = &fit.output_error;
-    let fitted = FittedModel::Hysteresis {
-        model: fit.model.clone(),
-        initial,
-        std: fit.std(),
-    };
-    let details = json!({
-        "admissibility": fit.model.admissibility(),
-        "threshold": fit.threshold,
-        "separated_regression": {
-            "d_history": fit.separated.d_history,
-            "termination": fit.separated.termination.to_string(),
-        },
-        "output_error_history": oe.report.history,
-    });
-    Ok(of_output_error(
-        "identify hysteresis",
-        oe,
-        data,
-        sources,
-        fitted.to_file(),
-        fit.elapsed_s,
-        UncertaintySummary::asymptotic(),
-        details,
-    )?)
 }
 
 /// Registers the report, model and plot destinations before the fit (refused when one is

@@ -29,7 +29,7 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
     let data = load(&args.data, &args.data.data)?;
     let exp = data.experiment(0);
     let (u, y) = (exp.input(0), exp.output(0));
-    eprintln!("fitting {family} to {} samples …", u.len());
+    crate::progress::note(&format!("fitting {family} to {} samples …", u.len()));
     let fitted = fit_operator(family, u, y, &options)
         .with_context(|| format!("identifying a {family} operator"))?;
     // The report's fit is the saved model's own simulation, so `hysid simulate` reproduces it.

@@ -31,13 +31,13 @@ use crate::numerics::metrics;
 use crate::numerics::signal::{decimate_fir, gaussian_noise, multisine, sine_sweep};
 use crate::numerics::{Control, IterationRecord, Observer};
 
-/// Sampling frequency of the benchmark records [Hz].
+/// Sampling frequency of the benchmark records \[Hz\].
 pub const FS: f64 = 750.0;
 
 /// Upsampling factor of the official simulator (750 Hz → 15 kHz).
 pub const UP: usize = 20;
 
-/// Published e_RMS [m] on the official multisine test set (docs/benchmarks.md §1.4).
+/// Published e_RMS \[m\] on the official multisine test set (docs/benchmarks.md §1.4).
 pub const PUBLISHED: [(&str, f64); 3] = [
     ("dynoNet (Forgione & Piga 2021)", 4.52e-5),
     ("decoupled polynomial nonlinear state space", 1.87e-5),
@@ -76,7 +76,7 @@ pub struct BoucWenResult {
     pub fit: GreyBoxFit,
     /// The fitted model, as saved and simulated.
     pub model: FittedModel,
-    /// e_RMS of the simulated output on the training record [m].
+    /// e_RMS of the simulated output on the training record \[m\].
     pub training_e_rms: f64,
     /// One score per test record.
     pub tests: Vec<BenchmarkTest>,
@@ -87,13 +87,13 @@ pub struct BoucWenResult {
 pub struct BenchmarkTest {
     /// Where the record came from (a file name).
     pub source: String,
-    /// e_RMS [m].
+    /// e_RMS \[m\].
     pub e_rms: f64,
     /// fit % of the simulated output.
     pub fit_percent: f64,
-    /// Measured output [m].
+    /// Measured output \[m\].
     pub y: Vec<f64>,
-    /// Simulated output [m].
+    /// Simulated output \[m\].
     pub yhat: Vec<f64>,
 }
 
@@ -213,19 +213,19 @@ pub enum TestSignal {
     },
 }
 
-/// A generated record at 750 Hz: time [s], force u [N], displacement y [m].
+/// A generated record at 750 Hz: time \[s\], force u \[N], displacement y [m\].
 #[derive(Clone, Debug)]
 pub struct GeneratedRecord {
-    /// Time [s].
+    /// Time \[s\].
     pub t: Vec<f64>,
-    /// Input force [N].
+    /// Input force \[N\].
     pub u: Vec<f64>,
-    /// Output displacement [m].
+    /// Output displacement \[m\].
     pub y: Vec<f64>,
 }
 
 /// Simulates a test record by the official recipe (see the module documentation), with
-/// white Gaussian output noise of standard deviation `noise` [m] (0 for none).
+/// white Gaussian output noise of standard deviation `noise` \[m\] (0 for none).
 pub fn generate(signal: TestSignal, noise: f64, seed: u64) -> Result<GeneratedRecord> {
     let (u, u_fine) = match signal {
         TestSignal::Multisine { periods } => {

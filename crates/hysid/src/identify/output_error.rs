@@ -62,7 +62,7 @@ pub trait OutputErrorModel: Sync {
     }
 
     /// Whether the estimator should compute the sensitivities together with the residuals at
-    /// every trial point (see [`Speculation`]). Worth it when a simulation with sensitivities
+    /// every trial point (see \[`Speculation`\]). Worth it when a simulation with sensitivities
     /// costs little more than one without and most trial points are accepted, as for the
     /// continuous-time grey-box models; `false` (the default) keeps trial points cheap.
     fn speculative_sensitivities(&self) -> bool {
@@ -330,7 +330,7 @@ impl<'a> OutputErrorProblem<'a> {
         })
     }
 
-    /// Turns on speculative sensitivities for the parameters `free` (see [`Speculation`]) when
+    /// Turns on speculative sensitivities for the parameters `free` (see \[`Speculation`\]) when
     /// the search runs alone and a core is idle for the split columns.
     pub fn speculate(&mut self, free: &[usize]) {
         // Inside a rayon job (a multi-start) the other core is busy already.

@@ -1,6 +1,6 @@
 //! What a plot shows: [`Figure`]s of labelled [`Series`], each drawn in a [`Style`].
 //!
-//! A figure is a description only; [`super::svg`] renders it.
+//! A figure is a description only; \[`super::svg`\] renders it.
 
 use std::borrow::Cow;
 
