@@ -213,7 +213,7 @@ pub enum TestSignal {
     },
 }
 
-/// A generated record at 750 Hz: time \[s\], force u \[N], displacement y [m\].
+/// A generated record at 750 Hz: time \[s\], force u \[N\], displacement y \[m\].
 #[derive(Clone, Debug)]
 pub struct GeneratedRecord {
     /// Time \[s\].
