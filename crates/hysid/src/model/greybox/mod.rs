@@ -15,6 +15,7 @@
 //!
 //! * [`simulate`]: integrators (RK4 with sub-steps, Newmark, adaptive Dormand–Prince) and the
 //!   input interpolation between samples.
+//! * [`fixed_rk4`]: RK4 with sensitivities on fixed-size arrays, for models that offer it.
 //! * [`stick_slip`]: RK4 steps that integrate Coulomb friction as stick–slip.
 //! * [`sensitivity`]: the right-hand side of the forward sensitivity equations.
 //! * [`discrete`]: discrete-time models (x\[k+1\] = f(…), [`StateSpaceModel::discrete_time`]),
@@ -26,6 +27,7 @@
 
 pub mod discrete;
 pub mod equation_model;
+pub mod fixed_rk4;
 pub mod models;
 pub mod sensitivity;
 pub mod simulate;
@@ -168,5 +170,19 @@ pub trait StateSpaceModel: Sync + Send {
         sensitivity::default_rhs_sensitivities(
             self, t, x, u, theta, held, params, s, scratch, dx, ds,
         )
+    }
+
+    /// RK4 with forward sensitivities through a path specialised to this model's sizes
+    /// ([`fixed_rk4`]: fixed-size arrays, the parameters' constants computed once), giving
+    /// the same numbers to the last bit as the generic path built on
+    /// [`rhs_sensitivities`](Self::rhs_sensitivities). Called only for RK4 whose input lies
+    /// on the half-step grid. None (the default) when the model has no such path for these
+    /// columns: the generic path runs.
+    fn fixed_rk4_sensitivities(
+        &self,
+        _run: &fixed_rk4::Rk4Sensitivities<'_>,
+        _on_sample: &mut fixed_rk4::SampleSink<'_>,
+    ) -> Option<crate::Result<()>> {
+        None
     }
 }

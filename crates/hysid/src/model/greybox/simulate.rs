@@ -30,6 +30,7 @@
 //! * [`Integrator::Adaptive`]: Dormand–Prince 5(4) with error control, restarted at every
 //!   sample (the input may jump there); the reference the tests compare the others with.
 
+use super::fixed_rk4::Rk4Sensitivities;
 use super::stick_slip::{Sensitivities, StickSlip};
 use super::{JacobianScratch, StateSpaceModel};
 use crate::numerics::integrate::Stage;
@@ -296,7 +297,7 @@ fn stage_input(
     }
 }
 
-fn diverged(k: usize) -> Error {
+pub(super) fn diverged(k: usize) -> Error {
     Error::Diverged {
         index: k,
         reason: "the state is not finite".into(),
@@ -652,6 +653,21 @@ pub fn simulate_sensitivities(
         z[n + i * q + params.len() + c] = 1.0;
     }
     let m = substeps.max(1);
+    if input.resolution() == 2 * m {
+        let run = Rk4Sensitivities {
+            theta,
+            x0,
+            s0: &z[n..],
+            input,
+            ts,
+            substeps: m,
+            params,
+            initial,
+        };
+        if let Some(done) = model.fixed_rk4_sensitivities(&run, &mut on_sample) {
+            return done.map(|()| true);
+        }
+    }
     let h = ts / m as f64;
     let mut rk4 = StickSlip::new(dim);
     let velocity = model.stick_slip_velocity();

@@ -29,6 +29,7 @@
 
 use super::sign0;
 use crate::data::Channel;
+use crate::model::greybox::fixed_rk4::{Rk4Sensitivities, SampleSink};
 use crate::model::greybox::{JacobianScratch, StateSpaceModel};
 use crate::model::{Parameter, ParameterSet};
 
@@ -45,13 +46,13 @@ use crate::model::{Parameter, ParameterSet};
 pub struct BoucWen;
 
 /// Indices into θ.
-const ML: usize = 0;
-const CL: usize = 1;
-const KL: usize = 2;
-const ALPHA: usize = 3;
-const BG: usize = 4;
-const BD: usize = 5;
-const NU: usize = 6;
+pub(super) const ML: usize = 0;
+pub(super) const CL: usize = 1;
+pub(super) const KL: usize = 2;
+pub(super) const ALPHA: usize = 3;
+pub(super) const BG: usize = 4;
+pub(super) const BD: usize = 5;
+pub(super) const NU: usize = 6;
 
 impl StateSpaceModel for BoucWen {
     fn kind(&self) -> &'static str {
@@ -257,12 +258,21 @@ impl StateSpaceModel for BoucWen {
         }
         true
     }
+
+    /// The fixed-size path of the private `bouc_wen_kernel` module: the same numbers as the generic one.
+    fn fixed_rk4_sensitivities(
+        &self,
+        run: &Rk4Sensitivities<'_>,
+        on_sample: &mut SampleSink<'_>,
+    ) -> Option<crate::Result<()>> {
+        super::bouc_wen_kernel::simulate(run, on_sample)
+    }
 }
 
 /// |z|^ν with the exponents that occur in practice (ν = 1, the benchmark's, and ν = 2)
 /// computed without `powf`: exactly equal, and several times cheaper.
 #[inline]
-fn abs_pow(z: f64, nu: f64) -> f64 {
+pub(super) fn abs_pow(z: f64, nu: f64) -> f64 {
     if nu == 1.0 {
         z.abs()
     } else if nu == 2.0 {

@@ -8,6 +8,7 @@
 
 mod actuator;
 mod bouc_wen;
+mod bouc_wen_kernel;
 mod rigid_body;
 
 pub use actuator::{ActuatorFixed, ActuatorFree};

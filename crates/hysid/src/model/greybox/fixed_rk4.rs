@@ -1,0 +1,163 @@
+//! RK4 with forward sensitivities for a model whose state count N and sensitivity column
+//! count Q are known at compile time.
+//!
+//! The generic path ([`super::simulate::simulate_sensitivities`]) integrates the augmented
+//! state z = [x, S] as one slice of run-time length n + n·q, calling the model through a
+//! trait object at every stage. For a small model such as the Bouc–Wen oscillator (n = 3,
+//! q ≤ 10) the bookkeeping of that path (slice splits, zipped loops of three elements, the
+//! model's constants recomputed per stage, the virtual call) costs more than the arithmetic.
+//! Here x is `[f64; N]` and S is `[[f64; Q]; N]` (the same row-major n × q layout), the
+//! right-hand side is a `FixedSensitivityRhs` known to the compiler, and the stage updates
+//! are loops of constant length that it unrolls and vectorises.
+//!
+//! The stages and the update are the classical RK4 of [`crate::numerics::integrate::Rk4`],
+//! with every element computed by the same operations in the same order (Rust does not
+//! contract a·b + c into a fused multiply–add), so the two paths give the same numbers to the
+//! last bit; `fixed_path_equals_the_generic_path` in the Bouc–Wen kernel checks this.
+//!
+//! Reference: W. Kutta, Z. Math. Phys. 46, 1901 (the stages); Hairer, Nørsett & Wanner,
+//! *Solving Ordinary Differential Equations I*, 2nd ed., §I.14 (the sensitivities).
+
+use super::simulate::{diverged, InputTrack};
+use crate::Result;
+
+/// Receives each sample k with x(t_k) and S(t_k) (row-major n × q).
+pub type SampleSink<'a> = dyn FnMut(usize, &[f64], &[f64]) + 'a;
+
+/// One simulation with forward sensitivities, as [`super::simulate::simulate_sensitivities`]
+/// asks a model's own fixed-size path for it
+/// ([`StateSpaceModel::fixed_rk4_sensitivities`](super::StateSpaceModel::fixed_rk4_sensitivities)).
+#[derive(Clone, Copy, Debug)]
+pub struct Rk4Sensitivities<'a> {
+    /// The parameter vector θ.
+    pub theta: &'a [f64],
+    /// The initial state x(t₀).
+    pub x0: &'a [f64],
+    /// S(t₀), row-major n × q: zero, with a one in the column of each estimated initial state.
+    pub s0: &'a [f64],
+    /// The input, tabulated at the half-step nodes of the sub-steps.
+    pub input: &'a InputTrack,
+    /// Sample time \[s\].
+    pub ts: f64,
+    /// RK4 sub-steps per sample (≥ 1).
+    pub substeps: usize,
+    /// The sensitivity columns of θ (indices into θ), first in S.
+    pub params: &'a [usize],
+    /// The sensitivity columns of the initial states (indices into x), after `params`.
+    pub initial: &'a [usize],
+}
+
+impl Rk4Sensitivities<'_> {
+    /// Number of sensitivity columns q.
+    pub fn columns(&self) -> usize {
+        self.params.len() + self.initial.len()
+    }
+}
+
+/// ẋ = f(x, u) and Ṡ = (∂f/∂x)·S + ∂f/∂p for a model of N states and Q sensitivity columns,
+/// its parameters bound when the kernel was built.
+pub(crate) trait FixedSensitivityRhs<const N: usize, const Q: usize> {
+    /// ẋ into `dx` and Ṡ into `ds` at state `x`, sensitivities `s` and input `u`.
+    fn eval(
+        &self,
+        x: &[f64; N],
+        u: &[f64],
+        s: &[[f64; Q]; N],
+        dx: &mut [f64; N],
+        ds: &mut [[f64; Q]; N],
+    );
+}
+
+/// The augmented state [x, S] of fixed size.
+#[derive(Clone, Copy)]
+struct Augmented<const N: usize, const Q: usize> {
+    x: [f64; N],
+    s: [[f64; Q]; N],
+}
+
+impl<const N: usize, const Q: usize> Augmented<N, Q> {
+    const ZERO: Self = Self {
+        x: [0.0; N],
+        s: [[0.0; Q]; N],
+    };
+
+    /// `self = base + c·k`, element by element.
+    #[inline(always)]
+    fn set_axpy(&mut self, base: &Self, c: f64, k: &Self) {
+        for i in 0..N {
+            self.x[i] = base.x[i] + c * k.x[i];
+            for j in 0..Q {
+                self.s[i][j] = base.s[i][j] + c * k.s[i][j];
+            }
+        }
+    }
+
+    /// `self += c·(a + 2b + 2c + d)`, the RK4 update.
+    #[inline(always)]
+    fn add_rk4(&mut self, sixth: f64, k: &[Self; 4]) {
+        let w = |a: f64, b: f64, c: f64, d: f64| sixth * (a + 2.0 * b + 2.0 * c + d);
+        for i in 0..N {
+            self.x[i] += w(k[0].x[i], k[1].x[i], k[2].x[i], k[3].x[i]);
+            for j in 0..Q {
+                self.s[i][j] += w(k[0].s[i][j], k[1].s[i][j], k[2].s[i][j], k[3].s[i][j]);
+            }
+        }
+    }
+
+    fn is_finite(&self) -> bool {
+        self.x
+            .iter()
+            .chain(self.s.as_flattened())
+            .all(|v| v.is_finite())
+    }
+}
+
+/// Simulates `run` with RK4 (its sub-steps per sample) from x0 with S(t₀) = s0 (row-major
+/// N × Q), calling `on_sample(k, x(t_k), S(t_k))` at every sample. The input is read at the
+/// half-step nodes of the track ([`InputTrack::at_node`]), which the caller has checked lie
+/// on its grid (resolution 2·substeps).
+pub(crate) fn simulate<K, const N: usize, const Q: usize>(
+    kernel: &K,
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+) -> Result<()>
+where
+    K: FixedSensitivityRhs<N, Q>,
+{
+    let input = run.input;
+    let mut z = Augmented::<N, Q>::ZERO;
+    z.x.copy_from_slice(run.x0);
+    z.s.as_flattened_mut().copy_from_slice(run.s0);
+    let m = run.substeps.max(1);
+    let h = run.ts / m as f64;
+    let (half, sixth) = (0.5 * h, h / 6.0);
+    let mut k = [Augmented::<N, Q>::ZERO; 4];
+    let mut stage = Augmented::<N, Q>::ZERO;
+    // The input at the three nodes of a sub-step: start, middle, end.
+    let mut nodes: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; input.n_channels()]);
+    let n_samples = input.len();
+    for sample in 0..n_samples {
+        if !z.is_finite() {
+            return Err(diverged(sample));
+        }
+        on_sample(sample, &z.x, z.s.as_flattened());
+        if sample + 1 == n_samples {
+            break;
+        }
+        for j in 0..m {
+            for (n, node) in nodes.iter_mut().enumerate() {
+                input.at_node(sample, 2 * j + n, node);
+            }
+            let [k1, k2, k3, k4] = &mut k;
+            kernel.eval(&z.x, &nodes[0], &z.s, &mut k1.x, &mut k1.s);
+            stage.set_axpy(&z, half, k1);
+            kernel.eval(&stage.x, &nodes[1], &stage.s, &mut k2.x, &mut k2.s);
+            stage.set_axpy(&z, half, k2);
+            kernel.eval(&stage.x, &nodes[1], &stage.s, &mut k3.x, &mut k3.s);
+            stage.set_axpy(&z, h, k3);
+            kernel.eval(&stage.x, &nodes[2], &stage.s, &mut k4.x, &mut k4.s);
+            z.add_rk4(sixth, &k);
+        }
+    }
+    Ok(())
+}

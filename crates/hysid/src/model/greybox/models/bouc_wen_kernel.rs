@@ -1,0 +1,266 @@
+//! The Bouc–Wen oscillator's sensitivity right-hand side on fixed-size arrays, for
+//! [`crate::model::greybox::fixed_rk4`]: the same expressions, in the same order, as
+//! [`BoucWen::rhs_sensitivities`](super::BoucWen), with what depends on θ alone (1/mL and the
+//! first Jacobian row's entries) computed once per simulation instead of once per stage, and
+//! the direct term ∂f/∂θ of each column picked from a table built once.
+//!
+//! Equations and reference: see [`super::BoucWen`] (Noël & Schoukens 2016).
+
+use super::bouc_wen::{abs_pow, ALPHA, BD, BG, CL, KL, ML, NU};
+use super::sign0;
+use crate::model::greybox::fixed_rk4::{self, FixedSensitivityRhs, Rk4Sensitivities, SampleSink};
+use crate::Result;
+
+/// The largest number of sensitivity columns with a fixed-size path: the seven parameters and
+/// the three initial states.
+const MAX_COLUMNS: usize = 10;
+
+/// Slot of the zero direct term in the per-stage table of direct terms (initial-state columns
+/// and parameters without one).
+const ZERO: usize = 7;
+
+/// The Bouc–Wen right-hand side with its parameters bound (see the module docs).
+struct Kernel<const Q: usize> {
+    theta: [f64; 7],
+    /// 1/mL.
+    inv_m: f64,
+    /// ∂ÿ/∂(y, ẏ, z) = (−kL/mL, −cL/mL, −1/mL).
+    f1: [f64; 3],
+    /// Whether ν has a sensitivity column (its direct term needs ln|z|).
+    with_nu: bool,
+    /// Per column, the slot of its direct term: the parameter index, or [`ZERO`].
+    direct: [usize; Q],
+}
+
+impl<const Q: usize> Kernel<Q> {
+    fn new(run: &Rk4Sensitivities<'_>) -> Option<Self> {
+        let theta: [f64; 7] = run.theta.try_into().ok()?;
+        let mut direct = [ZERO; Q];
+        for (slot, &i) in direct.iter_mut().zip(run.params) {
+            *slot = if i < 7 { i } else { ZERO };
+        }
+        let inv_m = 1.0 / theta[ML];
+        Some(Self {
+            theta,
+            inv_m,
+            f1: [-theta[KL] * inv_m, -theta[CL] * inv_m, -inv_m],
+            with_nu: run.params.contains(&NU),
+            direct,
+        })
+    }
+}
+
+impl<const Q: usize> FixedSensitivityRhs<3, Q> for Kernel<Q> {
+    #[inline(always)]
+    fn eval(
+        &self,
+        x: &[f64; 3],
+        u: &[f64],
+        s: &[[f64; Q]; 3],
+        dx: &mut [f64; 3],
+        ds: &mut [[f64; Q]; 3],
+    ) {
+        let th = &self.theta;
+        let [y, v, z] = *x;
+        let nu = th[NU];
+        let m = th[ML];
+        let a = abs_pow(z, nu);
+        let sz = sign0(z);
+        let acc = (u[0] - th[CL] * v - th[KL] * y - z) / m;
+        *dx = [
+            v,
+            acc,
+            th[ALPHA] * v - th[BG] * v.abs() * sz * a - th[BD] * v * a,
+        ];
+        let da = if z == 0.0 {
+            if nu == 1.0 {
+                1.0
+            } else {
+                0.0
+            }
+        } else {
+            nu * abs_pow(z, nu - 1.0)
+        };
+        let inv_m = self.inv_m;
+        let [f10, f11, f12] = self.f1;
+        let f21 = th[ALPHA] - th[BG] * sign0(v) * sz * a - th[BD] * a;
+        let f22 = -th[BG] * v.abs() * da - th[BD] * v * da * sz;
+        // Rows 1 and 2 of ∂f/∂θ, indexed by parameter, with the zero slot last.
+        let mut d1 = [0.0; 8];
+        let mut d2 = [0.0; 8];
+        d1[ML] = -acc * inv_m;
+        d1[CL] = -v * inv_m;
+        d1[KL] = -y * inv_m;
+        d2[ALPHA] = v;
+        d2[BG] = -v.abs() * sz * a;
+        d2[BD] = -v * a;
+        if self.with_nu {
+            let ln = if z == 0.0 { 0.0 } else { z.abs().ln() };
+            d2[NU] = -(th[BG] * v.abs() * sz + th[BD] * v) * a * ln;
+        }
+        let [s0, s1, s2] = s;
+        ds[0] = *s1;
+        for c in 0..Q {
+            let slot = self.direct[c];
+            ds[1][c] = d1[slot] + f10 * s0[c] + f11 * s1[c] + f12 * s2[c];
+            ds[2][c] = d2[slot] + f21 * s1[c] + f22 * s2[c];
+        }
+    }
+}
+
+/// Runs the fixed-size path for the run's column count, None when there is none (more
+/// columns than [`MAX_COLUMNS`], or a θ of another length).
+pub(super) fn simulate(
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+) -> Option<Result<()>> {
+    fn with<const Q: usize>(
+        run: &Rk4Sensitivities<'_>,
+        on_sample: &mut SampleSink<'_>,
+    ) -> Option<Result<()>> {
+        let kernel = Kernel::<Q>::new(run)?;
+        Some(fixed_rk4::simulate::<_, 3, Q>(&kernel, run, on_sample))
+    }
+    const { assert!(MAX_COLUMNS == 10) };
+    match run.columns() {
+        1 => with::<1>(run, on_sample),
+        2 => with::<2>(run, on_sample),
+        3 => with::<3>(run, on_sample),
+        4 => with::<4>(run, on_sample),
+        5 => with::<5>(run, on_sample),
+        6 => with::<6>(run, on_sample),
+        7 => with::<7>(run, on_sample),
+        8 => with::<8>(run, on_sample),
+        9 => with::<9>(run, on_sample),
+        10 => with::<10>(run, on_sample),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::BoucWen;
+    use crate::model::greybox::simulate::{
+        simulate_sensitivities, InputInterpolation, InputTrack, Integrator, Simulation,
+    };
+    use crate::model::greybox::{Channel, JacobianScratch, ParameterSet, StateSpaceModel};
+    use crate::numerics::signal::multisine;
+
+    /// The Bouc–Wen model without its fixed-size path, so the generic path runs.
+    struct Generic;
+
+    impl StateSpaceModel for Generic {
+        fn kind(&self) -> &'static str {
+            "bouc_wen_generic"
+        }
+        fn states(&self) -> Vec<Channel> {
+            BoucWen.states()
+        }
+        fn inputs(&self) -> Vec<Channel> {
+            BoucWen.inputs()
+        }
+        fn outputs(&self) -> Vec<Channel> {
+            BoucWen.outputs()
+        }
+        fn parameters(&self) -> ParameterSet {
+            BoucWen.parameters()
+        }
+        fn rhs(&self, t: f64, x: &[f64], u: &[f64], theta: &[f64], dx: &mut [f64]) {
+            BoucWen.rhs(t, x, u, theta, dx)
+        }
+        fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
+            BoucWen.output(x, u, theta, y)
+        }
+        fn rhs_jacobians(
+            &self,
+            t: f64,
+            x: &[f64],
+            u: &[f64],
+            theta: &[f64],
+            fx: &mut [f64],
+            ftheta: &mut [f64],
+        ) -> bool {
+            BoucWen.rhs_jacobians(t, x, u, theta, fx, ftheta)
+        }
+        fn rhs_sensitivities(
+            &self,
+            t: f64,
+            x: &[f64],
+            u: &[f64],
+            theta: &[f64],
+            held: Option<f64>,
+            params: &[usize],
+            s: &[f64],
+            scratch: &mut JacobianScratch,
+            dx: &mut [f64],
+            ds: &mut [f64],
+        ) -> bool {
+            BoucWen.rhs_sensitivities(t, x, u, theta, held, params, s, scratch, dx, ds)
+        }
+    }
+
+    fn run(
+        model: &dyn StateSpaceModel,
+        theta: &[f64],
+        interpolation: InputInterpolation,
+        params: &[usize],
+        initial: &[usize],
+    ) -> Vec<f64> {
+        let u = multisine(1024, 1, 750.0, 5.0, 150.0, 50.0, 7).unwrap();
+        let sim = Simulation {
+            integrator: Integrator::Rk4 { substeps: 4 },
+            interpolation,
+        };
+        let track = InputTrack::new(&[&u], &sim).unwrap();
+        let mut out = Vec::new();
+        let x0 = [1e-4, -2e-3, 5e-5];
+        let ran = simulate_sensitivities(
+            model,
+            theta,
+            &x0,
+            &track,
+            1.0 / 750.0,
+            4,
+            params,
+            initial,
+            |_, x, s| {
+                out.extend_from_slice(x);
+                out.extend_from_slice(s);
+            },
+        )
+        .unwrap();
+        assert!(ran);
+        out
+    }
+
+    #[test]
+    fn fixed_path_equals_the_generic_path() {
+        let nominal = BoucWen.parameters().values();
+        let mut other_nu = nominal.clone();
+        other_nu[super::NU] = 1.3;
+        let columns: [(&[usize], &[usize]); 3] = [
+            (&[0, 1, 2, 3, 4, 5], &[]),
+            (&[1, 3, 4, 5, 6], &[0, 2]),
+            (&[2], &[1]),
+        ];
+        for theta in [&nominal, &other_nu] {
+            for interpolation in [
+                InputInterpolation::ZeroOrderHold,
+                InputInterpolation::Linear,
+                InputInterpolation::BandLimited,
+            ] {
+                for (params, initial) in columns {
+                    let fixed = run(&BoucWen, theta, interpolation, params, initial);
+                    let generic = run(&Generic, theta, interpolation, params, initial);
+                    assert_eq!(fixed.len(), generic.len());
+                    for (i, (a, b)) in fixed.iter().zip(&generic).enumerate() {
+                        assert!(
+                            a.to_bits() == b.to_bits(),
+                            "{interpolation:?} {params:?}/{initial:?} element {i}: {a} vs {b}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
