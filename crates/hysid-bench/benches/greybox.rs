@@ -2,7 +2,7 @@
 //! (40 960 samples): one simulation, one set of normal equations (the Jacobian work of one
 //! Levenberg–Marquardt iteration), the full fit from one start and from 8 starts.
 //!
-//! Run with `cargo bench -p hysid --bench greybox`.
+//! Run with `cargo bench -p hysid-bench --bench greybox`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::data::{CsvSpec, IdData};

@@ -2,7 +2,7 @@
 //! (and of f alone), from `examples/equations/bouc_wen.toml`, against a hand-written Rust
 //! transcription of hysid's built-in Bouc–Wen model (Noël & Schoukens 2016).
 //!
-//! Run with `cargo bench -p hysid-equations --bench tape`.
+//! Run with `cargo bench -p hysid-bench --bench tape`.
 
 use std::hint::black_box;
 

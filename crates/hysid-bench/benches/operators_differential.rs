@@ -2,7 +2,7 @@
 //! Duhem, Dahl): simulation of 50 000 samples of a decaying sine with nested minor loops, and
 //! one fit of each family from the data alone (5 000 samples; Jiles–Atherton on 2 000).
 //!
-//! Run with `cargo bench -p hysid --bench operators_differential`.
+//! Run with `cargo bench -p hysid-bench --bench operators_differential`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::identify::operators::{bouc_wen, dahl, duhem, jiles_atherton};

@@ -2,7 +2,7 @@
 //! family on 50 000 samples, the PI analytic inverse, and the PI (10 thresholds) and Preisach
 //! (20 levels, 210 cells) fits on 50 000 samples.
 //!
-//! Run with `cargo bench -p hysid --bench operators_linear`.
+//! Run with `cargo bench -p hysid-bench --bench operators_linear`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::identify::operators::{pi, preisach};

@@ -3,7 +3,7 @@
 //! steps on them (step 1, step 2, the four output-error fits of step 3 and the tables), and
 //! the EMPS inverse-dynamics least squares (docs/benchmarks.md §2.2).
 //!
-//! Run with `cargo bench -p hysid --bench actuator`.
+//! Run with `cargo bench -p hysid-bench --bench actuator`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::data::{Channel, CsvSpec, Experiment, IdData};

@@ -3,7 +3,7 @@
 //! on 10⁶ samples, and full identifications (the examples, and 10⁶ samples as
 //! `hysid identify cascade` runs them).
 //!
-//! Run with `cargo bench -p hysid --bench cascade`.
+//! Run with `cargo bench -p hysid-bench --bench cascade`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::experiments::voros::CascadeExample;

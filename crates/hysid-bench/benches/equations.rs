@@ -6,7 +6,7 @@
 //! (`examples/equations/backlash_first_order.toml`, the recursion with its chain-rule
 //! sensitivities, three free parameters) on a 40 960-sample multisine.
 //!
-//! Run with `cargo bench -p hysid --bench equations`.
+//! Run with `cargo bench -p hysid-bench --bench equations`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::data::{CsvSpec, IdData};
