@@ -221,4 +221,4 @@ mod num;
 mod tape;
 
 pub use error::EquationError;
-pub use model::{ColumnTape, EquationModel, InitialSpec, ParameterSpec, Scratch, TimeDomain};
+pub use model::{BoundColumns, ColumnTape, EquationModel, InitialSpec, ParameterSpec, Scratch, TimeDomain};

@@ -158,6 +158,66 @@ impl ColumnTape {
     }
 }
 
+/// A [`ColumnTape`] specialised to one parameter vector θ, for a simulation that holds θ
+/// fixed ([`EquationModel::bind_columns`]): what depends on θ alone is computed once, and
+/// the rest runs over a register file of its own, from (t, x, u).
+#[derive(Clone, Debug)]
+pub struct BoundColumns {
+    tape: Tape,
+    regs: Vec<f64>,
+    states: usize,
+    inputs: usize,
+}
+
+impl BoundColumns {
+    /// Number of instructions run per evaluation.
+    pub fn len(&self) -> usize {
+        self.tape.len()
+    }
+
+    /// True when no instruction is left (f and its Jacobians are constants or inputs).
+    pub fn is_empty(&self) -> bool {
+        self.tape.len() == 0
+    }
+
+    /// Whether f or its Jacobians read the time t.
+    pub fn uses_time(&self) -> bool {
+        self.tape.reads(0)
+    }
+
+    /// The value of result `k` (layout of [`Self::eval`]) when it does not depend on
+    /// (t, x, u): a Jacobian entry that is zero for this θ, say. Derivatives are reported
+    /// finite as [`Self::eval`] reports them.
+    pub fn constant(&self, k: usize) -> Option<f64> {
+        let v = self.tape.constant_result(k)?;
+        Some(if k < self.states { v } else { finite_or_zero(v) })
+    }
+
+    /// f, then ∂f/∂x (n×n row-major), then the bound columns of ∂f/∂θ (n×k row-major) at
+    /// (t, x, u) into `out` (n + n² + n·k entries), with the values of
+    /// [`EquationModel::rhs_jacobian_columns_with`] at the bound θ (to the bit).
+    ///
+    /// # Panics
+    /// If x, u or `out` do not have the model's lengths.
+    #[inline]
+    pub fn eval(&mut self, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
+        let (n, m) = (self.states, self.inputs);
+        check_len(out, self.tape.outputs().len(), "out");
+        self.regs[0] = t;
+        self.regs[1..1 + n].copy_from_slice(x);
+        self.regs[1 + n..1 + n + m].copy_from_slice(u);
+        self.tape.run_code(&mut self.regs);
+        let (values, derivatives) = out.split_at_mut(n);
+        let (f, jac) = self.tape.outputs().split_at(n);
+        for (o, &r) in values.iter_mut().zip(f) {
+            *o = self.regs[r as usize];
+        }
+        for (o, &r) in derivatives.iter_mut().zip(jac) {
+            *o = finite_or_zero(self.regs[r as usize]);
+        }
+    }
+}
+
 thread_local! {
     static SCRATCH: RefCell<Scratch> = const { RefCell::new(Scratch { regs: Vec::new() }) };
 }
@@ -397,6 +457,24 @@ impl EquationModel {
         check_len(fx, n * n, "fx");
         check_len(ftheta, n * columns.params.len(), "ftheta");
         self.eval(s, &columns.tape, t, x, u, theta, &mut [dx, fx, ftheta]);
+    }
+
+    /// The tape of `columns` with θ bound ([`Tape::bind`] on the slots of θ), None when θ
+    /// does not have the length of [`Self::parameters`].
+    pub fn bind_columns(&self, columns: &ColumnTape, theta: &[f64]) -> Option<BoundColumns> {
+        let (n, m) = (self.states.len(), self.inputs.len());
+        if theta.len() != self.parameters.len() {
+            return None;
+        }
+        let tape = columns.tape.bind(1 + n + m, theta);
+        let mut regs = vec![0.0; tape.registers()];
+        tape.load_constants(&mut regs);
+        Some(BoundColumns {
+            tape,
+            regs,
+            states: n,
+            inputs: m,
+        })
     }
 
     /// h with ∂h/∂x (ny×n, row-major) and ∂h/∂θ (ny×p, row-major).

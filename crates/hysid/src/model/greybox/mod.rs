@@ -26,6 +26,7 @@
 //! * [`models`]: the built-in models (Bouc–Wen oscillator, rigid body with friction).
 
 pub mod discrete;
+mod equation_kernel;
 pub mod equation_model;
 pub mod fixed_rk4;
 pub mod models;
