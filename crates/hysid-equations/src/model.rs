@@ -10,7 +10,7 @@ use crate::error::{line_column, EquationError};
 use crate::file::{self, ExprText, FileModel, Named};
 use crate::lower::{lower, Binding, Scope};
 use crate::num::finite_or_zero;
-use crate::tape::Tape;
+use crate::tape::{Tape, SMALL};
 
 /// Whether `[equations]` give derivatives or next states.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -158,29 +158,75 @@ impl ColumnTape {
     }
 }
 
-/// A [`ColumnTape`] specialised to one parameter vector θ, for a simulation that holds θ
-/// fixed ([`EquationModel::bind_columns`]): what depends on θ alone is computed once, and
-/// the rest runs over a register file of its own, from (t, x, u).
+/// A [`ColumnTape`] (or the tape of f) specialised to one parameter vector θ, for a
+/// simulation that holds θ fixed ([`EquationModel::bind_columns`],
+/// [`EquationModel::bind_rhs`]): what depends on θ alone is computed once, and the rest runs
+/// over a register file of its own, from (t, x, u).
 #[derive(Clone, Debug)]
 pub struct BoundColumns {
     tape: Tape,
-    regs: Vec<f64>,
+    regs: Box<[f64; SMALL]>,
     states: usize,
     inputs: usize,
+    /// Where [`Self::eval`] writes each result (the layout of [`Self::eval`] unless
+    /// [`Self::place`] moved them).
+    positions: Vec<usize>,
+    /// The values of f that depend on (t, x, u): (position, register).
+    values: Vec<(usize, u8)>,
+    /// The derivatives that depend on (t, x, u): (position, register).
+    derivatives: Vec<(usize, u8)>,
 }
 
 impl BoundColumns {
+    /// None when the tape needs more than [`SMALL`] registers.
+    fn new(tape: Tape, states: usize, inputs: usize) -> Option<Self> {
+        if tape.registers() > SMALL {
+            return None;
+        }
+        let mut regs = Box::new([0.0; SMALL]);
+        tape.load_constants(&mut regs[..]);
+        let mut bound = Self {
+            positions: (0..tape.outputs().len()).collect(),
+            tape,
+            regs,
+            states,
+            inputs,
+            values: Vec::new(),
+            derivatives: Vec::new(),
+        };
+        bound.place(|k| k);
+        Some(bound)
+    }
+
+    /// Makes [`Self::eval`] write result k (in the layout [`Self::eval`] describes) at
+    /// `position(k)` of its output instead, e.g. ∂f/∂θ rows padded to a wider stride.
+    pub fn place(&mut self, position: impl Fn(usize) -> usize) {
+        self.positions = (0..self.tape.outputs().len()).map(position).collect();
+        let varying = (0..self.positions.len()).filter(|&k| self.tape.constant_result(k).is_none());
+        let (values, derivatives): (Vec<usize>, Vec<usize>) =
+            varying.partition(|&k| k < self.states);
+        // Registers fit a byte: checked in `new`.
+        let at = |k: usize| (self.positions[k], self.tape.outputs()[k] as u8);
+        self.values = values.into_iter().map(at).collect();
+        self.derivatives = derivatives.into_iter().map(at).collect();
+    }
+
     /// Number of instructions run per evaluation.
     pub fn len(&self) -> usize {
         self.tape.len()
     }
 
-    /// True when no instruction is left (f and its Jacobians are constants or inputs).
+    /// True when no instruction is left (the results are constants or inputs).
     pub fn is_empty(&self) -> bool {
         self.tape.len() == 0
     }
 
-    /// Whether f or its Jacobians read the time t.
+    /// Number of results: n + n² + n·k for columns, n for f.
+    pub fn results(&self) -> usize {
+        self.tape.outputs().len()
+    }
+
+    /// Whether a result reads the time t.
     pub fn uses_time(&self) -> bool {
         self.tape.reads(0)
     }
@@ -193,27 +239,44 @@ impl BoundColumns {
         Some(if k < self.states { v } else { finite_or_zero(v) })
     }
 
-    /// f, then ∂f/∂x (n×n row-major), then the bound columns of ∂f/∂θ (n×k row-major) at
-    /// (t, x, u) into `out` (n + n² + n·k entries), with the values of
-    /// [`EquationModel::rhs_jacobian_columns_with`] at the bound θ (to the bit).
+    /// Writes the results that do not depend on (t, x, u) at their positions in `out`
+    /// ([`Self::eval`] leaves them alone): once per buffer.
+    pub fn fill_constants(&self, out: &mut [f64]) {
+        for (k, &p) in self.positions.iter().enumerate() {
+            if let Some(v) = self.constant(k) {
+                out[p] = v;
+            }
+        }
+    }
+
+    /// The results at (t, x, u) into `out` — f, then (for columns) ∂f/∂x (n×n row-major)
+    /// and the bound columns of ∂f/∂θ (n×k row-major), or where [`Self::place`] put them —
+    /// writing only the entries that depend on (t, x, u) (the others:
+    /// [`Self::fill_constants`]), with the values of
+    /// [`EquationModel::rhs_jacobian_columns_with`] (or [`EquationModel::rhs_with`]) at the
+    /// bound θ, to the bit.
     ///
     /// # Panics
-    /// If x, u or `out` do not have the model's lengths.
+    /// If x or u are shorter than the model's lengths, or `out` than the positions.
     #[inline]
     pub fn eval(&mut self, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
         let (n, m) = (self.states, self.inputs);
-        check_len(out, self.tape.outputs().len(), "out");
-        self.regs[0] = t;
-        self.regs[1..1 + n].copy_from_slice(x);
-        self.regs[1 + n..1 + n + m].copy_from_slice(u);
-        self.tape.run_code(&mut self.regs);
-        let (values, derivatives) = out.split_at_mut(n);
-        let (f, jac) = self.tape.outputs().split_at(n);
-        for (o, &r) in values.iter_mut().zip(f) {
-            *o = self.regs[r as usize];
+        // Element by element: a `copy_from_slice` of a few entries is a library call.
+        let regs = &mut *self.regs;
+        regs[0] = t;
+        for (r, &v) in regs[1..1 + n].iter_mut().zip(x) {
+            *r = v;
         }
-        for (o, &r) in derivatives.iter_mut().zip(jac) {
-            *o = finite_or_zero(self.regs[r as usize]);
+        for (r, &v) in regs[1 + n..1 + n + m].iter_mut().zip(u) {
+            *r = v;
+        }
+        self.tape.run_code_small(regs);
+        for &(k, r) in &self.values {
+            out[k] = regs[usize::from(r)];
+        }
+        for &(k, r) in &self.derivatives {
+            // Derivatives finite by convention (see the crate docs).
+            out[k] = finite_or_zero(regs[usize::from(r)]);
         }
     }
 }
@@ -459,22 +522,26 @@ impl EquationModel {
         self.eval(s, &columns.tape, t, x, u, theta, &mut [dx, fx, ftheta]);
     }
 
-    /// The tape of `columns` with θ bound ([`Tape::bind`] on the slots of θ), None when θ
-    /// does not have the length of [`Self::parameters`].
+    /// The tape of `columns` with θ bound (partial evaluation on the slots of θ: what θ
+    /// alone determines computed once, exact identities such as pow(x, 1) = x applied,
+    /// products fused into multiply–add superinstructions), None when θ does not have the
+    /// length of [`Self::parameters`] or the bound tape needs more than 256 registers.
     pub fn bind_columns(&self, columns: &ColumnTape, theta: &[f64]) -> Option<BoundColumns> {
         let (n, m) = (self.states.len(), self.inputs.len());
         if theta.len() != self.parameters.len() {
             return None;
         }
-        let tape = columns.tape.bind(1 + n + m, theta);
-        let mut regs = vec![0.0; tape.registers()];
-        tape.load_constants(&mut regs);
-        Some(BoundColumns {
-            tape,
-            regs,
-            states: n,
-            inputs: m,
-        })
+        BoundColumns::new(columns.tape.bind(1 + n + m, theta), n, m)
+    }
+
+    /// The tape of f with θ bound (see [`Self::bind_columns`]): [`BoundColumns::eval`] then
+    /// writes ẋ only (n results). None as for [`Self::bind_columns`].
+    pub fn bind_rhs(&self, theta: &[f64]) -> Option<BoundColumns> {
+        let (n, m) = (self.states.len(), self.inputs.len());
+        if theta.len() != self.parameters.len() {
+            return None;
+        }
+        BoundColumns::new(self.tapes.f.bind(1 + n + m, theta), n, m)
     }
 
     /// h with ∂h/∂x (ny×n, row-major) and ∂h/∂θ (ny×p, row-major).

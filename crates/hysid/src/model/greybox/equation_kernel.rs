@@ -29,30 +29,45 @@ const MAX_STATES: usize = 4;
 /// The largest sensitivity column count with a fixed-size path.
 const MAX_COLUMNS: usize = 10;
 
-/// f with its Jacobians from a bound tape, for N states and Q columns, the first `k` of
+/// Room for f, ∂f/∂x and ∂f/∂θ of the largest fixed-size case, rows of ∂f/∂θ padded to Q.
+const OUT: usize = 64;
+const _: () = assert!(MAX_STATES + MAX_STATES * MAX_STATES + MAX_STATES * MAX_COLUMNS <= OUT);
+
+/// f with its Jacobians from a bound tape, for N states and Q columns, the first k of
 /// them parameter columns.
 struct TapeKernel<const N: usize, const Q: usize> {
     tape: BoundColumns,
-    /// f, ∂f/∂x (N×N), ∂f/∂θ\[params\] (N×k), as the tape writes them.
-    out: Vec<f64>,
-    /// Number of parameter columns (the rest, initial states, have no direct term).
-    k: usize,
+    /// f, ∂f/∂x (N×N), ∂f/∂θ\[params\] (N×Q: the k columns of the tape, then the zero direct
+    /// terms of the initial-state columns), as the tape writes them: every index below is
+    /// then known to be in bounds at compile time.
+    out: [f64; OUT],
     /// Whether ∂fᵢ/∂xⱼ can be non-zero (false for an entry the bound tape knows is zero).
     coupled: [[bool; N]; N],
 }
 
 impl<const N: usize, const Q: usize> TapeKernel<N, Q> {
-    fn new(tape: BoundColumns, k: usize) -> Self {
+    fn new(mut tape: BoundColumns, k: usize) -> Self {
         let mut coupled = [[true; N]; N];
         for (i, row) in coupled.iter_mut().enumerate() {
             for (j, c) in row.iter_mut().enumerate() {
                 *c = tape.constant(N + i * N + j) != Some(0.0);
             }
         }
+        // ∂f/∂θ row i, column c (stride k in the tape's layout) goes to stride Q.
+        let direct = N + N * N;
+        tape.place(|r| {
+            if r < direct {
+                r
+            } else {
+                let (i, c) = ((r - direct) / k, (r - direct) % k);
+                direct + i * Q + c
+            }
+        });
+        let mut out = [0.0; OUT];
+        tape.fill_constants(&mut out);
         Self {
             tape,
-            out: vec![0.0; N + N * N + N * k],
-            k,
+            out,
             coupled,
         }
     }
@@ -70,17 +85,19 @@ impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N,
     ) {
         // Time-free tapes only (checked by `simulate`'s caller), so t is not needed.
         self.tape.eval(0.0, x, u, &mut self.out);
-        let (f, rest) = self.out.split_at(N);
-        let (fx, direct) = rest.split_at(N * N);
-        dx.copy_from_slice(f);
-        let k = self.k;
+        let out = &self.out;
+        for (i, d) in dx.iter_mut().enumerate() {
+            *d = out[i];
+        }
         for (i, row) in ds.iter_mut().enumerate() {
-            let (head, tail) = row.split_at_mut(k);
-            head.copy_from_slice(&direct[i * k..(i + 1) * k]);
-            tail.fill(0.0);
+            // The direct term (0 in the initial-state columns), then f_x·S in the order of
+            // the generic path.
+            for (c, d) in row.iter_mut().enumerate() {
+                *d = out[N + N * N + i * Q + c];
+            }
             for (j, s_j) in s.iter().enumerate() {
                 if self.coupled[i][j] {
-                    let a = fx[i * N + j];
+                    let a = out[N + i * N + j];
                     for (d, &sj) in row.iter_mut().zip(s_j) {
                         *d += a * sj;
                     }
@@ -90,9 +107,31 @@ impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N,
     }
 }
 
+/// ẋ alone from the bound tape of f, for a simulation without sensitivity columns (Q = 0).
+struct RateKernel<const N: usize> {
+    tape: BoundColumns,
+    /// ẋ as the tape writes it.
+    out: [f64; N],
+}
+
+impl<const N: usize> FixedSensitivityRhs<N, 0> for RateKernel<N> {
+    #[inline(always)]
+    fn eval(
+        &mut self,
+        x: &[f64; N],
+        u: &[f64],
+        _s: &[[f64; 0]; N],
+        dx: &mut [f64; N],
+        _ds: &mut [[f64; 0]; N],
+    ) {
+        self.tape.eval(0.0, x, u, &mut self.out);
+        *dx = self.out;
+    }
+}
+
 /// Runs the fixed-size path with the bound tape `tape` (which must not read t), None when
 /// the run's sizes have none (more than [`MAX_STATES`] states or [`MAX_COLUMNS`] columns,
-/// or no column).
+/// or no column: see [`simulate_rates`]).
 pub(super) fn simulate(
     tape: BoundColumns,
     run: &Rk4Sensitivities<'_>,
@@ -132,6 +171,33 @@ pub(super) fn simulate(
         2 => columns::<2>(tape, run, on_sample),
         3 => columns::<3>(tape, run, on_sample),
         4 => columns::<4>(tape, run, on_sample),
+        _ => None,
+    }
+}
+
+/// Runs the fixed-size path without sensitivities (a plain simulation) with the bound tape
+/// of f `tape` (which must not read t), None for more than [`MAX_STATES`] states.
+pub(super) fn simulate_rates(
+    tape: BoundColumns,
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+) -> Option<Result<()>> {
+    fn with<const N: usize>(
+        tape: BoundColumns,
+        run: &Rk4Sensitivities<'_>,
+        on_sample: &mut SampleSink<'_>,
+    ) -> Option<Result<()>> {
+        let mut out = [0.0; N];
+        tape.fill_constants(&mut out);
+        // `fill_constants` and `eval` write positions below N only (the layout of f).
+        let mut kernel = RateKernel::<N> { tape, out };
+        Some(fixed_rk4::simulate::<_, N, 0>(&mut kernel, run, on_sample))
+    }
+    match run.x0.len() {
+        1 => with::<1>(tape, run, on_sample),
+        2 => with::<2>(tape, run, on_sample),
+        3 => with::<3>(tape, run, on_sample),
+        4 => with::<4>(tape, run, on_sample),
         _ => None,
     }
 }

@@ -319,8 +319,9 @@ impl StateSpaceModel for EquationStateSpace {
     }
 
     /// The fixed-size path of the private `equation_kernel` module: the Jacobian tape of the
-    /// run's columns bound to its θ, for up to 4 states and 10 columns of a continuous-time
-    /// file that does not read t (otherwise None: the generic path runs).
+    /// run's columns (the tape of f for a run without columns, a plain simulation) bound to
+    /// its θ, for up to 4 states and 10 columns of a continuous-time file that does not read
+    /// t (otherwise None: the generic path runs).
     fn fixed_rk4_sensitivities(
         &self,
         run: &Rk4Sensitivities<'_>,
@@ -331,6 +332,13 @@ impl StateSpaceModel for EquationStateSpace {
             || run.input.n_channels() != self.inputs.len()
         {
             return None;
+        }
+        if run.columns() == 0 {
+            let tape = self.model.bind_rhs(run.theta)?;
+            if tape.uses_time() {
+                return None;
+            }
+            return equation_kernel::simulate_rates(tape, run, on_sample);
         }
         let fresh;
         let columns = match &self.free_columns {
