@@ -221,4 +221,6 @@ mod num;
 mod tape;
 
 pub use error::EquationError;
-pub use model::{BoundColumns, ColumnTape, EquationModel, InitialSpec, ParameterSpec, Scratch, TimeDomain};
+pub use model::{
+    BoundColumns, ColumnTape, EquationModel, InitialSpec, ParameterSpec, Scratch, TimeDomain,
+};

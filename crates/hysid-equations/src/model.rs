@@ -236,7 +236,11 @@ impl BoundColumns {
     /// finite as [`Self::eval`] reports them.
     pub fn constant(&self, k: usize) -> Option<f64> {
         let v = self.tape.constant_result(k)?;
-        Some(if k < self.states { v } else { finite_or_zero(v) })
+        Some(if k < self.states {
+            v
+        } else {
+            finite_or_zero(v)
+        })
     }
 
     /// Writes the results that do not depend on (t, x, u) at their positions in `out`
@@ -261,15 +265,38 @@ impl BoundColumns {
     #[inline]
     pub fn eval(&mut self, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
         let (n, m) = (self.states, self.inputs);
-        // Element by element: a `copy_from_slice` of a few entries is a library call.
         let regs = &mut *self.regs;
         regs[0] = t;
-        for (r, &v) in regs[1..1 + n].iter_mut().zip(x) {
-            *r = v;
+        regs[1..1 + n].copy_from_slice(x);
+        regs[1 + n..1 + n + m].copy_from_slice(u);
+        self.run(out);
+    }
+
+    /// [`Self::eval`] for a state of N entries known at compile time: x and u reach the
+    /// registers as single moves (a `copy_from_slice` of a few entries of run-time length
+    /// is a library call, which costs as much as several instructions of the tape).
+    ///
+    /// # Panics
+    /// If N is not the number of states, or u or `out` are too short.
+    #[inline]
+    pub fn eval_fixed<const N: usize>(&mut self, t: f64, x: &[f64; N], u: &[f64], out: &mut [f64]) {
+        assert_eq!(N, self.states, "states");
+        let regs = &mut *self.regs;
+        regs[0] = t;
+        for (i, &v) in x.iter().enumerate() {
+            regs[1 + i] = v;
         }
-        for (r, &v) in regs[1 + n..1 + n + m].iter_mut().zip(u) {
-            *r = v;
+        match u {
+            [u0] if self.inputs == 1 => regs[1 + N] = *u0,
+            _ => regs[1 + N..1 + N + self.inputs].copy_from_slice(&u[..self.inputs]),
         }
+        self.run(out);
+    }
+
+    /// Runs the code over the loaded registers and writes the varying results.
+    #[inline(always)]
+    fn run(&mut self, out: &mut [f64]) {
+        let regs = &mut *self.regs;
         self.tape.run_code_small(regs);
         for &(k, r) in &self.values {
             out[k] = regs[usize::from(r)];

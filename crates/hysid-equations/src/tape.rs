@@ -132,7 +132,11 @@ impl Instr {
             | NegDiv(a, b) => {
                 vec![a, b]
             }
-            Select(c, a, b) | MulAdd(c, a, b) | MulSub(c, a, b) | SubMul(c, a, b) | Mul3(c, a, b) => {
+            Select(c, a, b)
+            | MulAdd(c, a, b)
+            | MulSub(c, a, b)
+            | SubMul(c, a, b)
+            | Mul3(c, a, b) => {
                 vec![c, a, b]
             }
         }
@@ -653,6 +657,64 @@ mod tests {
         let o = only.outputs();
         assert_eq!(regs[o[0] as usize], 0.75);
         assert_eq!(regs[o[1] as usize], 0.75f64.sin());
+    }
+
+    /// Each superinstruction replaces a pair and gives the pair's value to the bit; a
+    /// product read twice is not fused.
+    #[test]
+    fn fused_products_give_the_same_values_with_fewer_instructions() {
+        let mut g = Graph::default();
+        let (a, b, c) = (g.var(1), g.var(2), g.var(3));
+        let mut roots = Vec::new();
+        let ab = g.bin(Fn2::Mul, a, b);
+        roots.push(g.bin(Fn2::Add, ab, c)); // a·b + c
+        roots.push(g.bin(Fn2::Sub, ab, c)); // a·b − c
+        roots.push(g.bin(Fn2::Sub, c, ab)); // c − a·b
+        roots.push(g.bin(Fn2::Mul, ab, c)); // (a·b)·c
+        roots.push(g.neg(ab)); // −(a·b)
+        let na = g.neg(a);
+        roots.push(g.bin(Fn2::Div, na, c)); // (−a)/c
+        let ac = g.bin(Fn2::Mul, a, c);
+        let once = g.bin(Fn2::Add, ac, b); // a·c + b, the product read once
+        roots.push(once);
+        let tape = Tape::compile(&g, 4, &roots);
+        let fused = tape.fuse();
+        // a·b is read five times and stays; −a and a·c are read once and fuse.
+        assert_eq!((tape.len(), fused.len()), (10, 8));
+        for (x, y, z) in [(0.3, -1.7, 2.9), (1e-3, 7.0, -0.1), (0.0, -0.0, 1.0)] {
+            let run = |t: &Tape| {
+                let mut regs = vec![0.0; t.registers()];
+                regs[1..4].copy_from_slice(&[x, y, z]);
+                t.run(&mut regs);
+                t.outputs()
+                    .iter()
+                    .map(|&o| regs[o as usize].to_bits())
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(run(&tape), run(&fused));
+        }
+    }
+
+    /// Binding θ computes θ-only instructions once and applies pow(x, 1) = x.
+    #[test]
+    fn binding_folds_what_the_bound_slots_determine() {
+        let mut g = Graph::default();
+        let (x, k, nu) = (g.var(1), g.var(2), g.var(3));
+        let two = g.konst(2.0);
+        let k2 = g.bin(Fn2::Mul, two, k);
+        let p = g.bin(Fn2::Pow, x, nu);
+        let root = g.bin(Fn2::Mul, k2, p); // 2k·x^ν
+        let tape = Tape::compile(&g, 4, &[root]);
+        assert_eq!(tape.len(), 3);
+        let bound = tape.bind(2, &[3.0, 1.0]);
+        assert_eq!(bound.len(), 1); // 6·x
+        let mut regs = vec![0.0; bound.registers()];
+        regs[1] = 0.7;
+        bound.run(&mut regs);
+        assert_eq!(regs[bound.outputs()[0] as usize], 6.0 * 0.7);
+        let curved = tape.bind(2, &[3.0, 1.5]);
+        assert_eq!(curved.len(), 2); // x^1.5, then 6·that
+        assert!(!curved.reads(0) && curved.reads(1));
     }
 
     #[test]

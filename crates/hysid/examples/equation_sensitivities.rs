@@ -29,7 +29,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         time: None,
         ts: None,
     };
-    let data = IdData::from_csv(&root.join("data/bouc-wen/train_multisine_5periods.csv"), &spec)?;
+    let data = IdData::from_csv(
+        &root.join("data/bouc-wen/train_multisine_5periods.csv"),
+        &spec,
+    )?;
     let model: Arc<dyn StateSpaceModel> = match which {
         "built-in" => Arc::new(BoucWen),
         "file" => Arc::new(EquationStateSpace::load(
