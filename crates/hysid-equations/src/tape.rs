@@ -461,9 +461,9 @@ impl Tape {
                 Src::Known(v) => Some(v),
                 Src::Reg(_) => None,
             };
-            let reduced = match known_value(instr, &known) {
+            let reduced = match known_value(instr, known) {
                 Some(v) => Reduced::Value(v),
-                None => reduce(instr, &known),
+                None => reduce(instr, known),
             };
             let next = match reduced {
                 Reduced::Alias(r) => src[r as usize],
