@@ -197,6 +197,15 @@
 //! allocates, neither with a caller-owned [`Scratch`] (`*_with` methods) nor with the
 //! per-thread scratch the plain `&self` methods use (grown once per thread).
 //!
+//! A simulation holds θ fixed, so it can bind it ([`EquationModel::bind_columns`],
+//! [`EquationModel::bind_rhs`], giving a [`BoundColumns`]): the tape is partially evaluated
+//! with θ known — every instruction reading only parameters and constants is computed once,
+//! the exact identities x·1 = x, x·(−1) = −x, x/1 = x, pow(x, 1) = x, pow(x, 0) = 1 and
+//! `if` with a known condition apply — then each product read once is fused with the
+//! addition, subtraction, product or negation reading it (superinstructions). The bound
+//! tape computes the unbound tape's values to the bit, with about half the instructions
+//! for Bouc–Wen at ν = 1, over a register file of 256 entries read without bounds checks.
+//!
 //! ## Errors
 //!
 //! Every problem is one [`EquationError`], displayed on one line as
@@ -221,4 +230,6 @@ mod num;
 mod tape;
 
 pub use error::EquationError;
-pub use model::{ColumnTape, EquationModel, InitialSpec, ParameterSpec, Scratch, TimeDomain};
+pub use model::{
+    BoundColumns, ColumnTape, EquationModel, InitialSpec, ParameterSpec, Scratch, TimeDomain,
+};

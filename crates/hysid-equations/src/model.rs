@@ -10,7 +10,7 @@ use crate::error::{line_column, EquationError};
 use crate::file::{self, ExprText, FileModel, Named};
 use crate::lower::{lower, Binding, Scope};
 use crate::num::finite_or_zero;
-use crate::tape::Tape;
+use crate::tape::{Tape, SMALL};
 
 /// Whether `[equations]` give derivatives or next states.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -155,6 +155,156 @@ impl ColumnTape {
     /// constants).
     pub fn is_empty(&self) -> bool {
         self.tape.len() == 0
+    }
+}
+
+/// A [`ColumnTape`] (or the tape of f) specialised to one parameter vector θ, for a
+/// simulation that holds θ fixed ([`EquationModel::bind_columns`],
+/// [`EquationModel::bind_rhs`]): what depends on θ alone is computed once, and the rest runs
+/// over a register file of its own, from (t, x, u).
+#[derive(Clone, Debug)]
+pub struct BoundColumns {
+    tape: Tape,
+    regs: Box<[f64; SMALL]>,
+    states: usize,
+    inputs: usize,
+    /// Where [`Self::eval`] writes each result (the layout of [`Self::eval`] unless
+    /// [`Self::place`] moved them).
+    positions: Vec<usize>,
+    /// The values of f that depend on (t, x, u): (position, register).
+    values: Vec<(usize, u8)>,
+    /// The derivatives that depend on (t, x, u): (position, register).
+    derivatives: Vec<(usize, u8)>,
+}
+
+impl BoundColumns {
+    /// None when the tape needs more than [`SMALL`] registers.
+    fn new(tape: Tape, states: usize, inputs: usize) -> Option<Self> {
+        if tape.registers() > SMALL {
+            return None;
+        }
+        let mut regs = Box::new([0.0; SMALL]);
+        tape.load_constants(&mut regs[..]);
+        let mut bound = Self {
+            positions: (0..tape.outputs().len()).collect(),
+            tape,
+            regs,
+            states,
+            inputs,
+            values: Vec::new(),
+            derivatives: Vec::new(),
+        };
+        bound.place(|k| k);
+        Some(bound)
+    }
+
+    /// Makes [`Self::eval`] write result k (in the layout [`Self::eval`] describes) at
+    /// `position(k)` of its output instead, e.g. ∂f/∂θ rows padded to a wider stride.
+    pub fn place(&mut self, position: impl Fn(usize) -> usize) {
+        self.positions = (0..self.tape.outputs().len()).map(position).collect();
+        let varying = (0..self.positions.len()).filter(|&k| self.tape.constant_result(k).is_none());
+        let (values, derivatives): (Vec<usize>, Vec<usize>) =
+            varying.partition(|&k| k < self.states);
+        // Registers fit a byte: checked in `new`.
+        let at = |k: usize| (self.positions[k], self.tape.outputs()[k] as u8);
+        self.values = values.into_iter().map(at).collect();
+        self.derivatives = derivatives.into_iter().map(at).collect();
+    }
+
+    /// Number of instructions run per evaluation.
+    pub fn len(&self) -> usize {
+        self.tape.len()
+    }
+
+    /// True when no instruction is left (the results are constants or inputs).
+    pub fn is_empty(&self) -> bool {
+        self.tape.len() == 0
+    }
+
+    /// Number of results: n + n² + n·k for columns, n for f.
+    pub fn results(&self) -> usize {
+        self.tape.outputs().len()
+    }
+
+    /// Whether a result reads the time t.
+    pub fn uses_time(&self) -> bool {
+        self.tape.reads(0)
+    }
+
+    /// The value of result `k` (layout of [`Self::eval`]) when it does not depend on
+    /// (t, x, u): a Jacobian entry that is zero for this θ, say. Derivatives are reported
+    /// finite as [`Self::eval`] reports them.
+    pub fn constant(&self, k: usize) -> Option<f64> {
+        let v = self.tape.constant_result(k)?;
+        Some(if k < self.states {
+            v
+        } else {
+            finite_or_zero(v)
+        })
+    }
+
+    /// Writes the results that do not depend on (t, x, u) at their positions in `out`
+    /// ([`Self::eval`] leaves them alone): once per buffer.
+    pub fn fill_constants(&self, out: &mut [f64]) {
+        for (k, &p) in self.positions.iter().enumerate() {
+            if let Some(v) = self.constant(k) {
+                out[p] = v;
+            }
+        }
+    }
+
+    /// The results at (t, x, u) into `out` — f, then (for columns) ∂f/∂x (n×n row-major)
+    /// and the bound columns of ∂f/∂θ (n×k row-major), or where [`Self::place`] put them —
+    /// writing only the entries that depend on (t, x, u) (the others:
+    /// [`Self::fill_constants`]), with the values of
+    /// [`EquationModel::rhs_jacobian_columns_with`] (or [`EquationModel::rhs_with`]) at the
+    /// bound θ, to the bit.
+    ///
+    /// # Panics
+    /// If x or u are shorter than the model's lengths, or `out` than the positions.
+    #[inline]
+    pub fn eval(&mut self, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
+        let (n, m) = (self.states, self.inputs);
+        let regs = &mut *self.regs;
+        regs[0] = t;
+        regs[1..1 + n].copy_from_slice(x);
+        regs[1 + n..1 + n + m].copy_from_slice(u);
+        self.run(out);
+    }
+
+    /// [`Self::eval`] for a state of N entries known at compile time: x and u reach the
+    /// registers as single moves (a `copy_from_slice` of a few entries of run-time length
+    /// is a library call, which costs as much as several instructions of the tape).
+    ///
+    /// # Panics
+    /// If N is not the number of states, or u or `out` are too short.
+    #[inline]
+    pub fn eval_fixed<const N: usize>(&mut self, t: f64, x: &[f64; N], u: &[f64], out: &mut [f64]) {
+        assert_eq!(N, self.states, "states");
+        let regs = &mut *self.regs;
+        regs[0] = t;
+        for (i, &v) in x.iter().enumerate() {
+            regs[1 + i] = v;
+        }
+        match u {
+            [u0] if self.inputs == 1 => regs[1 + N] = *u0,
+            _ => regs[1 + N..1 + N + self.inputs].copy_from_slice(&u[..self.inputs]),
+        }
+        self.run(out);
+    }
+
+    /// Runs the code over the loaded registers and writes the varying results.
+    #[inline(always)]
+    fn run(&mut self, out: &mut [f64]) {
+        let regs = &mut *self.regs;
+        self.tape.run_code_small(regs);
+        for &(k, r) in &self.values {
+            out[k] = regs[usize::from(r)];
+        }
+        for &(k, r) in &self.derivatives {
+            // Derivatives finite by convention (see the crate docs).
+            out[k] = finite_or_zero(regs[usize::from(r)]);
+        }
     }
 }
 
@@ -397,6 +547,28 @@ impl EquationModel {
         check_len(fx, n * n, "fx");
         check_len(ftheta, n * columns.params.len(), "ftheta");
         self.eval(s, &columns.tape, t, x, u, theta, &mut [dx, fx, ftheta]);
+    }
+
+    /// The tape of `columns` with θ bound (partial evaluation on the slots of θ: what θ
+    /// alone determines computed once, exact identities such as pow(x, 1) = x applied,
+    /// products fused into multiply–add superinstructions), None when θ does not have the
+    /// length of [`Self::parameters`] or the bound tape needs more than 256 registers.
+    pub fn bind_columns(&self, columns: &ColumnTape, theta: &[f64]) -> Option<BoundColumns> {
+        let (n, m) = (self.states.len(), self.inputs.len());
+        if theta.len() != self.parameters.len() {
+            return None;
+        }
+        BoundColumns::new(columns.tape.bind(1 + n + m, theta), n, m)
+    }
+
+    /// The tape of f with θ bound (see [`Self::bind_columns`]): [`BoundColumns::eval`] then
+    /// writes ẋ only (n results). None as for [`Self::bind_columns`].
+    pub fn bind_rhs(&self, theta: &[f64]) -> Option<BoundColumns> {
+        let (n, m) = (self.states.len(), self.inputs.len());
+        if theta.len() != self.parameters.len() {
+            return None;
+        }
+        BoundColumns::new(self.tapes.f.bind(1 + n + m, theta), n, m)
     }
 
     /// h with ∂h/∂x (ny×n, row-major) and ∂h/∂θ (ny×p, row-major).

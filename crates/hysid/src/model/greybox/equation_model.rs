@@ -33,7 +33,8 @@
 //! S\[k+1\] = f_x·S\[k\] + f_θ ([`super::discrete`]); the integrator and the input
 //! interpolation do not apply to it.
 
-use super::{sensitivity, JacobianScratch, StateSpaceModel};
+use super::fixed_rk4::{Rk4Sensitivities, SampleSink};
+use super::{equation_kernel, sensitivity, JacobianScratch, StateSpaceModel};
 use crate::data::Channel;
 use crate::error::EquationFileError;
 use crate::model::{Parameter, ParameterSet};
@@ -315,6 +316,43 @@ impl StateSpaceModel for EquationStateSpace {
         }
         sensitivity_rates(n, fx, direct, s, ds);
         true
+    }
+
+    /// The fixed-size path of the private `equation_kernel` module: the Jacobian tape of the
+    /// run's columns (the tape of f for a run without columns, a plain simulation) bound to
+    /// its θ, for up to 4 states and 10 columns of a continuous-time file that does not read
+    /// t (otherwise None: the generic path runs).
+    fn fixed_rk4_sensitivities(
+        &self,
+        run: &Rk4Sensitivities<'_>,
+        on_sample: &mut SampleSink<'_>,
+    ) -> Option<Result<()>> {
+        if self.discrete_time()
+            || run.x0.len() != self.states.len()
+            || run.input.n_channels() != self.inputs.len()
+        {
+            return None;
+        }
+        if run.columns() == 0 {
+            let tape = self.model.bind_rhs(run.theta)?;
+            if tape.uses_time() {
+                return None;
+            }
+            return equation_kernel::simulate_rates(tape, run, on_sample);
+        }
+        let fresh;
+        let columns = match &self.free_columns {
+            Some(c) if c.params() == run.params => c,
+            _ => {
+                fresh = self.model.rhs_jacobian_columns(run.params)?;
+                &fresh
+            }
+        };
+        let tape = self.model.bind_columns(columns, run.theta)?;
+        if tape.uses_time() {
+            return None;
+        }
+        equation_kernel::simulate(tape, run, on_sample)
     }
 
     /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded).

@@ -55,11 +55,12 @@ impl Rk4Sensitivities<'_> {
 }
 
 /// ẋ = f(x, u) and Ṡ = (∂f/∂x)·S + ∂f/∂p for a model of N states and Q sensitivity columns,
-/// its parameters bound when the kernel was built.
+/// its parameters bound when the kernel was built. `&mut self`: a kernel may evaluate into
+/// buffers of its own (the equation-file tape's registers).
 pub(crate) trait FixedSensitivityRhs<const N: usize, const Q: usize> {
     /// ẋ into `dx` and Ṡ into `ds` at state `x`, sensitivities `s` and input `u`.
     fn eval(
-        &self,
+        &mut self,
         x: &[f64; N],
         u: &[f64],
         s: &[[f64; Q]; N],
@@ -117,7 +118,7 @@ impl<const N: usize, const Q: usize> Augmented<N, Q> {
 /// half-step nodes of the track ([`InputTrack::at_node`]), which the caller has checked lie
 /// on its grid (resolution 2·substeps).
 pub(crate) fn simulate<K, const N: usize, const Q: usize>(
-    kernel: &K,
+    kernel: &mut K,
     run: &Rk4Sensitivities<'_>,
     on_sample: &mut SampleSink<'_>,
 ) -> Result<()>

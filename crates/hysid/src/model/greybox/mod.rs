@@ -26,6 +26,7 @@
 //! * [`models`]: the built-in models (Bouc–Wen oscillator, rigid body with friction).
 
 pub mod discrete;
+mod equation_kernel;
 pub mod equation_model;
 pub mod fixed_rk4;
 pub mod models;
@@ -176,7 +177,8 @@ pub trait StateSpaceModel: Sync + Send {
     /// ([`fixed_rk4`]: fixed-size arrays, the parameters' constants computed once), giving
     /// the same numbers to the last bit as the generic path built on
     /// [`rhs_sensitivities`](Self::rhs_sensitivities). Called only for RK4 whose input lies
-    /// on the half-step grid. None (the default) when the model has no such path for these
+    /// on the half-step grid, also without columns (q = 0) for a plain simulation
+    /// ([`simulate::simulate`]). None (the default) when the model has no such path for these
     /// columns: the generic path runs.
     fn fixed_rk4_sensitivities(
         &self,

@@ -246,6 +246,26 @@ pub fn simulate(
     if model.discrete_time() {
         return super::discrete::simulate(model, theta, x0, input, ts, on_sample);
     }
+    if let Integrator::Rk4 { substeps } = integrator {
+        let m = substeps.max(1);
+        if input.resolution() == 2 * m {
+            // The model's fixed-size path without sensitivity columns, if it has one.
+            let run = Rk4Sensitivities {
+                theta,
+                x0,
+                s0: &[],
+                input,
+                ts,
+                substeps: m,
+                params: &[],
+                initial: &[],
+            };
+            let mut states_only = |k: usize, x: &[f64], _: &[f64]| on_sample(k, x);
+            if let Some(done) = model.fixed_rk4_sensitivities(&run, &mut states_only) {
+                return done;
+            }
+        }
+    }
     let n = input.len();
     let mut x = x0.to_vec();
     let mut stepper = Stepper::new(model, theta, input, ts, integrator)?;

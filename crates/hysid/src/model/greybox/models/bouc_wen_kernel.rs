@@ -53,7 +53,7 @@ impl<const Q: usize> Kernel<Q> {
 impl<const Q: usize> FixedSensitivityRhs<3, Q> for Kernel<Q> {
     #[inline(always)]
     fn eval(
-        &self,
+        &mut self,
         x: &[f64; 3],
         u: &[f64],
         s: &[[f64; Q]; 3],
@@ -118,8 +118,8 @@ pub(super) fn simulate(
         run: &Rk4Sensitivities<'_>,
         on_sample: &mut SampleSink<'_>,
     ) -> Option<Result<()>> {
-        let kernel = Kernel::<Q>::new(run)?;
-        Some(fixed_rk4::simulate::<_, 3, Q>(&kernel, run, on_sample))
+        let mut kernel = Kernel::<Q>::new(run)?;
+        Some(fixed_rk4::simulate::<_, 3, Q>(&mut kernel, run, on_sample))
     }
     const { assert!(MAX_COLUMNS == 10) };
     match run.columns() {

@@ -1,0 +1,402 @@
+//! The fixed-size RK4 sensitivity path ([`super::fixed_rk4`]) for equation-file models
+//! ([`super::equation_model`]).
+//!
+//! Per simulation, the tape of f, ∂f/∂x and the estimated columns of ∂f/∂θ is specialised to
+//! the simulation's θ ([`hysid_equations::EquationModel::bind_columns`]: everything that
+//! depends on θ alone computed once, the exact identities x·1 = x and pow(x, 1) = x applied,
+//! products fused into superinstructions), then each RK4 stage runs that shorter tape from
+//! (x, u) and forms
+//!
+//! ```text
+//! Ṡ = (∂f/∂x)·S + [∂f/∂θ, 0]
+//! ```
+//!
+//! on arrays of N states and Q columns known at compile time, skipping the entries of ∂f/∂x
+//! that are zero for this θ. The sums run in the order of the generic path
+//! ([`super::sensitivity::default_rhs_sensitivities`]), so the numbers are those of the
+//! generic path (up to the sign of a zero), which `equation_path_equals_the_generic_path`
+//! in the tests of [`super::equation_model`] checks to the bit.
+//!
+//! Reference: forward sensitivities of ODEs, Hairer, Nørsett & Wanner, *Solving Ordinary
+//! Differential Equations I*, 2nd ed., §I.14.
+
+use super::fixed_rk4::{self, FixedSensitivityRhs, Rk4Sensitivities, SampleSink};
+use crate::Result;
+use hysid_equations::BoundColumns;
+
+/// The largest state count with a fixed-size path.
+const MAX_STATES: usize = 4;
+/// The largest sensitivity column count with a fixed-size path.
+const MAX_COLUMNS: usize = 10;
+
+/// Room for f, ∂f/∂x and ∂f/∂θ of the largest fixed-size case, rows of ∂f/∂θ padded to Q.
+const OUT: usize = 64;
+const _: () = assert!(MAX_STATES + MAX_STATES * MAX_STATES + MAX_STATES * MAX_COLUMNS <= OUT);
+
+/// f with its Jacobians from a bound tape, for N states and Q columns, the first k of
+/// them parameter columns.
+struct TapeKernel<const N: usize, const Q: usize> {
+    tape: BoundColumns,
+    /// f, ∂f/∂x (N×N), ∂f/∂θ\[params\] (N×Q: the k columns of the tape, then the zero direct
+    /// terms of the initial-state columns), as the tape writes them: every index below is
+    /// then known to be in bounds at compile time.
+    out: [f64; OUT],
+    /// Whether ∂fᵢ/∂xⱼ can be non-zero (false for an entry the bound tape knows is zero).
+    coupled: [[bool; N]; N],
+}
+
+impl<const N: usize, const Q: usize> TapeKernel<N, Q> {
+    fn new(mut tape: BoundColumns, k: usize) -> Self {
+        let mut coupled = [[true; N]; N];
+        for (i, row) in coupled.iter_mut().enumerate() {
+            for (j, c) in row.iter_mut().enumerate() {
+                *c = tape.constant(N + i * N + j) != Some(0.0);
+            }
+        }
+        // ∂f/∂θ row i, column c (stride k in the tape's layout) goes to stride Q.
+        let direct = N + N * N;
+        tape.place(|r| {
+            if r < direct {
+                r
+            } else {
+                let (i, c) = ((r - direct) / k, (r - direct) % k);
+                direct + i * Q + c
+            }
+        });
+        let mut out = [0.0; OUT];
+        tape.fill_constants(&mut out);
+        Self { tape, out, coupled }
+    }
+}
+
+impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N, Q> {
+    #[inline(always)]
+    fn eval(
+        &mut self,
+        x: &[f64; N],
+        u: &[f64],
+        s: &[[f64; Q]; N],
+        dx: &mut [f64; N],
+        ds: &mut [[f64; Q]; N],
+    ) {
+        // Time-free tapes only (checked by `simulate`'s caller), so t is not needed.
+        self.tape.eval_fixed(0.0, x, u, &mut self.out);
+        let out = &self.out;
+        for (i, d) in dx.iter_mut().enumerate() {
+            *d = out[i];
+        }
+        for (i, row) in ds.iter_mut().enumerate() {
+            // The direct term (0 in the initial-state columns), then f_x·S in the order of
+            // the generic path.
+            for (c, d) in row.iter_mut().enumerate() {
+                *d = out[N + N * N + i * Q + c];
+            }
+            for (j, s_j) in s.iter().enumerate() {
+                if self.coupled[i][j] {
+                    let a = out[N + i * N + j];
+                    for (d, &sj) in row.iter_mut().zip(s_j) {
+                        *d += a * sj;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// ẋ alone from the bound tape of f, for a simulation without sensitivity columns (Q = 0).
+struct RateKernel<const N: usize> {
+    tape: BoundColumns,
+    /// ẋ as the tape writes it.
+    out: [f64; N],
+}
+
+impl<const N: usize> FixedSensitivityRhs<N, 0> for RateKernel<N> {
+    #[inline(always)]
+    fn eval(
+        &mut self,
+        x: &[f64; N],
+        u: &[f64],
+        _s: &[[f64; 0]; N],
+        dx: &mut [f64; N],
+        _ds: &mut [[f64; 0]; N],
+    ) {
+        self.tape.eval_fixed(0.0, x, u, &mut self.out);
+        *dx = self.out;
+    }
+}
+
+/// Runs the fixed-size path with the bound tape `tape` (which must not read t), None when
+/// the run's sizes have none (more than [`MAX_STATES`] states or [`MAX_COLUMNS`] columns,
+/// or no column: see [`simulate_rates`]).
+pub(super) fn simulate(
+    tape: BoundColumns,
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+) -> Option<Result<()>> {
+    fn with<const N: usize, const Q: usize>(
+        tape: BoundColumns,
+        run: &Rk4Sensitivities<'_>,
+        on_sample: &mut SampleSink<'_>,
+    ) -> Option<Result<()>> {
+        let mut kernel = TapeKernel::<N, Q>::new(tape, run.params.len());
+        Some(fixed_rk4::simulate::<_, N, Q>(&mut kernel, run, on_sample))
+    }
+    fn columns<const N: usize>(
+        tape: BoundColumns,
+        run: &Rk4Sensitivities<'_>,
+        on_sample: &mut SampleSink<'_>,
+    ) -> Option<Result<()>> {
+        const { assert!(MAX_COLUMNS == 10) };
+        match run.columns() {
+            1 => with::<N, 1>(tape, run, on_sample),
+            2 => with::<N, 2>(tape, run, on_sample),
+            3 => with::<N, 3>(tape, run, on_sample),
+            4 => with::<N, 4>(tape, run, on_sample),
+            5 => with::<N, 5>(tape, run, on_sample),
+            6 => with::<N, 6>(tape, run, on_sample),
+            7 => with::<N, 7>(tape, run, on_sample),
+            8 => with::<N, 8>(tape, run, on_sample),
+            9 => with::<N, 9>(tape, run, on_sample),
+            10 => with::<N, 10>(tape, run, on_sample),
+            _ => None,
+        }
+    }
+    const { assert!(MAX_STATES == 4) };
+    match run.x0.len() {
+        1 => columns::<1>(tape, run, on_sample),
+        2 => columns::<2>(tape, run, on_sample),
+        3 => columns::<3>(tape, run, on_sample),
+        4 => columns::<4>(tape, run, on_sample),
+        _ => None,
+    }
+}
+
+/// Runs the fixed-size path without sensitivities (a plain simulation) with the bound tape
+/// of f `tape` (which must not read t), None for more than [`MAX_STATES`] states.
+pub(super) fn simulate_rates(
+    tape: BoundColumns,
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+) -> Option<Result<()>> {
+    fn with<const N: usize>(
+        tape: BoundColumns,
+        run: &Rk4Sensitivities<'_>,
+        on_sample: &mut SampleSink<'_>,
+    ) -> Option<Result<()>> {
+        let mut out = [0.0; N];
+        tape.fill_constants(&mut out);
+        // `fill_constants` and `eval` write positions below N only (the layout of f).
+        let mut kernel = RateKernel::<N> { tape, out };
+        Some(fixed_rk4::simulate::<_, N, 0>(&mut kernel, run, on_sample))
+    }
+    match run.x0.len() {
+        1 => with::<1>(tape, run, on_sample),
+        2 => with::<2>(tape, run, on_sample),
+        3 => with::<3>(tape, run, on_sample),
+        4 => with::<4>(tape, run, on_sample),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::model::greybox::equation_model::EquationStateSpace;
+    use crate::model::greybox::simulate::{
+        simulate, simulate_sensitivities, InputInterpolation, InputTrack, Integrator, Simulation,
+    };
+    use crate::model::greybox::{Channel, JacobianScratch, ParameterSet, StateSpaceModel};
+    use crate::numerics::signal::multisine;
+
+    /// An equation model without its fixed-size path, so the generic path runs.
+    struct Generic(EquationStateSpace);
+
+    impl StateSpaceModel for Generic {
+        fn kind(&self) -> &'static str {
+            "equations_generic"
+        }
+        fn states(&self) -> Vec<Channel> {
+            self.0.states()
+        }
+        fn inputs(&self) -> Vec<Channel> {
+            self.0.inputs()
+        }
+        fn outputs(&self) -> Vec<Channel> {
+            self.0.outputs()
+        }
+        fn parameters(&self) -> ParameterSet {
+            self.0.parameters()
+        }
+        fn rhs(&self, t: f64, x: &[f64], u: &[f64], theta: &[f64], dx: &mut [f64]) {
+            self.0.rhs(t, x, u, theta, dx)
+        }
+        fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
+            self.0.output(x, u, theta, y)
+        }
+        fn rhs_jacobians(
+            &self,
+            t: f64,
+            x: &[f64],
+            u: &[f64],
+            theta: &[f64],
+            fx: &mut [f64],
+            ftheta: &mut [f64],
+        ) -> bool {
+            self.0.rhs_jacobians(t, x, u, theta, fx, ftheta)
+        }
+        fn rhs_sensitivities(
+            &self,
+            t: f64,
+            x: &[f64],
+            u: &[f64],
+            theta: &[f64],
+            held: Option<f64>,
+            params: &[usize],
+            s: &[f64],
+            scratch: &mut JacobianScratch,
+            dx: &mut [f64],
+            ds: &mut [f64],
+        ) -> bool {
+            self.0
+                .rhs_sensitivities(t, x, u, theta, held, params, s, scratch, dx, ds)
+        }
+    }
+
+    fn load(name: &str) -> EquationStateSpace {
+        let path = format!(
+            "{}/../../examples/equations/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        EquationStateSpace::load(std::path::Path::new(&path)).unwrap()
+    }
+
+    struct Case<'a> {
+        theta: &'a [f64],
+        x0: &'a [f64],
+        amplitude: f64,
+        interpolation: InputInterpolation,
+        params: &'a [usize],
+        initial: &'a [usize],
+    }
+
+    /// x and S at every sample (or x alone when `sensitivities` is false), RK4 × 4 over a
+    /// seeded multisine of 512 samples.
+    fn run(model: &dyn StateSpaceModel, case: &Case<'_>, sensitivities: bool) -> Vec<f64> {
+        let u: Vec<f64> = multisine(512, 1, 750.0, 5.0, 150.0, 1.0, 3)
+            .unwrap()
+            .iter()
+            .map(|v| case.amplitude * v)
+            .collect();
+        let sim = Simulation {
+            integrator: Integrator::Rk4 { substeps: 4 },
+            interpolation: case.interpolation,
+        };
+        let track = InputTrack::new(&[&u], &sim).unwrap();
+        let ts = 1.0 / 750.0;
+        let mut out = Vec::new();
+        if sensitivities {
+            let ran = simulate_sensitivities(
+                model,
+                case.theta,
+                case.x0,
+                &track,
+                ts,
+                4,
+                case.params,
+                case.initial,
+                |_, x, s| {
+                    out.extend_from_slice(x);
+                    out.extend_from_slice(s);
+                },
+            )
+            .unwrap();
+            assert!(ran);
+        } else {
+            simulate(
+                model,
+                case.theta,
+                case.x0,
+                &track,
+                ts,
+                sim.integrator,
+                |_, x| out.extend_from_slice(x),
+            )
+            .unwrap();
+        }
+        out
+    }
+
+    /// The fixed-size path (bound tape, fixed arrays) gives the generic path's x and S to
+    /// the bit (zeros compared by value): Bouc–Wen at ν = 1 and 1.3 with parameter and
+    /// initial-state columns, Duffing and the cascaded tanks (two states, estimated initial
+    /// levels), every input interpolation, with and without sensitivities.
+    #[test]
+    fn equation_path_equals_the_generic_path() {
+        let bouc_wen = load("bouc_wen.toml");
+        let nominal = bouc_wen.parameters().values();
+        let mut curved = nominal.clone();
+        curved[6] = 1.3;
+        let duffing = load("duffing.toml");
+        let mut stiff = duffing.parameters().values();
+        stiff[3] = 0.5;
+        let tanks = load("cascaded_tanks.toml");
+        let tanks_theta = tanks.parameters().values();
+        let free: Vec<usize> = (0..6).collect();
+        let interpolations = [
+            InputInterpolation::ZeroOrderHold,
+            InputInterpolation::Linear,
+            InputInterpolation::BandLimited,
+        ];
+        let mut cases: Vec<(&EquationStateSpace, Case<'_>)> = Vec::new();
+        for interpolation in interpolations {
+            for theta in [&nominal, &curved] {
+                for (params, initial) in [(&free[..], &[][..]), (&[1, 3, 4, 5, 6], &[0, 2])] {
+                    let case = Case {
+                        theta,
+                        x0: &[1e-4, -2e-3, 5e-5],
+                        amplitude: 50.0,
+                        interpolation,
+                        params,
+                        initial,
+                    };
+                    cases.push((&bouc_wen, case));
+                }
+            }
+            let case = Case {
+                theta: &stiff,
+                x0: &[0.1, 0.0],
+                amplitude: 1.0,
+                interpolation,
+                params: &[0, 1, 2, 3],
+                initial: &[0, 1],
+            };
+            cases.push((&duffing, case));
+            let case = Case {
+                theta: &tanks_theta,
+                x0: &[5.0, 4.0],
+                amplitude: 1.0,
+                interpolation,
+                params: &[0, 1, 2],
+                initial: &[0, 1],
+            };
+            cases.push((&tanks, case));
+        }
+        for (model, case) in &cases {
+            let generic = Generic((*model).clone());
+            for sensitivities in [true, false] {
+                let fixed = run(*model, case, sensitivities);
+                let reference = run(&generic, case, sensitivities);
+                assert_eq!(fixed.len(), reference.len());
+                for (i, (a, b)) in fixed.iter().zip(&reference).enumerate() {
+                    assert!(
+                        a.to_bits() == b.to_bits() || (*a == 0.0 && *b == 0.0),
+                        "{} {:?} {:?}/{:?} sensitivities {sensitivities}, element {i}: {a} vs {b}",
+                        model.name(),
+                        case.interpolation,
+                        case.params,
+                        case.initial
+                    );
+                }
+            }
+        }
+    }
+}
