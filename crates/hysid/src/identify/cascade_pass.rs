@@ -22,7 +22,9 @@
 //! long records with two or more threads, the (inherently sequential) recursion runs one block
 //! ahead on a second thread while the caller's sink consumes the previous block: the caller's
 //! work (the Gauss–Newton normal equations) overlaps the recursion. The rows and their order
-//! are the same either way, so the results are bit-identical.
+//! are the same either way, so the results are bit-identical. For ch4/ch6 with n ≤ 3 and
+//! m ≤ 3 both passes run as fixed-width instances (`fixed`: const-generic widths, rows in
+//! arrays), with the same operations in the same order as the generic passes.
 //!
 //! Reference: I. Vörös, "Iterative identification of nonlinear dynamic systems with output
 //! backlash using three-block cascade models", Nonlinear Dynamics 79, 2015 (the cascade and
