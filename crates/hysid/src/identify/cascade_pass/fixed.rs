@@ -15,11 +15,7 @@ const OUT_SLOTS: usize = 4;
 /// The (form width, n, m) of a cascade.
 fn shape(cascade: &HysteresisCascade) -> (usize, usize, usize) {
     let lin = &cascade.linear;
-    (
-        cascade.hysteresis.form().n_params(),
-        lin.na(),
-        lin.nb(),
-    )
+    (cascade.hysteresis.form().n_params(), lin.na(), lin.nb())
 }
 
 /// The coefficients of A and B as arrays (their lengths are checked by the dispatch).

@@ -48,9 +48,9 @@ impl Accumulator {
     /// Adds the row `scale · row` of J with residual `r`, written straight into the block.
     #[inline]
     pub(super) fn add_scaled(&mut self, scale: f64, row: &[f64], r: f64) {
-        let slots = self.block[self.rows..].iter_mut().step_by(BLOCK_ROWS);
-        for (slot, v) in slots.zip(row) {
-            *slot = scale * v;
+        let columns = self.block.chunks_exact_mut(BLOCK_ROWS);
+        for (column, v) in columns.zip(row) {
+            column[self.rows] = scale * v;
         }
         self.residuals[self.rows] = r;
         self.cost += r * r;
@@ -73,7 +73,7 @@ impl Accumulator {
                 self.jtj[i * p + j] = g;
                 self.jtj[j * p + i] = g;
             }
-            self.jtr[i] = dot(column(i), &self.residuals[..n]) + self.jtr[i];
+            self.jtr[i] += dot(column(i), &self.residuals[..n]);
         }
         self.rows = 0;
     }
