@@ -22,7 +22,9 @@
 //! long records with two or more threads, the (inherently sequential) recursion runs one block
 //! ahead on a second thread while the caller's sink consumes the previous block: the caller's
 //! work (the Gauss–Newton normal equations) overlaps the recursion. The rows and their order
-//! are the same either way, so the results are bit-identical.
+//! are the same either way, so the results are bit-identical. For ch4/ch6 with n ≤ 3 and
+//! m ≤ 3 both passes run as fixed-width instances (`fixed`: const-generic widths, rows in
+//! arrays), with the same operations in the same order as the generic passes.
 //!
 //! Reference: I. Vörös, "Iterative identification of nonlinear dynamic systems with output
 //! backlash using three-block cascade models", Nonlinear Dynamics 79, 2015 (the cascade and
@@ -33,6 +35,8 @@ use super::output_error::SensitivitySink;
 use crate::model::HysteresisCascade;
 use crate::{Error, Result};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
+
+mod fixed;
 
 /// Records at least this long are pipelined over two threads (shorter ones are not worth a
 /// thread: the window fits run hundreds of them, already in parallel).
@@ -78,6 +82,13 @@ impl Ring {
 /// the switching `h` held fixed when given, else h(t) = (|x(t)| > d). Same operations, in the
 /// same order, as the hysteresis simulation followed by [`crate::model::LinearBlock::simulate`].
 pub fn simulate_into(cascade: &HysteresisCascade, x: &[f64], h: Option<&[bool]>, y: &mut Vec<f64>) {
+    if fixed::simulate(cascade, x, h, y).is_none() {
+        simulate_generic(cascade, x, h, y);
+    }
+}
+
+/// [`simulate_into`] for any orders (lengths of A and B known only at run time).
+fn simulate_generic(cascade: &HysteresisCascade, x: &[f64], h: Option<&[bool]>, y: &mut Vec<f64>) {
     let ch = &cascade.hysteresis;
     let lin = &cascade.linear;
     let (a, b, k) = (lin.a(), lin.b(), lin.delay());
@@ -203,6 +214,20 @@ fn recursion(
     free: &[usize],
     mut on_row: impl FnMut(usize, f64, &[f64]),
 ) -> Option<usize> {
+    match fixed::recursion(cascade, x, h, free, &mut on_row) {
+        Some(failed) => failed,
+        None => recursion_generic(cascade, x, h, free, on_row),
+    }
+}
+
+/// [`recursion`] for any shape (widths known only at run time).
+fn recursion_generic(
+    cascade: &HysteresisCascade,
+    x: &[f64],
+    h: Option<&[bool]>,
+    free: &[usize],
+    mut on_row: impl FnMut(usize, f64, &[f64]),
+) -> Option<usize> {
     let lin = &cascade.linear;
     let (k, m) = (lin.delay(), lin.nb());
     let nh = cascade.hysteresis.form().n_params();
@@ -278,6 +303,60 @@ mod tests {
                 let mut y = vec![1.0; 3];
                 simulate_into(&ex.truth, &x, frozen, &mut y);
                 assert_eq!(y, expected, "example {n}");
+            }
+        }
+    }
+
+    /// The fixed-width passes are bit-identical to the generic ones for every instantiated
+    /// shape (ch4 and ch6, n ≤ 3, m ≤ 3, delays 1 and 3), with and without a frozen switching,
+    /// and decline the shapes they do not cover (n = 4).
+    #[test]
+    fn fixed_width_passes_equal_generic_passes() {
+        use crate::model::{ColemanHodgdon, LinearBlock};
+        let ex = CascadeExample::example1();
+        let x = ex.generate(7, false).unwrap().x;
+        let h: Vec<bool> = x.iter().map(|v| v.abs() > 2.5).collect();
+        let forms = [
+            ColemanHodgdon::saturated(0.3, 1.0, 0.5, 3.0).unwrap(),
+            ColemanHodgdon::general(0.25, 1.2, 0.15, 0.6, 0.1, 2.0).unwrap(),
+        ];
+        for ch in &forms {
+            for na in 0..=4 {
+                for nb in 1..=3 {
+                    for delay in [1, 3] {
+                        let a = [-0.5, 0.2, -0.05, 0.01][..na].to_vec();
+                        let b = [1.0, 0.4, -0.2][..nb].to_vec();
+                        let cascade = HysteresisCascade::new(
+                            ch.clone(),
+                            LinearBlock::new(a, b, delay).unwrap(),
+                        )
+                        .unwrap();
+                        let p = cascade.params().len();
+                        let free: Vec<usize> = (0..p).rev().step_by(2).collect();
+                        for frozen in [None, Some(h.as_slice())] {
+                            let mut generic = Vec::new();
+                            let g = recursion_generic(&cascade, &x, frozen, &free, |t, y, r| {
+                                generic.push((t, y, r.to_vec()))
+                            });
+                            let mut fast = Vec::new();
+                            let f = fixed::recursion(&cascade, &x, frozen, &free, |t, y, r| {
+                                fast.push((t, y, r.to_vec()))
+                            });
+                            let (mut ys, mut yf) = (Vec::new(), Vec::new());
+                            simulate_generic(&cascade, &x, frozen, &mut ys);
+                            let simulated = fixed::simulate(&cascade, &x, frozen, &mut yf);
+                            if na == 4 {
+                                assert_eq!(f, None);
+                                assert_eq!(simulated, None);
+                                continue;
+                            }
+                            assert_eq!(f, Some(g));
+                            assert!(fast == generic, "{na} {nb} {delay}");
+                            assert_eq!(simulated, Some(()));
+                            assert!(yf == ys, "{na} {nb} {delay}");
+                        }
+                    }
+                }
             }
         }
     }

@@ -31,6 +31,9 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::Mutex;
 
+mod gram;
+use gram::Accumulator;
+
 /// Receives one sample of simulated outputs and their sensitivities:
 /// `(t, ŷ(t) [n_y], ∂ŷ(t)/∂θ_free [n_y × n_free, row-major])`.
 pub type SensitivitySink<'a> = dyn FnMut(usize, &[f64], &[f64]) + 'a;
@@ -502,7 +505,6 @@ impl<'a> OutputErrorProblem<'a> {
         let exp = self.data.experiment(e);
         let rows = exp.len() - self.skip;
         let mut acc = Accumulator::new(p);
-        let mut row = vec![0.0; p];
         let skip = self.skip;
         let weights = &self.weights;
         let mut sink = |t: usize, yhat: &[f64], dyhat: &[f64]| {
@@ -514,10 +516,7 @@ impl<'a> OutputErrorProblem<'a> {
                 if let Some(out) = residuals.as_deref_mut() {
                     out[o * rows + t - skip] = r;
                 }
-                for (k, rk) in row.iter_mut().enumerate() {
-                    *rk = -w * dyhat[o * p + k];
-                }
-                acc.add(&row, r);
+                acc.add_scaled(-w, &dyhat[o * p..(o + 1) * p], r);
             }
         };
         let outcome = self
@@ -627,65 +626,6 @@ fn sum_normal_equations(
         });
     }
     total.map(Ok)
-}
-
-/// Accumulates JᵀJ, Jᵀr and Σr² row by row, in blocks so the rank-k update runs through a
-/// matrix product instead of a scalar double loop per sample.
-struct Accumulator {
-    block: DMatrix<f64>,
-    residuals: DVector<f64>,
-    rows: usize,
-    jtj: DMatrix<f64>,
-    jtr: DVector<f64>,
-    cost: f64,
-}
-
-const BLOCK_ROWS: usize = 512;
-
-impl Accumulator {
-    fn new(p: usize) -> Self {
-        Self {
-            block: DMatrix::zeros(BLOCK_ROWS, p),
-            residuals: DVector::zeros(BLOCK_ROWS),
-            rows: 0,
-            jtj: DMatrix::zeros(p, p),
-            jtr: DVector::zeros(p),
-            cost: 0.0,
-        }
-    }
-
-    #[inline]
-    fn add(&mut self, row: &[f64], r: f64) {
-        for (k, v) in row.iter().enumerate() {
-            self.block[(self.rows, k)] = *v;
-        }
-        self.residuals[self.rows] = r;
-        self.cost += r * r;
-        self.rows += 1;
-        if self.rows == BLOCK_ROWS {
-            self.flush();
-        }
-    }
-
-    fn flush(&mut self) {
-        if self.rows == 0 {
-            return;
-        }
-        let j = self.block.rows(0, self.rows);
-        let r = self.residuals.rows(0, self.rows);
-        self.jtj.gemm_tr(1.0, &j, &j, 1.0);
-        self.jtr.gemv_tr(1.0, &j, &r, 1.0);
-        self.rows = 0;
-    }
-
-    fn finish(mut self) -> NormalEquations {
-        self.flush();
-        NormalEquations {
-            jtj: self.jtj,
-            jtr: self.jtr,
-            cost: self.cost,
-        }
-    }
 }
 
 /// A measured output that never changes carries nothing to fit and leaves fit % undefined

@@ -16,7 +16,8 @@
 //! 2. **Interval scan**: the criterion restricted to one interval of d is smooth and equals
 //!    the frozen-h criterion there, so fitting with d bounded to each of a set of intervals
 //!    around d̂ (a coarse pass over d̂ ± 3s, then every neighbour of the best) and keeping the
-//!    best minimises the true, discontinuous criterion locally. On
+//!    best minimises the true, discontinuous criterion locally (the fits of one pass are
+//!    independent and run in parallel; their results are kept in the pass's order). On
 //!    noise-free data only the true interval fits exactly, which is what recovers every
 //!    parameter to working precision.
 
@@ -26,6 +27,7 @@ use crate::model::ParameterSet;
 use crate::numerics::levenberg_marquardt::{Control, IterationRecord, LmReport};
 use crate::Result;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 
 /// The switching h(t) = (|x(t)| > d) of every experiment, held fixed during a fit.
 pub type Switching = Vec<Vec<bool>>;
@@ -321,12 +323,28 @@ fn scan_intervals<M: OutputErrorModel>(
     let d_hat = params.get(d_index).value;
     let radius = 3.0 * start.std()[d_index];
     let mut results: Vec<(usize, OutputErrorFit)> = Vec::new();
-    let try_interval = |interval: usize, results: &mut Vec<(usize, OutputErrorFit)>| {
-        if !results.iter().any(|(i, _)| *i == interval) {
-            if let Some(fit) =
-                fit_in_interval(make, data, params, estimator, &edges, interval, d_index)
-            {
-                results.push((interval, fit));
+    // The fits of one pass are independent: they run in parallel, and their results join in
+    // the order of the pass, as when fitted one after the other.
+    let try_intervals = |intervals: &mut dyn Iterator<Item = usize>,
+                         results: &mut Vec<(usize, OutputErrorFit)>| {
+        let jobs: Vec<(usize, M, ParameterSet)> = intervals
+            .filter(|i| !results.iter().any(|(done, _)| done == i))
+            .filter_map(|i| {
+                let (model, params) = interval_problem(make, data, params, &edges, i, d_index)?;
+                Some((i, model, params))
+            })
+            .collect();
+        let fits: Vec<Option<OutputErrorFit>> = jobs
+            .par_iter()
+            .map(|(_, model, params)| {
+                estimator
+                    .estimate(model, data, params, &mut |_| Control::Continue)
+                    .ok()
+            })
+            .collect();
+        for ((i, _, _), fit) in jobs.into_iter().zip(fits) {
+            if let Some(fit) = fit {
+                results.push((i, fit));
             }
         }
     };
@@ -334,17 +352,13 @@ fn scan_intervals<M: OutputErrorModel>(
         let lo = interval_of(&edges, d_hat - radius);
         let hi = interval_of(&edges, d_hat + radius);
         let stride = ((hi - lo) / COARSE_INTERVALS).max(1);
-        for interval in (lo..=hi).step_by(stride) {
-            try_interval(interval, &mut results);
-        }
+        try_intervals(&mut (lo..=hi).step_by(stride), &mut results);
     }
     let mut centre = best_of(&results).unwrap_or_else(|| interval_of(&edges, d_hat));
     for _ in 0..MAX_ROUNDS {
         let lo = centre.saturating_sub(scan).max(1);
         let hi = (centre + scan).min(edges.len() - 1);
-        for interval in lo..=hi {
-            try_interval(interval, &mut results);
-        }
+        try_intervals(&mut (lo..=hi), &mut results);
         let Some(best) = best_of(&results) else {
             return Ok(None);
         };
@@ -372,17 +386,16 @@ fn best_of(results: &[(usize, OutputErrorFit)]) -> Option<usize> {
         .map(|(i, _)| *i)
 }
 
-/// The fit with d bounded to [edges[i−1], edges[i]) and h frozen accordingly; None when the
-/// fit fails there.
-fn fit_in_interval<M: OutputErrorModel>(
+/// The model with h frozen for d in [edges[i−1], edges[i]) and the start with d bounded to
+/// that interval; None when the interval is empty within the bounds of d.
+fn interval_problem<M: OutputErrorModel>(
     make: &dyn Fn(Option<Switching>) -> M,
     data: &IdData,
     start: &ParameterSet,
-    estimator: &OutputError,
     edges: &[f64],
     i: usize,
     d_index: usize,
-) -> Option<OutputErrorFit> {
+) -> Option<(M, ParameterSet)> {
     let (lo, hi) = (edges[i - 1], edges[i] - edges[i].abs() * 1e-14);
     if hi.is_nan() || hi <= lo {
         return None;
@@ -396,9 +409,7 @@ fn fit_in_interval<M: OutputErrorModel>(
     }
     d.value = d.value.clamp(d.min, d.max);
     let h = classify(data, 0.5 * (lo + hi));
-    estimator
-        .estimate(&make(Some(h)), data, &params, &mut |_| Control::Continue)
-        .ok()
+    Some((make(Some(h)), params))
 }
 
 /// Sorted distinct |x(t)|, t ≥ 1, over all experiments: the edges of the intervals of d inside
