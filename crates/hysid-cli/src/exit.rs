@@ -61,10 +61,26 @@ pub fn library_class(error: &Error) -> ExitClass {
     }
 }
 
+/// A command line that parses but asks for something impossible (flags that exclude each
+/// other in a way the parser cannot express): exit 2, like a parser error.
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
 /// The class of a command's error: that of the first library or I/O error in its chain,
 /// else bad input (the command's own checks are about what the user gave).
 pub fn classify(error: &anyhow::Error) -> ExitClass {
     for cause in error.chain() {
+        if cause.downcast_ref::<UsageError>().is_some() {
+            return ExitClass::Usage;
+        }
         if let Some(e) = cause.downcast_ref::<Error>() {
             return library_class(e);
         }

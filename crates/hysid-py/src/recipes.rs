@@ -405,23 +405,16 @@ fn rigid_body_ls(
             border,
         };
         let e = ls.estimate(&q, &u, ts)?;
-        let records = vec![json!({
-            "file": source()[0],
-            "role": "estimation",
-            "relative_error_percent": e.relative_error_percent,
-        })];
         let settings = json!({"position": "q", "input": "u"});
         let elapsed = clock.elapsed().as_secs_f64();
-        report::rigid_body_report(
-            &e,
-            &ls,
-            source().remove(0),
-            q.len(),
-            elapsed,
-            records,
-            settings,
-        )
-        .to_json()
+        let source = source().remove(0);
+        let record = report::RigidBodyRecord {
+            source: &source,
+            q: &q,
+            u: &u,
+            ts,
+        };
+        report::rigid_body_report(&e, &ls, record, &[], elapsed, settings)?.to_json()
     })
 }
 

@@ -124,6 +124,33 @@ pub enum Error {
     #[error("invalid configuration: {0}")]
     Config(String),
 
+    /// A setting of an estimator, a filter or a generator is out of range. `option` is the
+    /// library's name of the setting (a field name such as `cutoff_hz`); the CLI maps it to
+    /// its flag.
+    #[error("{option} = {value}: {reason}")]
+    InvalidOption {
+        /// The setting's name in the library (`cutoff_hz`, `substeps`, `starts`, …).
+        option: String,
+        /// The value given, as text.
+        value: String,
+        /// Why it is not acceptable, and the acceptable range.
+        reason: String,
+    },
+
+    /// A model (a saved file, or one put together by a caller) is inconsistent: a missing
+    /// structure key, a parameter set that does not fit its kind.
+    #[error("invalid model: {0}")]
+    InvalidModel(String),
+
+    /// An operation is not defined for a model of this kind.
+    #[error("model kind '{kind}' does not support {operation}")]
+    UnsupportedKind {
+        /// The model kind.
+        kind: String,
+        /// What was asked of it.
+        operation: String,
+    },
+
     /// A plot could not be laid out (an internal failure of the plot layout, never of the
     /// data).
     #[error("plot: {0}")]
@@ -190,6 +217,21 @@ pub struct EquationFileError {
     pub column: usize,
     /// What is wrong and what to do (one line).
     pub message: String,
+}
+
+impl Error {
+    /// [`Error::InvalidOption`] of the setting `option` with value `value`.
+    pub fn invalid_option(
+        option: &str,
+        value: impl std::fmt::Display,
+        reason: impl Into<String>,
+    ) -> Self {
+        Error::InvalidOption {
+            option: option.into(),
+            value: value.to_string(),
+            reason: reason.into(),
+        }
+    }
 }
 
 /// Shorthand for results in this crate.

@@ -35,6 +35,7 @@ use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::operators::OperatorModel;
+use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
 use crate::model::saved_equations::{equations_from_file, simulate_outputs};
 use crate::model::{CascadeOperator, OperatorCascade};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
@@ -140,6 +141,14 @@ pub struct ModelFile {
     /// are read from `parameters`. Checked on reading.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub operator: Option<serde_json::Value>,
+    /// The pre-filter the model was fitted with (the actuator's step 3): `hysid simulate`
+    /// filters input and measured output alike before simulating.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prefilter: Option<Prefilter>,
+    /// The preprocessing of an inverse-dynamics fit (kind `rigid_body` from `rigid-body ls`):
+    /// the model predicts the drive signal from the measured position, as the fit did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inverse_dynamics: Option<InverseDynamics>,
 }
 
 /// The simulation settings in a model file.
@@ -285,6 +294,35 @@ pub enum FittedModel {
         /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
         std: Vec<f64>,
     },
+    /// A model fitted to pre-filtered records: it filters every record (inputs and measured
+    /// output alike) before it simulates.
+    Prefiltered {
+        /// The model as fitted to the filtered records.
+        model: Box<FittedModel>,
+        /// The filter.
+        prefilter: Prefilter,
+    },
+    /// A rigid body (a [`FittedModel::GreyBox`] of kind `rigid_body`) fitted by inverse
+    /// dynamics: it predicts the drive signal from the measured position (see
+    /// [`InverseDynamics`]).
+    InverseDynamics {
+        /// The rigid body.
+        model: Box<FittedModel>,
+        /// The preprocessing of the fit.
+        preprocessing: InverseDynamics,
+    },
+}
+
+/// One record as a model's fit sees it: the inputs the model is driven by (filtered,
+/// decimated where the fit did so), its outputs, and the measured output processed alike.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// The inputs as the model sees them.
+    pub inputs: Vec<Vec<f64>>,
+    /// The model's outputs (simulated, or predicted by inverse dynamics).
+    pub outputs: Vec<Vec<f64>>,
+    /// The measured counterpart of output 0, processed as the fit processed it.
+    pub measured: Option<Vec<f64>>,
 }
 
 impl FittedModel {
@@ -338,6 +376,16 @@ impl FittedModel {
                 Ok(vec![simulate_switched(model, x, v0, None)])
             }
             FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::Prefiltered { model, prefilter } => {
+                let filtered = inputs
+                    .iter()
+                    .map(|x| prefilter.apply(x, ts))
+                    .collect::<Result<Vec<_>>>()?;
+                model.simulate_unchecked(&slices(&filtered), ts, y0)
+            }
+            FittedModel::InverseDynamics { preprocessing, .. } => Ok(vec![
+                preprocessing.predict(&self.rigid_body()?, first()?, ts)?.1,
+            ]),
             FittedModel::OperatorCascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
             FittedModel::Operator { model, .. } => {
                 Ok(vec![model.as_operator().simulate(first()?)?])
@@ -380,6 +428,108 @@ impl FittedModel {
         }
     }
 
+    /// The model's outputs for the inputs `inputs` sampled every `ts`, and the measured output
+    /// `measured` processed as the fit processed it: filtered for a
+    /// [`FittedModel::Prefiltered`], decimated and trimmed for a
+    /// [`FittedModel::InverseDynamics`] (whose input is the position and whose output the
+    /// predicted drive signal); as they are for every other model. fit % of
+    /// `outputs[0]` against `measured` is the fit the model's report states.
+    pub fn predict(
+        &self,
+        inputs: &[&[f64]],
+        measured: Option<&[f64]>,
+        ts: f64,
+    ) -> Result<Prediction> {
+        match self {
+            FittedModel::Prefiltered { model, prefilter } => {
+                let filtered = inputs
+                    .iter()
+                    .map(|x| prefilter.apply(x, ts))
+                    .collect::<Result<Vec<_>>>()?;
+                let measured = measured.map(|y| prefilter.apply(y, ts)).transpose()?;
+                model.predict(&slices(&filtered), measured.as_deref(), ts)
+            }
+            FittedModel::InverseDynamics { preprocessing, .. } => {
+                let q = inputs.first().copied().unwrap_or_default();
+                if let Some(u) = measured.filter(|u| u.len() != q.len()) {
+                    return Err(Error::InvalidData(format!(
+                        "the position has {} samples, the drive signal {}",
+                        q.len(),
+                        u.len()
+                    )));
+                }
+                let (position, predicted) = preprocessing.predict(&self.rigid_body()?, q, ts)?;
+                if let Some(index) = predicted.iter().position(|v| !v.is_finite()) {
+                    return Err(Error::Diverged {
+                        index,
+                        reason:
+                            "the predicted drive signal is not finite; scale the position data down"
+                                .into(),
+                    });
+                }
+                Ok(Prediction {
+                    inputs: vec![position],
+                    outputs: vec![predicted],
+                    measured: measured.map(|u| preprocessing.reduce(u)).transpose()?,
+                })
+            }
+            _ => Ok(Prediction {
+                outputs: self.simulate(inputs, ts, measured.and_then(|y| y.first().copied()))?,
+                inputs: inputs.iter().map(|x| x.to_vec()).collect(),
+                measured: measured.map(<[f64]>::to_vec),
+            }),
+        }
+    }
+
+    /// `model` fitted to records filtered by `prefilter` (unchanged when there is none).
+    pub fn prefiltered(model: FittedModel, prefilter: Option<Prefilter>) -> Self {
+        match prefilter {
+            Some(prefilter) => FittedModel::Prefiltered {
+                model: Box::new(model),
+                prefilter,
+            },
+            None => model,
+        }
+    }
+
+    /// The rigid body's values of an inverse-dynamics model (M, Fv, Fc, offset, gain).
+    fn rigid_body(&self) -> Result<RigidBodyValues> {
+        let inner = match self {
+            FittedModel::InverseDynamics { model, .. } => model.as_ref(),
+            other => other,
+        };
+        let parameters = match inner {
+            FittedModel::GreyBox {
+                kind, parameters, ..
+            } if kind == "rigid_body" => parameters,
+            other => {
+                return Err(Error::UnsupportedKind {
+                    kind: other.to_file().kind,
+                    operation: "inverse dynamics (a rigid_body model)".into(),
+                })
+            }
+        };
+        let value = |name: &str| parameters.iter().find(|p| p.name == name).map(|p| p.value);
+        match (
+            value("M"),
+            value("Fv"),
+            value("Fc"),
+            value("offset"),
+            value("gain"),
+        ) {
+            (Some(inertia), Some(fv), Some(fc), Some(offset), Some(gain)) => Ok(RigidBodyValues {
+                inertia,
+                fv,
+                fc,
+                offset,
+                gain,
+            }),
+            _ => Err(Error::InvalidModel(
+                "a rigid body needs the parameters M, Fv, Fc, offset and gain".into(),
+            )),
+        }
+    }
+
     /// A built-in-style grey-box fit ([`FittedModel::GreyBox`]) of the equation model with
     /// file text `equations`, as [`FittedModel::Equations`]; other variants unchanged.
     pub fn with_equations(self, equations: &str) -> Self {
@@ -415,6 +565,8 @@ impl FittedModel {
             equations: None,
             family: None,
             operator: None,
+            prefilter: None,
+            inverse_dynamics: None,
         };
         match self {
             FittedModel::Hysteresis {
@@ -481,6 +633,17 @@ impl FittedModel {
                         .collect(),
                 )
             },
+            FittedModel::Prefiltered { model, prefilter } => ModelFile {
+                prefilter: Some(*prefilter),
+                ..model.to_file()
+            },
+            FittedModel::InverseDynamics {
+                model,
+                preprocessing,
+            } => ModelFile {
+                inverse_dynamics: Some(*preprocessing),
+                ..model.to_file()
+            },
             FittedModel::Operator { family, model, std } => ModelFile {
                 family: Some(family.to_string()),
                 // The structure of a constructed operator is always representable; a failure
@@ -522,6 +685,27 @@ impl FittedModel {
                 "parameter '{}' has no finite value",
                 p.name
             )));
+        }
+        if let Some(prefilter) = file.prefilter {
+            check_prefilter(&prefilter)?;
+            let inner = ModelFile {
+                prefilter: None,
+                ..file.clone()
+            };
+            return Ok(Self::prefiltered(Self::from_file(&inner)?, Some(prefilter)));
+        }
+        if let Some(preprocessing) = file.inverse_dynamics {
+            check_inverse_dynamics(&preprocessing)?;
+            let inner = ModelFile {
+                inverse_dynamics: None,
+                ..file.clone()
+            };
+            let model = FittedModel::InverseDynamics {
+                model: Box::new(Self::from_file(&inner)?),
+                preprocessing,
+            };
+            model.rigid_body()?;
+            return Ok(model);
         }
         match file.kind.as_str() {
             "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
@@ -667,6 +851,41 @@ impl FittedModel {
             .map_err(|e| bad(format!("not a {MODEL_SCHEMA} model file: {e}")))?;
         Self::from_file(&file).map_err(|e| bad(e.to_string()))
     }
+}
+
+/// The slices of `signals`.
+fn slices(signals: &[Vec<f64>]) -> Vec<&[f64]> {
+    signals.iter().map(Vec::as_slice).collect()
+}
+
+/// The largest Butterworth order a model file may ask for (beyond it the filter is
+/// numerically meaningless and the file more likely corrupt).
+pub const MAX_FILTER_ORDER: usize = 20;
+
+/// Refuses a pre-filter no fit uses: an order outside 1..=[`MAX_FILTER_ORDER`], a cut-off
+/// that is not positive and finite.
+fn check_prefilter(p: &Prefilter) -> Result<()> {
+    check_filter(p.cutoff_hz.unwrap_or(1.0), p.order, "prefilter")
+}
+
+/// Refuses inverse-dynamics settings no fit uses (see [`check_prefilter`]; a decimation
+/// factor of at least 1).
+fn check_inverse_dynamics(p: &InverseDynamics) -> Result<()> {
+    if p.decimation == 0 {
+        return Err(Error::InvalidModel(
+            "\"inverse_dynamics\" needs a decimation factor of at least 1".into(),
+        ));
+    }
+    check_filter(p.cutoff_hz, p.order, "inverse_dynamics")
+}
+
+fn check_filter(cutoff_hz: f64, order: usize, key: &str) -> Result<()> {
+    if !(cutoff_hz.is_finite() && cutoff_hz > 0.0) || !(1..=MAX_FILTER_ORDER).contains(&order) {
+        return Err(Error::InvalidModel(format!(
+            "\"{key}\" needs a positive finite cut-off and an order in 1..={MAX_FILTER_ORDER} (got {cutoff_hz} Hz, order {order})"
+        )));
+    }
+    Ok(())
 }
 
 /// The kind of [`FittedModel::OperatorCascade`].
