@@ -204,9 +204,11 @@ pub fn simulation(integrator: &str, substeps: usize, interpolation: &str) -> Res
         "rk4" => Integrator::Rk4 { substeps },
         "newmark" => Integrator::Newmark { substeps },
         other => {
-            return Err(Error::Config(format!(
-                "integrator='{other}': use 'rk4' or 'newmark'"
-            )))
+            return Err(Error::invalid_option(
+                "integrator",
+                other,
+                format!("integrator='{other}': use 'rk4' or 'newmark'"),
+            ))
         }
     };
     let interpolation = match interpolation {
@@ -214,9 +216,11 @@ pub fn simulation(integrator: &str, substeps: usize, interpolation: &str) -> Res
         "linear" => InputInterpolation::Linear,
         "band-limited" | "band_limited" => InputInterpolation::BandLimited,
         other => {
-            return Err(Error::Config(format!(
-                "interpolation='{other}': use 'zoh', 'linear' or 'band-limited'"
-            )))
+            return Err(Error::invalid_option(
+                "interpolation",
+                other,
+                format!("interpolation='{other}': use 'zoh', 'linear' or 'band-limited'"),
+            ))
         }
     };
     Ok(Simulation {
@@ -445,7 +449,7 @@ fn simulate_model<'py>(
 /// A model file's JSON, parsed.
 fn parse_model(text: &str) -> Result<ModelFile> {
     serde_json::from_str(text)
-        .map_err(|e| Error::Config(format!("not a hysid.model/1 model file: {e}")))
+        .map_err(|e| Error::InvalidModel(format!("not a hysid.model/1 model file: {e}")))
 }
 
 /// Reads a model file the CLI wrote; returns its JSON (checked by rebuilding the model).
@@ -453,7 +457,8 @@ fn parse_model(text: &str) -> Result<ModelFile> {
 fn load_model(py: Python<'_>, path: std::path::PathBuf) -> PyResult<String> {
     guard(py, || {
         let model = FittedModel::load(&path)?;
-        serde_json::to_string(&model.to_file()).map_err(|e| Error::Config(format!("model: {e}")))
+        serde_json::to_string(&model.to_file())
+            .map_err(|e| Error::Serialization(format!("model: {e}")))
     })
 }
 
@@ -463,6 +468,6 @@ fn check_model(py: Python<'_>, model_json: &str) -> PyResult<String> {
     guard(py, || {
         let model = FittedModel::from_file(&parse_model(model_json)?)?;
         serde_json::to_string_pretty(&model.to_file())
-            .map_err(|e| Error::Config(format!("model: {e}")))
+            .map_err(|e| Error::Serialization(format!("model: {e}")))
     })
 }

@@ -195,17 +195,17 @@ impl SimulationSpec {
     pub fn simulation(&self) -> Result<Simulation> {
         let substeps = || match self.substeps {
             Some(n) if (1..=MAX_SUBSTEPS).contains(&n) => Ok(n),
-            Some(n) => Err(Error::Config(format!(
+            Some(n) => Err(Error::InvalidModel(format!(
                 "substeps {n} is outside 1..={MAX_SUBSTEPS}"
             ))),
-            None => Err(Error::Config(format!(
+            None => Err(Error::InvalidModel(format!(
                 "the {} integrator needs \"substeps\"",
                 self.integrator
             ))),
         };
         let tolerance = |name: &str, v: Option<f64>| match v {
             Some(t) if t.is_finite() && t > 0.0 => Ok(t),
-            _ => Err(Error::Config(format!(
+            _ => Err(Error::InvalidModel(format!(
                 "the dopri5 integrator needs a positive finite \"{name}\""
             ))),
         };
@@ -221,7 +221,7 @@ impl SimulationSpec {
                 atol: tolerance("atol", self.atol)?,
             },
             other => {
-                return Err(Error::Config(format!(
+                return Err(Error::InvalidModel(format!(
                     "unknown integrator '{other}'; use rk4, newmark or dopri5"
                 )))
             }
@@ -358,7 +358,7 @@ impl FittedModel {
             inputs
                 .first()
                 .copied()
-                .ok_or_else(|| Error::Config("no input channel given".into()))
+                .ok_or_else(|| Error::ModelMismatch("no input channel given".into()))
         };
         match self {
             FittedModel::Hysteresis { model, initial, .. } => {
@@ -366,8 +366,8 @@ impl FittedModel {
                 model.check_rate(x)?;
                 let v0 = match initial {
                     InitialOutput::Measured => y0.ok_or_else(|| {
-                        Error::Config(
-                            "this hysteresis starts from the measured output; give the output column (--output)"
+                        Error::ModelMismatch(
+                            "this hysteresis starts from the measured output; give the measured output"
                                 .into(),
                         )
                     })?,
@@ -675,13 +675,13 @@ impl FittedModel {
     /// Rebuilds a fitted model from a model file, checking every value.
     pub fn from_file(file: &ModelFile) -> Result<Self> {
         if file.schema != MODEL_SCHEMA {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "schema '{}' is not {MODEL_SCHEMA}; save the model again with this version",
                 file.schema
             )));
         }
         if let Some(p) = file.parameters.iter().find(|p| !p.value.is_finite()) {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "parameter '{}' has no finite value",
                 p.name
             )));
@@ -718,7 +718,7 @@ impl FittedModel {
 
     fn coleman_hodgdon_from_file(file: &ModelFile) -> Result<Self> {
         let form = file.hysteresis.ok_or_else(|| {
-            Error::Config(format!(
+            Error::InvalidModel(format!(
                 "a {} model needs \"hysteresis\": \"ch4\" or \"ch6\"",
                 file.kind
             ))
@@ -741,13 +741,13 @@ impl FittedModel {
         let b = coefficients(file, 'b')?;
         let a = coefficients(file, 'a')?;
         if b.is_empty() || b[0].value != 1.0 {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "a ch_cascade model needs b1 = 1 (the gain sits in the hysteresis)".into(),
             ));
         }
         let delay = file
             .delay
-            .ok_or_else(|| Error::Config("a ch_cascade model needs \"delay\"".into()))?;
+            .ok_or_else(|| Error::InvalidModel("a ch_cascade model needs \"delay\"".into()))?;
         let linear = LinearBlock::new(
             a.iter().map(|e| e.value).collect(),
             b.iter().map(|e| e.value).collect(),
@@ -763,7 +763,7 @@ impl FittedModel {
 
     fn operator_from_file(file: &ModelFile) -> Result<Self> {
         let (Some(family), Some(structure)) = (&file.family, &file.operator) else {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "an operator model needs \"family\" and \"operator\"; save the model again".into(),
             ));
         };
@@ -778,7 +778,7 @@ impl FittedModel {
 
     fn grey_box_from_file(kind: &str, file: &ModelFile) -> Result<Self> {
         let model = models::by_kind(kind).map_err(|_| {
-            Error::Config(format!(
+            Error::InvalidModel(format!(
                 "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed, actuator_free, equations, operator and operator_cascade"
             ))
         })?;
@@ -806,7 +806,7 @@ impl FittedModel {
         let n = model.states().len();
         let initial_state = file.initial_state.clone().unwrap_or_else(|| vec![0.0; n]);
         if initial_state.len() != n || initial_state.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "\"initial_state\" needs {n} finite values for the {kind} model"
             )));
         }
@@ -895,17 +895,20 @@ pub const OPERATOR_CASCADE_KIND: &str = "operator_cascade";
 /// `parameters` (validated by the family's constructor).
 fn operator_cascade_from_file(file: &ModelFile) -> Result<FittedModel> {
     let structure = file.operator.clone().ok_or_else(|| {
-        Error::Config("an operator_cascade model needs \"operator\" (family and structure)".into())
+        Error::InvalidModel(
+            "an operator_cascade model needs \"operator\" (family and structure)".into(),
+        )
     })?;
-    let operator: CascadeOperator = serde_json::from_value(structure)
-        .map_err(|e| Error::Config(format!("the operator of the operator_cascade model: {e}")))?;
+    let operator: CascadeOperator = serde_json::from_value(structure).map_err(|e| {
+        Error::InvalidModel(format!("the operator of the operator_cascade model: {e}"))
+    })?;
     let delay = file
         .delay
-        .ok_or_else(|| Error::Config("an operator_cascade model needs \"delay\"".into()))?;
+        .ok_or_else(|| Error::InvalidModel("an operator_cascade model needs \"delay\"".into()))?;
     let b = coefficients(file, 'b')?;
     let a = coefficients(file, 'a')?;
     if b.is_empty() || b[0].value != 1.0 {
-        return Err(Error::Config(
+        return Err(Error::InvalidModel(
             "an operator_cascade model needs b1 = 1 (the gain sits in the operator)".into(),
         ));
     }
@@ -964,7 +967,7 @@ fn record<'a>(file: &'a ModelFile, name: &str) -> Result<&'a ParameterRecord> {
         .iter()
         .find(|p| p.name == name)
         .ok_or_else(|| {
-            Error::Config(format!(
+            Error::InvalidModel(format!(
                 "parameter '{name}' is missing from the {} model",
                 file.kind
             ))
@@ -984,7 +987,7 @@ fn coefficients(file: &ModelFile, letter: char) -> Result<Vec<ParameterRecord>> 
     found.sort_by_key(|(k, _)| *k);
     for (i, (k, _)) in found.iter().enumerate() {
         if *k != i + 1 {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "coefficient {letter}{} is missing from the {} model",
                 i + 1,
                 file.kind

@@ -184,7 +184,7 @@ impl FitSummary {
         {
             Ok(())
         } else {
-            Err(Error::Config(
+            Err(Error::NonFiniteOutput(
                 "the model's simulated output is not finite on these data: the model is unstable or the data are outside its range".into(),
             ))
         }
@@ -345,7 +345,7 @@ impl ValidationEntry {
         {
             Ok(entry)
         } else {
-            Err(Error::Config(format!(
+            Err(Error::NonFiniteOutput(format!(
                 "the model's output on {} is not finite: the model is unstable or the data are outside its range",
                 entry.source
             )))
@@ -415,7 +415,7 @@ impl Report {
     /// write it as null and hide the failure).
     pub fn to_json(&self) -> Result<String> {
         self.check_finite()?;
-        serde_json::to_string_pretty(self).map_err(|e| Error::Config(format!("report: {e}")))
+        serde_json::to_string_pretty(self).map_err(|e| Error::Serialization(format!("report: {e}")))
     }
 
     /// Errors naming the first non-finite number of the fit, search, validation or model.
@@ -441,7 +441,7 @@ impl Report {
         }
         match bad.first() {
             None => Ok(()),
-            Some(what) => Err(Error::Config(format!(
+            Some(what) => Err(Error::NonFiniteOutput(format!(
                 "{what} is not a finite number; the estimate failed numerically"
             ))),
         }
