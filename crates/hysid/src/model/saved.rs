@@ -27,6 +27,15 @@
 //! | `equations` | `equations` (the equation file's text), `simulation`, `initial_state` | the file's `[parameters]` |
 //! | `operator` | `family` (`pi`, `gpi`, `preisach`, `jiles-atherton`, `bouc-wen`, `duhem`, `dahl`, `maxwell-slip`, `backlash`), `operator` (the operator's full structure: thresholds, weights, grid, orientation, initial state) | the family's, named as in the literature |
 //!
+//! Any kind may carry the processing its fit applied to the records ([`record_filters`]):
+//! `prefilter` (`{remove_mean, cutoff_hz, order}`, the actuator's step 3: records filtered
+//! before simulating, [`FittedModel::Prefiltered`]) or, for `rigid_body`, `inverse_dynamics`
+//! (`{cutoff_hz, order, decimation, border}`: the drive signal predicted from the position,
+//! [`FittedModel::InverseDynamics`]). [`FittedModel::predict`] applies it, so the fit % of a
+//! report is reproduced from its model file.
+//!
+//! [`record_filters`]: crate::model::record_filters
+//!
 //! `simulation` saves the integrator faithfully: `{"integrator": "rk4", "substeps": 10,
 //! "interpolation": "zero_order_hold"}`, `newmark` with `substeps`, or `dopri5` with `rtol`
 //! and `atol`.
@@ -880,7 +889,7 @@ fn check_inverse_dynamics(p: &InverseDynamics) -> Result<()> {
 }
 
 fn check_filter(cutoff_hz: f64, order: usize, key: &str) -> Result<()> {
-    if !(cutoff_hz.is_finite() && cutoff_hz > 0.0) || !(1..=MAX_FILTER_ORDER).contains(&order) {
+    if !(cutoff_hz.is_finite() && cutoff_hz > 0.0 && (1..=MAX_FILTER_ORDER).contains(&order)) {
         return Err(Error::InvalidModel(format!(
             "\"{key}\" needs a positive finite cut-off and an order in 1..={MAX_FILTER_ORDER} (got {cutoff_hz} Hz, order {order})"
         )));
