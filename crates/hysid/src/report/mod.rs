@@ -29,7 +29,9 @@ pub mod plot;
 pub mod rigid_body;
 pub mod simulate;
 
-pub use cascade::{cascade_report, hysteresis_report};
+pub use cascade::{
+    cascade_report, hysteresis_report, operator_cascade_model, operator_cascade_report,
+};
 pub use greybox::{bouc_wen_benchmark_report, greybox_report, greybox_residuals};
 pub use rigid_body::{rigid_body_model, rigid_body_report, RigidBodyRecord};
 pub use simulate::simulate_report;
