@@ -644,13 +644,16 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub model: PathBuf,
     /// CSV file with a header row, or a MATLAB .mat file (-v7 or older; columns are then
-    /// variable names, or name(:,k) for column k of a matrix).
-    #[arg(long)]
-    pub data: PathBuf,
-    /// Input column (repeat for models with several inputs).
+    /// variable names, or name(:,k) for column k of a matrix). Repeat for several records:
+    /// the fit is then over all of them, as a multi-record fit's report states it.
+    #[arg(long, required = true)]
+    pub data: Vec<PathBuf>,
+    /// Input column (repeat for models with several inputs; the position for a rigid body
+    /// fitted by `rigid-body ls`).
     #[arg(long, required = true)]
     pub input: Vec<String>,
-    /// Measured output column, for fit % and RMSE.
+    /// Measured output column, for fit % and RMSE (the drive signal for a rigid body fitted
+    /// by `rigid-body ls`, which predicts it from the position).
     #[arg(long)]
     pub output: Option<String>,
     /// Sample time [s]; otherwise from the time column, else 1. Range (0, 1e12].
@@ -659,7 +662,8 @@ pub struct SimulateArgs {
     /// Time column (default: a column named t, time, t_s or time_s, if any).
     #[arg(long)]
     pub time: Option<String>,
-    /// Write the input and the simulated output (and the measured one) as CSV here.
+    /// Write the input and the simulated output (and the measured one) as CSV here, as the
+    /// model sees them (filtered or decimated where its fit was). Only with one --data.
     #[arg(long)]
     pub csv: Option<PathBuf>,
     /// Write the JSON report here.

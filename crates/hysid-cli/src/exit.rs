@@ -51,20 +51,38 @@ impl ExitClass {
 pub fn library_class(error: &Error) -> ExitClass {
     match error {
         Error::Io { .. } => ExitClass::Io,
-        Error::Singular(_) | Error::Diverged { .. } | Error::NonFiniteResult { .. } => {
-            ExitClass::Numerical
-        }
+        Error::Singular(_)
+        | Error::Diverged { .. }
+        | Error::NonFiniteResult { .. }
+        | Error::NonFiniteOutput(_) => ExitClass::Numerical,
         // Csv, MissingColumn, NotNumeric, NonFinite, InvalidData, TooFewSamples,
-        // NotExciting, RateLimit, InvalidParameter, Config, ModelFile — and any variant added
-        // later until it is classified here — describe what the user gave.
+        // NotExciting, RateLimit, InvalidParameter, InvalidOption, InvalidModel,
+        // ModelMismatch, UnknownParameter, Unsupported(Kind), InvalidOutput, ModelFile — and
+        // any variant added later until it is classified here — describe what the user gave.
         _ => ExitClass::BadInput,
     }
 }
+
+/// A command line that parses but asks for something impossible (flags that exclude each
+/// other in a way the parser cannot express): exit 2, like a parser error.
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
 
 /// The class of a command's error: that of the first library or I/O error in its chain,
 /// else bad input (the command's own checks are about what the user gave).
 pub fn classify(error: &anyhow::Error) -> ExitClass {
     for cause in error.chain() {
+        if cause.downcast_ref::<UsageError>().is_some() {
+            return ExitClass::Usage;
+        }
         if let Some(e) = cause.downcast_ref::<Error>() {
             return library_class(e);
         }
@@ -75,8 +93,39 @@ pub fn classify(error: &anyhow::Error) -> ExitClass {
     ExitClass::BadInput
 }
 
+/// The command-line flag of a library setting ([`Error::InvalidOption`]'s `option`), where
+/// the CLI has one.
+const FLAGS: [(&str, &str); 12] = [
+    ("cutoff_hz", "--cutoff"),
+    ("starts", "--starts"),
+    ("start_factor", "--start-factor"),
+    ("replicates", "--replicates"),
+    ("example", "--example"),
+    ("levels", "--levels"),
+    ("lambda", "--lambda"),
+    ("family", "--family"),
+    ("hysteresis", "--hysteresis"),
+    ("model", "--model"),
+    ("substeps", "--substeps"),
+    ("noise", "--noise"),
+];
+
+/// The flag a library error is about, when it is a setting the CLI has a flag for: the
+/// library speaks of its settings, the CLI of its flags.
+fn flag_of(e: &anyhow::Error) -> Option<&'static str> {
+    e.chain()
+        .find_map(|cause| match cause.downcast_ref::<Error>() {
+            Some(Error::InvalidOption { option, .. }) => FLAGS
+                .iter()
+                .find(|(name, _)| name == option)
+                .map(|(_, flag)| *flag),
+            _ => None,
+        })
+}
+
 /// The error chain on one line, "context: cause", leaving out causes the message already
-/// quotes (the library's errors include their source in their own text).
+/// quotes (the library's errors include their source in their own text); a setting out of
+/// range is prefixed by its flag.
 pub fn one_line(e: &anyhow::Error) -> String {
     let mut message = String::new();
     for cause in e.chain() {
@@ -87,6 +136,9 @@ pub fn one_line(e: &anyhow::Error) -> String {
             }
             message.push_str(&text);
         }
+    }
+    if let Some(flag) = flag_of(e) {
+        message = format!("{flag}: {message}");
     }
     collapse(&message)
 }

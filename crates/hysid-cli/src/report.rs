@@ -1,28 +1,6 @@
 //! The JSON report and the printed parameter table.
 
-use hysid::data::IdData;
-use hysid::identify::OutputErrorFit;
-use hysid::model::saved::ModelFile;
 pub use hysid::report::Report;
-use hysid::report::UncertaintySummary;
-
-/// The report of an output-error fit (output 0 of every experiment of `data`, stacked).
-#[allow(clippy::too_many_arguments)]
-pub fn of_output_error(
-    command: &str,
-    fit: &OutputErrorFit,
-    data: &IdData,
-    sources: Vec<String>,
-    model: ModelFile,
-    elapsed_s: f64,
-    uncertainty: UncertaintySummary,
-    details: serde_json::Value,
-) -> hysid::Result<Report> {
-    Ok(
-        Report::of_output_error(command, data, sources, model, fit, elapsed_s, uncertainty)?
-            .with_details(details),
-    )
-}
 
 /// The fit % and RMSE of a report for printing (NaN when it holds no fit).
 pub fn figures(report: &Report) -> (f64, f64, f64) {

@@ -92,18 +92,26 @@ fn check_parameters(value: &serde_json::Value, name: &str) {
 
 /// `hysid simulate` of `model` on `data` reproduces `fit` % to 1e-9 relative.
 fn reproduces(dir: &Path, model: &Path, data: &Path, io: (&str, &str), fit: f64) {
+    let simulated = simulate(dir, model, &[data], io);
+    assert_close(fit_of(&simulated), fit, model);
+}
+
+/// The report of `hysid simulate` of `model` on the records `data`.
+fn simulate(dir: &Path, model: &Path, data: &[&Path], io: (&str, &str)) -> Report {
     let json = dir.join("simulated.report.json");
-    hysid()
-        .args(["simulate", "--model"])
-        .arg(model)
-        .arg("--data")
-        .arg(data)
-        .args(["--input", io.0, "--output", io.1, "--json"])
+    let mut cmd = hysid();
+    cmd.args(["simulate", "--model"]).arg(model);
+    for d in data {
+        cmd.arg("--data").arg(d);
+    }
+    cmd.args(["--input", io.0, "--output", io.1, "--json"])
         .arg(&json)
         .assert()
         .success();
-    let report = check(&json, "simulate");
-    let simulated = report.fit.unwrap().fit_percent;
+    check(&json, "simulate")
+}
+
+fn assert_close(simulated: f64, fit: f64, model: &Path) {
     assert!(
         ((simulated - fit) / fit).abs() < 1e-9,
         "{}: simulate gives {simulated} %, the report {fit} %",
@@ -290,8 +298,40 @@ fn actuator_and_rigid_body_reports_and_model_files() {
         assert!(step.command.starts_with("actuator identify: step"));
     }
     assert_eq!(report.validation.len(), 3);
-    // The m67 file simulates (its fit % is on the filtered records, see the report).
-    assert!(hysid::model::saved::FittedModel::load(&m67).is_ok());
+    // The m67 file carries its pre-filter: on the raw data sets 6 and 7 it reproduces the
+    // fit over both, each set's fit, and the validation fit on set 8.
+    let set = |k: usize| rig.join(format!("dataset{k}.csv"));
+    let io = ("tau_Nm", "theta_rad");
+    let both = simulate(dir, &m67, &[&set(6), &set(7)], io);
+    assert_close(fit_of(&both), fit_of(&report), &m67);
+    let per_set = &report.fit.as_ref().unwrap().per_experiment;
+    for (k, entry) in [6, 7].iter().zip(per_set) {
+        assert_close(
+            fit_of(&simulate(dir, &m67, &[&set(*k)], io)),
+            entry.fit_percent,
+            &m67,
+        );
+    }
+    for (k, entry) in (6..=8).zip(&report.validation) {
+        assert_close(
+            fit_of(&simulate(dir, &m67, &[&set(k)], io)),
+            entry.fit_percent,
+            &m67,
+        );
+    }
+    // Several records and --csv: a usage error (exit 2) in one line.
+    hysid()
+        .args(["simulate", "--model"])
+        .arg(&m67)
+        .arg("--data")
+        .arg(set(6))
+        .arg("--data")
+        .arg(set(7))
+        .args(["--input", "tau_Nm", "--csv"])
+        .arg(dir.join("x.csv"))
+        .assert()
+        .code(2);
+    assert!(!dir.join("x.csv").exists());
 
     let emps = repo("data/emps/DATA_EMPS.csv");
     let rb = dir.join("rb.model.json");
@@ -310,16 +350,17 @@ fn actuator_and_rigid_body_reports_and_model_files() {
             "--gain",
             "35.15065188",
             "--offset",
+            "--validate",
+            emps.to_str().unwrap(),
             "--model-out",
             rb.to_str().unwrap(),
         ],
-    );
-    assert!(
-        report.fit.is_none(),
-        "inverse dynamics predicts, it does not simulate"
     );
     let loaded = hysid::model::saved::FittedModel::load(&rb).unwrap();
     let file = loaded.to_file();
     let m = file.parameters.iter().find(|p| p.name == "M").unwrap();
     assert!((m.value - 95.1167).abs() < 0.01, "M = {}", m.value);
+    // The model predicts the drive signal from the position as the fit did.
+    reproduces(dir, &rb, &emps, ("qm_m", "vir_V"), fit_of(&report));
+    assert_eq!(report.validation[0].fit_percent, fit_of(&report));
 }

@@ -156,11 +156,15 @@ fn actuator_three_steps(
     run_on(py, threads, move || {
         if let Some(t) = &truth {
             if t.len() != PARAMETERS.len() || t.iter().any(|v| !v.is_finite()) {
-                return Err(Error::Config(format!(
-                    "truth: give {} finite values ({})",
-                    PARAMETERS.len(),
-                    PARAMETERS.join(", ")
-                )));
+                return Err(Error::invalid_option(
+                    "truth",
+                    format!("{t:?}"),
+                    format!(
+                        "truth: give {} finite values ({})",
+                        PARAMETERS.len(),
+                        PARAMETERS.join(", ")
+                    ),
+                ));
             }
         }
         let clock = std::time::Instant::now();
@@ -198,23 +202,33 @@ fn actuator_rig<'py>(
 > {
     let records = run(py, move || {
         if !(noise.is_finite() && noise >= 0.0) {
-            return Err(Error::Config(format!(
-                "noise = {noise}: give a non-negative multiple of the documented noise levels"
-            )));
+            return Err(Error::invalid_option(
+                "noise",
+                noise,
+                format!(
+                    "noise = {noise}: give a non-negative multiple of the documented noise levels"
+                ),
+            ));
         }
         if !(backlash.is_finite() && backlash >= 0.0) {
-            return Err(Error::Config(format!(
-                "backlash = {backlash}: give a non-negative play width in rad"
-            )));
+            return Err(Error::invalid_option(
+                "backlash",
+                backlash,
+                format!("backlash = {backlash}: give a non-negative play width in rad"),
+            ));
         }
         let defaults = Rig::default();
         let truth = truth.unwrap_or_else(|| defaults.truth.clone());
         if truth.len() != PARAMETERS.len() {
-            return Err(Error::Config(format!(
-                "truth: give {} values ({})",
-                PARAMETERS.len(),
-                PARAMETERS.join(", ")
-            )));
+            return Err(Error::invalid_option(
+                "truth",
+                format!("{truth:?}"),
+                format!(
+                    "truth: give {} values ({})",
+                    PARAMETERS.len(),
+                    PARAMETERS.join(", ")
+                ),
+            ));
         }
         let rig = Rig {
             truth,

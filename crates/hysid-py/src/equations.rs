@@ -94,7 +94,7 @@ fn equation_model_file(
         let model = EquationStateSpace::parse(text, "equation model")?;
         let parameters = checked_parameters(&model, &params)?;
         if x0.len() != model.states().len() {
-            return Err(Error::Config(format!(
+            return Err(Error::ModelMismatch(format!(
                 "x0 has {} values for the {} states of model '{}'",
                 x0.len(),
                 model.states().len(),
@@ -109,7 +109,7 @@ fn equation_model_file(
             initial_state: x0,
         }
         .to_file();
-        serde_json::to_string(&file).map_err(|e| Error::Config(format!("model: {e}")))
+        serde_json::to_string(&file).map_err(|e| Error::Serialization(format!("model: {e}")))
     })
 }
 
@@ -121,7 +121,7 @@ fn checked_parameters(
     let set = parameter_set(params)?;
     let expected = model.parameters().names();
     if set.names() != expected {
-        return Err(Error::Config(format!(
+        return Err(Error::ModelMismatch(format!(
             "model '{}' has the parameters {}, got {}",
             model.name(),
             expected.join(", "),

@@ -82,8 +82,15 @@ pub fn to_py(py: Python<'_>, e: hysid::Error) -> PyErr {
         | E::Csv { .. }
         | E::MissingColumn { .. }
         | E::NotNumeric { .. } => "DataError",
-        E::InvalidParameter { .. } | E::Config(_) | E::Equations(_) => "ConfigError",
-        E::ModelFile { .. } | E::Io { .. } => "ModelFileError",
+        E::InvalidParameter { .. }
+        | E::InvalidOption { .. }
+        | E::InvalidModel(_)
+        | E::ModelMismatch(_)
+        | E::UnknownParameter(_)
+        | E::Unsupported(_)
+        | E::UnsupportedKind { .. }
+        | E::Equations(_) => "ConfigError",
+        E::ModelFile { .. } | E::Io { .. } | E::InvalidOutput(_) => "ModelFileError",
         _ => "NumericalError",
     };
     named(py, class, message)

@@ -204,9 +204,11 @@ pub fn simulation(integrator: &str, substeps: usize, interpolation: &str) -> Res
         "rk4" => Integrator::Rk4 { substeps },
         "newmark" => Integrator::Newmark { substeps },
         other => {
-            return Err(Error::Config(format!(
-                "integrator='{other}': use 'rk4' or 'newmark'"
-            )))
+            return Err(Error::invalid_option(
+                "integrator",
+                other,
+                format!("integrator='{other}': use 'rk4' or 'newmark'"),
+            ))
         }
     };
     let interpolation = match interpolation {
@@ -214,9 +216,11 @@ pub fn simulation(integrator: &str, substeps: usize, interpolation: &str) -> Res
         "linear" => InputInterpolation::Linear,
         "band-limited" | "band_limited" => InputInterpolation::BandLimited,
         other => {
-            return Err(Error::Config(format!(
-                "interpolation='{other}': use 'zoh', 'linear' or 'band-limited'"
-            )))
+            return Err(Error::invalid_option(
+                "interpolation",
+                other,
+                format!("interpolation='{other}': use 'zoh', 'linear' or 'band-limited'"),
+            ))
         }
     };
     Ok(Simulation {
@@ -405,23 +409,16 @@ fn rigid_body_ls(
             border,
         };
         let e = ls.estimate(&q, &u, ts)?;
-        let records = vec![json!({
-            "file": source()[0],
-            "role": "estimation",
-            "relative_error_percent": e.relative_error_percent,
-        })];
         let settings = json!({"position": "q", "input": "u"});
         let elapsed = clock.elapsed().as_secs_f64();
-        report::rigid_body_report(
-            &e,
-            &ls,
-            source().remove(0),
-            q.len(),
-            elapsed,
-            records,
-            settings,
-        )
-        .to_json()
+        let source = source().remove(0);
+        let record = report::RigidBodyRecord {
+            source: &source,
+            q: &q,
+            u: &u,
+            ts,
+        };
+        report::rigid_body_report(&e, &ls, record, &[], elapsed, settings)?.to_json()
     })
 }
 
@@ -452,7 +449,7 @@ fn simulate_model<'py>(
 /// A model file's JSON, parsed.
 fn parse_model(text: &str) -> Result<ModelFile> {
     serde_json::from_str(text)
-        .map_err(|e| Error::Config(format!("not a hysid.model/1 model file: {e}")))
+        .map_err(|e| Error::InvalidModel(format!("not a hysid.model/1 model file: {e}")))
 }
 
 /// Reads a model file the CLI wrote; returns its JSON (checked by rebuilding the model).
@@ -460,7 +457,8 @@ fn parse_model(text: &str) -> Result<ModelFile> {
 fn load_model(py: Python<'_>, path: std::path::PathBuf) -> PyResult<String> {
     guard(py, || {
         let model = FittedModel::load(&path)?;
-        serde_json::to_string(&model.to_file()).map_err(|e| Error::Config(format!("model: {e}")))
+        serde_json::to_string(&model.to_file())
+            .map_err(|e| Error::Serialization(format!("model: {e}")))
     })
 }
 
@@ -470,6 +468,6 @@ fn check_model(py: Python<'_>, model_json: &str) -> PyResult<String> {
     guard(py, || {
         let model = FittedModel::from_file(&parse_model(model_json)?)?;
         serde_json::to_string_pretty(&model.to_file())
-            .map_err(|e| Error::Config(format!("model: {e}")))
+            .map_err(|e| Error::Serialization(format!("model: {e}")))
     })
 }

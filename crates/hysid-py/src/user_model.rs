@@ -191,7 +191,7 @@ type ModelSpec = (
 fn build(spec: ModelSpec) -> Result<(Arc<PythonModel>, Vec<f64>)> {
     let (rhs, output, states, n_inputs, n_outputs, params, x0) = spec;
     if x0.len() != states.len() {
-        return Err(Error::Config(format!(
+        return Err(Error::ModelMismatch(format!(
             "x0 has {} values for {} states",
             x0.len(),
             states.len()
@@ -340,9 +340,11 @@ fn simulate_user<'py>(
 /// Errors when the sample time is not positive or an input sample is not finite.
 pub fn check_inputs(inputs: &[Vec<f64>], ts: f64) -> Result<()> {
     if !(ts.is_finite() && ts > 0.0) {
-        return Err(Error::Config(format!(
-            "ts = {ts}: give a positive sample time"
-        )));
+        return Err(Error::invalid_option(
+            "ts",
+            ts,
+            format!("ts = {ts}: give a positive sample time"),
+        ));
     }
     for (i, u) in inputs.iter().enumerate() {
         if let Some(k) = u.iter().position(|v| !v.is_finite()) {

@@ -120,9 +120,65 @@ pub enum Error {
         reason: String,
     },
 
-    /// A model or estimator configuration is inconsistent.
-    #[error("invalid configuration: {0}")]
-    Config(String),
+    /// A setting of an estimator, a filter or a generator is out of range or unknown.
+    /// `option` is the library's name of the setting (a field name such as `cutoff_hz`); the
+    /// CLI maps it to its flag. The message is `reason`, which names the value.
+    #[error("{reason}")]
+    InvalidOption {
+        /// The setting's name in the library (`cutoff_hz`, `substeps`, `starts`, …).
+        option: String,
+        /// The value given, as text.
+        value: String,
+        /// Why it is not acceptable, and the acceptable range.
+        reason: String,
+    },
+
+    /// A model (a saved file, or one put together by a caller) is inconsistent: a missing
+    /// structure key, a parameter set that does not fit its kind.
+    #[error("invalid model: {0}")]
+    InvalidModel(String),
+
+    /// A model and what it is applied to do not match: the data's channel counts, the
+    /// number of initial states or parameter values given.
+    #[error("{0}")]
+    ModelMismatch(String),
+
+    /// A parameter name that the model does not have.
+    #[error("{0}")]
+    UnknownParameter(String),
+
+    /// An operation the model or method does not support (e.g. Newmark integration of a
+    /// model that is not second-order mechanical).
+    #[error("{0}")]
+    Unsupported(String),
+
+    /// A result or a model could not be turned into JSON (an internal failure, never of the
+    /// data).
+    #[error("serialisation: {0}")]
+    Serialization(String),
+
+    /// A model's output on the data is NaN or ±∞ (a numerical failure: the model is
+    /// unstable or the data lie outside its range).
+    #[error("{0}")]
+    NonFiniteOutput(String),
+
+    /// The caller asked a computation to stop (a replicate skipped, a search cancelled).
+    #[error("cancelled: {0}")]
+    Cancelled(String),
+
+    /// An output file cannot be written as asked (it is an input, it appears twice, its
+    /// directory is missing).
+    #[error("{0}")]
+    InvalidOutput(String),
+
+    /// An operation is not defined for a model of this kind.
+    #[error("model kind '{kind}' does not support {operation}")]
+    UnsupportedKind {
+        /// The model kind.
+        kind: String,
+        /// What was asked of it.
+        operation: String,
+    },
 
     /// A plot could not be laid out (an internal failure of the plot layout, never of the
     /// data).
@@ -190,6 +246,17 @@ pub struct EquationFileError {
     pub column: usize,
     /// What is wrong and what to do (one line).
     pub message: String,
+}
+
+impl Error {
+    /// [`Error::InvalidOption`] of the setting `option` with value `value`.
+    pub fn invalid_option(option: &str, value: impl std::fmt::Display, reason: String) -> Self {
+        Error::InvalidOption {
+            option: option.into(),
+            value: value.to_string(),
+            reason,
+        }
+    }
 }
 
 /// Shorthand for results in this crate.

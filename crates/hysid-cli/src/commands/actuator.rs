@@ -11,7 +11,6 @@ use hysid::experiments::actuator_rig::Rig;
 use hysid::identify::actuator::{
     read_data_sets, ActuatorIdentification, Record, ThreeSteps, PARAMETERS,
 };
-use hysid::model::greybox::models::ActuatorFixed;
 use hysid::model::greybox::Simulation;
 use hysid::numerics::LmConfig;
 use hysid::report::actuator::three_steps_report;
@@ -144,8 +143,8 @@ fn publish(
     } else {
         None
     };
-    let m67 = id.step3["m67"].fitted_model(&ActuatorFixed, simulation);
-    out.finish(report.as_ref(), Some(&m67))
+    let m67 = id.fitted("m67", simulation);
+    out.finish(report.as_ref(), m67.as_ref())
 }
 
 fn three_steps(args: &ThreeStepArgs, constants: &ActuatorConstants) -> ThreeSteps {

@@ -4,7 +4,7 @@
 //! simulation mode (docs/benchmarks.md §1); `generate` makes test signals by the official recipe.
 
 use super::greybox::configure;
-use super::present::{print_fit, print_residuals, report};
+use super::present::{print_fit, print_residuals};
 use crate::cli::{BoucWenArgs, BoucWenGenerate, BoucWenGenerateArgs, SignalArg};
 use crate::output::{write_figures, Outputs};
 use crate::progress::FitProgress;
@@ -15,8 +15,7 @@ use hysid::identify::bouc_wen_benchmark::{
     PUBLISHED, UP,
 };
 use hysid::report::plot::{benchmark_test_figures, greybox_figures};
-use hysid::report::ValidationEntry;
-use serde_json::json;
+use hysid::report::{bouc_wen_benchmark_report, ValidationEntry};
 use std::path::Path;
 
 /// Runs the benchmark (or the generator).
@@ -86,30 +85,21 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
         write_figures(&dir.tmp, &greybox_figures(fit, &data, &residuals)?)?;
         write_figures(&dir.tmp, &benchmark_test_figures(&result.tests)?)?;
     }
-    let report = if out.json.is_some() {
-        let extra = json!({
-            "training_e_rms": result.training_e_rms,
-            "steady_state": args.steady_state,
-            "published_multisine_e_rms": PUBLISHED.iter().map(|(who, e)| json!({"method": who, "e_rms": e})).collect::<Vec<_>>(),
-            "residual_analysis": residuals,
-        });
-        let sources = vec![train.display().to_string()];
-        let mut report = report(
-            "benchmark bouc-wen",
+    // The report (with its own residual analysis) only when it is written.
+    let report = match out.json {
+        Some(_) => Some(bouc_wen_benchmark_report(
             fit,
             &data,
-            sources,
+            vec![train.display().to_string()],
             result.model.to_file(),
-            extra,
-        )?;
-        report.validation = result
-            .tests
-            .iter()
-            .map(ValidationEntry::of_benchmark)
-            .collect::<hysid::Result<_>>()?;
-        Some(report)
-    } else {
-        None
+            result
+                .tests
+                .iter()
+                .map(ValidationEntry::of_benchmark)
+                .collect::<hysid::Result<_>>()?,
+            args.steady_state,
+        )?),
+        None => None,
     };
     out.finish(report.as_ref(), Some(&result.model))
 }

@@ -1,6 +1,6 @@
 //! `hysid greybox fit`: output-error estimation of a built-in grey-box model.
 
-use super::present::{print_fit, print_residuals, print_sensitivity, report};
+use super::present::{print_fit, print_residuals, print_sensitivity};
 use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
 use crate::commands::identify::load;
 use crate::output::Outputs;
@@ -13,6 +13,7 @@ use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::{models, InputInterpolation, Integrator, Simulation, StateSpaceModel};
 use hysid::model::ParameterSet;
 use hysid::numerics::LmConfig;
+use hysid::report::greybox_report;
 use hysid::report::plot::greybox_figures;
 use serde_json::json;
 use std::sync::Arc;
@@ -109,7 +110,7 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     out.figures(|| greybox_figures(&fit, &data, &residuals))?;
     let extra = json!({"residual_analysis": residuals, "sensitivity": sensitivity});
     let sources = vec![args.data.data.display().to_string()];
-    let report = report("greybox fit", &fit, &data, sources, fitted.to_file(), extra)?;
+    let report = greybox_report("greybox fit", &fit, &data, sources, fitted.to_file(), extra)?;
     out.finish(Some(&report), Some(&fitted))
 }
 

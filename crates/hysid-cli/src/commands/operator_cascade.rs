@@ -5,14 +5,13 @@
 use super::identify::{load, register};
 use crate::cli::{CascadeArgs, UncertaintyArg};
 use crate::progress::FitProgress;
-use crate::report::{figures, of_output_error, print_table, Row};
+use crate::report::{figures, print_table, Row};
 use anyhow::Result;
 use hysid::identify::operator_cascade::{
     CascadeFamily, OperatorCascadeFit, OperatorCascadeIdentification,
 };
-use hysid::model::saved::FittedModel;
 use hysid::report::plot::operator_cascade_figures;
-use hysid::report::UncertaintySummary;
+use hysid::report::{operator_cascade_model, operator_cascade_report};
 use serde_json::json;
 
 /// The family named on the command line with its structure options (the lead unifies this
@@ -78,30 +77,10 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
         u.len()
     );
     print_table(&rows(&fit));
-    let model = FittedModel::OperatorCascade {
-        model: fit.model.clone(),
-        std: fit.output_error.std().to_vec(),
-    };
-    let details = json!({
-        "input": args.data.input,
-        "output": args.data.output,
-        "family": id.family.name(),
-        "initialisation": fit.initialisation,
-        "start": fit.start.parameters().values(),
-        "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
-        "linear_block_zero_radius": fit.model.zero_radius(),
-        "output_error_history": fit.output_error.report.history,
-    });
-    let report = of_output_error(
-        "identify cascade",
-        &fit.output_error,
-        &data,
-        vec![args.data.data.display().to_string()],
-        model.to_file(),
-        fit.elapsed_s,
-        UncertaintySummary::asymptotic(),
-        details,
-    )?;
+    let model = operator_cascade_model(&fit);
+    let extra = json!({"input": args.data.input, "output": args.data.output});
+    let source = vec![args.data.data.display().to_string()];
+    let report = operator_cascade_report(id.family.name(), &fit, &data, source, extra)?;
     let (fit_percent, rmse, fpe) = figures(&report);
     println!(
         "  start: {}; output-error fit: {} iterations, {}",

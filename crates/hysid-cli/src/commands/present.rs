@@ -2,13 +2,10 @@
 //! bounds and fixed flags; strong correlations; fit per experiment; loss, FPE, AIC; why the
 //! search stopped; residual analysis; optional sensitivity table.
 
-use crate::report::{of_output_error, Report};
-use anyhow::Result;
 use hysid::data::IdData;
 use hysid::identify::greybox::GreyBoxFit;
-use hysid::identify::validate::{residual_analysis, ResidualAnalysis, SensitivityRow};
-use hysid::report::UncertaintySummary;
-use serde_json::json;
+use hysid::identify::validate::{ResidualAnalysis, SensitivityRow};
+use hysid::report::greybox_residuals;
 
 /// Prints the parameter table and the fit statistics.
 pub fn print_fit(title: &str, fit: &GreyBoxFit) {
@@ -90,23 +87,22 @@ pub fn strong_correlations(fit: &GreyBoxFit, limit: f64) -> Vec<(String, String,
     out
 }
 
-/// Residual analysis of every experiment's first output, printed in one line each.
+/// Residual analysis of every experiment's first output (the library's), printed in one
+/// line each.
 pub fn print_residuals(fit: &GreyBoxFit, data: &IdData) -> Vec<ResidualAnalysis> {
-    (0..data.n_experiments())
-        .map(|e| {
-            let a = residual_analysis(data, e, 0, &fit.fit.simulated[e][0], 25);
-            println!(
-                "  residuals, experiment {}: {} of {} auto-correlations and {} of {} input cross-correlations outside the 99 % band ±{:.3}",
-                e + 1,
-                a.auto_outside,
-                a.max_lag,
-                a.cross_outside.iter().sum::<usize>(),
-                a.cross_correlation.iter().map(|c| c.len()).sum::<usize>(),
-                a.band
-            );
-            a
-        })
-        .collect()
+    let analyses = greybox_residuals(fit, data);
+    for (e, a) in analyses.iter().enumerate() {
+        println!(
+            "  residuals, experiment {}: {} of {} auto-correlations and {} of {} input cross-correlations outside the 99 % band ±{:.3}",
+            e + 1,
+            a.auto_outside,
+            a.max_lag,
+            a.cross_outside.iter().sum::<usize>(),
+            a.cross_correlation.iter().map(|c| c.len()).sum::<usize>(),
+            a.band
+        );
+    }
+    analyses
 }
 
 /// Prints the sensitivity table.
@@ -120,42 +116,4 @@ pub fn print_sensitivity(rows: &[SensitivityRow]) {
                 .collect();
         println!("    {:<12} {}", r.name, cells.join("   "));
     }
-}
-
-/// The JSON report of a grey-box fit.
-pub fn report(
-    command: &str,
-    fit: &GreyBoxFit,
-    data: &IdData,
-    sources: Vec<String>,
-    model_file: hysid::model::saved::ModelFile,
-    extra: serde_json::Value,
-) -> Result<Report> {
-    let oe = &fit.fit;
-    let n = oe.parameters.len();
-    let correlation: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| oe.covariance.correlation[(i, j)]).collect())
-        .collect();
-    let mut details = json!({
-        "mse_per_experiment": oe.mse,
-        "simulations_without_sensitivities": oe.report.residual_evaluations,
-        "simulations_with_sensitivities": oe.report.sensitivity_evaluations,
-        "rejected_trials": oe.report.rejected_trials,
-        "correlation": correlation,
-        "history": oe.report.history,
-        "starts": fit.starts,
-    });
-    if let (Some(obj), serde_json::Value::Object(more)) = (details.as_object_mut(), extra) {
-        obj.extend(more);
-    }
-    Ok(of_output_error(
-        command,
-        oe,
-        data,
-        sources,
-        model_file,
-        fit.elapsed_s,
-        UncertaintySummary::asymptotic(),
-        details,
-    )?)
 }

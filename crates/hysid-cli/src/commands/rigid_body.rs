@@ -6,14 +6,11 @@ use crate::output::Outputs;
 use anyhow::{Context, Result};
 use hysid::data::{CsvSpec, IdData};
 use hysid::identify::rigid_body::{RigidBodyEstimate, RigidBodyLs};
-use hysid::model::greybox::models::RigidBody;
-use hysid::model::greybox::{Simulation, StateSpaceModel};
-use hysid::model::saved::FittedModel;
-use hysid::report::{DataSummary, Report, SearchSummary, UncertaintySummary};
+use hysid::report::{rigid_body_model, rigid_body_report, Report, RigidBodyRecord};
 use serde_json::json;
 use std::path::Path;
 
-/// Estimates on one record; relative errors on every validation record.
+/// Estimates on one record; relative errors and fit % on every validation record.
 pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
     let mut inputs = vec![args.data.as_path()];
     inputs.extend(args.validate.iter().map(|p| p.as_path()));
@@ -38,31 +35,60 @@ pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
         .estimate(&q, &u, ts)
         .with_context(|| args.data.display().to_string())?;
     print_estimate(&estimate, args);
-    let mut records = vec![json!({
-        "file": args.data,
-        "role": "estimation",
-        "relative_error_percent": estimate.relative_error_percent,
-    })];
-    for path in &args.validate {
-        let (q, u, ts) = record(path, args)?;
-        let error = ls
-            .relative_error(&estimate, &q, &u, ts)
-            .with_context(|| path.display().to_string())?;
-        println!("  relative error {error:.4} % on {}", path.display());
-        records.push(json!({
-            "file": path,
-            "role": "validation",
-            "relative_error_percent": error,
-        }));
-    }
-    let report = report(
+    let validation = args
+        .validate
+        .iter()
+        .map(|path| Ok((path.display().to_string(), record(path, args)?)))
+        .collect::<Result<Vec<_>>>()?;
+    let source = args.data.display().to_string();
+    let estimation = RigidBodyRecord {
+        source: &source,
+        q: &q,
+        u: &u,
+        ts,
+    };
+    let validation: Vec<RigidBodyRecord> = validation
+        .iter()
+        .map(|(source, (q, u, ts))| RigidBodyRecord {
+            source,
+            q,
+            u,
+            ts: *ts,
+        })
+        .collect();
+    let settings = json!({"position": args.position, "input": args.input});
+    let report = rigid_body_report(
         &estimate,
-        records,
-        args,
-        q.len(),
+        &ls,
+        estimation,
+        &validation,
         clock.elapsed().as_secs_f64(),
-    );
-    out.finish(Some(&report), Some(&fitted(&estimate, args)))
+        settings,
+    )?;
+    print_records(&report);
+    out.finish(Some(&report), Some(&rigid_body_model(&estimate, &ls)))
+}
+
+/// The relative error and fit % of the predicted drive signal per record.
+fn print_records(report: &Report) {
+    if let Some(fit) = &report.fit {
+        println!(
+            "  predicted drive signal: fit {:.2} % on the estimation record (decimated, borders dropped)",
+            fit.fit_percent
+        );
+    }
+    let records = report.details["records"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    for (r, v) in records.iter().skip(1).zip(&report.validation) {
+        println!(
+            "  relative error {:.4} %, fit {:.2} % on {}",
+            r["relative_error_percent"].as_f64().unwrap_or(f64::NAN),
+            v.fit_percent,
+            v.source
+        );
+    }
 }
 
 /// The settings, the estimates with their standard deviations, the fit and the condition.
@@ -95,71 +121,6 @@ fn print_estimate(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) {
         estimate.condition_number_unscaled,
         estimate.condition_number
     );
-}
-
-/// The report: the estimate as a `rigid_body` model (M q̈ + Fv q̇ + Fc sgn(q̇) + offset =
-/// gain·u), `fit` null (an inverse-dynamics fit predicts the force, it does not simulate),
-/// the relative error per record, the condition numbers and the settings in `details`.
-fn report(
-    estimate: &RigidBodyEstimate,
-    records: Vec<serde_json::Value>,
-    args: &RigidBodyLsArgs,
-    samples: usize,
-    elapsed_s: f64,
-) -> Report {
-    Report {
-        data: Some(DataSummary {
-            source: vec![args.data.display().to_string()],
-            samples,
-            experiments: 1,
-            ts: None,
-        }),
-        model: Some(fitted(estimate, args).to_file()),
-        search: Some(SearchSummary::direct(elapsed_s)),
-        uncertainty: Some(UncertaintySummary::least_squares()),
-        details: json!({
-            "relative_std_percent": estimate.names.iter().cloned().zip(estimate.relative_std_percent.iter().copied()).collect::<std::collections::BTreeMap<_, _>>(),
-            "records": records,
-            "condition_number": estimate.condition_number_unscaled,
-            "condition_number_scaled": estimate.condition_number,
-            "equations": estimate.equations,
-            "settings": {
-                "gain": args.gain, "offset": args.offset, "cutoff_hz": args.cutoff,
-                "filter_order": args.order, "decimation": args.decimate, "border": args.border,
-                "position": args.position, "input": args.input,
-            },
-        }),
-        ..Report::new("rigid-body ls")
-    }
-}
-
-/// The estimate as the built-in `rigid_body` grey-box model (offset fixed at 0 when not
-/// estimated, the gain fixed at `--gain`).
-fn fitted(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) -> FittedModel {
-    let mut parameters = RigidBody.parameters();
-    let mut std = vec![f64::NAN; parameters.len()];
-    for (i, sigma) in std.iter_mut().enumerate() {
-        let p = parameters.get_mut(i);
-        match estimate.names.iter().position(|n| *n == p.name) {
-            Some(k) => {
-                p.value = estimate.values[k];
-                *sigma = estimate.std[k];
-            }
-            None => {
-                p.fixed = true;
-                if p.name == "gain" {
-                    p.value = args.gain;
-                }
-            }
-        }
-    }
-    FittedModel::GreyBox {
-        kind: "rigid_body".into(),
-        parameters,
-        std,
-        simulation: Simulation::default(),
-        initial_state: vec![0.0; RigidBody.states().len()],
-    }
 }
 
 /// Position, drive signal and sample time of a record.

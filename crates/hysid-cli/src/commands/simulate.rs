@@ -1,22 +1,26 @@
-//! `hysid simulate`: run a saved model (or the model of a report) on new input data.
+//! `hysid simulate`: run a saved model (or the model of a report) on new records.
 
 use crate::cli::SimulateArgs;
+use crate::exit::UsageError;
 use crate::output::Outputs;
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::model::saved::FittedModel;
-use hysid::report::{DataSummary, FitSummary, Report};
+use hysid::report::simulate_report;
 
-/// Simulates the model on the input columns; compares with the output column when given.
-/// The outputs are one transaction: written to temporaries, renamed into place together at
-/// the end, and never an input file.
+/// Runs the model on every record (processed as its fit processed them) and compares with
+/// the output column when given. The outputs are one transaction: written to temporaries,
+/// renamed into place together at the end, and never an input file.
 pub fn run(args: &SimulateArgs) -> Result<()> {
-    let mut out = Outputs::new(
-        &[args.model.as_path(), args.data.as_path()],
-        args.json.as_deref(),
-        None,
-        None,
-    )?;
+    if args.csv.is_some() && args.data.len() > 1 {
+        return Err(UsageError(
+            "--csv writes the signals of one record; give one --data with --csv, or leave --csv out; run 'hysid simulate --help' for the options".into(),
+        )
+        .into());
+    }
+    let mut inputs = vec![args.model.as_path()];
+    inputs.extend(args.data.iter().map(|p| p.as_path()));
+    let mut out = Outputs::new(&inputs, args.json.as_deref(), None, None)?;
     let csv = out.file(args.csv.as_deref())?;
     let model = FittedModel::load(&args.model)?;
     let spec = CsvSpec {
@@ -25,50 +29,51 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         time: args.time.clone(),
         ts: args.ts,
     };
-    let data = IdData::from_file(&args.data, &spec)?;
-    let exp = data.experiment(0);
-    let inputs: Vec<&[f64]> = (0..args.input.len()).map(|c| exp.input(c)).collect();
-    let measured = args.output.as_ref().map(|_| exp.output(0));
+    let data = args
+        .data
+        .iter()
+        .map(|path| IdData::from_file(path, &spec))
+        .collect::<hysid::Result<Vec<_>>>()?;
+    let records: Vec<(String, &IdData)> = args
+        .data
+        .iter()
+        .map(|p| p.display().to_string())
+        .zip(&data)
+        .collect();
     // Errors (never returns) when the simulated output is not finite.
-    let outputs = model
-        .simulate(
-            &inputs,
-            data.ts(),
-            measured.and_then(|y| y.first().copied()),
+    let (report, predictions) = simulate_report(&model, &records).with_context(|| {
+        format!(
+            "simulating on {}",
+            records
+                .iter()
+                .map(|(s, _)| s.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
         )
-        .with_context(|| format!("simulating on {}", args.data.display()))?;
-    let yhat = &outputs[0];
-    let file = model.to_file();
-    let kind = file.kind.clone();
-    let mut report = Report::new("simulate");
-    report.data = Some(DataSummary::of(
-        &data,
-        vec![args.data.display().to_string()],
-    ));
-    if let Some(y) = measured {
-        report.fit = Some(FitSummary::of(
-            std::slice::from_ref(&exp.name),
-            &[y],
-            &[yhat],
-        )?);
-    }
-    report.model = Some(file);
-    if let Some(csv) = &csv {
+    })?;
+    if let (Some(csv), Some(p)) = (&csv, predictions.first()) {
         let mut headers: Vec<&str> = args.input.iter().map(String::as_str).collect();
         headers.push("simulated");
-        let mut cols: Vec<&[f64]> = inputs.clone();
-        cols.push(yhat);
-        if let (Some(name), Some(y)) = (&args.output, measured) {
+        let mut cols: Vec<&[f64]> = p.inputs.iter().map(Vec::as_slice).collect();
+        cols.push(&p.outputs[0]);
+        if let (Some(name), Some(y)) = (&args.output, &p.measured) {
             headers.push(name.as_str());
             cols.push(y);
         }
         write_csv(&csv.tmp, &headers, &cols)?;
     }
-    println!(
-        "Simulated {kind} on {} ({} samples)",
-        args.data.display(),
-        exp.len()
-    );
+    let kind = report.model.as_ref().map_or("", |m| m.kind.as_str());
+    for ((source, d), p) in records.iter().zip(&predictions) {
+        println!(
+            "Simulated {kind} on {source} ({} samples{})",
+            d.experiment(0).len(),
+            if p.outputs[0].len() == d.experiment(0).len() {
+                String::new()
+            } else {
+                format!(", {} as the fit saw them", p.outputs[0].len())
+            }
+        );
+    }
     if let Some(fit) = &report.fit {
         println!("  fit {:.2} %   RMSE {:.4e}", fit.fit_percent, fit.rmse);
     }

@@ -217,9 +217,11 @@ impl Rig {
                 )
             }
             other => {
-                return Err(Error::Config(format!(
-                    "the rig has data sets 1 to 8, not {other}"
-                )))
+                return Err(Error::invalid_option(
+                    "data_set",
+                    other,
+                    format!("the rig has data sets 1 to 8, not {other}"),
+                ))
             }
         };
         let (torque, angle) = self.run(
@@ -249,7 +251,9 @@ impl Rig {
 
     fn validate(&self) -> Result<()> {
         if self.truth.len() != 7 || self.truth.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Config(
+            return Err(Error::invalid_option(
+                "truth",
+                format!("{:?}", self.truth),
                 "the rig needs 7 finite true parameters (J, Fv, Fc, k1, k2, alpha, A)".into(),
             ));
         }
@@ -273,12 +277,17 @@ impl Rig {
             || self.angle_noise < 0.0
             || self.torque_noise < 0.0
         {
-            return Err(Error::Config(
+            return Err(Error::invalid_option(
+                "rig",
+                format!(
+                    "fs = {}, substeps = {}, backlash = {}, noise = {}/{}",
+                    self.fs, self.substeps, self.backlash, self.angle_noise, self.torque_noise
+                ),
                 "the rig needs fs > 0, substeps >= 1 and non-negative backlash and noise".into(),
             ));
         }
         if !(self.r.is_finite() && self.r > 0.0 && self.m.is_finite() && self.m >= 0.0) {
-            return Err(Error::Config(format!(
+            return Err(Error::invalid_option("r, m", format!("{}, {}", self.r, self.m), format!(
                 "the rig needs a positive gear ratio and a non-negative saddle mass, got r = {} m/rad, m = {} kg",
                 self.r, self.m
             )));

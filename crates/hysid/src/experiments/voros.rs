@@ -70,9 +70,11 @@ impl CascadeExample {
         match n {
             1 => Ok(Self::example1()),
             2 => Ok(Self::example2()),
-            _ => Err(Error::Config(format!(
-                "there are examples 1 and 2, not {n}"
-            ))),
+            _ => Err(Error::invalid_option(
+                "example",
+                n,
+                format!("there are examples 1 and 2, not {n}"),
+            )),
         }
     }
 

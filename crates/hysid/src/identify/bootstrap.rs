@@ -51,9 +51,11 @@ pub fn parametric_bootstrap(
     refit: &(dyn Fn(&IdData) -> Result<Vec<f64>> + Sync),
 ) -> Result<Bootstrap> {
     if replicates < 2 {
-        return Err(Error::Config(format!(
-            "a bootstrap needs at least 2 replicates, got {replicates}"
-        )));
+        return Err(Error::invalid_option(
+            "replicates",
+            replicates,
+            format!("a bootstrap needs at least 2 replicates, got {replicates}"),
+        ));
     }
     let outcomes: Vec<Option<Vec<f64>>> = (0..replicates)
         .into_par_iter()

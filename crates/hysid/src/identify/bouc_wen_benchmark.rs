@@ -109,9 +109,13 @@ impl BoucWenBenchmark {
     /// `start_factor` (the protocol's test of robustness to the start).
     pub fn start_values(start_factor: f64) -> Result<ParameterSet> {
         if !(start_factor.is_finite() && start_factor > 0.0) {
-            return Err(Error::Config(format!(
+            return Err(Error::invalid_option(
+                "start_factor",
+                start_factor,
+                format!(
                 "start factor {start_factor}: give a finite positive multiple of the nominal values"
-            )));
+            ),
+            ));
         }
         let mut params = BoucWen.parameters();
         for i in params.free_indices() {
@@ -230,7 +234,9 @@ pub fn generate(signal: TestSignal, noise: f64, seed: u64) -> Result<GeneratedRe
     let (u, u_fine) = match signal {
         TestSignal::Multisine { periods } => {
             if periods < 1 {
-                return Err(Error::Config(
+                return Err(Error::invalid_option(
+                    "periods",
+                    0,
                     "a multisine test record needs at least 1 period".into(),
                 ));
             }
@@ -241,7 +247,9 @@ pub fn generate(signal: TestSignal, noise: f64, seed: u64) -> Result<GeneratedRe
         }
         TestSignal::Sweep { samples } => {
             if samples < 2 {
-                return Err(Error::Config(
+                return Err(Error::invalid_option(
+                    "samples",
+                    samples,
                     "a sine-sweep test record needs at least 2 samples".into(),
                 ));
             }

@@ -318,12 +318,12 @@ impl CascadeIdentification {
     fn validate(&self, data: &IdData) -> Result<()> {
         let s = &self.structure;
         if s.delay < 1 || s.nb < 1 {
-            return Err(Error::Config(
-                "the cascade needs --delay >= 1 and --nb >= 1".into(),
+            return Err(Error::InvalidModel(
+                "the cascade needs a delay k >= 1 and nb >= 1 B coefficients".into(),
             ));
         }
         if data.input_channels().len() != 1 || data.output_channels().len() != 1 {
-            return Err(Error::Config(
+            return Err(Error::ModelMismatch(
                 "the cascade needs exactly one input and one output channel".into(),
             ));
         }
@@ -484,7 +484,7 @@ impl CascadeIdentification {
         let done = AtomicUsize::new(0);
         let refit = |replicate: &IdData| -> Result<Vec<f64>> {
             if self.observer.should_stop("bootstrap replicate") {
-                return Err(Error::Config(
+                return Err(Error::Cancelled(
                     "replicate skipped at the caller's request".into(),
                 ));
             }

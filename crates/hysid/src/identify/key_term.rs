@@ -178,20 +178,21 @@ impl KeyTermSeparation {
 
     fn validate(&self, initial: &ColemanHodgdon) -> Result<()> {
         if self.delay < 1 || self.nb < 1 {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "key-term separation needs delay k >= 1 and nb >= 1".into(),
             ));
         }
         if initial.form() != self.form {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "initial hysteresis has the wrong form".into(),
             ));
         }
         if !(self.relaxation > 0.0 && self.relaxation <= 1.0) {
-            return Err(Error::Config(format!(
-                "relaxation must be in (0, 1], got {}",
-                self.relaxation
-            )));
+            return Err(Error::invalid_option(
+                "relaxation",
+                self.relaxation,
+                format!("relaxation must be in (0, 1], got {}", self.relaxation),
+            ));
         }
         Ok(())
     }

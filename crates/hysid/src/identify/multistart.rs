@@ -94,8 +94,9 @@ pub fn best_of(
     }
     match best {
         Some(b) => Ok((b, outcomes)),
-        None => Err(first_error
-            .unwrap_or_else(|| Error::Config("multi-start needs at least one start".into()))),
+        None => Err(first_error.unwrap_or_else(|| {
+            Error::invalid_option("starts", 0, "multi-start needs at least one start".into())
+        })),
     }
 }
 

@@ -213,12 +213,14 @@ impl OperatorCascadeIdentification {
 
     fn check(&self, data: &IdData) -> Result<()> {
         if self.nb == 0 {
-            return Err(Error::Config(
+            return Err(Error::invalid_option(
+                "nb",
+                0,
                 "the linear block needs at least one B coefficient (b1 = 1); give nb >= 1".into(),
             ));
         }
         if data.input_channels().len() != 1 || data.output_channels().len() != 1 {
-            return Err(Error::Config(format!(
+            return Err(Error::ModelMismatch(format!(
                 "an operator cascade has one input and one output; the data have {} and {}",
                 data.input_channels().len(),
                 data.output_channels().len()
@@ -273,7 +275,7 @@ impl OperatorCascadeIdentification {
         let c = DMatrix::from_fn(nb, l, |j, m| coef[na + j * l + m]);
         let svd = c.svd(true, true);
         let (Some(us), Some(vt)) = (svd.u, svd.v_t) else {
-            return Err(Error::Config("rank-one factorisation failed".into()));
+            return Err(Error::Singular("rank-one factorisation failed".into()));
         };
         let best = svd.singular_values.iter().enumerate().fold(0, |b, (i, s)| {
             if *s > svd.singular_values[b] {
@@ -348,7 +350,9 @@ impl OperatorCascadeIdentification {
 
     fn backlash_start(&self, u: &[f64], y: &[f64], points: usize) -> Result<OperatorCascade> {
         if points < 2 {
-            return Err(Error::Config(
+            return Err(Error::invalid_option(
+                "profile_points",
+                points,
                 "backlash: give at least 2 profile points".into(),
             ));
         }
@@ -422,7 +426,7 @@ impl OperatorCascadeIdentification {
                 CascadeOperator::Dahl(dahl::fit(u, y, &DahlOptions::default())?.model)
             }
             other => {
-                return Err(Error::Config(format!(
+                return Err(Error::Unsupported(format!(
                     "{} has a least-squares start, not a family start",
                     other.name()
                 )))

@@ -205,9 +205,11 @@ impl OutputError {
             Some(w) if w.len() == n_outputs && w.iter().all(|v| v.is_finite() && *v > 0.0) => {
                 Ok(w.clone())
             }
-            Some(w) => Err(Error::Config(format!(
-                "need {n_outputs} positive output weights, got {w:?}"
-            ))),
+            Some(w) => Err(Error::invalid_option(
+                "output_weights",
+                format!("{w:?}"),
+                format!("need {n_outputs} positive output weights, got {w:?}"),
+            )),
         }
     }
 }
@@ -298,7 +300,7 @@ impl<'a> OutputErrorProblem<'a> {
     ) -> Result<Self> {
         let ny = model.n_outputs();
         if data.output_channels().len() != ny {
-            return Err(Error::Config(format!(
+            return Err(Error::ModelMismatch(format!(
                 "the model has {ny} output(s) but the data have {}",
                 data.output_channels().len()
             )));

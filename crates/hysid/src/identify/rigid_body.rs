@@ -23,8 +23,8 @@
 //! this is the published preprocessing of the EMPS reference model (Janot, Gautier & Brunot
 //! 2019).
 
+use crate::model::record_filters::InverseDynamics;
 use crate::numerics::least_squares::{least_squares, LsSolution};
-use crate::numerics::signal::{butter, decimate, filtfilt, gradient};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use serde::Serialize;
@@ -143,6 +143,17 @@ impl RigidBodyLs {
         Ok(relative_error(&w, &force, &estimate.values))
     }
 
+    /// The preprocessing of the regression, saved with the model so that it predicts the
+    /// drive signal as the fit did.
+    pub fn preprocessing(&self) -> InverseDynamics {
+        InverseDynamics {
+            cutoff_hz: self.cutoff_hz,
+            order: self.filter_order,
+            decimation: self.decimation,
+            border: self.border,
+        }
+    }
+
     fn names(&self) -> Vec<String> {
         let mut names = vec![self.inertia_name.clone(), "Fv".into(), "Fc".into()];
         if self.offset {
@@ -168,38 +179,11 @@ impl RigidBodyLs {
                     .into(),
             });
         }
-        let nyquist = 0.5 / ts;
-        if !(self.cutoff_hz > 0.0 && self.cutoff_hz < nyquist) {
-            return Err(Error::Config(format!(
-                "the filter cut-off {} Hz must lie between 0 and the Nyquist frequency {nyquist} Hz",
-                self.cutoff_hz
-            )));
-        }
-        // Saturating: border and decimation come from the user and may be huge.
-        let needed = self
-            .border
-            .saturating_mul(2)
-            .saturating_add(self.decimation.max(1).saturating_mul(20))
-            .saturating_add(30);
-        if q.len() < needed {
-            return Err(Error::TooFewSamples {
-                samples: q.len(),
-                parameters: self.names().len(),
-                needed,
-            });
-        }
-        let qf = filtfilt(&butter(self.filter_order, self.cutoff_hz / nyquist)?, q)?;
-        let qd = gradient(&qf, ts);
-        let qdd = gradient(&qd, ts);
+        let preprocessing = self.preprocessing();
+        preprocessing.check(q.len(), ts, self.names().len())?;
+        let [_, qd, qdd] = preprocessing.motion(q, ts)?;
         self.check_direction(&qd)?;
-        let mut columns = vec![
-            qdd,
-            qd.clone(),
-            qd.iter().map(|v| crate::numerics::sign0(*v)).collect(),
-        ];
-        if self.offset {
-            columns.push(vec![1.0; q.len()]);
-        }
+        let columns = InverseDynamics::columns(&qd, qdd, self.offset);
         let force: Vec<f64> = u.iter().map(|v| self.gain * v).collect();
         if force.iter().all(|f| *f == 0.0) {
             return Err(Error::NotExciting {
@@ -210,16 +194,12 @@ impl RigidBodyLs {
                 ),
             });
         }
-        let r = self.decimation.max(1);
-        let decimated: Vec<Vec<f64>> = columns
+        let reduced: Vec<Vec<f64>> = columns
             .iter()
-            .map(|c| decimate(c, r))
+            .map(|c| preprocessing.reduce(c))
             .collect::<Result<_>>()?;
-        let force = decimate(&force, r)?;
-        let cut = self.border / r;
-        let rows = force.len().saturating_sub(2 * cut);
-        let w = DMatrix::from_fn(rows, decimated.len(), |i, j| decimated[j][i + cut]);
-        let force = force[cut..cut + rows].to_vec();
+        let force = preprocessing.reduce(&force)?;
+        let w = DMatrix::from_fn(force.len(), reduced.len(), |i, j| reduced[j][i]);
         // A sample near the floating-point limit (1e308) overflows g·u, the filter or the
         // derivatives: the regression would be NaN.
         if let Some(k) = force.iter().position(|f| !f.is_finite()) {

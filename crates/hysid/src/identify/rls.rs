@@ -46,14 +46,18 @@ struct Recursion {
 impl Recursion {
     fn new(theta: Vec<f64>, initial_covariance: f64, forgetting: f64) -> Result<Self> {
         if !(forgetting > 0.0 && forgetting <= 1.0) {
-            return Err(Error::Config(format!(
-                "forgetting factor must be in (0, 1], got {forgetting}"
-            )));
+            return Err(Error::invalid_option(
+                "forgetting",
+                forgetting,
+                format!("forgetting factor must be in (0, 1], got {forgetting}"),
+            ));
         }
         if !(initial_covariance > 0.0 && initial_covariance.is_finite()) {
-            return Err(Error::Config(format!(
-                "initial covariance must be finite and > 0, got {initial_covariance}"
-            )));
+            return Err(Error::invalid_option(
+                "initial_covariance",
+                initial_covariance,
+                format!("initial covariance must be finite and > 0, got {initial_covariance}"),
+            ));
         }
         let p = theta.len();
         Ok(Self {

@@ -108,11 +108,11 @@ impl OutputSet {
     /// existing directory, a missing or unwritable directory.
     pub fn file(&mut self, path: &Path) -> Result<PathBuf> {
         if path.is_dir() {
-            return Err(config(path, "is a directory; give a file name"));
+            return Err(invalid_output(path, "is a directory; give a file name"));
         }
         let parent = parent_of(path);
         if !parent.is_dir() {
-            return Err(config(
+            return Err(invalid_output(
                 path,
                 &format!(
                     "directory {} does not exist; create it or choose another path",
@@ -133,7 +133,7 @@ impl OutputSet {
     /// registered, an existing file, an unwritable parent.
     pub fn dir(&mut self, path: &Path) -> Result<PathBuf> {
         if path.exists() && !path.is_dir() {
-            return Err(config(
+            return Err(invalid_output(
                 path,
                 "exists and is not a directory; give a directory",
             ));
@@ -142,7 +142,7 @@ impl OutputSet {
         self.create_parents(&parent)?;
         let canonical = self.check_new(path)?;
         if let Some(input) = self.inputs.iter().find(|i| i.starts_with(&canonical)) {
-            return Err(config(
+            return Err(invalid_output(
                 path,
                 &format!(
                     "holds the input {}, which replacing the directory would delete; choose another directory",
@@ -204,7 +204,7 @@ impl OutputSet {
     fn check_new(&self, path: &Path) -> Result<PathBuf> {
         let canonical = canonical_target(path)?;
         if self.inputs.contains(&canonical) {
-            return Err(config(
+            return Err(invalid_output(
                 path,
                 "is also an input of this run; writing it would destroy the input: choose another output path",
             ));
@@ -215,7 +215,7 @@ impl OutputSet {
             .iter()
             .find(|o| o.canonical.starts_with(&canonical) || canonical.starts_with(&o.canonical));
         if let Some(other) = clash {
-            return Err(config(
+            return Err(invalid_output(
                 path,
                 &format!(
                     "clashes with the output {} of the same run; give each output its own path",
@@ -343,7 +343,7 @@ fn canonical_target(path: &Path) -> Result<PathBuf> {
     }
     let name = match path.components().next_back() {
         Some(Component::Normal(name)) => name.to_owned(),
-        _ => return Err(config(path, "does not name a file or directory")),
+        _ => return Err(invalid_output(path, "does not name a file or directory")),
     };
     let parent = fs::canonicalize(parent_of(path)).map_err(|source| io(path, source))?;
     Ok(parent.join(name))
@@ -359,7 +359,7 @@ fn probe(path: &Path, dir: &Path) -> Result<()> {
         .open(&probe);
     match created {
         Ok(_) => fs::remove_file(&probe).map_err(|source| io(&probe, source)),
-        Err(e) => Err(config(
+        Err(e) => Err(invalid_output(
             path,
             &format!(
                 "cannot be written: directory {} is not writable ({e}); choose another path",
@@ -369,8 +369,8 @@ fn probe(path: &Path, dir: &Path) -> Result<()> {
     }
 }
 
-fn config(path: &Path, message: &str) -> Error {
-    Error::Config(format!("output {}: {message}", path.display()))
+fn invalid_output(path: &Path, message: &str) -> Error {
+    Error::InvalidOutput(format!("output {}: {message}", path.display()))
 }
 
 fn io(path: &Path, source: std::io::Error) -> Error {

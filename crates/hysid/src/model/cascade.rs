@@ -53,13 +53,13 @@ impl HysteresisCascade {
     /// Builds a cascade; b1 must be 1 and the delay at least 1.
     pub fn new(hysteresis: ColemanHodgdon, linear: LinearBlock) -> Result<Self> {
         if (linear.b()[0] - 1.0).abs() > 1e-12 {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "the cascade fixes b1 = 1 (it splits the gain between the blocks), got b1 = {}",
                 linear.b()[0]
             )));
         }
         if linear.delay() < 1 {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "the cascade needs a delay k >= 1 (key-term separation isolates v(t-k))".into(),
             ));
         }
@@ -98,7 +98,7 @@ impl HysteresisCascade {
         let nh = form.n_params();
         let expected = nh + nb.saturating_sub(1) + na;
         if p.len() != expected || nb == 0 {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "a {} cascade with na = {na}, nb = {nb} has {expected} parameters, got {}",
                 form.short_name(),
                 p.len()

@@ -96,7 +96,7 @@ impl ChForm {
         match name.trim().to_ascii_lowercase().as_str() {
             "ch4" => Ok(ChForm::Saturated4),
             "ch6" => Ok(ChForm::General6),
-            other => Err(Error::Config(format!(
+            other => Err(Error::invalid_option("hysteresis", other, format!(
                 "unknown hysteresis form '{other}'; use ch4 (saturated, 4 parameters) or ch6 (6 parameters)"
             ))),
         }
@@ -161,7 +161,7 @@ impl ColemanHodgdon {
     pub fn from_params(form: ChForm, p: &[f64]) -> Result<Self> {
         let names = form.parameter_names();
         if p.len() != names.len() {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "{} needs {} parameters ({}), got {}",
                 form.short_name(),
                 names.len(),

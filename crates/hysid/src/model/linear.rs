@@ -43,7 +43,7 @@ impl LinearBlock {
     /// A block with denominator coefficients `a` = [a1…an], numerator `b` = [b1…bm] and delay k.
     pub fn new(a: Vec<f64>, b: Vec<f64>, delay: usize) -> Result<Self> {
         if b.is_empty() {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "the numerator B needs at least one coefficient (b1)".into(),
             ));
         }

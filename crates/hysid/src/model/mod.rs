@@ -11,6 +11,8 @@
 //! * [`greybox`]: continuous-time state-space models ([`greybox::StateSpaceModel`]), the
 //!   built-in ones (Bouc–Wen oscillator, rigid body, the actuator of Gunnar et al. 2006),
 //!   their integrators and forward sensitivities.
+//! * [`record_filters`]: the processing a fit applied to its records (pre-filter,
+//!   inverse-dynamics preprocessing), saved with the model.
 //! * [`saved`]: fitted models and the saved-model file.
 
 mod cascade;
@@ -21,6 +23,7 @@ mod linear;
 pub mod operator_cascade;
 pub mod operators;
 mod parameters;
+pub mod record_filters;
 pub mod saved;
 mod saved_equations;
 

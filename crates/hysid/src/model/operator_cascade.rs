@@ -87,7 +87,7 @@ impl CascadeOperator {
     pub fn with_values(&self, values: &[f64]) -> Result<Self> {
         let expected = self.as_operator().parameters().len();
         if values.len() != expected {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "a {} operator has {expected} parameters, got {}",
                 self.family(),
                 values.len()
@@ -281,7 +281,7 @@ impl OperatorCascade {
     /// Builds a cascade; b1 must be 1 (the normalisation, module doc).
     pub fn new(operator: CascadeOperator, linear: LinearBlock) -> Result<Self> {
         if linear.b()[0] != 1.0 {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "the operator cascade fixes b1 = 1 (the gain sits in the operator), got b1 = {}",
                 linear.b()[0]
             )));
@@ -352,7 +352,7 @@ impl OperatorCascade {
         let no = self.n_operator_parameters();
         let (na, nb) = (self.linear.na(), self.linear.nb());
         if values.len() != no + na + nb {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "a {} cascade with na = {na}, nb = {nb} has {} parameters, got {}",
                 self.operator.family(),
                 no + na + nb,
@@ -407,7 +407,7 @@ impl OperatorCascade {
         }
         let radius = self.zero_radius();
         if radius >= 1.0 {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "the linear block is not minimum phase (a zero of B at |z| = {radius:.4} >= 1): \
                  its inverse is unstable; compensate the hysteresis operator alone, or refit \
                  with fewer B coefficients"

@@ -64,7 +64,7 @@ impl ParameterSet {
     pub fn new(params: Vec<Parameter>) -> Result<Self> {
         for (i, p) in params.iter().enumerate() {
             if params[..i].iter().any(|q| q.name == p.name) {
-                return Err(Error::Config(format!(
+                return Err(Error::InvalidModel(format!(
                     "parameter name '{}' appears twice",
                     p.name
                 )));
@@ -122,7 +122,7 @@ impl ParameterSet {
             .iter()
             .position(|p| p.name == name)
             .ok_or_else(|| {
-                Error::Config(format!(
+                Error::UnknownParameter(format!(
                     "no parameter named '{name}' (parameters: {})",
                     self.names().join(", ")
                 ))

@@ -27,6 +27,15 @@
 //! | `equations` | `equations` (the equation file's text), `simulation`, `initial_state` | the file's `[parameters]` |
 //! | `operator` | `family` (`pi`, `gpi`, `preisach`, `jiles-atherton`, `bouc-wen`, `duhem`, `dahl`, `maxwell-slip`, `backlash`), `operator` (the operator's full structure: thresholds, weights, grid, orientation, initial state) | the family's, named as in the literature |
 //!
+//! Any kind may carry the processing its fit applied to the records ([`record_filters`]):
+//! `prefilter` (`{remove_mean, cutoff_hz, order}`, the actuator's step 3: records filtered
+//! before simulating, [`FittedModel::Prefiltered`]) or, for `rigid_body`, `inverse_dynamics`
+//! (`{cutoff_hz, order, decimation, border}`: the drive signal predicted from the position,
+//! [`FittedModel::InverseDynamics`]). [`FittedModel::predict`] applies it, so the fit % of a
+//! report is reproduced from its model file.
+//!
+//! [`record_filters`]: crate::model::record_filters
+//!
 //! `simulation` saves the integrator faithfully: `{"integrator": "rk4", "substeps": 10,
 //! "interpolation": "zero_order_hold"}`, `newmark` with `substeps`, or `dopri5` with `rtol`
 //! and `atol`.
@@ -35,6 +44,7 @@ use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::operators::OperatorModel;
+use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
 use crate::model::saved_equations::{equations_from_file, simulate_outputs};
 use crate::model::{CascadeOperator, OperatorCascade};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
@@ -140,6 +150,14 @@ pub struct ModelFile {
     /// are read from `parameters`. Checked on reading.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub operator: Option<serde_json::Value>,
+    /// The pre-filter the model was fitted with (the actuator's step 3): `hysid simulate`
+    /// filters input and measured output alike before simulating.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prefilter: Option<Prefilter>,
+    /// The preprocessing of an inverse-dynamics fit (kind `rigid_body` from `rigid-body ls`):
+    /// the model predicts the drive signal from the measured position, as the fit did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inverse_dynamics: Option<InverseDynamics>,
 }
 
 /// The simulation settings in a model file.
@@ -186,17 +204,17 @@ impl SimulationSpec {
     pub fn simulation(&self) -> Result<Simulation> {
         let substeps = || match self.substeps {
             Some(n) if (1..=MAX_SUBSTEPS).contains(&n) => Ok(n),
-            Some(n) => Err(Error::Config(format!(
+            Some(n) => Err(Error::InvalidModel(format!(
                 "substeps {n} is outside 1..={MAX_SUBSTEPS}"
             ))),
-            None => Err(Error::Config(format!(
+            None => Err(Error::InvalidModel(format!(
                 "the {} integrator needs \"substeps\"",
                 self.integrator
             ))),
         };
         let tolerance = |name: &str, v: Option<f64>| match v {
             Some(t) if t.is_finite() && t > 0.0 => Ok(t),
-            _ => Err(Error::Config(format!(
+            _ => Err(Error::InvalidModel(format!(
                 "the dopri5 integrator needs a positive finite \"{name}\""
             ))),
         };
@@ -212,7 +230,7 @@ impl SimulationSpec {
                 atol: tolerance("atol", self.atol)?,
             },
             other => {
-                return Err(Error::Config(format!(
+                return Err(Error::InvalidModel(format!(
                     "unknown integrator '{other}'; use rk4, newmark or dopri5"
                 )))
             }
@@ -285,6 +303,35 @@ pub enum FittedModel {
         /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
         std: Vec<f64>,
     },
+    /// A model fitted to pre-filtered records: it filters every record (inputs and measured
+    /// output alike) before it simulates.
+    Prefiltered {
+        /// The model as fitted to the filtered records.
+        model: Box<FittedModel>,
+        /// The filter.
+        prefilter: Prefilter,
+    },
+    /// A rigid body (a [`FittedModel::GreyBox`] of kind `rigid_body`) fitted by inverse
+    /// dynamics: it predicts the drive signal from the measured position (see
+    /// [`InverseDynamics`]).
+    InverseDynamics {
+        /// The rigid body.
+        model: Box<FittedModel>,
+        /// The preprocessing of the fit.
+        preprocessing: InverseDynamics,
+    },
+}
+
+/// One record as a model's fit sees it: the inputs the model is driven by (filtered,
+/// decimated where the fit did so), its outputs, and the measured output processed alike.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// The inputs as the model sees them.
+    pub inputs: Vec<Vec<f64>>,
+    /// The model's outputs (simulated, or predicted by inverse dynamics).
+    pub outputs: Vec<Vec<f64>>,
+    /// The measured counterpart of output 0, processed as the fit processed it.
+    pub measured: Option<Vec<f64>>,
 }
 
 impl FittedModel {
@@ -320,7 +367,7 @@ impl FittedModel {
             inputs
                 .first()
                 .copied()
-                .ok_or_else(|| Error::Config("no input channel given".into()))
+                .ok_or_else(|| Error::ModelMismatch("no input channel given".into()))
         };
         match self {
             FittedModel::Hysteresis { model, initial, .. } => {
@@ -328,8 +375,8 @@ impl FittedModel {
                 model.check_rate(x)?;
                 let v0 = match initial {
                     InitialOutput::Measured => y0.ok_or_else(|| {
-                        Error::Config(
-                            "this hysteresis starts from the measured output; give the output column (--output)"
+                        Error::ModelMismatch(
+                            "this hysteresis starts from the measured output; give the measured output"
                                 .into(),
                         )
                     })?,
@@ -338,6 +385,16 @@ impl FittedModel {
                 Ok(vec![simulate_switched(model, x, v0, None)])
             }
             FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::Prefiltered { model, prefilter } => {
+                let filtered = inputs
+                    .iter()
+                    .map(|x| prefilter.apply(x, ts))
+                    .collect::<Result<Vec<_>>>()?;
+                model.simulate_unchecked(&slices(&filtered), ts, y0)
+            }
+            FittedModel::InverseDynamics { preprocessing, .. } => Ok(vec![
+                preprocessing.predict(&self.rigid_body()?, first()?, ts)?.1,
+            ]),
             FittedModel::OperatorCascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
             FittedModel::Operator { model, .. } => {
                 Ok(vec![model.as_operator().simulate(first()?)?])
@@ -380,6 +437,108 @@ impl FittedModel {
         }
     }
 
+    /// The model's outputs for the inputs `inputs` sampled every `ts`, and the measured output
+    /// `measured` processed as the fit processed it: filtered for a
+    /// [`FittedModel::Prefiltered`], decimated and trimmed for a
+    /// [`FittedModel::InverseDynamics`] (whose input is the position and whose output the
+    /// predicted drive signal); as they are for every other model. fit % of
+    /// `outputs[0]` against `measured` is the fit the model's report states.
+    pub fn predict(
+        &self,
+        inputs: &[&[f64]],
+        measured: Option<&[f64]>,
+        ts: f64,
+    ) -> Result<Prediction> {
+        match self {
+            FittedModel::Prefiltered { model, prefilter } => {
+                let filtered = inputs
+                    .iter()
+                    .map(|x| prefilter.apply(x, ts))
+                    .collect::<Result<Vec<_>>>()?;
+                let measured = measured.map(|y| prefilter.apply(y, ts)).transpose()?;
+                model.predict(&slices(&filtered), measured.as_deref(), ts)
+            }
+            FittedModel::InverseDynamics { preprocessing, .. } => {
+                let q = inputs.first().copied().unwrap_or_default();
+                if let Some(u) = measured.filter(|u| u.len() != q.len()) {
+                    return Err(Error::InvalidData(format!(
+                        "the position has {} samples, the drive signal {}",
+                        q.len(),
+                        u.len()
+                    )));
+                }
+                let (position, predicted) = preprocessing.predict(&self.rigid_body()?, q, ts)?;
+                if let Some(index) = predicted.iter().position(|v| !v.is_finite()) {
+                    return Err(Error::Diverged {
+                        index,
+                        reason:
+                            "the predicted drive signal is not finite; scale the position data down"
+                                .into(),
+                    });
+                }
+                Ok(Prediction {
+                    inputs: vec![position],
+                    outputs: vec![predicted],
+                    measured: measured.map(|u| preprocessing.reduce(u)).transpose()?,
+                })
+            }
+            _ => Ok(Prediction {
+                outputs: self.simulate(inputs, ts, measured.and_then(|y| y.first().copied()))?,
+                inputs: inputs.iter().map(|x| x.to_vec()).collect(),
+                measured: measured.map(<[f64]>::to_vec),
+            }),
+        }
+    }
+
+    /// `model` fitted to records filtered by `prefilter` (unchanged when there is none).
+    pub fn prefiltered(model: FittedModel, prefilter: Option<Prefilter>) -> Self {
+        match prefilter {
+            Some(prefilter) => FittedModel::Prefiltered {
+                model: Box::new(model),
+                prefilter,
+            },
+            None => model,
+        }
+    }
+
+    /// The rigid body's values of an inverse-dynamics model (M, Fv, Fc, offset, gain).
+    fn rigid_body(&self) -> Result<RigidBodyValues> {
+        let inner = match self {
+            FittedModel::InverseDynamics { model, .. } => model.as_ref(),
+            other => other,
+        };
+        let parameters = match inner {
+            FittedModel::GreyBox {
+                kind, parameters, ..
+            } if kind == "rigid_body" => parameters,
+            other => {
+                return Err(Error::UnsupportedKind {
+                    kind: other.to_file().kind,
+                    operation: "inverse dynamics (a rigid_body model)".into(),
+                })
+            }
+        };
+        let value = |name: &str| parameters.iter().find(|p| p.name == name).map(|p| p.value);
+        match (
+            value("M"),
+            value("Fv"),
+            value("Fc"),
+            value("offset"),
+            value("gain"),
+        ) {
+            (Some(inertia), Some(fv), Some(fc), Some(offset), Some(gain)) => Ok(RigidBodyValues {
+                inertia,
+                fv,
+                fc,
+                offset,
+                gain,
+            }),
+            _ => Err(Error::InvalidModel(
+                "a rigid body needs the parameters M, Fv, Fc, offset and gain".into(),
+            )),
+        }
+    }
+
     /// A built-in-style grey-box fit ([`FittedModel::GreyBox`]) of the equation model with
     /// file text `equations`, as [`FittedModel::Equations`]; other variants unchanged.
     pub fn with_equations(self, equations: &str) -> Self {
@@ -415,6 +574,8 @@ impl FittedModel {
             equations: None,
             family: None,
             operator: None,
+            prefilter: None,
+            inverse_dynamics: None,
         };
         match self {
             FittedModel::Hysteresis {
@@ -481,6 +642,17 @@ impl FittedModel {
                         .collect(),
                 )
             },
+            FittedModel::Prefiltered { model, prefilter } => ModelFile {
+                prefilter: Some(*prefilter),
+                ..model.to_file()
+            },
+            FittedModel::InverseDynamics {
+                model,
+                preprocessing,
+            } => ModelFile {
+                inverse_dynamics: Some(*preprocessing),
+                ..model.to_file()
+            },
             FittedModel::Operator { family, model, std } => ModelFile {
                 family: Some(family.to_string()),
                 // The structure of a constructed operator is always representable; a failure
@@ -512,16 +684,37 @@ impl FittedModel {
     /// Rebuilds a fitted model from a model file, checking every value.
     pub fn from_file(file: &ModelFile) -> Result<Self> {
         if file.schema != MODEL_SCHEMA {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "schema '{}' is not {MODEL_SCHEMA}; save the model again with this version",
                 file.schema
             )));
         }
         if let Some(p) = file.parameters.iter().find(|p| !p.value.is_finite()) {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "parameter '{}' has no finite value",
                 p.name
             )));
+        }
+        if let Some(prefilter) = file.prefilter {
+            check_prefilter(&prefilter)?;
+            let inner = ModelFile {
+                prefilter: None,
+                ..file.clone()
+            };
+            return Ok(Self::prefiltered(Self::from_file(&inner)?, Some(prefilter)));
+        }
+        if let Some(preprocessing) = file.inverse_dynamics {
+            check_inverse_dynamics(&preprocessing)?;
+            let inner = ModelFile {
+                inverse_dynamics: None,
+                ..file.clone()
+            };
+            let model = FittedModel::InverseDynamics {
+                model: Box::new(Self::from_file(&inner)?),
+                preprocessing,
+            };
+            model.rigid_body()?;
+            return Ok(model);
         }
         match file.kind.as_str() {
             "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
@@ -534,7 +727,7 @@ impl FittedModel {
 
     fn coleman_hodgdon_from_file(file: &ModelFile) -> Result<Self> {
         let form = file.hysteresis.ok_or_else(|| {
-            Error::Config(format!(
+            Error::InvalidModel(format!(
                 "a {} model needs \"hysteresis\": \"ch4\" or \"ch6\"",
                 file.kind
             ))
@@ -557,13 +750,13 @@ impl FittedModel {
         let b = coefficients(file, 'b')?;
         let a = coefficients(file, 'a')?;
         if b.is_empty() || b[0].value != 1.0 {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "a ch_cascade model needs b1 = 1 (the gain sits in the hysteresis)".into(),
             ));
         }
         let delay = file
             .delay
-            .ok_or_else(|| Error::Config("a ch_cascade model needs \"delay\"".into()))?;
+            .ok_or_else(|| Error::InvalidModel("a ch_cascade model needs \"delay\"".into()))?;
         let linear = LinearBlock::new(
             a.iter().map(|e| e.value).collect(),
             b.iter().map(|e| e.value).collect(),
@@ -579,7 +772,7 @@ impl FittedModel {
 
     fn operator_from_file(file: &ModelFile) -> Result<Self> {
         let (Some(family), Some(structure)) = (&file.family, &file.operator) else {
-            return Err(Error::Config(
+            return Err(Error::InvalidModel(
                 "an operator model needs \"family\" and \"operator\"; save the model again".into(),
             ));
         };
@@ -594,7 +787,7 @@ impl FittedModel {
 
     fn grey_box_from_file(kind: &str, file: &ModelFile) -> Result<Self> {
         let model = models::by_kind(kind).map_err(|_| {
-            Error::Config(format!(
+            Error::InvalidModel(format!(
                 "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed, actuator_free, equations, operator and operator_cascade"
             ))
         })?;
@@ -622,7 +815,7 @@ impl FittedModel {
         let n = model.states().len();
         let initial_state = file.initial_state.clone().unwrap_or_else(|| vec![0.0; n]);
         if initial_state.len() != n || initial_state.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "\"initial_state\" needs {n} finite values for the {kind} model"
             )));
         }
@@ -669,6 +862,41 @@ impl FittedModel {
     }
 }
 
+/// The slices of `signals`.
+fn slices(signals: &[Vec<f64>]) -> Vec<&[f64]> {
+    signals.iter().map(Vec::as_slice).collect()
+}
+
+/// The largest Butterworth order a model file may ask for (beyond it the filter is
+/// numerically meaningless and the file more likely corrupt).
+pub const MAX_FILTER_ORDER: usize = 20;
+
+/// Refuses a pre-filter no fit uses: an order outside 1..=[`MAX_FILTER_ORDER`], a cut-off
+/// that is not positive and finite.
+fn check_prefilter(p: &Prefilter) -> Result<()> {
+    check_filter(p.cutoff_hz.unwrap_or(1.0), p.order, "prefilter")
+}
+
+/// Refuses inverse-dynamics settings no fit uses (see [`check_prefilter`]; a decimation
+/// factor of at least 1).
+fn check_inverse_dynamics(p: &InverseDynamics) -> Result<()> {
+    if p.decimation == 0 {
+        return Err(Error::InvalidModel(
+            "\"inverse_dynamics\" needs a decimation factor of at least 1".into(),
+        ));
+    }
+    check_filter(p.cutoff_hz, p.order, "inverse_dynamics")
+}
+
+fn check_filter(cutoff_hz: f64, order: usize, key: &str) -> Result<()> {
+    if !(cutoff_hz.is_finite() && cutoff_hz > 0.0 && (1..=MAX_FILTER_ORDER).contains(&order)) {
+        return Err(Error::InvalidModel(format!(
+            "\"{key}\" needs a positive finite cut-off and an order in 1..={MAX_FILTER_ORDER} (got {cutoff_hz} Hz, order {order})"
+        )));
+    }
+    Ok(())
+}
+
 /// The kind of [`FittedModel::OperatorCascade`].
 pub const OPERATOR_CASCADE_KIND: &str = "operator_cascade";
 
@@ -676,17 +904,20 @@ pub const OPERATOR_CASCADE_KIND: &str = "operator_cascade";
 /// `parameters` (validated by the family's constructor).
 fn operator_cascade_from_file(file: &ModelFile) -> Result<FittedModel> {
     let structure = file.operator.clone().ok_or_else(|| {
-        Error::Config("an operator_cascade model needs \"operator\" (family and structure)".into())
+        Error::InvalidModel(
+            "an operator_cascade model needs \"operator\" (family and structure)".into(),
+        )
     })?;
-    let operator: CascadeOperator = serde_json::from_value(structure)
-        .map_err(|e| Error::Config(format!("the operator of the operator_cascade model: {e}")))?;
+    let operator: CascadeOperator = serde_json::from_value(structure).map_err(|e| {
+        Error::InvalidModel(format!("the operator of the operator_cascade model: {e}"))
+    })?;
     let delay = file
         .delay
-        .ok_or_else(|| Error::Config("an operator_cascade model needs \"delay\"".into()))?;
+        .ok_or_else(|| Error::InvalidModel("an operator_cascade model needs \"delay\"".into()))?;
     let b = coefficients(file, 'b')?;
     let a = coefficients(file, 'a')?;
     if b.is_empty() || b[0].value != 1.0 {
-        return Err(Error::Config(
+        return Err(Error::InvalidModel(
             "an operator_cascade model needs b1 = 1 (the gain sits in the operator)".into(),
         ));
     }
@@ -745,7 +976,7 @@ fn record<'a>(file: &'a ModelFile, name: &str) -> Result<&'a ParameterRecord> {
         .iter()
         .find(|p| p.name == name)
         .ok_or_else(|| {
-            Error::Config(format!(
+            Error::InvalidModel(format!(
                 "parameter '{name}' is missing from the {} model",
                 file.kind
             ))
@@ -765,7 +996,7 @@ fn coefficients(file: &ModelFile, letter: char) -> Result<Vec<ParameterRecord>> 
     found.sort_by_key(|(k, _)| *k);
     for (i, (k, _)) in found.iter().enumerate() {
         if *k != i + 1 {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "coefficient {letter}{} is missing from the {} model",
                 i + 1,
                 file.kind

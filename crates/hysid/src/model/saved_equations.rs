@@ -12,7 +12,7 @@ use crate::{Error, Result};
 /// `initial_state` or else the text's `[initial]`.
 pub(crate) fn equations_from_file(file: &ModelFile) -> Result<FittedModel> {
     let text = file.equations.as_ref().ok_or_else(|| {
-        Error::Config(
+        Error::InvalidModel(
             "an equations model needs \"equations\": the equation file's text; save the model again"
                 .into(),
         )
@@ -27,7 +27,7 @@ pub(crate) fn equations_from_file(file: &ModelFile) -> Result<FittedModel> {
             .iter()
             .find(|p| p.name == name)
             .ok_or_else(|| {
-                Error::Config(format!(
+                Error::InvalidModel(format!(
                     "parameter '{name}' of the equations is missing from \"parameters\""
                 ))
             })?;
@@ -41,7 +41,7 @@ pub(crate) fn equations_from_file(file: &ModelFile) -> Result<FittedModel> {
         .clone()
         .unwrap_or_else(|| model.initial_values());
     if initial_state.len() != n || initial_state.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Config(format!(
+        return Err(Error::InvalidModel(format!(
             "\"initial_state\" needs {n} finite values for the equations model '{}'",
             model.name()
         )));
@@ -70,7 +70,7 @@ pub(crate) fn simulate_outputs(
     simulation: &Simulation,
 ) -> Result<Vec<Vec<f64>>> {
     if inputs.len() != model.inputs().len() {
-        return Err(Error::Config(format!(
+        return Err(Error::ModelMismatch(format!(
             "the {} model has {} input(s), {} given",
             model.kind(),
             model.inputs().len(),

@@ -35,7 +35,7 @@ pub struct Nnls {
 pub fn nnls_gram(g: &DMatrix<f64>, b: &DVector<f64>, unconstrained: &[bool]) -> Result<Nnls> {
     let n = b.len();
     if g.nrows() != n || g.ncols() != n || unconstrained.len() != n {
-        return Err(Error::Config(format!(
+        return Err(Error::ModelMismatch(format!(
             "NNLS: Gram matrix {}x{}, right-hand side {n}, {} flags; sizes must agree",
             g.nrows(),
             g.ncols(),

@@ -1,12 +1,14 @@
 //! The report of the three-step actuator identification of Gunnar et al. (2006): one
-//! [`Report`] per step in `details.steps`, the m67 model at the top.
+//! [`Report`] per step in `details.steps`, the m67 model at the top. The step-2 and step-3
+//! models carry the pre-filter they were fitted with (`prefilter`), so that `hysid simulate`
+//! on the raw data sets reproduces their fit %.
 
 use super::{DataSummary, Report, SearchSummary, UncertaintySummary, ValidationEntry};
 use crate::identify::actuator::{tables::MODELS, ActuatorIdentification, PARAMETERS};
 use crate::model::greybox::models::ActuatorFixed;
 use crate::model::greybox::{Simulation, StateSpaceModel};
 use crate::model::saved::FittedModel;
-use crate::Result;
+use crate::{Error, Result};
 use serde_json::json;
 
 /// The report of `id`: `model`, `fit` and `search` are m67's (sets 6 and 7), `validation`
@@ -23,7 +25,10 @@ pub fn three_steps_report(
     for (name, second) in [("m67", 1), ("m68", 2), ("m67f", 1), ("m68f", 2)] {
         let data = id.validation.select(&[0, second])?;
         let fit = &id.step3[name];
-        let model = fit.fitted_model(&ActuatorFixed, simulation).to_file();
+        let model = id
+            .fitted(name, simulation)
+            .map(|m| m.to_file())
+            .ok_or_else(|| Error::InvalidModel(format!("step 3 has no fit {name}")))?;
         let step = Report::of_output_error(
             &format!("actuator identify: step 3 {name}"),
             &data,
@@ -114,13 +119,16 @@ fn step2(id: &ActuatorIdentification, simulation: Simulation) -> Report {
     std[1] = id.step1.std.get(1).copied().unwrap_or(f64::NAN);
     std[2] = id.step1.std.get(2).copied().unwrap_or(f64::NAN);
     std[3..].copy_from_slice(&id.step2.std);
-    let m0 = FittedModel::GreyBox {
-        kind: "actuator_fixed".into(),
-        parameters,
-        std,
-        simulation,
-        initial_state: vec![0.0; 3],
-    };
+    let m0 = FittedModel::prefiltered(
+        FittedModel::GreyBox {
+            kind: "actuator_fixed".into(),
+            parameters,
+            std,
+            simulation,
+            initial_state: vec![0.0; 3],
+        },
+        id.prefilter,
+    );
     Report {
         data: Some(DataSummary {
             source: vec!["data sets 2-5".into()],

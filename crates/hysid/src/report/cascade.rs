@@ -12,6 +12,7 @@ use super::{Report, UncertaintySummary};
 use crate::data::IdData;
 use crate::identify::cascade::CascadeFit;
 use crate::identify::hysteresis::{HysteresisFit, InitialOutput};
+use crate::identify::operator_cascade::OperatorCascadeFit;
 use crate::model::saved::FittedModel;
 use crate::Result;
 use serde_json::{json, Value};
@@ -106,4 +107,45 @@ pub(super) fn merged(mut details: Value, extra: Value) -> Value {
         obj.extend(more);
     }
     details
+}
+
+/// The fitted model of an operator cascade (any hysteresis operator followed by a linear
+/// block, `docs/models/operator-cascade.md`) with its asymptotic standard deviations.
+pub fn operator_cascade_model(fit: &OperatorCascadeFit) -> FittedModel {
+    FittedModel::OperatorCascade {
+        model: fit.model.clone(),
+        std: fit.output_error.std().to_vec(),
+    }
+}
+
+/// The report of `identify cascade` with an operator family (`family`) on `data` (read
+/// from `source`): the output-error fit of the operator cascade; `details` hold the family,
+/// the global start and how it was found, the spectral radius of the linear block and the
+/// largest modulus of its zeros, and the output-error history; the keys of `extra` are
+/// added to `details`.
+pub fn operator_cascade_report(
+    family: &str,
+    fit: &OperatorCascadeFit,
+    data: &IdData,
+    source: Vec<String>,
+    extra: Value,
+) -> Result<Report> {
+    let details = json!({
+        "family": family,
+        "initialisation": fit.initialisation,
+        "start": fit.start.parameters().values(),
+        "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
+        "linear_block_zero_radius": fit.model.zero_radius(),
+        "output_error_history": fit.output_error.report.history,
+    });
+    Ok(Report::of_output_error(
+        "identify cascade",
+        data,
+        source,
+        operator_cascade_model(fit).to_file(),
+        &fit.output_error,
+        fit.elapsed_s,
+        UncertaintySummary::asymptotic(),
+    )?
+    .with_details(merged(extra, details)))
 }

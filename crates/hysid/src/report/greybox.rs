@@ -12,21 +12,12 @@
 use super::cascade::merged;
 use super::{Report, UncertaintySummary, ValidationEntry};
 use crate::data::IdData;
+use crate::identify::bouc_wen_benchmark::PUBLISHED;
 use crate::identify::greybox::GreyBoxFit;
 use crate::identify::validate::{residual_analysis, ResidualAnalysis};
 use crate::model::saved::ModelFile;
 use crate::Result;
 use serde_json::{json, Value};
-
-/// Published e_RMS \[m\] of other methods on the benchmark's multisine test record
-/// (M. Forgione, D. Piga, "dynoNet", Int. J. Adapt. Control Signal Process. 2021; the
-/// decoupled polynomial nonlinear state-space and local-model-network entries of the
-/// benchmark's results table).
-pub const PUBLISHED_MULTISINE_E_RMS: [(&str, f64); 3] = [
-    ("dynoNet (Forgione & Piga 2021)", 4.52e-5),
-    ("decoupled polynomial nonlinear state space", 1.87e-5),
-    ("local-model network", 16.3e-5),
-];
 
 /// Residual lags of the residual analysis in the reports.
 pub const RESIDUAL_LAGS: usize = 25;
@@ -89,7 +80,7 @@ pub fn bouc_wen_benchmark_report(
     let extra = json!({
         "training_e_rms": fit.fit.mse[0][0].sqrt(),
         "steady_state": steady_state,
-        "published_multisine_e_rms": PUBLISHED_MULTISINE_E_RMS.iter().map(|(who, e)| json!({"method": who, "e_rms": e})).collect::<Vec<_>>(),
+        "published_multisine_e_rms": PUBLISHED.iter().map(|(who, e)| json!({"method": who, "e_rms": e})).collect::<Vec<_>>(),
         "residual_analysis": greybox_residuals(fit, data),
     });
     let mut report = greybox_report("benchmark bouc-wen", fit, data, source, model, extra)?;

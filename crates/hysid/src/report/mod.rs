@@ -27,10 +27,14 @@ pub mod cascade;
 pub mod greybox;
 pub mod plot;
 pub mod rigid_body;
+pub mod simulate;
 
-pub use cascade::{cascade_report, hysteresis_report};
+pub use cascade::{
+    cascade_report, hysteresis_report, operator_cascade_model, operator_cascade_report,
+};
 pub use greybox::{bouc_wen_benchmark_report, greybox_report, greybox_residuals};
-pub use rigid_body::{rigid_body_model, rigid_body_report};
+pub use rigid_body::{rigid_body_model, rigid_body_report, RigidBodyRecord};
+pub use simulate::simulate_report;
 
 use crate::data::IdData;
 use crate::identify::OutputErrorFit;
@@ -182,7 +186,7 @@ impl FitSummary {
         {
             Ok(())
         } else {
-            Err(Error::Config(
+            Err(Error::NonFiniteOutput(
                 "the model's simulated output is not finite on these data: the model is unstable or the data are outside its range".into(),
             ))
         }
@@ -343,7 +347,7 @@ impl ValidationEntry {
         {
             Ok(entry)
         } else {
-            Err(Error::Config(format!(
+            Err(Error::NonFiniteOutput(format!(
                 "the model's output on {} is not finite: the model is unstable or the data are outside its range",
                 entry.source
             )))
@@ -413,7 +417,7 @@ impl Report {
     /// write it as null and hide the failure).
     pub fn to_json(&self) -> Result<String> {
         self.check_finite()?;
-        serde_json::to_string_pretty(self).map_err(|e| Error::Config(format!("report: {e}")))
+        serde_json::to_string_pretty(self).map_err(|e| Error::Serialization(format!("report: {e}")))
     }
 
     /// Errors naming the first non-finite number of the fit, search, validation or model.
@@ -439,7 +443,7 @@ impl Report {
         }
         match bad.first() {
             None => Ok(()),
-            Some(what) => Err(Error::Config(format!(
+            Some(what) => Err(Error::NonFiniteOutput(format!(
                 "{what} is not a finite number; the estimate failed numerically"
             ))),
         }

@@ -28,9 +28,11 @@ use crate::identify::validate::{sensitivity_table, SensitivityRow};
 use crate::identify::OutputErrorModel;
 use crate::model::greybox::models::ActuatorFixed;
 use crate::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use crate::model::record_filters::Prefilter;
+use crate::model::saved::FittedModel;
 use crate::model::ParameterSet;
 use crate::numerics::metrics::fit_percent;
-use crate::numerics::signal::{butter, filtfilt, gradient, remove_mean};
+use crate::numerics::signal::gradient;
 use crate::numerics::{least_squares, Control, LmConfig};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
@@ -157,6 +159,21 @@ pub struct ActuatorIdentification {
     pub sensitivity: Vec<SensitivityRow>,
     /// The filtered estimation data of sets 6, 7, 8 (for plots).
     pub validation: IdData,
+    /// What step 3 did to the records (saved with its models, so that they reproduce
+    /// their fits on the raw records).
+    pub prefilter: Option<Prefilter>,
+}
+
+impl ActuatorIdentification {
+    /// The step-3 model `name` (m67, m68, m67f, m68f) simulated with `simulation`, with the
+    /// pre-filter it was fitted with.
+    pub fn fitted(&self, name: &str, simulation: Simulation) -> Option<FittedModel> {
+        let fit = self.step3.get(name)?;
+        Some(FittedModel::prefiltered(
+            fit.fitted_model(&ActuatorFixed, simulation),
+            self.prefilter,
+        ))
+    }
 }
 
 /// Names of the actuator parameters, in order.
@@ -215,6 +232,7 @@ impl ThreeSteps {
             simulated,
             sensitivity,
             validation,
+            prefilter: self.step3_filter(),
         })
     }
 
@@ -251,32 +269,40 @@ impl ThreeSteps {
         Ok(())
     }
 
-    /// A signal as step 3 fits it: pre-filtered as in the paper, or raw (mean removal
-    /// applies either way).
-    fn step3_signal(&self, x: &[f64], ts: f64) -> Result<Vec<f64>> {
+    /// The pre-filter of the paper (§VI-B): optional mean removal, then a 4th-order
+    /// zero-phase Butterworth low-pass at `cutoff_hz`.
+    pub fn record_filter(&self) -> Prefilter {
+        Prefilter {
+            remove_mean: self.remove_mean,
+            cutoff_hz: Some(self.cutoff_hz),
+            order: 4,
+        }
+    }
+
+    /// What step 3 and the fit tables do to a record: the pre-filter, mean removal alone, or
+    /// nothing (None).
+    pub fn step3_filter(&self) -> Option<Prefilter> {
         match (self.prefilter_step3, self.remove_mean) {
-            (true, _) => self.prefilter(x, ts),
-            (false, true) => Ok(remove_mean(x)),
-            (false, false) => Ok(x.to_vec()),
+            (true, _) => Some(self.record_filter()),
+            (false, true) => Some(Prefilter {
+                cutoff_hz: None,
+                ..self.record_filter()
+            }),
+            (false, false) => None,
+        }
+    }
+
+    /// A signal as step 3 fits it.
+    fn step3_signal(&self, x: &[f64], ts: f64) -> Result<Vec<f64>> {
+        match self.step3_filter() {
+            Some(f) => f.apply(x, ts),
+            None => Ok(x.to_vec()),
         }
     }
 
     /// The zero-phase Butterworth pre-filter (with optional mean removal).
     fn prefilter(&self, x: &[f64], ts: f64) -> Result<Vec<f64>> {
-        let nyquist = 0.5 / ts;
-        if self.cutoff_hz >= nyquist {
-            return Err(Error::Config(format!(
-                "the pre-filter cut-off {} Hz is not below the data's Nyquist frequency {nyquist} Hz; choose a lower cut-off",
-                self.cutoff_hz
-            )));
-        }
-        let tf = butter(4, self.cutoff_hz * 2.0 * ts)?;
-        let x = if self.remove_mean {
-            remove_mean(x)
-        } else {
-            x.to_vec()
-        };
-        filtfilt(&tf, &x)
+        self.record_filter().apply(x, ts)
     }
 
     /// Step 1 on data set 1.

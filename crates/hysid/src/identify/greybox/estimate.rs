@@ -202,7 +202,7 @@ impl GreyBoxEstimation {
 fn check_names(model: &dyn StateSpaceModel, params: &ParameterSet) -> Result<()> {
     let expected = model.parameters().names();
     if params.names() != expected {
-        return Err(Error::Config(format!(
+        return Err(Error::ModelMismatch(format!(
             "the {} model's parameters are {}, got {}",
             model.kind(),
             expected.join(", "),

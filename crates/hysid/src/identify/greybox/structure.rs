@@ -61,7 +61,7 @@ impl GreyBox {
             model.states().len(),
         );
         if data.input_channels().len() != nu || data.output_channels().len() != ny {
-            return Err(Error::Config(format!(
+            return Err(Error::ModelMismatch(format!(
                 "the {} model has {nu} input(s) and {ny} output(s); the data have {} and {}",
                 model.kind(),
                 data.input_channels().len(),
@@ -72,7 +72,7 @@ impl GreyBox {
             || initial.values.iter().any(|v| v.len() != nx)
             || initial.estimated.len() != nx
         {
-            return Err(Error::Config(format!(
+            return Err(Error::ModelMismatch(format!(
                 "initial states: need {nx} values for each of the {} experiments",
                 data.n_experiments()
             )));

@@ -86,7 +86,9 @@ pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFi
     let start = Instant::now();
     check_data(u, y, 3)?;
     if options.profile_points < 2 {
-        return Err(Error::Config(
+        return Err(Error::invalid_option(
+            "profile_points",
+            options.profile_points,
             "backlash: give at least 2 profile points".into(),
         ));
     }

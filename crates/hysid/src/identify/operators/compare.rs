@@ -159,7 +159,9 @@ pub fn compare(
         )));
     }
     if options.families.is_empty() {
-        return Err(Error::Config(
+        return Err(Error::invalid_option(
+            "families",
+            "[]",
             "no family to compare; name at least one".into(),
         ));
     }
@@ -202,9 +204,11 @@ fn split<'a>(
         return Ok((split, (u, y), (uv, yv)));
     }
     if !(fraction > 0.0 && fraction < 1.0) {
-        return Err(Error::Config(format!(
-            "the training fraction {fraction} must lie strictly between 0 and 1"
-        )));
+        return Err(Error::invalid_option(
+            "training_fraction",
+            fraction,
+            format!("the training fraction {fraction} must lie strictly between 0 and 1"),
+        ));
     }
     let train = (fraction * u.len() as f64).round() as usize;
     if train < 2 || u.len() - train < 2 {

@@ -174,7 +174,8 @@ pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) ->
         }
     }
     let best = best.ok_or_else(|| {
-        first_error.unwrap_or_else(|| Error::Config("no start for the search".into()))
+        first_error
+            .unwrap_or_else(|| Error::invalid_option("starts", 0, "no start for the search".into()))
     })?;
     Ok(Searched {
         best,

@@ -89,10 +89,14 @@ impl Family {
             .into_iter()
             .find(|f| f.name() == wanted)
             .ok_or_else(|| {
-                Error::Config(format!(
-                    "unknown hysteresis family '{name}'; use one of {}",
-                    Family::ALL.map(Family::name).join(", ")
-                ))
+                Error::invalid_option(
+                    "family",
+                    name,
+                    format!(
+                        "unknown hysteresis family '{name}'; use one of {}",
+                        Family::ALL.map(Family::name).join(", ")
+                    ),
+                )
             })
     }
 
@@ -109,7 +113,9 @@ impl Family {
             }
         }
         if out.is_empty() {
-            return Err(Error::Config(
+            return Err(Error::invalid_option(
+                "families",
+                "[]",
                 "the family list is empty; name at least one family, or all".into(),
             ));
         }
@@ -172,19 +178,25 @@ impl FamilyOptions {
             if (lo..=hi).contains(&v) {
                 Ok(())
             } else {
-                Err(Error::Config(format!(
-                    "{what} = {v} is outside {lo}..={hi}; choose a value in that range"
-                )))
+                Err(Error::invalid_option(
+                    what,
+                    v,
+                    format!("{what} = {v} is outside {lo}..={hi}; choose a value in that range"),
+                ))
             }
         };
         range("the threshold count", self.thresholds, 1, MAX_THRESHOLDS)?;
         range("the Preisach grid size", self.grid, 1, MAX_GRID)?;
         range("the dead-zone count", self.dead_zones, 0, MAX_DEAD_ZONES)?;
         if !(self.lambda.is_finite() && self.lambda >= 0.0) {
-            return Err(Error::Config(format!(
-                "the Preisach smoothness lambda = {} must be finite and >= 0",
-                self.lambda
-            )));
+            return Err(Error::invalid_option(
+                "lambda",
+                self.lambda,
+                format!(
+                    "the Preisach smoothness lambda = {} must be finite and >= 0",
+                    self.lambda
+                ),
+            ));
         }
         if let Some(g) = &self.threshold_grid {
             crate::model::operators::validate_thresholds("threshold", g)?;

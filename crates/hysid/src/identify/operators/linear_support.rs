@@ -78,7 +78,9 @@ pub(crate) fn range(x: &[f64]) -> (f64, f64) {
 /// half-width ≥ half the input range would never move after its first reversal.
 pub(crate) fn threshold_grid(x: &[f64], n: usize) -> Result<Vec<f64>> {
     if n == 0 {
-        return Err(Error::Config(
+        return Err(Error::invalid_option(
+            "thresholds",
+            0,
             "the number of thresholds must be >= 1".into(),
         ));
     }

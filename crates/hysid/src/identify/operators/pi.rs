@@ -121,7 +121,11 @@ fn fit_selected(
         }
     }
     let (_, n) = best.ok_or_else(|| {
-        Error::Config("no candidate threshold count could be fitted; give counts >= 1".into())
+        Error::invalid_option(
+            "threshold_counts",
+            "none",
+            "no candidate threshold count could be fitted; give counts >= 1".into(),
+        )
     })?;
     fit(
         u,

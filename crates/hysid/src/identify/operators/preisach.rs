@@ -56,18 +56,24 @@ impl Default for PreisachOptions {
 pub fn fit(u: &[f64], y: &[f64], options: &PreisachOptions) -> Result<OperatorFit<Preisach>> {
     let start = Instant::now();
     if options.levels == 0 || !(options.lambda >= 0.0 && options.lambda.is_finite()) {
-        return Err(Error::Config(format!(
-            "Preisach: levels = {}, lambda = {}; need levels >= 1 and a finite lambda >= 0",
-            options.levels, options.lambda
-        )));
+        return Err(Error::invalid_option(
+            "levels",
+            options.levels,
+            format!(
+                "Preisach: levels = {}, lambda = {}; need levels >= 1 and a finite lambda >= 0",
+                options.levels, options.lambda
+            ),
+        ));
     }
     let o = orientation(u, y, options.orientation)?;
     let (x, v) = o.core_data(u, y);
     let (lower, upper) = options.range.unwrap_or_else(|| range(&x));
     if upper <= lower || !lower.is_finite() || !upper.is_finite() {
-        return Err(Error::Config(format!(
-            "Preisach grid range [{lower}, {upper}] is empty; give lower < upper"
-        )));
+        return Err(Error::invalid_option(
+            "grid",
+            format!("[{lower}, {upper}]"),
+            format!("Preisach grid range [{lower}, {upper}] is empty; give lower < upper"),
+        ));
     }
     let grid = Grid {
         lower,

@@ -181,7 +181,7 @@ impl EquationStateSpace {
         )?;
         parameters
             .validate()
-            .map_err(|e| Error::Config(format!("{origin}: {e}")))?;
+            .map_err(|e| Error::InvalidModel(format!("{origin}: {e}")))?;
         Ok(Self {
             free_columns: model.rhs_jacobian_columns(&parameters.free_indices()),
             states: model.states().iter().map(channel).collect(),

@@ -345,14 +345,14 @@ impl<'a> Stepper<'a> {
         integrator: Integrator,
     ) -> Result<Self> {
         if model.stick_slip_velocity().is_some() && !matches!(integrator, Integrator::Rk4 { .. }) {
-            return Err(Error::Config(format!(
+            return Err(Error::Unsupported(format!(
                 "{} has Coulomb friction, and only RK4 integrates its stick phases; use the RK4 integrator",
                 model.kind()
             )));
         }
         if let Integrator::Newmark { .. } = integrator {
             if model.mechanical_dofs().is_none() {
-                return Err(Error::Config(format!(
+                return Err(Error::Unsupported(format!(
                     "Newmark integration needs a second-order mechanical model; {} is not one (use RK4)",
                     model.kind()
                 )));

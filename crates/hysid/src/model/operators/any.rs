@@ -146,10 +146,14 @@ impl OperatorModel {
                 )?)
             }
             other => {
-                return Err(Error::Config(format!(
-                    "unknown operator family '{other}'; use one of {}",
-                    OPERATOR_FAMILIES.join(", ")
-                )))
+                return Err(Error::invalid_option(
+                    "family",
+                    other,
+                    format!(
+                        "unknown operator family '{other}'; use one of {}",
+                        OPERATOR_FAMILIES.join(", ")
+                    ),
+                ))
             }
         })
     }
@@ -166,12 +170,12 @@ fn rebuild_pi(m: &PrandtlIshlinskii) -> Result<PrandtlIshlinskii> {
 }
 
 fn to_value(m: &impl Serialize) -> Result<serde_json::Value> {
-    serde_json::to_value(m).map_err(|e| Error::Config(format!("operator structure: {e}")))
+    serde_json::to_value(m).map_err(|e| Error::Serialization(format!("operator structure: {e}")))
 }
 
 fn from_value<T: DeserializeOwned>(family: &str, v: &serde_json::Value) -> Result<T> {
     serde_json::from_value(v.clone()).map_err(|e| {
-        Error::Config(format!(
+        Error::InvalidModel(format!(
             "the \"operator\" object is not a {family} operator ({e}); save the model again"
         ))
     })

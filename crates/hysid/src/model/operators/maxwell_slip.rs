@@ -51,7 +51,7 @@ impl MaxwellSlip {
         check_finite("k0", k0)?;
         validate_thresholds("delta", &widths)?;
         if stiffness.len() != widths.len() {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "Maxwell-slip: {} stiffnesses for {} widths; give one per element",
                 stiffness.len(),
                 widths.len()

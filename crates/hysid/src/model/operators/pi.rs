@@ -59,7 +59,7 @@ impl PrandtlIshlinskii {
         }
         validate_thresholds("r", &thresholds)?;
         if weights.len() != thresholds.len() {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "PI: {} weights for {} thresholds; give one weight per threshold",
                 weights.len(),
                 thresholds.len()

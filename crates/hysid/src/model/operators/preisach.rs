@@ -219,13 +219,13 @@ impl Preisach {
         check_finite("a0", a0)?;
         check_finite("c", offset)?;
         if upper <= lower || n == 0 {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "Preisach grid [{lower}, {upper}] with {n} intervals: need lower < upper and n >= 1"
             )));
         }
         let grid = Grid { lower, upper, n };
         if weights.len() != grid.cells() {
-            return Err(Error::Config(format!(
+            return Err(Error::InvalidModel(format!(
                 "Preisach: {} weights for a {n}-level triangle of {} cells",
                 weights.len(),
                 grid.cells()

@@ -53,9 +53,11 @@ pub fn butter(order: usize, wn: f64) -> Result<TransferFunction> {
 pub fn cheby1(order: usize, ripple_db: f64, wn: f64) -> Result<TransferFunction> {
     check_design(order, wn, "cheby1")?;
     if ripple_db.is_nan() || ripple_db <= 0.0 {
-        return Err(Error::Config(format!(
-            "cheby1 needs a positive ripple in dB, got {ripple_db}"
-        )));
+        return Err(Error::invalid_option(
+            "ripple_db",
+            ripple_db,
+            format!("cheby1 needs a positive ripple in dB, got {ripple_db}"),
+        ));
     }
     let n = order as f64;
     let eps = (10f64.powf(ripple_db / 10.0) - 1.0).sqrt();
@@ -81,7 +83,7 @@ pub fn cheby1(order: usize, ripple_db: f64, wn: f64) -> Result<TransferFunction>
 
 fn check_design(order: usize, wn: f64, name: &str) -> Result<()> {
     if order == 0 || !(wn > 0.0 && wn < 1.0) {
-        return Err(Error::Config(format!(
+        return Err(Error::invalid_option("cutoff", wn, format!(
             "{name} needs an order >= 1 and a cut-off strictly between 0 and 1 (relative to Nyquist), got order {order}, cut-off {wn}"
         )));
     }

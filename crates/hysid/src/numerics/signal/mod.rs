@@ -38,9 +38,11 @@ pub struct Segment {
 /// ```
 pub fn triangle_schedule(period: usize, segments: &[Segment]) -> Result<Vec<f64>> {
     if period < 4 {
-        return Err(Error::Config(format!(
-            "triangle period must be at least 4 samples, got {period}"
-        )));
+        return Err(Error::invalid_option(
+            "period",
+            period,
+            format!("triangle period must be at least 4 samples, got {period}"),
+        ));
     }
     let mut x = Vec::with_capacity(segments.iter().map(|s| s.len).sum());
     for segment in segments {
@@ -90,9 +92,13 @@ pub fn multisine(
         .filter(|&k| (f_lo..=f_hi).contains(&(k as f64 * df)))
         .collect();
     if bins.is_empty() {
-        return Err(Error::Config(format!(
+        return Err(Error::invalid_option(
+            "band",
+            format!("[{f_lo}, {f_hi}]"),
+            format!(
             "no frequency bin of a {period}-sample period at {fs} Hz lies in [{f_lo}, {f_hi}] Hz"
-        )));
+        ),
+        ));
     }
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let phases: Vec<f64> = bins
@@ -167,23 +173,31 @@ pub fn decimate_fir(x: &[f64], factor: usize) -> Vec<f64> {
 /// `n` samples uniformly distributed on [−half_width, half_width].
 pub fn uniform_noise(n: usize, half_width: f64, seed: u64) -> Result<Vec<f64>> {
     if !(half_width >= 0.0 && half_width.is_finite()) {
-        return Err(Error::Config(format!(
-            "uniform disturbance half-width must be finite and >= 0, got {half_width}"
-        )));
+        return Err(Error::invalid_option(
+            "half_width",
+            half_width,
+            format!("uniform disturbance half-width must be finite and >= 0, got {half_width}"),
+        ));
     }
     if half_width == 0.0 {
         return Ok(vec![0.0; n]);
     }
-    let dist = Uniform::new_inclusive(-half_width, half_width)
-        .map_err(|e| Error::Config(format!("uniform disturbance: {e}")))?;
+    let dist = Uniform::new_inclusive(-half_width, half_width).map_err(|e| {
+        Error::invalid_option(
+            "half_width",
+            half_width,
+            format!("uniform disturbance: {e}"),
+        )
+    })?;
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     Ok((0..n).map(|_| rng.sample(dist)).collect())
 }
 
 /// `n` samples of zero-mean Gaussian noise with standard deviation `std`.
 pub fn gaussian_noise(n: usize, std: f64, seed: u64) -> Result<Vec<f64>> {
-    let dist = Normal::new(0.0, std)
-        .map_err(|e| Error::Config(format!("Gaussian noise with std {std}: {e}")))?;
+    let dist = Normal::new(0.0, std).map_err(|e| {
+        Error::invalid_option("std", std, format!("Gaussian noise with std {std}: {e}"))
+    })?;
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     Ok((0..n).map(|_| rng.sample(dist)).collect())
 }
@@ -193,9 +207,11 @@ pub fn gaussian_noise(n: usize, std: f64, seed: u64) -> Result<Vec<f64>> {
 /// output and noise variances"). Returns the noisy signal and the noise std used.
 pub fn add_noise_snr(y: &[f64], snr: f64, seed: u64) -> Result<(Vec<f64>, f64)> {
     if !(snr > 0.0 && snr.is_finite()) {
-        return Err(Error::Config(format!(
-            "SNR must be finite and > 0, got {snr}"
-        )));
+        return Err(Error::invalid_option(
+            "snr",
+            snr,
+            format!("SNR must be finite and > 0, got {snr}"),
+        ));
     }
     let std = crate::numerics::metrics::std_dev(y) / snr;
     let noise = gaussian_noise(y.len(), std, seed)?;

@@ -26,7 +26,7 @@ pub fn by_kind(kind: &str) -> Result<Box<dyn StateSpaceModel>> {
         "rigid_body" => Ok(Box::new(RigidBody)),
         "actuator_fixed" => Ok(Box::new(ActuatorFixed)),
         "actuator_free" => Ok(Box::new(ActuatorFree)),
-        other => Err(Error::Config(format!(
+        other => Err(Error::invalid_option("model", other, format!(
             "unknown grey-box model '{other}'; the built-in ones are bouc-wen, rigid-body, actuator-fixed and actuator-free"
         ))),
     }
