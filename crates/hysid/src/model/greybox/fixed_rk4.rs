@@ -93,10 +93,10 @@ impl<const N: usize, const Q: usize> Augmented<N, Q> {
         }
     }
 
-    /// `self += c·(a + 2b + 2c + d)`, the RK4 update.
+    /// `self += (h/6)·(k₁ + 2k₂ + 2k₃ + k₄)`, the RK4 update of [`crate::numerics::integrate::rk4::increment`].
     #[inline(always)]
     fn add_rk4(&mut self, sixth: f64, k: &[Self; 4]) {
-        let w = |a: f64, b: f64, c: f64, d: f64| sixth * (a + 2.0 * b + 2.0 * c + d);
+        let w = |a, b, c, d| crate::numerics::integrate::rk4::increment(sixth, a, b, c, d);
         for i in 0..N {
             self.x[i] += w(k[0].x[i], k[1].x[i], k[2].x[i], k[3].x[i]);
             for j in 0..Q {

@@ -105,9 +105,17 @@ impl Rk4 {
             .zip(k3.iter())
             .zip(k4.iter())
         {
-            *xi += sixth * (a + 2.0 * b + 2.0 * c + d);
+            *xi += increment(sixth, *a, *b, *c, *d);
         }
     }
+}
+
+/// The classical RK4 increment (h/6)·(k₁ + 2k₂ + 2k₃ + k₄) of one element, given h/6:
+/// the one place its weights are written, shared by [`Rk4::step`] and the fixed-size
+/// sensitivity path of the grey-box models (which must agree with it to the last bit).
+#[inline(always)]
+pub fn increment(sixth: f64, k1: f64, k2: f64, k3: f64, k4: f64) -> f64 {
+    sixth * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 }
 
 #[cfg(test)]
