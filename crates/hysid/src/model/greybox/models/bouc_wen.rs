@@ -189,42 +189,14 @@ impl StateSpaceModel for BoucWen {
         dx: &mut [f64],
         ds: &mut [f64],
     ) -> bool {
-        let (y, v, z) = (x[0], x[1], x[2]);
-        let nu = th[NU];
-        let m = th[ML];
-        let a = abs_pow(z, nu);
-        let sz = sign0(z);
-        let acc = (u[0] - th[CL] * v - th[KL] * y - z) / m;
-        dx[0] = v;
-        dx[1] = acc;
-        dx[2] = th[ALPHA] * v - th[BG] * v.abs() * sz * a - th[BD] * v * a;
-        let da = if z == 0.0 {
-            if nu == 1.0 {
-                1.0
-            } else {
-                0.0
-            }
-        } else {
-            nu * abs_pow(z, nu - 1.0)
-        };
-        // Rows 1 and 2 of ∂f/∂x (row 0 is [0, 1, 0]).
-        let inv_m = 1.0 / m;
+        let inv_m = 1.0 / th[ML];
+        let local = local_derivatives(th, inv_m, [x[0], x[1], x[2]], u[0], params.contains(&NU));
+        dx.copy_from_slice(&local.dx);
+        // Row 1 of ∂f/∂x depends on θ only (row 0 is [0, 1, 0]).
         let (f10, f11, f12) = (-th[KL] * inv_m, -th[CL] * inv_m, -inv_m);
-        let f21 = th[ALPHA] - th[BG] * sign0(v) * sz * a - th[BD] * a;
-        let f22 = -th[BG] * v.abs() * da - th[BD] * v * da * sz;
-        // Rows 1 and 2 of ∂f/∂θ.
-        let mut d1 = [0.0; 7];
-        let mut d2 = [0.0; 7];
-        d1[ML] = -acc * inv_m;
-        d1[CL] = -v * inv_m;
-        d1[KL] = -y * inv_m;
-        d2[ALPHA] = v;
-        d2[BG] = -v.abs() * sz * a;
-        d2[BD] = -v * a;
-        if params.contains(&NU) {
-            let ln = if z == 0.0 { 0.0 } else { z.abs().ln() };
-            d2[NU] = -(th[BG] * v.abs() * sz + th[BD] * v) * a * ln;
-        }
+        let LocalDerivatives {
+            f21, f22, d1, d2, ..
+        } = local;
         let q = s.len() / 3;
         let (s0, rest) = s.split_at(q);
         let (s1, s2) = rest.split_at(q);
@@ -242,7 +214,8 @@ impl StateSpaceModel for BoucWen {
             .zip(&s2[..np])
             .zip(params);
         for (((((o1, o2), a), b), c), &i) in parameter_columns {
-            let (direct1, direct2) = if i < 7 { (d1[i], d2[i]) } else { (0.0, 0.0) };
+            let slot = i.min(ZERO_SLOT);
+            let (direct1, direct2) = (d1[slot], d2[slot]);
             *o1 = direct1 + f10 * a + f11 * b + f12 * c;
             *o2 = direct2 + f21 * b + f22 * c;
         }
@@ -266,6 +239,75 @@ impl StateSpaceModel for BoucWen {
         on_sample: &mut SampleSink<'_>,
     ) -> Option<crate::Result<()>> {
         super::bouc_wen_kernel::simulate(run, on_sample)
+    }
+}
+
+/// Slot of [`LocalDerivatives::d1`] and [`LocalDerivatives::d2`] that holds zero: the direct
+/// term of a column that is not a model parameter (an initial state).
+pub(super) const ZERO_SLOT: usize = 7;
+
+/// ẋ and the state-dependent entries of the Jacobians at one point, shared by the generic
+/// sensitivity path ([`BoucWen::rhs_sensitivities`]) and the fixed-size one
+/// (`bouc_wen_kernel`), so that both compute them by the same operations.
+pub(super) struct LocalDerivatives {
+    /// ẋ = (ẏ, ÿ, ż).
+    pub dx: [f64; 3],
+    /// ∂ż/∂ẏ = α − β_γ·sign(ẏ)·sign(z)·|z|^ν − β_δ·|z|^ν.
+    pub f21: f64,
+    /// ∂ż/∂z = −(β_γ·|ẏ| + β_δ·ẏ·sign(z))·ν|z|^(ν−1).
+    pub f22: f64,
+    /// Row 1 of ∂f/∂θ by parameter index, [`ZERO_SLOT`] zero.
+    pub d1: [f64; 8],
+    /// Row 2 of ∂f/∂θ by parameter index, [`ZERO_SLOT`] zero; ∂ż/∂ν only `with_nu`
+    /// (it needs ln|z|).
+    pub d2: [f64; 8],
+}
+
+/// [`LocalDerivatives`] at state x = (y, ẏ, z) and input u, with 1/m_L given (a kernel
+/// computes it once per simulation; it is the same number either way).
+#[inline(always)]
+pub(super) fn local_derivatives(
+    th: &[f64],
+    inv_m: f64,
+    [y, v, z]: [f64; 3],
+    u: f64,
+    with_nu: bool,
+) -> LocalDerivatives {
+    let nu = th[NU];
+    let a = abs_pow(z, nu);
+    let sz = sign0(z);
+    let acc = (u - th[CL] * v - th[KL] * y - z) / th[ML];
+    let da = if z == 0.0 {
+        if nu == 1.0 {
+            1.0
+        } else {
+            0.0
+        }
+    } else {
+        nu * abs_pow(z, nu - 1.0)
+    };
+    let mut d1 = [0.0; 8];
+    let mut d2 = [0.0; 8];
+    d1[ML] = -acc * inv_m;
+    d1[CL] = -v * inv_m;
+    d1[KL] = -y * inv_m;
+    d2[ALPHA] = v;
+    d2[BG] = -v.abs() * sz * a;
+    d2[BD] = -v * a;
+    if with_nu {
+        let ln = if z == 0.0 { 0.0 } else { z.abs().ln() };
+        d2[NU] = -(th[BG] * v.abs() * sz + th[BD] * v) * a * ln;
+    }
+    LocalDerivatives {
+        dx: [
+            v,
+            acc,
+            th[ALPHA] * v - th[BG] * v.abs() * sz * a - th[BD] * v * a,
+        ],
+        f21: th[ALPHA] - th[BG] * sign0(v) * sz * a - th[BD] * a,
+        f22: -th[BG] * v.abs() * da - th[BD] * v * da * sz,
+        d1,
+        d2,
     }
 }
 

@@ -1,23 +1,18 @@
 //! The Bouc–Wen oscillator's sensitivity right-hand side on fixed-size arrays, for
-//! [`crate::model::greybox::fixed_rk4`]: the same expressions, in the same order, as
-//! [`BoucWen::rhs_sensitivities`](super::BoucWen), with what depends on θ alone (1/mL and the
+//! [`crate::model::greybox::fixed_rk4`]: the point derivatives of
+//! `bouc_wen::local_derivatives`, shared with [`BoucWen::rhs_sensitivities`](super::BoucWen), with what depends on θ alone (1/mL and the
 //! first Jacobian row's entries) computed once per simulation instead of once per stage, and
 //! the direct term ∂f/∂θ of each column picked from a table built once.
 //!
 //! Equations and reference: see [`super::BoucWen`] (Noël & Schoukens 2016).
 
-use super::bouc_wen::{abs_pow, ALPHA, BD, BG, CL, KL, ML, NU};
-use super::sign0;
+use super::bouc_wen::{local_derivatives, LocalDerivatives, CL, KL, ML, NU, ZERO_SLOT};
 use crate::model::greybox::fixed_rk4::{self, FixedSensitivityRhs, Rk4Sensitivities, SampleSink};
 use crate::Result;
 
 /// The largest number of sensitivity columns with a fixed-size path: the seven parameters and
 /// the three initial states.
 const MAX_COLUMNS: usize = 10;
-
-/// Slot of the zero direct term in the per-stage table of direct terms (initial-state columns
-/// and parameters without one).
-const ZERO: usize = 7;
 
 /// The Bouc–Wen right-hand side with its parameters bound (see the module docs).
 struct Kernel<const Q: usize> {
@@ -28,16 +23,16 @@ struct Kernel<const Q: usize> {
     f1: [f64; 3],
     /// Whether ν has a sensitivity column (its direct term needs ln|z|).
     with_nu: bool,
-    /// Per column, the slot of its direct term: the parameter index, or [`ZERO`].
+    /// Per column, the slot of its direct term: the parameter index, or [`ZERO_SLOT`].
     direct: [usize; Q],
 }
 
 impl<const Q: usize> Kernel<Q> {
     fn new(run: &Rk4Sensitivities<'_>) -> Option<Self> {
         let theta: [f64; 7] = run.theta.try_into().ok()?;
-        let mut direct = [ZERO; Q];
+        let mut direct = [ZERO_SLOT; Q];
         for (slot, &i) in direct.iter_mut().zip(run.params) {
-            *slot = if i < 7 { i } else { ZERO };
+            *slot = i.min(ZERO_SLOT);
         }
         let inv_m = 1.0 / theta[ML];
         Some(Self {
@@ -60,44 +55,12 @@ impl<const Q: usize> FixedSensitivityRhs<3, Q> for Kernel<Q> {
         dx: &mut [f64; 3],
         ds: &mut [[f64; Q]; 3],
     ) {
-        let th = &self.theta;
-        let [y, v, z] = *x;
-        let nu = th[NU];
-        let m = th[ML];
-        let a = abs_pow(z, nu);
-        let sz = sign0(z);
-        let acc = (u[0] - th[CL] * v - th[KL] * y - z) / m;
-        *dx = [
-            v,
-            acc,
-            th[ALPHA] * v - th[BG] * v.abs() * sz * a - th[BD] * v * a,
-        ];
-        let da = if z == 0.0 {
-            if nu == 1.0 {
-                1.0
-            } else {
-                0.0
-            }
-        } else {
-            nu * abs_pow(z, nu - 1.0)
-        };
-        let inv_m = self.inv_m;
+        let local = local_derivatives(&self.theta, self.inv_m, *x, u[0], self.with_nu);
+        *dx = local.dx;
         let [f10, f11, f12] = self.f1;
-        let f21 = th[ALPHA] - th[BG] * sign0(v) * sz * a - th[BD] * a;
-        let f22 = -th[BG] * v.abs() * da - th[BD] * v * da * sz;
-        // Rows 1 and 2 of ∂f/∂θ, indexed by parameter, with the zero slot last.
-        let mut d1 = [0.0; 8];
-        let mut d2 = [0.0; 8];
-        d1[ML] = -acc * inv_m;
-        d1[CL] = -v * inv_m;
-        d1[KL] = -y * inv_m;
-        d2[ALPHA] = v;
-        d2[BG] = -v.abs() * sz * a;
-        d2[BD] = -v * a;
-        if self.with_nu {
-            let ln = if z == 0.0 { 0.0 } else { z.abs().ln() };
-            d2[NU] = -(th[BG] * v.abs() * sz + th[BD] * v) * a * ln;
-        }
+        let LocalDerivatives {
+            f21, f22, d1, d2, ..
+        } = local;
         let [s0, s1, s2] = s;
         ds[0] = *s1;
         for c in 0..Q {
