@@ -201,65 +201,12 @@ pub(super) fn simulate_rates(
 #[cfg(test)]
 mod tests {
     use crate::model::greybox::equation_model::EquationStateSpace;
+    use crate::model::greybox::fixed_rk4::GenericPath;
     use crate::model::greybox::simulate::{
         simulate, simulate_sensitivities, InputInterpolation, InputTrack, Integrator, Simulation,
     };
-    use crate::model::greybox::{Channel, JacobianScratch, ParameterSet, StateSpaceModel};
+    use crate::model::greybox::StateSpaceModel;
     use crate::numerics::signal::multisine;
-
-    /// An equation model without its fixed-size path, so the generic path runs.
-    struct Generic(EquationStateSpace);
-
-    impl StateSpaceModel for Generic {
-        fn kind(&self) -> &'static str {
-            "equations_generic"
-        }
-        fn states(&self) -> Vec<Channel> {
-            self.0.states()
-        }
-        fn inputs(&self) -> Vec<Channel> {
-            self.0.inputs()
-        }
-        fn outputs(&self) -> Vec<Channel> {
-            self.0.outputs()
-        }
-        fn parameters(&self) -> ParameterSet {
-            self.0.parameters()
-        }
-        fn rhs(&self, t: f64, x: &[f64], u: &[f64], theta: &[f64], dx: &mut [f64]) {
-            self.0.rhs(t, x, u, theta, dx)
-        }
-        fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
-            self.0.output(x, u, theta, y)
-        }
-        fn rhs_jacobians(
-            &self,
-            t: f64,
-            x: &[f64],
-            u: &[f64],
-            theta: &[f64],
-            fx: &mut [f64],
-            ftheta: &mut [f64],
-        ) -> bool {
-            self.0.rhs_jacobians(t, x, u, theta, fx, ftheta)
-        }
-        fn rhs_sensitivities(
-            &self,
-            t: f64,
-            x: &[f64],
-            u: &[f64],
-            theta: &[f64],
-            held: Option<f64>,
-            params: &[usize],
-            s: &[f64],
-            scratch: &mut JacobianScratch,
-            dx: &mut [f64],
-            ds: &mut [f64],
-        ) -> bool {
-            self.0
-                .rhs_sensitivities(t, x, u, theta, held, params, s, scratch, dx, ds)
-        }
-    }
 
     fn load(name: &str) -> EquationStateSpace {
         let path = format!(
@@ -381,7 +328,7 @@ mod tests {
             cases.push((&tanks, case));
         }
         for (model, case) in &cases {
-            let generic = Generic((*model).clone());
+            let generic = GenericPath(*model);
             for sensitivities in [true, false] {
                 let fixed = run(*model, case, sensitivities);
                 let reference = run(&generic, case, sensitivities);

@@ -103,64 +103,12 @@ pub(super) fn simulate(
 #[cfg(test)]
 mod tests {
     use super::super::BoucWen;
+    use crate::model::greybox::fixed_rk4::GenericPath;
     use crate::model::greybox::simulate::{
         simulate_sensitivities, InputInterpolation, InputTrack, Integrator, Simulation,
     };
-    use crate::model::greybox::{Channel, JacobianScratch, ParameterSet, StateSpaceModel};
+    use crate::model::greybox::StateSpaceModel;
     use crate::numerics::signal::multisine;
-
-    /// The Bouc–Wen model without its fixed-size path, so the generic path runs.
-    struct Generic;
-
-    impl StateSpaceModel for Generic {
-        fn kind(&self) -> &'static str {
-            "bouc_wen_generic"
-        }
-        fn states(&self) -> Vec<Channel> {
-            BoucWen.states()
-        }
-        fn inputs(&self) -> Vec<Channel> {
-            BoucWen.inputs()
-        }
-        fn outputs(&self) -> Vec<Channel> {
-            BoucWen.outputs()
-        }
-        fn parameters(&self) -> ParameterSet {
-            BoucWen.parameters()
-        }
-        fn rhs(&self, t: f64, x: &[f64], u: &[f64], theta: &[f64], dx: &mut [f64]) {
-            BoucWen.rhs(t, x, u, theta, dx)
-        }
-        fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
-            BoucWen.output(x, u, theta, y)
-        }
-        fn rhs_jacobians(
-            &self,
-            t: f64,
-            x: &[f64],
-            u: &[f64],
-            theta: &[f64],
-            fx: &mut [f64],
-            ftheta: &mut [f64],
-        ) -> bool {
-            BoucWen.rhs_jacobians(t, x, u, theta, fx, ftheta)
-        }
-        fn rhs_sensitivities(
-            &self,
-            t: f64,
-            x: &[f64],
-            u: &[f64],
-            theta: &[f64],
-            held: Option<f64>,
-            params: &[usize],
-            s: &[f64],
-            scratch: &mut JacobianScratch,
-            dx: &mut [f64],
-            ds: &mut [f64],
-        ) -> bool {
-            BoucWen.rhs_sensitivities(t, x, u, theta, held, params, s, scratch, dx, ds)
-        }
-    }
 
     fn run(
         model: &dyn StateSpaceModel,
@@ -214,7 +162,13 @@ mod tests {
             ] {
                 for (params, initial) in columns {
                     let fixed = run(&BoucWen, theta, interpolation, params, initial);
-                    let generic = run(&Generic, theta, interpolation, params, initial);
+                    let generic = run(
+                        &GenericPath(&BoucWen),
+                        theta,
+                        interpolation,
+                        params,
+                        initial,
+                    );
                     assert_eq!(fixed.len(), generic.len());
                     for (i, (a, b)) in fixed.iter().zip(&generic).enumerate() {
                         assert!(
