@@ -100,7 +100,7 @@ fn simulate_generic(cascade: &HysteresisCascade, x: &[f64], h: Option<&[bool]>, 
         let vt = if t == 0 {
             0.0
         } else {
-            let outside = h.map_or(x[t].abs() > ch.d(), |h| h[t]);
+            let outside = ch.outside_at(x, t, h);
             ch.step_in(v_prev, x[t - 1], x[t], outside)
         };
         v.row_mut(t)[0] = vt;

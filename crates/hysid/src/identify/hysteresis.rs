@@ -145,7 +145,7 @@ pub fn hysteresis_sensitivities(
     }
     on_sample(0, v, &s);
     for t in 1..x.len() {
-        let outside = h.map_or(x[t].abs() > ch.d(), |h| h[t]);
+        let outside = ch.outside_at(x, t, h);
         let factor = ch.step_partials_in(v, x[t - 1], x[t], outside, &mut partial);
         v = ch.step_in(v, x[t - 1], x[t], outside);
         for (sk, pk) in s.iter_mut().zip(&partial) {

@@ -270,6 +270,14 @@ impl ColemanHodgdon {
         self.step_in(y_prev, x_prev, x, x.abs() > self.d)
     }
 
+    /// The segment of sample t of `x` for [`step_in`](Self::step_in): the held
+    /// classification `held[t]` (h(t) = 1 outside) when the estimator holds one, else
+    /// |x(t)| > d.
+    #[inline]
+    pub fn outside_at(&self, x: &[f64], t: usize, held: Option<&[bool]>) -> bool {
+        held.map_or(x[t].abs() > self.d, |h| h[t])
+    }
+
     /// One step of (D) with the segment of the material functions given by `outside`
     /// (h(t) = 1) instead of by |x(t)| > d: the internal variable h held fixed, as the
     /// estimators do while d moves inside one classification of the samples.

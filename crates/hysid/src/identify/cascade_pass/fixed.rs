@@ -54,7 +54,7 @@ fn recursion_fixed<const NH: usize, const NA: usize, const M: usize, const P: us
     let mut failed = None;
     for t in 0..x.len() {
         if t > 0 {
-            let outside = h.map_or(x[t].abs() > ch.d(), |h| h[t]);
+            let outside = ch.outside_at(x, t, h);
             let factor = ch.step_partials_in(v, x[t - 1], x[t], outside, &mut partial);
             v = ch.step_in(v, x[t - 1], x[t], outside);
             for (si, pi) in s.iter_mut().zip(&partial) {
@@ -124,7 +124,7 @@ fn simulate_fixed<const NA: usize, const M: usize>(
         let vt = if t == 0 {
             0.0
         } else {
-            let outside = h.map_or(x[t].abs() > ch.d(), |h| h[t]);
+            let outside = ch.outside_at(x, t, h);
             ch.step_in(v_prev, x[t - 1], x[t], outside)
         };
         ring_v[t & mask] = vt;
