@@ -35,8 +35,6 @@ use super::stick_slip::{Sensitivities, StickSlip};
 use super::{JacobianScratch, StateSpaceModel};
 use crate::numerics::integrate::Stage;
 use crate::{Error, Result};
-use rustfft::num_complex::Complex;
-use rustfft::FftPlanner;
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -204,31 +202,9 @@ impl InputTrack {
 }
 
 /// The band-limited interpolation of a periodic record at `factor` points per sample:
-/// zero-padding of its DFT, the Nyquist bin split between the positive and negative halves.
-pub fn band_limited_upsample(x: &[f64], factor: usize) -> Vec<f64> {
-    let n = x.len();
-    if n < 2 || factor <= 1 {
-        return x.to_vec();
-    }
-    let m = n * factor;
-    let mut planner = FftPlanner::<f64>::new();
-    let mut spectrum: Vec<Complex<f64>> = x.iter().map(|&v| Complex::new(v, 0.0)).collect();
-    planner.plan_fft_forward(n).process(&mut spectrum);
-    let mut padded = vec![Complex::new(0.0, 0.0); m];
-    let half = n / 2;
-    padded[..=half].copy_from_slice(&spectrum[..=half]);
-    for k in 1..n - half {
-        padded[m - k] = spectrum[n - k];
-    }
-    if n.is_multiple_of(2) {
-        // The Nyquist bin belongs to both halves of the longer spectrum.
-        let nyquist = spectrum[half] * 0.5;
-        padded[half] = nyquist;
-        padded[m - half] = nyquist;
-    }
-    planner.plan_fft_inverse(m).process(&mut padded);
-    padded.iter().map(|c| c.re / n as f64).collect()
-}
+/// zero-padding of its DFT, the Nyquist bin split between the positive and negative halves
+/// (in the `hysid-spectral` crate, where the FFT planner is compiled once).
+pub use hysid_spectral::band_limited_upsample;
 
 /// Simulates `model` over the samples of `input` with sample time `ts` from the initial
 /// state `x0`, calling `on_sample(k, x(t_k))` at every sample. Errors with
@@ -719,17 +695,6 @@ pub fn simulate_sensitivities(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn band_limited_upsampling_reproduces_a_periodic_sine() {
-        let n = 64;
-        let f = |t: f64| (2.0 * std::f64::consts::PI * 3.0 * t / n as f64).sin() + 0.5;
-        let x: Vec<f64> = (0..n).map(|k| f(k as f64)).collect();
-        let up = band_limited_upsample(&x, 8);
-        for (i, v) in up.iter().enumerate() {
-            assert!((v - f(i as f64 / 8.0)).abs() < 1e-12, "{i}");
-        }
-    }
 
     #[test]
     fn zero_order_hold_holds_to_the_end_of_the_interval() {

@@ -8,7 +8,7 @@
 //! them against the published JSON Schema (`docs/schema/hysid.report.v1.json`) with an
 //! independent validator (`tools/validate_reports.py`).
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use hysid::report::Report;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -27,10 +27,6 @@ const TOP_LEVEL: [&str; 10] = [
     "details",
 ];
 const PARAMETER_KEYS: [&str; 7] = ["fixed", "lower", "name", "std", "unit", "upper", "value"];
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
 
 fn repo(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

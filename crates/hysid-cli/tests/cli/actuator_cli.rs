@@ -1,14 +1,11 @@
 //! `hysid actuator`, `hysid demo actuator` and `hysid rigid-body ls` end to end, and their
 //! one-line errors.
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use tempfile::TempDir;
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
 
 /// Runs `cmd` expecting failure: one line on stderr, no panic; returns it.
 fn one_line_error(cmd: &mut Command) -> String {

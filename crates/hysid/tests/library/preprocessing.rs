@@ -6,7 +6,7 @@ use hysid::numerics::signal::{butter, filtfilt, gradient};
 use serde_json::Value;
 
 fn reference() -> Value {
-    let text = include_str!("data/filter_reference.json");
+    let text = include_str!("../data/filter_reference.json");
     serde_json::from_str(text).unwrap()
 }
 

@@ -1,16 +1,13 @@
 //! `hysid identify cascade --hysteresis FAMILY` with an operator family: a simulated backlash
 //! cascade is recovered, its model file simulates to the report's fit, bad names are one line.
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use hysid::model::operators::{Backlash, Orientation};
 use hysid::model::{CascadeOperator, LinearBlock, OperatorCascade};
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use tempfile::TempDir;
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()

@@ -222,7 +222,12 @@ fn sigterm_removes_the_temporaries_and_keeps_the_previous_outputs() {
     fs::write(dir.path().join("report.json"), "old").unwrap();
     fs::create_dir(dir.path().join("plots")).unwrap();
     let mut child = std::process::Command::new(std::env::current_exe().unwrap())
-        .args(["--ignored", "--exact", "sigterm_child", "--nocapture"])
+        .args([
+            "--ignored",
+            "--exact",
+            "atomic_outputs::sigterm_child",
+            "--nocapture",
+        ])
         .env("HYSID_SIGTERM_DIR", dir.path())
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())

@@ -2,15 +2,11 @@
 //! that `hysid simulate` reproduces, `compare` on the piezo record, `compensate`, and bad input
 //! (one line on stderr, the documented exit code, no panic).
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use hysid::model::operators::{Dahl, HysteresisOperator};
 use std::fs;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
 
 fn repo_data(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -3,13 +3,10 @@
 //! invalid physics, progress goes to stderr only, and `--time-limit` stops a search with its
 //! best result reported as such.
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
+use std::process::Command;
 
 /// Runs `cmd`, expects exit `code` and one line on stderr; returns that line.
 fn fails_with(cmd: &mut Command, code: i32) -> String {

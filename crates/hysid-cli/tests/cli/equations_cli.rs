@@ -2,14 +2,11 @@
 //! on the benchmark's estimation record, saved, and re-simulated by `hysid simulate` on the
 //! validation record; and the one-line errors of a bad file or of two models.
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use tempfile::TempDir;
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")

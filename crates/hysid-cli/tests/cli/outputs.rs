@@ -2,16 +2,10 @@
 //! registered before any work, refused when one equals an input, renamed into place together
 //! at the end — a failed run leaves neither a file nor a temporary.
 
-use assert_cmd::Command;
-use predicates::prelude::*;
-use predicates::str::contains;
+use crate::common::{hysid, Assert};
 use std::fs;
 use std::path::Path;
 use tempfile::TempDir;
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
 
 /// The sorted names of the entries of `dir`.
 fn entries(dir: &Path) -> Vec<String> {
@@ -67,7 +61,7 @@ fn an_unwritable_second_output_leaves_no_file_and_no_temporary() {
         .arg(dir.join("missing/model.json"))
         .assert()
         .failure()
-        .stderr(contains("does not exist"));
+        .stderr_contains("does not exist");
     assert_eq!(entries(dir), ["ex1.csv"]);
 }
 
@@ -85,9 +79,9 @@ fn an_output_equal_to_an_input_is_refused_before_computing() {
         .arg(&data)
         .assert()
         .failure()
-        .stderr(contains("is also an input"))
+        .stderr_contains("is also an input")
         // Refused at registration: the fit never started.
-        .stdout(contains("Cascade").not());
+        .stdout_lacks("Cascade");
     assert_eq!(fs::read(&data).unwrap(), before);
     assert_eq!(entries(dir), ["ex1.csv"]);
 }

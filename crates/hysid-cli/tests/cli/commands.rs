@@ -1,9 +1,10 @@
 //! Command-line tests: the commands work end to end, and bad input gives one clear line on
 //! stderr, a non-zero exit, no panic and no output file.
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use tempfile::TempDir;
 
 /// The entry of parameter `name` in a report's `model.parameters`.
@@ -14,10 +15,6 @@ fn param<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value
         .iter()
         .find(|p| p["name"] == name)
         .unwrap_or_else(|| panic!("no parameter {name} in {report}"))
-}
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
 }
 
 /// Writes a CSV file with the given header and rows.

@@ -1,13 +1,10 @@
 //! The exit-code table (0 success, 1 bad input, 2 usage, 3 numerical failure, 4 I/O) and
 //! one-line errors, usage errors included; `simulate`'s all-or-nothing outputs.
 
-use assert_cmd::Command;
+use crate::common::{hysid, Assert};
 use std::fs;
 use std::path::Path;
-
-fn hysid() -> Command {
-    Command::cargo_bin("hysid").unwrap()
-}
+use std::process::Command;
 
 /// Runs `cmd`, expects exit `code` and exactly one line on stderr; returns that line.
 fn fails_with(cmd: &mut Command, code: i32) -> String {

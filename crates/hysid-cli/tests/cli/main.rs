@@ -1,0 +1,14 @@
+//! The `hysid` command line end to end, in one test binary (one link and one copy of the
+//! shared code for all of them) with a module per area.
+
+mod common;
+
+mod actuator_cli;
+mod commands;
+mod equations_cli;
+mod exit_codes;
+mod hardening;
+mod operator_cascade_cli;
+mod outputs;
+mod report_schema;
+mod zoo_cli;
