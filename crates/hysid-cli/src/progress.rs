@@ -178,6 +178,12 @@ impl FitProgress {
         }
     }
 
+    /// Shows what the stage is doing now (a step of a recipe without counts, e.g. "step 2:
+    /// steady-state loops").
+    pub fn show(&self, what: &str) {
+        self.sink.show(what.to_string());
+    }
+
     /// The observer to put in a recipe's settings: shows "phase k/N", and stops the phase at
     /// the time limit.
     pub fn observer(&self) -> Observer {

@@ -6,6 +6,7 @@ use crate::cli::{
     ActuatorConstants, ActuatorIdentifyArgs, DemoActuatorArgs, RigArgs, RigSettings, ThreeStepArgs,
 };
 use crate::output::{write_figures, Outputs};
+use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
 use hysid::experiments::actuator_rig::Rig;
 use hysid::identify::actuator::{
@@ -17,7 +18,6 @@ use hysid::report::actuator::three_steps_report;
 use hysid::report::plot::actuator_figures;
 use serde_json::json;
 use std::collections::BTreeMap;
-use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
@@ -97,16 +97,12 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     Ok(())
 }
 
-/// The three steps, naming each stage on stderr when it is a terminal (so that an error
-/// stays the only line there otherwise).
+/// The three steps, showing the step each is at on stderr (a live line on a terminal, a plain
+/// line at most every few seconds otherwise, nothing with `--quiet`; a run that fails within
+/// the first seconds prints only its error).
 fn run(steps: &ThreeSteps, records: &BTreeMap<usize, Record>) -> Result<ActuatorIdentification> {
-    let terminal = std::io::stderr().is_terminal();
-    let id = steps.run_reporting(records, &mut |stage| {
-        if terminal {
-            eprintln!("  {stage}");
-        }
-    })?;
-    Ok(id)
+    let progress = FitProgress::new("identifying actuator");
+    Ok(steps.run_reporting(records, &mut |stage| progress.show(stage))?)
 }
 
 /// Prints the tables; writes Markdown and plots, the report and the m67 model (read from
