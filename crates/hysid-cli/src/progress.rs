@@ -89,7 +89,7 @@ pub fn time_limit_warning() -> Option<String> {
     time_limit_hit().then(|| {
         format!(
             "warning: the time limit of {limit} s stopped the search; the results are the best \
-             found so far (search.termination = time_limit)"
+             found so far, and the report says so (search.termination = time_limit)"
         )
     })
 }

@@ -3,8 +3,11 @@
 
 use super::zoo::{family_options, load, loops, write_text};
 use crate::cli_zoo::CompareArgs;
+use crate::progress::{mark_report, FitProgress};
 use anyhow::{Context, Result};
-use hysid::identify::operators::{compare, CompareOptions, CompareRow, Comparison, Family};
+use hysid::identify::operators::{
+    compare, CompareOptions, CompareRow, Comparison, Family, FamilyOptions,
+};
 use hysid::io::atomic::OutputSet;
 use hysid::report::{DataSummary, Report, ValidationEntry};
 use serde_json::json;
@@ -13,9 +16,13 @@ use std::path::Path;
 /// Fits the families, prints the ranked table, writes the report, best model and plot.
 pub fn run(args: &CompareArgs) -> Result<()> {
     let families = Family::parse_list(&args.families).context("--families")?;
+    let progress = FitProgress::new("comparing families");
     let options = CompareOptions {
         families,
-        family: family_options(&args.options)?,
+        family: FamilyOptions {
+            observer: progress.observer(),
+            ..family_options(&args.options)?
+        },
         ..CompareOptions::default()
     };
     let mut inputs = vec![args.data.data.as_path()];
@@ -44,6 +51,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         exp.len()
     ));
     let comparison = compare(exp.input(0), exp.output(0), held_out, &options)?;
+    drop(progress);
     println!("Split: {}", comparison.split);
     print_table(&comparison.rows);
     for row in comparison.rows.iter().filter(|r| r.error.is_some()) {
@@ -67,7 +75,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         plot_loops(dir, &data, &comparison)?;
     }
     if let Some(path) = &json_tmp {
-        write_text(path, &report.to_json()?)?;
+        write_text(path, &mark_report(&report).to_json()?)?;
     }
     if let Some(path) = &model_tmp {
         let model = best.and_then(|b| b.fitted.as_ref()).ok_or_else(|| {

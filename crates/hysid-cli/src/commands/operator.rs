@@ -2,6 +2,7 @@
 
 use super::zoo::{family_options, load, loops, signals, write_text};
 use crate::cli_zoo::OperatorArgs;
+use crate::progress::{mark_report, FitProgress};
 use crate::report::{print_table, Row};
 use anyhow::{Context, Result};
 use hysid::identify::operators::{fit_operator, Family, FittedOperator};
@@ -17,7 +18,7 @@ const PRINTED_PARAMETERS: usize = 16;
 /// Fits the family, prints the parameters and fit, writes the report, model and plots.
 pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family).context("--family")?;
-    let options = family_options(&args.options)?;
+    let mut options = family_options(&args.options)?;
     let mut files = OutputSet::new(&[args.data.data.as_path()])?;
     let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
     let model_tmp = args
@@ -30,8 +31,11 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
     let exp = data.experiment(0);
     let (u, y) = (exp.input(0), exp.output(0));
     crate::progress::note(&format!("fitting {family} to {} samples …", u.len()));
+    let progress = FitProgress::new(&format!("fitting {family}"));
+    options.observer = progress.observer();
     let fitted = fit_operator(family, u, y, &options)
         .with_context(|| format!("identifying a {family} operator"))?;
+    drop(progress);
     // The report's fit is the saved model's own simulation, so `hysid simulate` reproduces it.
     let yhat = fitted
         .fit
@@ -81,7 +85,7 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
         )?;
     }
     if let Some(path) = &json_tmp {
-        write_text(path, &report.to_json()?)?;
+        write_text(path, &mark_report(&report).to_json()?)?;
     }
     if let Some(path) = &model_tmp {
         let text = serde_json::to_string_pretty(&fitted.fit.model.to_file())?;

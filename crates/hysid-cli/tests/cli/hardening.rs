@@ -268,6 +268,57 @@ fn a_time_limit_keeps_the_best_result_and_says_so() {
 }
 
 #[test]
+fn a_time_limit_stops_an_operator_fit_and_a_comparison() {
+    // The Dahl search on the piezo loop takes about a thousand simulations (seconds); a
+    // 10 ms limit stops it at its first accepted iteration.
+    let piezo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/piezo/piezo_150V_1Hz.csv");
+    let dir = tempfile::tempdir().unwrap();
+    for (command, json) in [
+        (
+            &["identify", "operator", "--family", "dahl"][..],
+            "operator.json",
+        ),
+        (
+            &["compare", "--families", "jiles-atherton,pi"][..],
+            "compare.json",
+        ),
+    ] {
+        let json = dir.path().join(json);
+        let out = hysid()
+            .arg("--quiet")
+            .args(command)
+            .arg("--data")
+            .arg(&piezo)
+            .args(["--input", "voltage_V", "--output", "displacement_um"])
+            .args(["--time-limit", "0.01", "--json"])
+            .arg(&json)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(out.status.code(), Some(0), "{command:?}: {stderr}");
+        assert!(
+            stderr
+                .lines()
+                .any(|l| l.starts_with("warning: the time limit")),
+            "{command:?}: {stderr}"
+        );
+        let report: serde_json::Value = serde_json::from_slice(&fs::read(&json).unwrap()).unwrap();
+        if command[0] == "compare" {
+            // No single search: the family the limit stopped says so in its row.
+            let rows = report["details"]["families"].as_array().unwrap();
+            let ja = rows
+                .iter()
+                .find(|r| r["family"] == "jiles-atherton")
+                .unwrap();
+            assert_eq!(ja["converged"], false, "{ja}");
+            assert_eq!(ja["termination"], "stopped by the caller", "{ja}");
+        } else {
+            assert_eq!(report["search"]["termination"]["code"], "time_limit");
+        }
+    }
+}
+
+#[test]
 fn quiet_runs_print_nothing_on_stderr() {
     let dir = tempfile::tempdir().unwrap();
     let data = rigid_body_csv(dir.path(), None);

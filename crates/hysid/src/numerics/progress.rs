@@ -38,6 +38,18 @@ impl fmt::Debug for Observer {
     }
 }
 
+/// Two observers are equal when both are absent or both are the same function (one `Arc`):
+/// settings that carry an observer stay comparable.
+impl PartialEq for Observer {
+    fn eq(&self, other: &Self) -> bool {
+        match (&self.0, &other.0) {
+            (None, None) => true,
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        }
+    }
+}
+
 impl Observer {
     /// An observer calling `f` on every step.
     pub fn new(f: impl Fn(&Progress<'_>) -> Control + Send + Sync + 'static) -> Self {

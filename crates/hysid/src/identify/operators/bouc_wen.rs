@@ -16,6 +16,7 @@ use super::differential_fit::{self as common, Search, Simulated};
 use super::OperatorFit;
 use crate::model::operators::{BoucWen, HysteresisOperator, InputOde, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
+use crate::numerics::Observer;
 use crate::Result;
 use std::time::Instant;
 
@@ -30,6 +31,8 @@ pub struct BoucWenOptions {
     pub starts: usize,
     /// Levenberg–Marquardt settings.
     pub config: LmConfig,
+    /// Sees the search's starts and iterations and may stop it (see [`Search::observer`]).
+    pub observer: Observer,
 }
 
 impl Default for BoucWenOptions {
@@ -39,6 +42,7 @@ impl Default for BoucWenOptions {
             estimate_n: false,
             starts: 3,
             config: common::default_config(),
+            observer: Observer::none(),
         }
     }
 }
@@ -78,6 +82,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit
         lower: vec![-inf, kw_lo, 0.0, 0.0, -inf, 1.0, -inf],
         upper: vec![inf, kw_hi, inf, inf, inf, 20.0, inf],
         config: options.config.clone(),
+        observer: options.observer.clone(),
     };
     let simulate = |theta: &[f64]| model_of(theta)?.simulate(u);
     let problem = Simulated {

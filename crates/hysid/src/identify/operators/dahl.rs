@@ -18,6 +18,7 @@ use super::differential_fit::{self as common, Search, Simulated};
 use super::OperatorFit;
 use crate::model::operators::{Dahl, HysteresisOperator, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
+use crate::numerics::Observer;
 use crate::Result;
 use std::time::Instant;
 
@@ -32,6 +33,8 @@ pub struct DahlOptions {
     pub starts: usize,
     /// Levenberg–Marquardt settings.
     pub config: LmConfig,
+    /// Sees the search's starts and iterations and may stop it (see [`Search::observer`]).
+    pub observer: Observer,
 }
 
 impl Default for DahlOptions {
@@ -41,6 +44,7 @@ impl Default for DahlOptions {
             estimate_i: true,
             starts: 3,
             config: common::default_config(),
+            observer: Observer::none(),
         }
     }
 }
@@ -76,6 +80,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Da
         lower: vec![0.0, 0.0, 1.0, -inf],
         upper: vec![inf, inf, 50.0, inf],
         config: options.config.clone(),
+        observer: options.observer.clone(),
     };
     let simulate = |theta: &[f64]| model_of(theta, orientation)?.simulate(u);
     let problem = Simulated {

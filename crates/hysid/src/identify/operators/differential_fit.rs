@@ -14,6 +14,7 @@ use crate::model::operators::HysteresisOperator;
 use crate::model::ParameterSet;
 use crate::numerics::levenberg_marquardt::{minimize, LeastSquaresProblem, LmConfig, LmReport};
 use crate::numerics::metrics;
+use crate::numerics::Observer;
 use crate::{Error, Result};
 use std::time::Instant;
 
@@ -114,6 +115,10 @@ pub struct Search {
     pub upper: Vec<f64>,
     /// Levenberg–Marquardt settings.
     pub config: LmConfig,
+    /// Sees "start k/N" after every start and "iteration k/max" after every accepted
+    /// iteration; its [`Control::Stop`](crate::numerics::Control::Stop) ends the search with
+    /// the best start so far (how a time limit is honoured).
+    pub observer: Observer,
 }
 
 /// The default engine settings of these fits: 200 iterations, tight tolerances.
@@ -141,7 +146,10 @@ pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) ->
     let mut best: Option<LmReport> = None;
     let (mut iterations, mut evaluations) = (0, 0);
     let mut first_error = None;
-    for start in starts {
+    for (k, start) in starts.iter().enumerate() {
+        if k > 0 && search.observer.should_stop("start") {
+            break;
+        }
         let theta: Vec<f64> = start
             .iter()
             .zip(search.lower.iter().zip(&search.upper))
@@ -154,7 +162,11 @@ pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) ->
             &search.lower,
             &search.upper,
             &search.config,
-            &mut |_| crate::numerics::Control::Continue,
+            &mut |r| {
+                search
+                    .observer
+                    .report("iteration", r.iteration, search.config.max_iterations)
+            },
         ) {
             Ok(report) => {
                 iterations += report.iterations;
@@ -172,6 +184,7 @@ pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) ->
                 first_error.get_or_insert(e);
             }
         }
+        search.observer.report("start", k + 1, starts.len());
     }
     let best = best.ok_or_else(|| {
         first_error

@@ -16,6 +16,7 @@ use super::differential_fit::{self as common, Search, Simulated};
 use super::OperatorFit;
 use crate::model::operators::{Duhem, HysteresisOperator};
 use crate::numerics::levenberg_marquardt::LmConfig;
+use crate::numerics::Observer;
 use crate::Result;
 use std::time::Instant;
 
@@ -26,6 +27,8 @@ pub struct DuhemOptions {
     pub starts: usize,
     /// Levenberg–Marquardt settings.
     pub config: LmConfig,
+    /// Sees the search's starts and iterations and may stop it (see [`Search::observer`]).
+    pub observer: Observer,
 }
 
 impl Default for DuhemOptions {
@@ -33,6 +36,7 @@ impl Default for DuhemOptions {
         Self {
             starts: 3,
             config: common::default_config(),
+            observer: Observer::none(),
         }
     }
 }
@@ -61,6 +65,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &DuhemOptions) -> Result<OperatorFit<D
         lower: vec![0.0, -inf, -inf, -inf, -inf],
         upper: vec![inf; 5],
         config: options.config.clone(),
+        observer: options.observer.clone(),
     };
     let simulate = |theta: &[f64]| model_of(theta)?.simulate(u);
     let problem = Simulated {

@@ -28,6 +28,7 @@ use crate::model::saved::FittedModel;
 use crate::model::{ChForm, Parameter, ParameterSet};
 use crate::numerics::levenberg_marquardt::Control;
 use crate::numerics::metrics;
+use crate::numerics::Observer;
 use crate::{Error, Result};
 use std::time::Instant;
 
@@ -146,6 +147,9 @@ pub struct FamilyOptions {
     pub dead_zones: usize,
     /// The loop orientation; detected from the data when None (linear-in-weights families).
     pub orientation: Option<Orientation>,
+    /// Sees the starts and iterations of the differential families' searches (Jiles–Atherton,
+    /// Bouc–Wen, Duhem, Dahl) and may stop them with the best result so far.
+    pub observer: Observer,
 }
 
 impl Default for FamilyOptions {
@@ -157,6 +161,7 @@ impl Default for FamilyOptions {
             lambda: 1e-6,
             dead_zones: 4,
             orientation: None,
+            observer: Observer::none(),
         }
     }
 }
@@ -297,15 +302,49 @@ pub fn fit_operator(
             OperatorModel::Backlash,
         ),
         Family::JilesAtherton => boxed(
-            jiles_atherton::fit(u, y, &Default::default())?,
+            jiles_atherton::fit(
+                u,
+                y,
+                &jiles_atherton::JilesAthertonOptions {
+                    observer: options.observer.clone(),
+                    ..Default::default()
+                },
+            )?,
             OperatorModel::JilesAtherton,
         ),
         Family::BoucWen => boxed(
-            bouc_wen::fit(u, y, &Default::default())?,
+            bouc_wen::fit(
+                u,
+                y,
+                &bouc_wen::BoucWenOptions {
+                    observer: options.observer.clone(),
+                    ..Default::default()
+                },
+            )?,
             OperatorModel::BoucWen,
         ),
-        Family::Duhem => boxed(duhem::fit(u, y, &Default::default())?, OperatorModel::Duhem),
-        Family::Dahl => boxed(dahl::fit(u, y, &Default::default())?, OperatorModel::Dahl),
+        Family::Duhem => boxed(
+            duhem::fit(
+                u,
+                y,
+                &duhem::DuhemOptions {
+                    observer: options.observer.clone(),
+                    ..Default::default()
+                },
+            )?,
+            OperatorModel::Duhem,
+        ),
+        Family::Dahl => boxed(
+            dahl::fit(
+                u,
+                y,
+                &dahl::DahlOptions {
+                    observer: options.observer.clone(),
+                    ..Default::default()
+                },
+            )?,
+            OperatorModel::Dahl,
+        ),
         Family::Ch4 => coleman_hodgdon(ChForm::Saturated4, u, y)?,
         Family::Ch6 => coleman_hodgdon(ChForm::General6, u, y)?,
     };

@@ -25,6 +25,7 @@ use crate::model::operators::{
     Anhysteretic, HysteresisOperator, JaOutput, JilesAtherton, LoopOrientation,
 };
 use crate::numerics::levenberg_marquardt::LmConfig;
+use crate::numerics::Observer;
 use crate::Result;
 use std::time::Instant;
 
@@ -37,6 +38,8 @@ pub struct JilesAthertonOptions {
     pub output: JaOutput,
     /// Levenberg–Marquardt settings.
     pub config: LmConfig,
+    /// Sees the search's starts and iterations and may stop it (see [`Search::observer`]).
+    pub observer: Observer,
 }
 
 impl Default for JilesAthertonOptions {
@@ -45,6 +48,7 @@ impl Default for JilesAthertonOptions {
             anhysteretic: Anhysteretic::Langevin,
             output: JaOutput::FluxDensity,
             config: common::default_config(),
+            observer: Observer::none(),
         }
     }
 }
@@ -96,6 +100,7 @@ pub fn fit(
         lower: vec![tiny(s0[0]), tiny(s0[1]), tiny(s0[2]), 0.0, 0.0, -inf],
         upper: vec![inf, inf, inf, 1.0 - 1e-9, inf, inf],
         config: options.config.clone(),
+        observer: options.observer.clone(),
     };
     let simulate = |theta: &[f64]| model_of(theta, structure)?.simulate(u);
     let problem = Simulated {
