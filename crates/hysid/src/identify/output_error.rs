@@ -38,6 +38,41 @@ use gram::Accumulator;
 /// `(t, ŷ(t) [n_y], ∂ŷ(t)/∂θ_free [n_y × n_free, row-major])`.
 pub type SensitivitySink<'a> = dyn FnMut(usize, &[f64], &[f64]) + 'a;
 
+/// Consecutive samples of a single-output model's simulation with its sensitivities, column
+/// by column: the same rows a [`SensitivitySink`] would see one at a time, handed over in
+/// blocks so that the receiver works on contiguous columns (a vectorised copy into the
+/// Gram block) instead of a call per sample.
+pub struct SensitivityBlock<'a> {
+    /// Sample index of the block's first row.
+    pub start: usize,
+    /// ŷ(t) for t = start … start + len − 1.
+    pub yhat: &'a [f64],
+    /// ∂ŷ(t)/∂θ_free\[k\] at `columns[k · stride + t − start]`.
+    pub columns: &'a [f64],
+    /// Distance between consecutive columns in `columns` (≥ the number of rows).
+    pub stride: usize,
+}
+
+impl SensitivityBlock<'_> {
+    /// Number of rows (samples) in the block.
+    pub fn len(&self) -> usize {
+        self.yhat.len()
+    }
+
+    /// True when the block has no rows.
+    pub fn is_empty(&self) -> bool {
+        self.yhat.is_empty()
+    }
+
+    /// The sensitivities to free parameter `k` over the block's rows.
+    pub fn column(&self, k: usize) -> &[f64] {
+        &self.columns[k * self.stride..k * self.stride + self.len()]
+    }
+}
+
+/// Receives the blocks of [`OutputErrorModel::simulate_sensitivity_blocks`] in sample order.
+pub type BlockSink<'a> = dyn FnMut(&SensitivityBlock<'_>) + 'a;
+
 /// A model structure that an output-error estimator can fit.
 pub trait OutputErrorModel: Sync {
     /// The parameters (names, units, bounds, fixed flags, default values).
@@ -60,6 +95,21 @@ pub trait OutputErrorModel: Sync {
         _exp: usize,
         _free: &[usize],
         _sink: &mut SensitivitySink<'_>,
+    ) -> Option<Result<()>> {
+        None
+    }
+
+    /// Optionally the same pass as [`simulate_sensitivities`](Self::simulate_sensitivities)
+    /// for a single-output model, streamed in blocks of consecutive samples (see
+    /// [`SensitivityBlock`]); the rows must be the same, bit for bit. `None` (the default)
+    /// makes the estimator use the per-sample stream.
+    fn simulate_sensitivity_blocks(
+        &self,
+        _theta: &[f64],
+        _data: &IdData,
+        _exp: usize,
+        _free: &[usize],
+        _sink: &mut BlockSink<'_>,
     ) -> Option<Result<()>> {
         None
     }
@@ -503,6 +553,9 @@ impl<'a> OutputErrorProblem<'a> {
         e: usize,
         mut residuals: Option<&mut [f64]>,
     ) -> Option<Result<NormalEquations>> {
+        if let Some(system) = self.experiment_blocks(theta, free, e, residuals.as_deref_mut()) {
+            return Some(system);
+        }
         let p = free.len();
         let exp = self.data.experiment(e);
         let rows = exp.len() - self.skip;
@@ -524,6 +577,45 @@ impl<'a> OutputErrorProblem<'a> {
         let outcome = self
             .model
             .simulate_sensitivities(theta, self.data, e, free, &mut sink)?;
+        Some(outcome.map(|()| acc.finish()))
+    }
+
+    /// [`experiment_normal_equations`](Self::experiment_normal_equations) from the model's
+    /// block stream, when it has one (single-output models only). The rows, residuals and
+    /// their order are those of the per-sample stream, so the result is bit-identical.
+    fn experiment_blocks(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+        e: usize,
+        mut residuals: Option<&mut [f64]>,
+    ) -> Option<Result<NormalEquations>> {
+        let [w] = self.weights[..] else {
+            return None;
+        };
+        let y = self.data.experiment(e).output(0);
+        let skip = self.skip;
+        let mut acc = Accumulator::new(free.len());
+        let mut r = Vec::new();
+        let mut sink = |block: &SensitivityBlock<'_>| {
+            // Rows before `skip` are left out of the criterion.
+            let first = skip.saturating_sub(block.start).min(block.len());
+            let t0 = block.start + first;
+            r.clear();
+            r.extend(
+                y[t0..block.start + block.len()]
+                    .iter()
+                    .zip(&block.yhat[first..])
+                    .map(|(y, yhat)| w * (y - yhat)),
+            );
+            if let Some(out) = residuals.as_deref_mut() {
+                out[t0 - skip..t0 - skip + r.len()].copy_from_slice(&r);
+            }
+            acc.add_rows(-w, block.columns, block.stride, first, &r);
+        };
+        let outcome = self
+            .model
+            .simulate_sensitivity_blocks(theta, self.data, e, free, &mut sink)?;
         Some(outcome.map(|()| acc.finish()))
     }
 }
