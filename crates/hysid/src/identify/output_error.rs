@@ -224,6 +224,8 @@ impl OutputError {
         let free = params.free_indices();
         if model.speculative_sensitivities() {
             problem.speculate(&free);
+        } else {
+            problem.overlap(&free);
         }
         if problem.n_residuals() <= free.len() {
             return Err(Error::TooFewSamples {
@@ -315,6 +317,25 @@ pub struct OutputErrorProblem<'a> {
     /// simulating a long record once more.
     last: Mutex<Option<(Vec<f64>, Simulations)>>,
     speculation: Option<Speculation>,
+    overlap: Option<Overlap>,
+}
+
+/// Records at least this long (residuals) get their trial points' normal equations computed
+/// side by side with the trial simulation (see [`Overlap`]).
+const OVERLAP_RESIDUALS: usize = 1 << 16;
+
+/// Normal equations computed alongside every trial point's plain simulation, on the core the
+/// simulation leaves idle ([`rayon::join`]), and kept for the engine's request that follows
+/// when the point is accepted.
+///
+/// Unlike [`Speculation`], the residuals still come from the plain simulation and the normal
+/// equations from the model's own pass, so every number is the one the sequential engine
+/// computes; only the order in time changes. A rejected trial point wastes its normal
+/// equations (CPU time on the idle core), which is rare from the good starts of long-record
+/// fits. The engine's evaluation counts are those of its requests, as without the overlap.
+struct Overlap {
+    free: Vec<usize>,
+    cache: Mutex<Option<(Vec<f64>, NormalEquations)>>,
 }
 
 /// Speculative sensitivities: every trial point is simulated *with* its sensitivities, and the
@@ -382,6 +403,7 @@ impl<'a> OutputErrorProblem<'a> {
             data_scale,
             last: Mutex::new(None),
             speculation: None,
+            overlap: None,
         })
     }
 
@@ -404,6 +426,20 @@ impl<'a> OutputErrorProblem<'a> {
             without: 0.into(),
             disabled: false.into(),
         });
+    }
+
+    /// Turns on the overlap of trial simulations and normal equations for the parameters
+    /// `free` (see [`Overlap`]) when the record is long, the search runs alone (not inside a
+    /// parallel multi-start) and the experiments leave a core idle.
+    pub fn overlap(&mut self, free: &[usize]) {
+        let alone = rayon::current_thread_index().is_none();
+        let idle_cores = rayon::current_num_threads() > self.data.n_experiments();
+        if alone && idle_cores && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty() {
+            self.overlap = Some(Overlap {
+                free: free.to_vec(),
+                cache: Mutex::new(None),
+            });
+        }
     }
 
     /// Replaces the engine's request counts by the simulations actually run, when trial
@@ -650,6 +686,46 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         if let Some(spec) = &self.speculation {
             spec.without.fetch_add(1, Relaxed);
         }
+        if let Some(overlap) = &self.overlap {
+            let (plain, system) = rayon::join(
+                || self.plain_residuals(theta, r),
+                || self.direct_normal_equations(theta, &overlap.free),
+            );
+            // A failed pass is left for the engine's own request to meet again.
+            if let Some(Ok(system)) = system {
+                *overlap.cache.lock().unwrap_or_else(|p| p.into_inner()) =
+                    Some((theta.to_vec(), system));
+            }
+            return plain;
+        }
+        self.plain_residuals(theta, r)
+    }
+
+    fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
+        if let Some(overlap) = &self.overlap {
+            let kept = overlap
+                .cache
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .take();
+            if let Some((at, system)) = kept {
+                if at == theta && overlap.free == free {
+                    return Some(Ok(system));
+                }
+            }
+        }
+        self.speculative_or_direct_normal_equations(theta, free)
+    }
+
+    fn cost_floor(&self) -> f64 {
+        // Residuals at the 1e-13 relative level are round-off: the fit is exact.
+        1e-26 * self.data_scale
+    }
+}
+
+impl OutputErrorProblem<'_> {
+    /// The residuals from a plain simulation (kept as the last simulation).
+    fn plain_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
         let sims = self.simulate_all(theta)?;
         let mut k = 0;
         for (e, sim) in sims.iter().enumerate() {
@@ -666,7 +742,13 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         Ok(())
     }
 
-    fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
+    /// The normal equations from the speculative cache or pass when speculating, else
+    /// [`direct_normal_equations`](Self::direct_normal_equations).
+    fn speculative_or_direct_normal_equations(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+    ) -> Option<Result<NormalEquations>> {
         if let Some(spec) = &self.speculation {
             let mut cache = spec.cache.lock().unwrap_or_else(|p| p.into_inner());
             if let Some((at, system)) = cache.take() {
@@ -685,16 +767,20 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
                 }
             }
         }
+        self.direct_normal_equations(theta, free)
+    }
+
+    /// The normal equations of every experiment's sensitivity pass, summed.
+    fn direct_normal_equations(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+    ) -> Option<Result<NormalEquations>> {
         let parts: Vec<Option<Result<NormalEquations>>> = (0..self.data.n_experiments())
             .into_par_iter()
             .map(|e| self.experiment_normal_equations(theta, free, e, None))
             .collect();
         sum_normal_equations(parts)
-    }
-
-    fn cost_floor(&self) -> f64 {
-        // Residuals at the 1e-13 relative level are round-off: the fit is exact.
-        1e-26 * self.data_scale
     }
 }
 
