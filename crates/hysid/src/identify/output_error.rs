@@ -429,7 +429,7 @@ impl<'a> OutputErrorProblem<'a> {
     }
 
     /// Turns on the overlap of trial simulations and normal equations for the parameters
-    /// `free` (see [`Overlap`]) when the record is long, the search runs alone (not inside a
+    /// `free` (see `Overlap`) when the record is long, the search runs alone (not inside a
     /// parallel multi-start) and the experiments leave a core idle.
     pub fn overlap(&mut self, free: &[usize]) {
         let alone = rayon::current_thread_index().is_none();
