@@ -280,7 +280,10 @@ impl CascadeIdentification {
         let grid = self.grid.search(x, y)?;
         self.observer.report("grid", 1, 1);
         let long = data.n_samples() > window.n_samples();
-        let (key_term, candidates, switched) = if long {
+        // Not inside a rayon job (a bootstrap replicate): a worker blocked on the iteration's
+        // thread, which itself waits for the pool, could leave the pool without workers.
+        let alone = rayon::current_thread_index().is_none();
+        let (key_term, candidates, switched) = if long && alone {
             self.search_and_fit_overlapped(data, &window, &grid, callback)?
         } else {
             self.search_then_fit(data, &window, &grid, callback)?
@@ -336,8 +339,8 @@ impl CascadeIdentification {
         Ok((key_term, candidates, switched))
     }
 
-    /// Stages 2–4 of a long record, the same fits with the same outcome as
-    /// [`search_then_fit`](Self::search_then_fit), overlapped: the paper's iteration (one
+    /// Stages 2–4 of a long record outside the rayon pool, the same fits with the same
+    /// outcome as [`search_then_fit`](Self::search_then_fit), overlapped: the paper's iteration (one
     /// core for its whole length) and the refinement of its result run on a thread of their
     /// own while this thread refines the grid candidates and starts the final fit from the
     /// best of them. The iteration's candidate wins only when its cost is strictly lower
