@@ -21,11 +21,13 @@
 //! u = [Σⱼ bⱼ s(t−k−j+1), v(t−k−j+1) for b_j, −ŷ(t−i) for aᵢ].
 
 use super::bootstrap::{parametric_bootstrap, Bootstrap};
-use super::cascade_pass::{simulate_into, stream_sensitivities};
+use super::cascade_pass::{simulate_into, stream_sensitivities, stream_sensitivity_blocks};
 use super::global::{GlobalSearch, GridCandidate};
 use super::hysteresis::{alpha_max, bounded_parameter, check_excitation, check_finite, rate_error};
 use super::key_term::{KeyTermFit, KeyTermSeparation};
-use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel, SensitivitySink};
+use super::output_error::{
+    BlockSink, OutputError, OutputErrorFit, OutputErrorModel, SensitivitySink,
+};
 use super::switching::{
     fit_with_switching_updates, place_threshold, true_cost, SwitchedFit, Switching,
     ThresholdPosterior,
@@ -112,6 +114,28 @@ impl OutputErrorModel for CascadeStructure {
         };
         let h = self.switching.as_ref().map(|s| s[exp].as_slice());
         Some(stream_sensitivities(
+            &cascade,
+            data.experiment(exp).input(0),
+            h,
+            free,
+            sink,
+        ))
+    }
+
+    fn simulate_sensitivity_blocks(
+        &self,
+        theta: &[f64],
+        data: &IdData,
+        exp: usize,
+        free: &[usize],
+        sink: &mut BlockSink<'_>,
+    ) -> Option<Result<()>> {
+        let cascade = match self.cascade(theta) {
+            Ok(c) => c,
+            Err(e) => return Some(Err(e)),
+        };
+        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
+        Some(stream_sensitivity_blocks(
             &cascade,
             data.experiment(exp).input(0),
             h,
@@ -255,36 +279,15 @@ impl CascadeIdentification {
         );
         let grid = self.grid.search(x, y)?;
         self.observer.report("grid", 1, 1);
-        // The paper's iteration and the grid candidates' refinement are independent: run them
-        // side by side, then refine the iteration's result (candidates keep their order).
-        let (key_term, mut candidates) = rayon::join(
-            || self.run_key_term(&window, &grid),
-            || self.refine_candidates(&window, &grid, None),
-        );
-        let key_term = key_term?;
-        candidates.extend(self.refine_candidates(&window, &[], key_term.as_ref()));
-        let best = candidates
-            .iter()
-            .min_by(|a, b| a.cost.total_cmp(&b.cost))
-            .ok_or_else(|| {
-                Error::Singular(
-                    "no starting candidate could be refined; the data do not fit a cascade".into(),
-                )
-            })?;
-        // A long record gets its interval scan on the window; the full-data fit then only
-        // re-estimates the switching (its intervals are too narrow to matter one by one).
         let long = data.n_samples() > window.n_samples();
-        let start = if long {
-            self.fit(&window, &best.refined, self.scan, &mut |_| {
-                Control::Continue
-            })?
-            .fit
-            .parameters
-            .values()
+        // Not inside a rayon job (a bootstrap replicate): a worker blocked on the iteration's
+        // thread, which itself waits for the pool, could leave the pool without workers.
+        let alone = rayon::current_thread_index().is_none();
+        let (key_term, candidates, switched) = if long && alone {
+            self.search_and_fit_overlapped(data, &window, &grid, callback)?
         } else {
-            best.refined.clone()
+            self.search_then_fit(data, &window, &grid, callback)?
         };
-        let switched = self.fit(data, &start, if long { 0 } else { self.scan }, callback)?;
         let d_index = self.structure.form.n_params() - 1;
         let (output_error, threshold) = place_threshold(&self.make(), data, switched.fit, d_index)?;
         let model = self.structure.cascade(&output_error.parameters.values())?;
@@ -313,6 +316,90 @@ impl CascadeIdentification {
             candidates,
             elapsed_s: clock.elapsed().as_secs_f64(),
         })
+    }
+
+    /// Stages 2–4 one after the other: the paper's iteration beside the grid candidates'
+    /// refinement (independent, so side by side), the iteration's result refined, the best
+    /// candidate's final fit.
+    fn search_then_fit(
+        &self,
+        data: &IdData,
+        window: &IdData,
+        grid: &[GridCandidate],
+        callback: &mut dyn FnMut(&IterationRecord) -> Control,
+    ) -> Result<(Option<KeyTermFit>, Vec<CandidateOutcome>, SwitchedFit)> {
+        let (key_term, mut candidates) = rayon::join(
+            || self.run_key_term(window, grid),
+            || self.refine_candidates(window, grid, None),
+        );
+        let key_term = key_term?;
+        candidates.extend(self.refine_candidates(window, &[], key_term.as_ref()));
+        let best = best_candidate(&candidates)?;
+        let switched = self.final_fit(data, window, &candidates[best].refined, callback)?;
+        Ok((key_term, candidates, switched))
+    }
+
+    /// Stages 2–4 of a long record outside the rayon pool, the same fits with the same
+    /// outcome as [`search_then_fit`](Self::search_then_fit), overlapped: the paper's iteration (one
+    /// core for its whole length) and the refinement of its result run on a thread of their
+    /// own while this thread refines the grid candidates and starts the final fit from the
+    /// best of them. The iteration's candidate wins only when its cost is strictly lower
+    /// (the first of equal minima is kept, and it comes last); only then is the early final
+    /// fit dropped and the fit made again from it. The early fit reports its iterations to
+    /// `callback` either way.
+    fn search_and_fit_overlapped(
+        &self,
+        data: &IdData,
+        window: &IdData,
+        grid: &[GridCandidate],
+        callback: &mut dyn FnMut(&IterationRecord) -> Control,
+    ) -> Result<(Option<KeyTermFit>, Vec<CandidateOutcome>, SwitchedFit)> {
+        let (iteration, mut candidates, early) = std::thread::scope(|scope| {
+            let iteration = scope.spawn(|| -> Result<_> {
+                let key_term = self.run_key_term(window, grid)?;
+                let refined = self.refine_candidates(window, &[], key_term.as_ref());
+                Ok((key_term, refined))
+            });
+            let candidates = self.refine_candidates(window, grid, None);
+            let early = best_candidate(&candidates).ok().map(|best| {
+                let fit = self.final_fit(data, window, &candidates[best].refined, callback);
+                (best, fit)
+            });
+            let iteration = iteration
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            (iteration, candidates, early)
+        });
+        let (key_term, refined) = iteration?;
+        candidates.extend(refined);
+        let best = best_candidate(&candidates)?;
+        let switched = match early {
+            Some((early_best, fit)) if early_best == best => fit?,
+            _ => self.final_fit(data, window, &candidates[best].refined, callback)?,
+        };
+        Ok((key_term, candidates, switched))
+    }
+
+    /// Stage 4 from `start`: a long record gets its interval scan on the window; the
+    /// full-data fit then only re-estimates the switching (its intervals are too narrow to
+    /// matter one by one).
+    fn final_fit(
+        &self,
+        data: &IdData,
+        window: &IdData,
+        start: &[f64],
+        callback: &mut dyn FnMut(&IterationRecord) -> Control,
+    ) -> Result<SwitchedFit> {
+        let long = data.n_samples() > window.n_samples();
+        let start = if long {
+            self.fit(window, start, self.scan, &mut |_| Control::Continue)?
+                .fit
+                .parameters
+                .values()
+        } else {
+            start.to_vec()
+        };
+        self.fit(data, &start, if long { 0 } else { self.scan }, callback)
     }
 
     fn validate(&self, data: &IdData) -> Result<()> {
@@ -536,11 +623,139 @@ impl CascadeIdentification {
     }
 }
 
+/// Index of the candidate with the lowest windowed cost (the first of equal ones).
+fn best_candidate(candidates: &[CandidateOutcome]) -> Result<usize> {
+    candidates
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.cost.total_cmp(&b.1.cost))
+        .map(|(i, _)| i)
+        .ok_or_else(|| {
+            Error::Singular(
+                "no starting candidate could be refined; the data do not fit a cascade".into(),
+            )
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::experiments::voros::CascadeExample;
     use crate::identify::switching::classify;
+
+    /// The overlapped stages of a long record make the same fits as the sequential ones:
+    /// the same candidates and the same final estimate, bit for bit.
+    #[test]
+    fn overlapped_stages_equal_sequential_stages() {
+        let ex = CascadeExample::example1();
+        let data = ex.generate(6, true).unwrap().id_data().unwrap();
+        let lin = &ex.truth.linear;
+        let mut id =
+            CascadeIdentification::new(ex.truth.hysteresis.form(), lin.na(), lin.nb(), lin.delay());
+        id.window = 3_000;
+        let window = id.window_data(&data).unwrap();
+        assert!(data.n_samples() > window.n_samples());
+        let (x, y) = (
+            window.experiment(0).input(0),
+            window.experiment(0).output(0),
+        );
+        let grid = id.grid.search(x, y).unwrap();
+        let mut seen = (0, 0);
+        let (kt_a, cand_a, fit_a) = id
+            .search_then_fit(&data, &window, &grid, &mut |_| {
+                seen.0 += 1;
+                Control::Continue
+            })
+            .unwrap();
+        let (kt_b, cand_b, fit_b) = id
+            .search_and_fit_overlapped(&data, &window, &grid, &mut |_| {
+                seen.1 += 1;
+                Control::Continue
+            })
+            .unwrap();
+        assert_eq!(kt_a.map(|k| k.history), kt_b.map(|k| k.history));
+        let costs = |c: &[CandidateOutcome]| {
+            c.iter()
+                .map(|c| (c.cost, c.refined.clone()))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(costs(&cand_a), costs(&cand_b));
+        assert_eq!(fit_a.fit.parameters.values(), fit_b.fit.parameters.values());
+        assert_eq!(fit_a.fit.report.cost, fit_b.fit.report.cost);
+        assert_eq!(fit_a.fits, fit_b.fits);
+        assert!(seen.0 > 0 && seen.1 >= seen.0, "{seen:?}");
+    }
+
+    /// The cascade with only the per-sample sensitivity stream (the estimator's fallback).
+    struct RowsOnly(CascadeStructure);
+
+    impl OutputErrorModel for RowsOnly {
+        fn parameters(&self) -> ParameterSet {
+            self.0.parameters()
+        }
+        fn n_outputs(&self) -> usize {
+            1
+        }
+        fn simulate(
+            &self,
+            theta: &[f64],
+            data: &IdData,
+            exp: usize,
+            y: &mut [Vec<f64>],
+        ) -> Result<()> {
+            self.0.simulate(theta, data, exp, y)
+        }
+        fn simulate_sensitivities(
+            &self,
+            theta: &[f64],
+            data: &IdData,
+            exp: usize,
+            free: &[usize],
+            sink: &mut SensitivitySink<'_>,
+        ) -> Option<Result<()>> {
+            self.0.simulate_sensitivities(theta, data, exp, free, sink)
+        }
+    }
+
+    /// The normal equations from the block stream equal those from the per-sample stream bit
+    /// for bit, on a short record and on one long enough to be pipelined, with leading samples
+    /// left out of the criterion.
+    #[test]
+    fn block_normal_equations_equal_row_normal_equations() {
+        use crate::identify::output_error::OutputErrorProblem;
+        use crate::numerics::levenberg_marquardt::LeastSquaresProblem;
+        let ex = CascadeExample::example1();
+        for len in [3_001, (1 << 16) + 1_234] {
+            let data = ex
+                .clone()
+                .extended(len)
+                .generate(4, true)
+                .unwrap()
+                .id_data()
+                .unwrap();
+            let lin = &ex.truth.linear;
+            let structure = CascadeStructure {
+                form: ex.truth.hysteresis.form(),
+                na: lin.na(),
+                nb: lin.nb(),
+                delay: lin.delay(),
+                switching: None,
+            };
+            let theta: Vec<f64> = ex.truth.params().iter().map(|v| v * 1.01).collect();
+            let free = [0, 1, 3, 4, 6];
+            for skip in [0, 9] {
+                let rows_only = RowsOnly(structure.clone());
+                let by_rows = OutputErrorProblem::new(&rows_only, &data, vec![1.0], skip).unwrap();
+                let by_blocks =
+                    OutputErrorProblem::new(&structure, &data, vec![1.0], skip).unwrap();
+                let a = by_rows.normal_equations(&theta, &free).unwrap().unwrap();
+                let b = by_blocks.normal_equations(&theta, &free).unwrap().unwrap();
+                assert_eq!(a.jtj, b.jtj, "{len} {skip}");
+                assert_eq!(a.jtr, b.jtr, "{len} {skip}");
+                assert_eq!(a.cost, b.cost, "{len} {skip}");
+            }
+        }
+    }
 
     /// Streamed sensitivities agree with central differences of the simulation (switching
     /// frozen, so the output is smooth in every parameter).

@@ -31,7 +31,7 @@
 //! its internal variables).
 
 use super::hysteresis::hysteresis_sensitivities;
-use super::output_error::SensitivitySink;
+use super::output_error::{BlockSink, SensitivityBlock, SensitivitySink};
 use crate::model::HysteresisCascade;
 use crate::{Error, Result};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
@@ -44,6 +44,10 @@ const PIPELINE_SAMPLES: usize = 1 << 16;
 
 /// Rows handed from the recursion thread to the sink per block.
 const BLOCK_ROWS: usize = 4096;
+
+/// Rows per block when the recursion and the sink share a thread (the block stays in the
+/// first-level caches).
+const SEQUENTIAL_ROWS: usize = 512;
 
 /// Recent rows of a signal and its derivatives, in a ring of power-of-two length.
 struct Ring {
@@ -121,7 +125,8 @@ fn simulate_generic(cascade: &HysteresisCascade, x: &[f64], h: Option<&[bool]>, 
 }
 
 /// Simulates the cascade with its output sensitivities to the parameters `free` (see the
-/// module docs) and streams them into `sink`, pipelined over two threads on long records.
+/// module docs) and streams them into `sink` sample by sample (the rows of
+/// [`stream_sensitivity_blocks`], one at a time).
 /// Fails with [`Error::Diverged`] at the first sample whose simulated output is not finite.
 pub fn stream_sensitivities(
     cascade: &HysteresisCascade,
@@ -130,10 +135,42 @@ pub fn stream_sensitivities(
     free: &[usize],
     sink: &mut SensitivitySink<'_>,
 ) -> Result<()> {
+    let mut row = vec![0.0; free.len()];
+    stream_sensitivity_blocks(cascade, x, h, free, &mut |block| {
+        for (i, yhat) in block.yhat.iter().enumerate() {
+            for (k, r) in row.iter_mut().enumerate() {
+                *r = block.columns[k * block.stride + i];
+            }
+            sink(block.start + i, std::slice::from_ref(yhat), &row);
+        }
+    })
+}
+
+/// Simulates the cascade with its output sensitivities to the parameters `free` and streams
+/// them into `sink` in blocks of consecutive samples, pipelined over two threads on long
+/// records. Fails with [`Error::Diverged`] at the first sample whose simulated output is not
+/// finite.
+pub fn stream_sensitivity_blocks(
+    cascade: &HysteresisCascade,
+    x: &[f64],
+    h: Option<&[bool]>,
+    free: &[usize],
+    sink: &mut BlockSink<'_>,
+) -> Result<()> {
     let failed = if x.len() >= PIPELINE_SAMPLES && rayon::current_num_threads() >= 2 {
         pipelined(cascade, x, h, free, sink)
     } else {
-        recursion(cascade, x, h, free, |t, yhat, row| sink(t, &[yhat], row))
+        let mut block = Block::new(free.len(), SEQUENTIAL_ROWS);
+        let failed = recursion(cascade, x, h, free, |t, yhat, row| {
+            if block.push(t, yhat, row) {
+                sink(&block.view());
+                block.len = 0;
+            }
+        });
+        if block.len > 0 {
+            sink(&block.view());
+        }
+        failed
     };
     match failed {
         None => Ok(()),
@@ -144,32 +181,77 @@ pub fn stream_sensitivities(
     }
 }
 
-/// The recursion on a second thread, its rows `[ŷ, ∂ŷ/∂θ_free]` handed over in blocks; the
-/// sink runs on the calling thread. Three buffers circulate, so neither side allocates.
+/// Rows `[ŷ, ∂ŷ/∂θ_free]` of consecutive samples gathered column by column, the storage
+/// behind a [`SensitivityBlock`]: the receiver then copies whole columns instead of one
+/// short row per sample.
+struct Block {
+    start: usize,
+    len: usize,
+    capacity: usize,
+    yhat: Vec<f64>,
+    columns: Vec<f64>,
+}
+
+impl Block {
+    /// An empty block of `capacity` rows of `width` sensitivities.
+    fn new(width: usize, capacity: usize) -> Self {
+        Self {
+            start: 0,
+            len: 0,
+            capacity,
+            yhat: vec![0.0; capacity],
+            columns: vec![0.0; capacity * width],
+        }
+    }
+
+    /// Appends the row of sample `t`; true when the block is then full.
+    #[inline]
+    fn push(&mut self, t: usize, yhat: f64, row: &[f64]) -> bool {
+        if self.len == 0 {
+            self.start = t;
+        }
+        self.yhat[self.len] = yhat;
+        for (k, &v) in row.iter().enumerate() {
+            self.columns[k * self.capacity + self.len] = v;
+        }
+        self.len += 1;
+        self.len == self.capacity
+    }
+
+    fn view(&self) -> SensitivityBlock<'_> {
+        SensitivityBlock {
+            start: self.start,
+            yhat: &self.yhat[..self.len],
+            columns: &self.columns,
+            stride: self.capacity,
+        }
+    }
+}
+
+/// The recursion on a second thread, its rows handed over in blocks; the sink runs on the
+/// calling thread. Three blocks circulate, so neither side allocates.
 fn pipelined(
     cascade: &HysteresisCascade,
     x: &[f64],
     h: Option<&[bool]>,
     free: &[usize],
-    sink: &mut SensitivitySink<'_>,
+    sink: &mut BlockSink<'_>,
 ) -> Option<usize> {
-    let width = 1 + free.len();
-    let (full_tx, full_rx) = sync_channel::<Vec<f64>>(2);
-    let (empty_tx, empty_rx) = sync_channel::<Vec<f64>>(3);
+    let width = free.len();
+    let (full_tx, full_rx) = sync_channel::<Block>(2);
+    let (empty_tx, empty_rx) = sync_channel::<Block>(3);
     std::thread::scope(|scope| {
         let producer = scope.spawn(move || {
-            let fresh = || Vec::with_capacity(BLOCK_ROWS * width);
+            let fresh = || Block::new(width, BLOCK_ROWS);
             let mut block = empty_rx.recv().unwrap_or_else(|_| fresh());
-            let failed = recursion(cascade, x, h, free, |_, yhat, row| {
-                block.push(yhat);
-                block.extend_from_slice(row);
-                if block.len() == BLOCK_ROWS * width {
+            let failed = recursion(cascade, x, h, free, |t, yhat, row| {
+                if block.push(t, yhat, row) {
                     let next = empty_rx.recv().unwrap_or_else(|_| fresh());
                     // A send fails only when the consumer is gone; the rows are then unwanted.
                     let _ = full_tx.send(std::mem::replace(&mut block, next));
                 }
             });
-            if !block.is_empty() {
+            if block.len > 0 {
                 let _ = full_tx.send(block);
             }
             failed
@@ -185,22 +267,18 @@ fn pipelined(
 /// The sink's side of [`pipelined`]. It owns its ends of both channels, so leaving (by a
 /// panic of the sink too) drops them and releases a recursion blocked on either.
 fn consume(
-    full: Receiver<Vec<f64>>,
-    empty: SyncSender<Vec<f64>>,
+    full: Receiver<Block>,
+    empty: SyncSender<Block>,
     width: usize,
-    sink: &mut SensitivitySink<'_>,
+    sink: &mut BlockSink<'_>,
 ) {
     for _ in 0..3 {
         // Cannot block: the channel has room for all three.
-        let _ = empty.send(Vec::with_capacity(BLOCK_ROWS * width));
+        let _ = empty.send(Block::new(width, BLOCK_ROWS));
     }
-    let mut t = 0;
     for mut block in full {
-        for r in block.chunks_exact(width) {
-            sink(t, &r[..1], &r[1..]);
-            t += 1;
-        }
-        block.clear();
+        sink(&block.view());
+        block.len = 0;
         let _ = empty.send(block);
     }
 }
@@ -372,8 +450,11 @@ mod tests {
             sequential.push((t, yhat, row.to_vec()))
         });
         let mut piped = Vec::new();
-        let failed = pipelined(&ex.truth, &x, None, &free, &mut |t, yhat, row| {
-            piped.push((t, yhat[0], row.to_vec()))
+        let failed = pipelined(&ex.truth, &x, None, &free, &mut |block| {
+            for (i, &yhat) in block.yhat.iter().enumerate() {
+                let row: Vec<f64> = (0..free.len()).map(|k| block.column(k)[i]).collect();
+                piped.push((block.start + i, yhat, row));
+            }
         });
         assert_eq!(failed, None);
         assert_eq!(piped.len(), x.len());

@@ -38,6 +38,41 @@ use gram::Accumulator;
 /// `(t, ŷ(t) [n_y], ∂ŷ(t)/∂θ_free [n_y × n_free, row-major])`.
 pub type SensitivitySink<'a> = dyn FnMut(usize, &[f64], &[f64]) + 'a;
 
+/// Consecutive samples of a single-output model's simulation with its sensitivities, column
+/// by column: the same rows a [`SensitivitySink`] would see one at a time, handed over in
+/// blocks so that the receiver works on contiguous columns (a vectorised copy into the
+/// Gram block) instead of a call per sample.
+pub struct SensitivityBlock<'a> {
+    /// Sample index of the block's first row.
+    pub start: usize,
+    /// ŷ(t) for t = start … start + len − 1.
+    pub yhat: &'a [f64],
+    /// ∂ŷ(t)/∂θ_free\[k\] at `columns[k · stride + t − start]`.
+    pub columns: &'a [f64],
+    /// Distance between consecutive columns in `columns` (≥ the number of rows).
+    pub stride: usize,
+}
+
+impl SensitivityBlock<'_> {
+    /// Number of rows (samples) in the block.
+    pub fn len(&self) -> usize {
+        self.yhat.len()
+    }
+
+    /// True when the block has no rows.
+    pub fn is_empty(&self) -> bool {
+        self.yhat.is_empty()
+    }
+
+    /// The sensitivities to free parameter `k` over the block's rows.
+    pub fn column(&self, k: usize) -> &[f64] {
+        &self.columns[k * self.stride..k * self.stride + self.len()]
+    }
+}
+
+/// Receives the blocks of [`OutputErrorModel::simulate_sensitivity_blocks`] in sample order.
+pub type BlockSink<'a> = dyn FnMut(&SensitivityBlock<'_>) + 'a;
+
 /// A model structure that an output-error estimator can fit.
 pub trait OutputErrorModel: Sync {
     /// The parameters (names, units, bounds, fixed flags, default values).
@@ -60,6 +95,21 @@ pub trait OutputErrorModel: Sync {
         _exp: usize,
         _free: &[usize],
         _sink: &mut SensitivitySink<'_>,
+    ) -> Option<Result<()>> {
+        None
+    }
+
+    /// Optionally the same pass as [`simulate_sensitivities`](Self::simulate_sensitivities)
+    /// for a single-output model, streamed in blocks of consecutive samples (see
+    /// [`SensitivityBlock`]); the rows must be the same, bit for bit. `None` (the default)
+    /// makes the estimator use the per-sample stream.
+    fn simulate_sensitivity_blocks(
+        &self,
+        _theta: &[f64],
+        _data: &IdData,
+        _exp: usize,
+        _free: &[usize],
+        _sink: &mut BlockSink<'_>,
     ) -> Option<Result<()>> {
         None
     }
@@ -174,6 +224,8 @@ impl OutputError {
         let free = params.free_indices();
         if model.speculative_sensitivities() {
             problem.speculate(&free);
+        } else {
+            problem.overlap(&free);
         }
         if problem.n_residuals() <= free.len() {
             return Err(Error::TooFewSamples {
@@ -265,6 +317,25 @@ pub struct OutputErrorProblem<'a> {
     /// simulating a long record once more.
     last: Mutex<Option<(Vec<f64>, Simulations)>>,
     speculation: Option<Speculation>,
+    overlap: Option<Overlap>,
+}
+
+/// Records at least this long (residuals) get their trial points' normal equations computed
+/// side by side with the trial simulation (see [`Overlap`]).
+const OVERLAP_RESIDUALS: usize = 1 << 16;
+
+/// Normal equations computed alongside every trial point's plain simulation, on the core the
+/// simulation leaves idle ([`rayon::join`]), and kept for the engine's request that follows
+/// when the point is accepted.
+///
+/// Unlike [`Speculation`], the residuals still come from the plain simulation and the normal
+/// equations from the model's own pass, so every number is the one the sequential engine
+/// computes; only the order in time changes. A rejected trial point wastes its normal
+/// equations (CPU time on the idle core), which is rare from the good starts of long-record
+/// fits. The engine's evaluation counts are those of its requests, as without the overlap.
+struct Overlap {
+    free: Vec<usize>,
+    cache: Mutex<Option<(Vec<f64>, NormalEquations)>>,
 }
 
 /// Speculative sensitivities: every trial point is simulated *with* its sensitivities, and the
@@ -332,6 +403,7 @@ impl<'a> OutputErrorProblem<'a> {
             data_scale,
             last: Mutex::new(None),
             speculation: None,
+            overlap: None,
         })
     }
 
@@ -354,6 +426,20 @@ impl<'a> OutputErrorProblem<'a> {
             without: 0.into(),
             disabled: false.into(),
         });
+    }
+
+    /// Turns on the overlap of trial simulations and normal equations for the parameters
+    /// `free` (see `Overlap`) when the record is long, the search runs alone (not inside a
+    /// parallel multi-start) and the experiments leave a core idle.
+    pub fn overlap(&mut self, free: &[usize]) {
+        let alone = rayon::current_thread_index().is_none();
+        let idle_cores = rayon::current_num_threads() > self.data.n_experiments();
+        if alone && idle_cores && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty() {
+            self.overlap = Some(Overlap {
+                free: free.to_vec(),
+                cache: Mutex::new(None),
+            });
+        }
     }
 
     /// Replaces the engine's request counts by the simulations actually run, when trial
@@ -503,6 +589,9 @@ impl<'a> OutputErrorProblem<'a> {
         e: usize,
         mut residuals: Option<&mut [f64]>,
     ) -> Option<Result<NormalEquations>> {
+        if let Some(system) = self.experiment_blocks(theta, free, e, residuals.as_deref_mut()) {
+            return Some(system);
+        }
         let p = free.len();
         let exp = self.data.experiment(e);
         let rows = exp.len() - self.skip;
@@ -524,6 +613,45 @@ impl<'a> OutputErrorProblem<'a> {
         let outcome = self
             .model
             .simulate_sensitivities(theta, self.data, e, free, &mut sink)?;
+        Some(outcome.map(|()| acc.finish()))
+    }
+
+    /// [`experiment_normal_equations`](Self::experiment_normal_equations) from the model's
+    /// block stream, when it has one (single-output models only). The rows, residuals and
+    /// their order are those of the per-sample stream, so the result is bit-identical.
+    fn experiment_blocks(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+        e: usize,
+        mut residuals: Option<&mut [f64]>,
+    ) -> Option<Result<NormalEquations>> {
+        let [w] = self.weights[..] else {
+            return None;
+        };
+        let y = self.data.experiment(e).output(0);
+        let skip = self.skip;
+        let mut acc = Accumulator::new(free.len());
+        let mut r = Vec::new();
+        let mut sink = |block: &SensitivityBlock<'_>| {
+            // Rows before `skip` are left out of the criterion.
+            let first = skip.saturating_sub(block.start).min(block.len());
+            let t0 = block.start + first;
+            r.clear();
+            r.extend(
+                y[t0..block.start + block.len()]
+                    .iter()
+                    .zip(&block.yhat[first..])
+                    .map(|(y, yhat)| w * (y - yhat)),
+            );
+            if let Some(out) = residuals.as_deref_mut() {
+                out[t0 - skip..t0 - skip + r.len()].copy_from_slice(&r);
+            }
+            acc.add_rows(-w, block.columns, block.stride, first, &r);
+        };
+        let outcome = self
+            .model
+            .simulate_sensitivity_blocks(theta, self.data, e, free, &mut sink)?;
         Some(outcome.map(|()| acc.finish()))
     }
 }
@@ -558,6 +686,46 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         if let Some(spec) = &self.speculation {
             spec.without.fetch_add(1, Relaxed);
         }
+        if let Some(overlap) = &self.overlap {
+            let (plain, system) = rayon::join(
+                || self.plain_residuals(theta, r),
+                || self.direct_normal_equations(theta, &overlap.free),
+            );
+            // A failed pass is left for the engine's own request to meet again.
+            if let Some(Ok(system)) = system {
+                *overlap.cache.lock().unwrap_or_else(|p| p.into_inner()) =
+                    Some((theta.to_vec(), system));
+            }
+            return plain;
+        }
+        self.plain_residuals(theta, r)
+    }
+
+    fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
+        if let Some(overlap) = &self.overlap {
+            let kept = overlap
+                .cache
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .take();
+            if let Some((at, system)) = kept {
+                if at == theta && overlap.free == free {
+                    return Some(Ok(system));
+                }
+            }
+        }
+        self.speculative_or_direct_normal_equations(theta, free)
+    }
+
+    fn cost_floor(&self) -> f64 {
+        // Residuals at the 1e-13 relative level are round-off: the fit is exact.
+        1e-26 * self.data_scale
+    }
+}
+
+impl OutputErrorProblem<'_> {
+    /// The residuals from a plain simulation (kept as the last simulation).
+    fn plain_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
         let sims = self.simulate_all(theta)?;
         let mut k = 0;
         for (e, sim) in sims.iter().enumerate() {
@@ -574,7 +742,13 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         Ok(())
     }
 
-    fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
+    /// The normal equations from the speculative cache or pass when speculating, else
+    /// [`direct_normal_equations`](Self::direct_normal_equations).
+    fn speculative_or_direct_normal_equations(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+    ) -> Option<Result<NormalEquations>> {
         if let Some(spec) = &self.speculation {
             let mut cache = spec.cache.lock().unwrap_or_else(|p| p.into_inner());
             if let Some((at, system)) = cache.take() {
@@ -593,16 +767,20 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
                 }
             }
         }
+        self.direct_normal_equations(theta, free)
+    }
+
+    /// The normal equations of every experiment's sensitivity pass, summed.
+    fn direct_normal_equations(
+        &self,
+        theta: &[f64],
+        free: &[usize],
+    ) -> Option<Result<NormalEquations>> {
         let parts: Vec<Option<Result<NormalEquations>>> = (0..self.data.n_experiments())
             .into_par_iter()
             .map(|e| self.experiment_normal_equations(theta, free, e, None))
             .collect();
         sum_normal_equations(parts)
-    }
-
-    fn cost_floor(&self) -> f64 {
-        // Residuals at the 1e-13 relative level are round-off: the fit is exact.
-        1e-26 * self.data_scale
     }
 }
 

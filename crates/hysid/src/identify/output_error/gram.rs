@@ -60,6 +60,42 @@ impl Accumulator {
         }
     }
 
+    /// Adds the rows `from … from + r.len() − 1` of the column-major rows `columns` (column
+    /// k at `k · stride`), each scaled by `scale`, with residuals `r`: the same rows as that
+    /// many calls of [`add_scaled`](Self::add_scaled), copied a column at a time.
+    pub(super) fn add_rows(
+        &mut self,
+        scale: f64,
+        columns: &[f64],
+        stride: usize,
+        from: usize,
+        r: &[f64],
+    ) {
+        let mut done = 0;
+        while done < r.len() {
+            let take = (BLOCK_ROWS - self.rows).min(r.len() - done);
+            let (at, src) = (self.rows, from + done);
+            for (k, column) in self.block.chunks_exact_mut(BLOCK_ROWS).enumerate() {
+                let source = &columns[k * stride + src..k * stride + src + take];
+                for (d, v) in column[at..at + take].iter_mut().zip(source) {
+                    *d = scale * v;
+                }
+            }
+            for (d, &v) in self.residuals[at..at + take]
+                .iter_mut()
+                .zip(&r[done..done + take])
+            {
+                *d = v;
+                self.cost += v * v;
+            }
+            self.rows += take;
+            done += take;
+            if self.rows == BLOCK_ROWS {
+                self.flush();
+            }
+        }
+    }
+
     /// Adds the block's upper-triangular Gram matrix and its Jᵀr to the totals.
     fn flush(&mut self) {
         let (n, p) = (self.rows, self.p);
@@ -144,6 +180,46 @@ mod tests {
             assert_eq!(got.jtj, jtj, "p = {p}");
             assert_eq!(got.jtr, jtr, "p = {p}");
             assert_eq!(got.cost, cost, "p = {p}");
+        }
+    }
+
+    /// Rows added a column-major block at a time (blocks of uneven lengths, the first rows of
+    /// one left out, a stride longer than the block) give the normal equations of the same
+    /// rows added one by one, bit for bit.
+    #[test]
+    fn block_rows_equal_single_rows() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(29);
+        for p in [1, 4, 7] {
+            let n = 2 * BLOCK_ROWS + 301;
+            let rows: Vec<Vec<f64>> = (0..n)
+                .map(|_| (0..p).map(|_| rng.random_range(-1.0..1.0)).collect())
+                .collect();
+            let res: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let skip = 5;
+            let mut single = Accumulator::new(p);
+            for (row, &r) in rows.iter().zip(&res).skip(skip) {
+                single.add_scaled(-0.5, row, r);
+            }
+            let mut blocks = Accumulator::new(p);
+            let (mut start, mut len) = (0, 7);
+            while start < n {
+                let end = (start + len).min(n);
+                let stride = end - start + 3;
+                let mut columns = vec![f64::NAN; p * stride];
+                for (i, row) in rows[start..end].iter().enumerate() {
+                    for (k, v) in row.iter().enumerate() {
+                        columns[k * stride + i] = *v;
+                    }
+                }
+                let from = skip.saturating_sub(start).min(end - start);
+                blocks.add_rows(-0.5, &columns, stride, from, &res[start + from..end]);
+                start = end;
+                len = len * 3 + 1;
+            }
+            let (a, b) = (single.finish(), blocks.finish());
+            assert_eq!(a.jtj, b.jtj, "p = {p}");
+            assert_eq!(a.jtr, b.jtr, "p = {p}");
+            assert_eq!(a.cost, b.cost, "p = {p}");
         }
     }
 }
