@@ -60,7 +60,7 @@ fn emps() -> PathBuf {
 /// The rig writes eight data sets; identify recovers the noise-free truth (m67 within
 /// 0.1 %) and writes the tables, the figures and the JSON report.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn rig_and_identify_regenerate_the_tables() {
     let dir = TempDir::new().unwrap();
     let data = rig(dir.path(), &["--noise", "0"]);
@@ -299,7 +299,7 @@ fn bad_three_step_settings_are_one_line() {
 }
 
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn rig_and_identify_take_the_actuator_constants() {
     let dir = TempDir::new().unwrap();
     let err = one_line_error(

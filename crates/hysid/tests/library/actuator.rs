@@ -22,7 +22,7 @@ fn relative(a: f64, b: f64) -> f64 {
 /// Without noise and backlash the rig is the model: step 3 (m67) recovers the truth within
 /// 0.1 %; step 2 gives k1, k2 within 5 % and α, A within 15 % (the bars of the issue).
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn noise_free_rig_without_backlash() {
     let rig = Rig {
         angle_noise: 0.0,
@@ -96,7 +96,7 @@ fn unfiltered_step3_recovers_the_noise_free_truth_exactly() {
 /// With the rig's measurement noise, the m67 estimates lie within 3 of their reported
 /// standard deviations of the truth.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn noisy_rig_estimates_lie_within_three_standard_deviations() {
     let rig = Rig::default();
     let id = identify(&rig);
@@ -119,7 +119,7 @@ fn noisy_rig_estimates_lie_within_three_standard_deviations() {
 /// m0 on every data set. The variants with J, Fv, Fc held at their step-1 values (m67f,
 /// m68f) must at least lower the output error on the data they were fitted to.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn backlash_gives_the_papers_pattern() {
     let rig = Rig {
         backlash: 3e-3,

@@ -49,7 +49,7 @@ fn noise_free_examples_are_recovered_from_the_documented_initial_values() {
 /// quiet cores): `#[ignore]`d so that the default test command stays under 3 minutes; CI
 /// runs it with `cargo test --workspace --release -- --ignored`.
 #[test]
-#[ignore = "long coverage test (~1 min): CI runs it with `cargo test --profile quick -- --ignored`"]
+#[ignore = "long coverage test (~1 min): CI runs it with `cargo test --release -- --ignored`"]
 fn noise_free_examples_are_recovered_from_random_rough_starts() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(2015);
     for n in [1, 2] {

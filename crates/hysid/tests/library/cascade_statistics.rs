@@ -8,9 +8,9 @@
 //!   spread of the estimates over the seeds.
 //!
 //! These are the long statistical tests of the suite (some 190 s each on two cores), so
-//! they are `#[ignore]`d by the README's fast command (`cargo test --profile quick --tests`),
+//! they are `#[ignore]`d by the README's fast command (`cargo test --release --tests`),
 //! which must stay under 3 minutes on a fresh clone; CI (`.ci/run`) runs them with
-//! `cargo test --workspace --profile quick -- --ignored`.
+//! `cargo test --workspace --release -- --ignored`.
 
 use hysid::experiments::voros::CascadeExample;
 use hysid::identify::cascade::CascadeIdentification;
@@ -69,13 +69,13 @@ fn check_example(n: u8) {
 }
 
 #[test]
-#[ignore = "long statistical test (~3 min): CI runs it with `cargo test --profile quick -- --ignored`"]
+#[ignore = "long statistical test (~3 min): CI runs it with `cargo test --release -- --ignored`"]
 fn example_1_standard_deviations_describe_the_spread() {
     check_example(1);
 }
 
 #[test]
-#[ignore = "long statistical test (~3 min): CI runs it with `cargo test --profile quick -- --ignored`"]
+#[ignore = "long statistical test (~3 min): CI runs it with `cargo test --release -- --ignored`"]
 fn example_2_standard_deviations_describe_the_spread() {
     check_example(2);
 }

@@ -407,7 +407,7 @@ fn fit_duffing(data: &IdData) -> (Vec<f64>, Vec<f64>) {
 /// output's RMS) at least 90 % of the (seed, parameter) pairs over 5 seeds lie within 3σ of
 /// the truth.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn duffing_parameters_are_recovered() {
     let (clean, _) = fit_duffing(&duffing_record(1, 0.0));
     for (e, t) in clean.iter().zip(DUFFING) {
@@ -435,7 +435,7 @@ fn duffing_parameters_are_recovered() {
 /// black-box 0.34 V, grey-box with overflow 0.18 V). The pump's dead zone u0 (fitted
 /// 0.79 V) and the estimated overflow level are what bring it down from 0.515 V.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn cascaded_tanks_validation_rmse() {
     let est = csv("data/cascaded-tanks/estimation.csv", "u_V", "y_V");
     let val = csv("data/cascaded-tanks/validation.csv", "u_V", "y_V");
@@ -606,7 +606,7 @@ fn discrete_backlash_round_trip() {
 /// benchmark command's settings (nominal start, 8 starts, seed 1, RK4 × 4, band-limited
 /// input), gives the built-in model's parameters to 1e-6.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn bouc_wen_file_fit_equals_the_built_in_fit() {
     let data = csv("data/bouc-wen/train_multisine_5periods.csv", "u_N", "y_m");
     let estimation = GreyBoxEstimation {

@@ -171,7 +171,7 @@ fn sensitivities_match_finite_differences() {
 
 /// Noise-free, the parameters come back to 1e-6 from starts off by a factor 2.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn noise_free_round_trip_from_factor_two_starts() {
     let data = synthetic_record(3, 11);
     let truth = BoucWen.parameters().values();
@@ -210,7 +210,7 @@ fn noise_free_round_trip_from_factor_two_starts() {
 /// With white output noise at the benchmark's level (RMS 8e-6 m), the estimates lie within 3
 /// reported standard deviations of the truth over 10 seeds.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn benchmark_noise_estimates_lie_within_their_standard_deviations() {
     let clean = synthetic_record(3, 12);
     let truth = BoucWen.parameters().values();
@@ -318,7 +318,7 @@ fn training_record_fit_recovers_the_true_parameters() {
 /// lower ones: the stiffness far too high for the mass) a single start converges to a local
 /// minimum; 16 starts drawn inside the bounds find the global fit.
 #[test]
-#[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
 fn multi_start_finds_the_global_fit_where_a_single_start_fails() {
     let data = train_record();
     let mut params = BoucWen.parameters();

@@ -168,7 +168,7 @@ mod tests {
     }
 
     #[test]
-    #[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+    #[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
     fn inverse_follows_a_reachable_reference() {
         for m in [truth(0.4), truth(2.6)] {
             let r = m.simulate(&nested_loops(800, 1.5)).unwrap();

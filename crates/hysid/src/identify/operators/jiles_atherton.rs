@@ -202,14 +202,14 @@ mod tests {
     }
 
     #[test]
-    #[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+    #[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
     fn recovers_both_orientations_without_noise() {
         check_recovery(&truth(LoopOrientation::CounterClockwise));
         check_recovery(&truth(LoopOrientation::Clockwise));
     }
 
     #[test]
-    #[ignore = "long (several seconds): run by `cargo test --profile quick -- --ignored` and CI"]
+    #[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
     fn noisy_estimates_lie_within_three_sigma() {
         let m = truth(LoopOrientation::CounterClockwise);
         let u = nested_loops(800, 60.0);
