@@ -1,22 +1,10 @@
 //! `hysid actuator`, `hysid demo actuator` and `hysid rigid-body ls` end to end, and their
 //! one-line errors.
 
-use crate::common::{hysid, Assert};
+use crate::common::{hysid, one_line_error, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use tempfile::TempDir;
-
-/// Runs `cmd` expecting failure: one line on stderr, no panic; returns it.
-fn one_line_error(cmd: &mut Command) -> String {
-    let out = cmd.assert().failure().get_output().stderr.clone();
-    let err = String::from_utf8(out).unwrap();
-    assert!(
-        !err.contains("panicked") && err.lines().count() == 1 && err.starts_with("error: "),
-        "{err}"
-    );
-    err
-}
 
 fn rig(dir: &Path, extra: &[&str]) -> PathBuf {
     let data = dir.join("rig");

@@ -10,6 +10,29 @@ pub fn hysid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_hysid"))
 }
 
+/// Runs `cmd`, expects a failure exit and exactly one line on stderr, "error: …", without a
+/// panic; returns that line.
+pub fn one_line_error(cmd: &mut Command) -> String {
+    let out = cmd.assert().failure().get_output().stderr.clone();
+    let err = String::from_utf8(out).unwrap();
+    assert!(
+        !err.contains("panicked") && err.lines().count() == 1 && err.starts_with("error: "),
+        "{err}"
+    );
+    err
+}
+
+/// Runs `cmd`, expects exit `code` and exactly one line on stderr, "error: …"; returns that
+/// line.
+pub fn fails_with(cmd: &mut Command, code: i32) -> String {
+    let out = cmd.output().unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(code), "stderr: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "not one line: {stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    stderr
+}
+
 /// Runs a command and keeps its outcome for the checks of [`Outcome`].
 pub trait Assert {
     /// Runs the command to the end, capturing stdout and stderr; panics only if it cannot

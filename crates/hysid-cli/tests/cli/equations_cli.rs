@@ -2,10 +2,9 @@
 //! on the benchmark's estimation record, saved, and re-simulated by `hysid simulate` on the
 //! validation record; and the one-line errors of a bad file or of two models.
 
-use crate::common::{hysid, Assert};
+use crate::common::{hysid, one_line_error, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use tempfile::TempDir;
 
 fn root() -> PathBuf {
@@ -67,17 +66,6 @@ fn equation_file_fit_saves_a_self_contained_model() {
         .success();
     let rmse = json(&sim)["fit"]["rmse"].as_f64().unwrap();
     assert!((rmse - 0.3384).abs() < 0.005, "validation RMSE {rmse} V");
-}
-
-/// Runs `cmd` expecting failure: one line on stderr, no panic; returns it.
-fn one_line_error(cmd: &mut Command) -> String {
-    let out = cmd.assert().failure().get_output().stderr.clone();
-    let err = String::from_utf8(out).unwrap();
-    assert!(
-        !err.contains("panicked") && err.lines().count() == 1 && err.starts_with("error: "),
-        "{err}"
-    );
-    err
 }
 
 #[test]

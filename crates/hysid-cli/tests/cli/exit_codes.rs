@@ -1,20 +1,9 @@
 //! The exit-code table (0 success, 1 bad input, 2 usage, 3 numerical failure, 4 I/O) and
 //! one-line errors, usage errors included; `simulate`'s all-or-nothing outputs.
 
-use crate::common::{hysid, Assert};
+use crate::common::{fails_with, hysid, Assert};
 use std::fs;
 use std::path::Path;
-use std::process::Command;
-
-/// Runs `cmd`, expects exit `code` and exactly one line on stderr; returns that line.
-fn fails_with(cmd: &mut Command, code: i32) -> String {
-    let out = cmd.output().unwrap();
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(out.status.code(), Some(code), "stderr: {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "not one line: {stderr}");
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    stderr
-}
 
 /// Example 1 data, `samples` long, written to `dir/data.csv`.
 fn example_data(dir: &Path, samples: &str) -> std::path::PathBuf {

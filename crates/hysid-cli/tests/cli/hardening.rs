@@ -3,20 +3,9 @@
 //! invalid physics, progress goes to stderr only, and `--time-limit` stops a search with its
 //! best result reported as such.
 
-use crate::common::{hysid, Assert};
+use crate::common::{fails_with, hysid, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-/// Runs `cmd`, expects exit `code` and one line on stderr; returns that line.
-fn fails_with(cmd: &mut Command, code: i32) -> String {
-    let out = cmd.output().unwrap();
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(out.status.code(), Some(code), "stderr: {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "not one line: {stderr}");
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    stderr
-}
 
 /// Names of the files in `dir`.
 fn files_in(dir: &Path) -> Vec<String> {

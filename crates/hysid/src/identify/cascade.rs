@@ -95,8 +95,8 @@ impl OutputErrorModel for CascadeStructure {
 
     fn simulate(&self, theta: &[f64], data: &IdData, exp: usize, y: &mut [Vec<f64>]) -> Result<()> {
         let cascade = self.cascade(theta)?;
-        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
-        simulate_into(&cascade, data.experiment(exp).input(0), h, &mut y[0]);
+        let (x, h) = self.pass_inputs(data, exp);
+        simulate_into(&cascade, x, h, &mut y[0]);
         check_finite(&y[0])
     }
 
@@ -108,18 +108,10 @@ impl OutputErrorModel for CascadeStructure {
         free: &[usize],
         sink: &mut SensitivitySink<'_>,
     ) -> Option<Result<()>> {
-        let cascade = match self.cascade(theta) {
-            Ok(c) => c,
-            Err(e) => return Some(Err(e)),
-        };
-        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
-        Some(stream_sensitivities(
-            &cascade,
-            data.experiment(exp).input(0),
-            h,
-            free,
-            sink,
-        ))
+        Some(self.cascade(theta).and_then(|cascade| {
+            let (x, h) = self.pass_inputs(data, exp);
+            stream_sensitivities(&cascade, x, h, free, sink)
+        }))
     }
 
     fn simulate_sensitivity_blocks(
@@ -130,18 +122,19 @@ impl OutputErrorModel for CascadeStructure {
         free: &[usize],
         sink: &mut BlockSink<'_>,
     ) -> Option<Result<()>> {
-        let cascade = match self.cascade(theta) {
-            Ok(c) => c,
-            Err(e) => return Some(Err(e)),
-        };
+        Some(self.cascade(theta).and_then(|cascade| {
+            let (x, h) = self.pass_inputs(data, exp);
+            stream_sensitivity_blocks(&cascade, x, h, free, sink)
+        }))
+    }
+}
+
+impl CascadeStructure {
+    /// What a pass over experiment `exp` reads besides θ: the input x and, when the
+    /// switching is held, its branch indicator h.
+    fn pass_inputs<'a>(&'a self, data: &'a IdData, exp: usize) -> (&'a [f64], Option<&'a [bool]>) {
         let h = self.switching.as_ref().map(|s| s[exp].as_slice());
-        Some(stream_sensitivity_blocks(
-            &cascade,
-            data.experiment(exp).input(0),
-            h,
-            free,
-            sink,
-        ))
+        (data.experiment(exp).input(0), h)
     }
 }
 
