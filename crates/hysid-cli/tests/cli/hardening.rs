@@ -308,6 +308,44 @@ fn a_time_limit_stops_an_operator_fit_and_a_comparison() {
 }
 
 #[test]
+fn a_time_limit_stops_the_cascade_grid_with_a_result() {
+    // A limit of 1 µs is over before the grid starts: its first point is still scored and
+    // refined, so the run ends with that candidate's fit, marked as stopped.
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data.csv");
+    hysid()
+        .args(["generate", "voros", "--samples", "20000", "--csv"])
+        .arg(&data)
+        .assert()
+        .success();
+    let json = dir.path().join("r.json");
+    let out = hysid()
+        .args(["--quiet", "identify", "cascade", "--data"])
+        .arg(&data)
+        .args(["--input", "x", "--output", "y", "--hysteresis", "ch4"])
+        .args([
+            "--na",
+            "2",
+            "--nb",
+            "2",
+            "--delay",
+            "1",
+            "--time-limit",
+            "1e-6",
+            "--json",
+        ])
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stderr.starts_with("warning: the time limit"), "{stderr}");
+    let report: serde_json::Value = serde_json::from_slice(&fs::read(&json).unwrap()).unwrap();
+    assert_eq!(report["search"]["termination"]["code"], "time_limit");
+    assert!(report["fit"]["fit_percent"].as_f64().unwrap().is_finite());
+}
+
+#[test]
 fn quiet_runs_print_nothing_on_stderr() {
     let dir = tempfile::tempdir().unwrap();
     let data = rigid_body_csv(dir.path(), None);

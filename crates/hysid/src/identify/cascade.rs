@@ -270,7 +270,7 @@ impl CascadeIdentification {
             window.experiment(0).input(0),
             window.experiment(0).output(0),
         );
-        let grid = self.grid.search(x, y)?;
+        let grid = self.grid.search_observed(x, y, &self.observer)?;
         self.observer.report("grid", 1, 1);
         let long = data.n_samples() > window.n_samples();
         // Not inside a rayon job (a bootstrap replicate): a worker blocked on the iteration's
@@ -451,7 +451,8 @@ impl CascadeIdentification {
         };
         let kts = KeyTermSeparation::new(s.form, s.na, s.nb, s.delay)
             .relaxation(self.relaxation)
-            .max_iterations(self.key_term_iterations);
+            .max_iterations(self.key_term_iterations)
+            .observer(self.observer.clone());
         // A singular regression from a poor start is an outcome of the paper's method, not a
         // failure of the identification: the grid candidates still stand.
         Ok(kts.estimate(window, &initial).ok())

@@ -45,6 +45,7 @@ use super::grid_regression::EquationError;
 use crate::model::coleman_hodgdon::switching;
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::numerics::nelder_mead::nelder_mead;
+use crate::numerics::Observer;
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -103,18 +104,44 @@ impl GlobalSearch {
     /// Scores the whole grid on the record (x, y) and returns the best points, best first
     /// (by output-error cost), at most one per d-α neighbourhood.
     pub fn search(&self, x: &[f64], y: &[f64]) -> Result<Vec<GridCandidate>> {
+        self.search_observed(x, y, &Observer::none())
+    }
+
+    /// [`search`](Self::search), asking `observer` before every grid point and every local
+    /// refinement: once it answers [`Control::Stop`](crate::numerics::Control::Stop) the
+    /// remaining points are skipped and the best of those scored are returned (how a time
+    /// limit is honoured). Errors with [`Error::Cancelled`] when it stops the grid before any
+    /// point was scored.
+    pub fn search_observed(
+        &self,
+        x: &[f64],
+        y: &[f64],
+        observer: &Observer,
+    ) -> Result<Vec<GridCandidate>> {
         let grid = self.grid(x)?;
         // Stage A: plain equation error over the whole grid. Its *cost* ranks (α, d) well even
         // with output noise; its linear estimates are what the noise biases.
         let regression = EquationError::new(self.form, self.na, self.nb, self.delay, x, y);
         let mut ranked: Vec<(f64, f64, f64)> = grid
             .par_iter()
+            .enumerate()
             .map_init(
                 || regression.scratch(),
-                |s, &(alpha, d)| Some((alpha, d, regression.cost(alpha, d, s)?)),
+                |s, (i, &(alpha, d))| {
+                    // The first point is scored even then: a stopped search keeps a result.
+                    if i > 0 && observer.should_stop("grid") {
+                        return None;
+                    }
+                    Some((alpha, d, regression.cost(alpha, d, s)?))
+                },
             )
             .flatten()
             .collect();
+        if ranked.is_empty() && observer.should_stop("grid") {
+            return Err(Error::Cancelled(
+                "the time limit was reached before any (alpha, d) grid point was scored; allow more time".into(),
+            ));
+        }
         if ranked.is_empty() {
             return Err(Error::Singular(
                 "no (alpha, d) grid point gives a solvable regression; the input does not excite the cascade".into(),
@@ -126,7 +153,13 @@ impl GlobalSearch {
         // good grid point, then refined instrumental variables there, scored by output error.
         let mut scored: Vec<GridCandidate> = starts
             .par_iter()
-            .filter_map(|&(alpha, d)| {
+            .enumerate()
+            .filter_map(|(i, &(alpha, d))| {
+                // The best-ranked point is refined even then: a stopped search still has
+                // a candidate.
+                if i > 0 && observer.should_stop("grid refinement") {
+                    return None;
+                }
                 let (alpha, d) = self.local_minimum(x, y, alpha, d);
                 self.evaluate(x, y, alpha, d)
             })

@@ -31,7 +31,7 @@
 use crate::data::IdData;
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::numerics::least_squares::least_squares;
-use crate::numerics::Termination;
+use crate::numerics::{Observer, Termination};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 
@@ -52,6 +52,10 @@ pub struct KeyTermSeparation {
     pub tolerance: f64,
     /// Relaxation factor λ in (0, 1]; 1 is the paper's plain iteration.
     pub relaxation: f64,
+    /// Asked before every iteration; its [`Control::Stop`](crate::numerics::Control::Stop)
+    /// ends the iteration with the last estimate (termination `Stopped`), how a time limit is
+    /// honoured.
+    pub observer: Observer,
 }
 
 /// The outcome of the iteration, with its history.
@@ -79,7 +83,14 @@ impl KeyTermSeparation {
             max_iterations: 100,
             tolerance: 1e-10,
             relaxation: 1.0,
+            observer: Observer::none(),
         }
+    }
+
+    /// Sets the observer asked before every iteration.
+    pub fn observer(mut self, observer: Observer) -> Self {
+        self.observer = observer;
+        self
     }
 
     /// Sets the relaxation factor λ.
@@ -111,7 +122,11 @@ impl KeyTermSeparation {
         // The internal variable v̂ of the current hysteresis estimate; each iteration's check
         // of the new estimate simulates the next one.
         let mut v = hysteresis.simulate_unchecked(x, 0.0);
-        for _ in 0..self.max_iterations {
+        for iteration in 0..self.max_iterations {
+            if iteration > 0 && self.observer.should_stop("key-term iteration") {
+                termination = Termination::Stopped;
+                break;
+            }
             let (phi, target) = self.rows(x, y, &v, hysteresis.d());
             let ls = least_squares(&phi, &target, &[])?;
             costs.push(ls.residual_ss);
