@@ -5,6 +5,25 @@
 use std::ffi::OsStr;
 use std::process::{Command, Output};
 
+/// `identify cascade` of Example 1's structure (4-parameter hysteresis, n = m = 2, delay 1)
+/// on columns x → y, without `--data`.
+pub const IDENTIFY_CASCADE: [&str; 14] = [
+    "identify",
+    "cascade",
+    "--input",
+    "x",
+    "--output",
+    "y",
+    "--hysteresis",
+    "ch4",
+    "--na",
+    "2",
+    "--nb",
+    "2",
+    "--delay",
+    "1",
+];
+
 /// A command running the `hysid` binary that Cargo built for these tests.
 pub fn hysid() -> Command {
     Command::new(env!("CARGO_BIN_EXE_hysid"))

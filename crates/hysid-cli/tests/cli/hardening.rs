@@ -3,7 +3,7 @@
 //! invalid physics, progress goes to stderr only, and `--time-limit` stops a search with its
 //! best result reported as such.
 
-use crate::common::{fails_with, hysid, Assert};
+use crate::common::{fails_with, hysid, Assert, IDENTIFY_CASCADE};
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -320,20 +320,11 @@ fn a_time_limit_stops_the_cascade_grid_with_a_result() {
         .success();
     let json = dir.path().join("r.json");
     let out = hysid()
-        .args(["--quiet", "identify", "cascade", "--data"])
+        .arg("--quiet")
+        .args(IDENTIFY_CASCADE)
+        .arg("--data")
         .arg(&data)
-        .args(["--input", "x", "--output", "y", "--hysteresis", "ch4"])
-        .args([
-            "--na",
-            "2",
-            "--nb",
-            "2",
-            "--delay",
-            "1",
-            "--time-limit",
-            "1e-6",
-            "--json",
-        ])
+        .args(["--time-limit", "1e-6", "--json"])
         .arg(&json)
         .output()
         .unwrap();

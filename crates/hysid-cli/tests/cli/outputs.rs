@@ -2,7 +2,7 @@
 //! registered before any work, refused when one equals an input, renamed into place together
 //! at the end — a failed run leaves neither a file nor a temporary.
 
-use crate::common::{hysid, Assert};
+use crate::common::{hysid, Assert, IDENTIFY_CASCADE};
 use std::fs;
 use std::path::Path;
 use tempfile::TempDir;
@@ -27,30 +27,13 @@ fn example_data(dir: &Path) -> std::path::PathBuf {
     data
 }
 
-const CASCADE: [&str; 14] = [
-    "identify",
-    "cascade",
-    "--input",
-    "x",
-    "--output",
-    "y",
-    "--hysteresis",
-    "ch4",
-    "--na",
-    "2",
-    "--nb",
-    "2",
-    "--delay",
-    "1",
-];
-
 #[test]
 fn an_unwritable_second_output_leaves_no_file_and_no_temporary() {
     let tmp = TempDir::new().unwrap();
     let dir = tmp.path();
     let data = example_data(dir);
     hysid()
-        .args(CASCADE)
+        .args(IDENTIFY_CASCADE)
         .arg("--data")
         .arg(&data)
         .arg("--json")
@@ -72,7 +55,7 @@ fn an_output_equal_to_an_input_is_refused_before_computing() {
     let data = example_data(dir);
     let before = fs::read(&data).unwrap();
     hysid()
-        .args(CASCADE)
+        .args(IDENTIFY_CASCADE)
         .arg("--data")
         .arg(&data)
         .arg("--json")
@@ -93,7 +76,7 @@ fn all_outputs_of_a_run_appear_together() {
     let data = example_data(dir);
     hysid()
         .current_dir(dir)
-        .args(CASCADE)
+        .args(IDENTIFY_CASCADE)
         .args(["--data", "ex1.csv", "--json", "report.json"])
         .args(["--model-out", "model.json", "--plots", "plots"])
         .assert()
