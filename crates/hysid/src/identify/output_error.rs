@@ -317,25 +317,49 @@ pub struct OutputErrorProblem<'a> {
     /// simulating a long record once more.
     last: Mutex<Option<(Vec<f64>, Simulations)>>,
     speculation: Option<Speculation>,
-    overlap: Option<Overlap>,
+    /// Normal equations computed beside every trial point's plain simulation (see
+    /// [`OVERLAP_RESIDUALS`]).
+    overlap: Option<KeptSystem>,
 }
 
 /// Records at least this long (residuals) get their trial points' normal equations computed
-/// side by side with the trial simulation (see [`Overlap`]).
-const OVERLAP_RESIDUALS: usize = 1 << 16;
-
-/// Normal equations computed alongside every trial point's plain simulation, on the core the
-/// simulation leaves idle ([`rayon::join`]), and kept for the engine's request that follows
-/// when the point is accepted.
+/// side by side with the trial simulation: on the core the simulation leaves idle
+/// ([`rayon::join`]), kept for the engine's request that follows when the point is accepted.
 ///
 /// Unlike [`Speculation`], the residuals still come from the plain simulation and the normal
 /// equations from the model's own pass, so every number is the one the sequential engine
 /// computes; only the order in time changes. A rejected trial point wastes its normal
 /// equations (CPU time on the idle core), which is rare from the good starts of long-record
 /// fits. The engine's evaluation counts are those of its requests, as without the overlap.
-struct Overlap {
+const OVERLAP_RESIDUALS: usize = 1 << 16;
+
+/// Normal equations computed ahead of the engine's request, at trial point θ for the free
+/// parameters `free`: handed over once, when the engine asks for exactly that point.
+struct KeptSystem {
     free: Vec<usize>,
-    cache: Mutex<Option<(Vec<f64>, NormalEquations)>>,
+    slot: Mutex<Option<(Vec<f64>, NormalEquations)>>,
+}
+
+impl KeptSystem {
+    fn new(free: &[usize]) -> Self {
+        Self {
+            free: free.to_vec(),
+            slot: Mutex::new(None),
+        }
+    }
+
+    /// Keeps `system`, computed at `theta`, in place of whatever was kept.
+    fn keep(&self, theta: &[f64], system: NormalEquations) {
+        *self.slot.lock().unwrap_or_else(|p| p.into_inner()) = Some((theta.to_vec(), system));
+    }
+
+    /// The kept system if it was computed at `theta` for `free`; empties the slot either way
+    /// (the engine never asks twice for one point).
+    fn take(&self, theta: &[f64], free: &[usize]) -> Option<NormalEquations> {
+        let kept = self.slot.lock().unwrap_or_else(|p| p.into_inner()).take();
+        kept.filter(|(at, _)| at == theta && self.free == free)
+            .map(|(_, system)| system)
+    }
 }
 
 /// Speculative sensitivities: every trial point is simulated *with* its sensitivities, and the
@@ -350,9 +374,8 @@ struct Overlap {
 /// ([`rayon::join`]), each integrating the state with half of the columns: the state is
 /// integrated twice, the sensitivities once.
 struct Speculation {
-    free: Vec<usize>,
     split: bool,
-    cache: std::sync::Mutex<Option<(Vec<f64>, NormalEquations)>>,
+    kept: KeptSystem,
     with_sensitivities: std::sync::atomic::AtomicUsize,
     without: std::sync::atomic::AtomicUsize,
     disabled: std::sync::atomic::AtomicBool,
@@ -410,18 +433,14 @@ impl<'a> OutputErrorProblem<'a> {
     /// Turns on speculative sensitivities for the parameters `free` (see \[`Speculation`\]) when
     /// the search runs alone and a core is idle for the split columns.
     pub fn speculate(&mut self, free: &[usize]) {
-        // Inside a rayon job (a multi-start) the other core is busy already.
-        let alone = rayon::current_thread_index().is_none();
-        let idle_cores = rayon::current_num_threads() > self.data.n_experiments();
         // On one core a plain simulation is several times cheaper than one with
         // sensitivities, so speculating pays only when the columns can be split.
-        if !(alone && idle_cores && free.len() >= 2) {
+        if !(self.has_idle_core() && free.len() >= 2) {
             return;
         }
         self.speculation = Some(Speculation {
-            free: free.to_vec(),
             split: true,
-            cache: std::sync::Mutex::new(None),
+            kept: KeptSystem::new(free),
             with_sensitivities: 0.into(),
             without: 0.into(),
             disabled: false.into(),
@@ -429,17 +448,18 @@ impl<'a> OutputErrorProblem<'a> {
     }
 
     /// Turns on the overlap of trial simulations and normal equations for the parameters
-    /// `free` (see `Overlap`) when the record is long, the search runs alone (not inside a
-    /// parallel multi-start) and the experiments leave a core idle.
+    /// `free` (see [`OVERLAP_RESIDUALS`]) when the record is long and a core is idle.
     pub fn overlap(&mut self, free: &[usize]) {
-        let alone = rayon::current_thread_index().is_none();
-        let idle_cores = rayon::current_num_threads() > self.data.n_experiments();
-        if alone && idle_cores && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty() {
-            self.overlap = Some(Overlap {
-                free: free.to_vec(),
-                cache: Mutex::new(None),
-            });
+        if self.has_idle_core() && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty() {
+            self.overlap = Some(KeptSystem::new(free));
         }
+    }
+
+    /// True when the search runs alone (inside a rayon job, a multi-start, the other core is
+    /// busy already) and the experiments, simulated in parallel, leave a core idle.
+    fn has_idle_core(&self) -> bool {
+        rayon::current_thread_index().is_none()
+            && rayon::current_num_threads() > self.data.n_experiments()
     }
 
     /// Replaces the engine's request counts by the simulations actually run, when trial
@@ -672,12 +692,10 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
             .as_ref()
             .filter(|s| !s.disabled.load(Relaxed))
         {
-            match self.residuals_with_normal_equations(theta, &spec.free, spec.split, r) {
+            match self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, r) {
                 Some(system) => {
                     spec.with_sensitivities.fetch_add(1, Relaxed);
-                    let system = system?;
-                    *spec.cache.lock().unwrap_or_else(|p| p.into_inner()) =
-                        Some((theta.to_vec(), system));
+                    spec.kept.keep(theta, system?);
                     return Ok(());
                 }
                 None => spec.disabled.store(true, Relaxed),
@@ -693,8 +711,7 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
             );
             // A failed pass is left for the engine's own request to meet again.
             if let Some(Ok(system)) = system {
-                *overlap.cache.lock().unwrap_or_else(|p| p.into_inner()) =
-                    Some((theta.to_vec(), system));
+                overlap.keep(theta, system);
             }
             return plain;
         }
@@ -702,17 +719,8 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 
     fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
-        if let Some(overlap) = &self.overlap {
-            let kept = overlap
-                .cache
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .take();
-            if let Some((at, system)) = kept {
-                if at == theta && overlap.free == free {
-                    return Some(Ok(system));
-                }
-            }
+        if let Some(system) = self.overlap.as_ref().and_then(|o| o.take(theta, free)) {
+            return Some(Ok(system));
         }
         self.speculative_or_direct_normal_equations(theta, free)
     }
@@ -750,17 +758,13 @@ impl OutputErrorProblem<'_> {
         free: &[usize],
     ) -> Option<Result<NormalEquations>> {
         if let Some(spec) = &self.speculation {
-            let mut cache = spec.cache.lock().unwrap_or_else(|p| p.into_inner());
-            if let Some((at, system)) = cache.take() {
-                if at == theta && spec.free == free {
-                    return Some(Ok(system));
-                }
+            if let Some(system) = spec.kept.take(theta, free) {
+                return Some(Ok(system));
             }
-            drop(cache);
             if !spec.disabled.load(std::sync::atomic::Ordering::Relaxed) {
                 spec.with_sensitivities
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                if spec.split && spec.free == free {
+                if spec.split && spec.kept.free == free {
                     // The start: the engine asks for the normal equations first.
                     let mut r = vec![0.0; self.n_residuals];
                     return self.residuals_with_normal_equations(theta, free, true, &mut r);
