@@ -448,7 +448,8 @@ impl<'a> OutputErrorProblem<'a> {
     }
 
     /// Turns on the overlap of trial simulations and normal equations for the parameters
-    /// `free` (see [`OVERLAP_RESIDUALS`]) when the record is long and a core is idle.
+    /// `free` when the record is long (at least 2¹⁶ residuals) and a core is idle: each
+    /// trial point's normal equations are then computed beside its plain simulation.
     pub fn overlap(&mut self, free: &[usize]) {
         if self.has_idle_core() && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty() {
             self.overlap = Some(KeptSystem::new(free));
