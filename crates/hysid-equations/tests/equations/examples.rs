@@ -2,7 +2,7 @@
 //! Bouc–Wen and the fixed-saddle actuator equal hand-written transcriptions of hysid's
 //! built-in models.
 
-mod common;
+use crate::common;
 
 use common::{assert_rows_close, example, fd_output, fd_rhs, Arg, Rng};
 use hysid_equations::{EquationModel, TimeDomain};

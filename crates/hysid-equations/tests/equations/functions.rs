@@ -1,7 +1,7 @@
 //! Every construct of the language: values, derivatives against central differences at
 //! seeded random points, the conventions at non-smooth points, folding and sharing.
 
-mod common;
+use crate::common;
 
 use common::{assert_rows_close, fd_rhs, Arg, Rng};
 use hysid_equations::{EquationModel, Scratch, TimeDomain};

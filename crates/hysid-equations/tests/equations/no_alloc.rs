@@ -2,7 +2,7 @@
 //! while f, h and their Jacobians are evaluated many times, with a caller-owned scratch
 //! and with the per-thread one.
 
-mod common;
+use crate::common;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -3,7 +3,7 @@
 //! and at random points; fewer instructions; and the structure a simulation relies on
 //! (constant Jacobian entries, whether t is read).
 
-mod common;
+use crate::common;
 
 use common::{example, Rng};
 use hysid_equations::EquationModel;
