@@ -10,6 +10,7 @@ import hysid
 import pytest
 from conftest import FS, bouc_wen_model, excitation
 
+
 def in_thread(f):
     """Runs ``f`` in a thread while this thread ticks; returns (f's result, its duration,
     the longest gap between two ticks here). A call holding the GIL stops the ticks for
