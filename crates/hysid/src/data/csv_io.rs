@@ -477,7 +477,7 @@ fn push_f64(out: &mut String, value: f64) {
     written.expect("writing to a String cannot fail");
 }
 
-mod float;
-mod pipeline;
-#[cfg(test)]
-mod tests;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod float;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod pipeline;

@@ -315,6 +315,3 @@ fn in_file(path: &Path, error: Error) -> Error {
         other => other,
     }
 }
-
-#[cfg(test)]
-mod tests;

@@ -36,14 +36,17 @@ use crate::model::HysteresisCascade;
 use crate::{Error, Result};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 
-mod fixed;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod fixed;
 
 /// Records at least this long are pipelined over two threads (shorter ones are not worth a
 /// thread: the window fits run hundreds of them, already in parallel).
-const PIPELINE_SAMPLES: usize = 1 << 16;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub const PIPELINE_SAMPLES: usize = 1 << 16;
 
 /// Rows handed from the recursion thread to the sink per block.
-const BLOCK_ROWS: usize = 4096;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub const BLOCK_ROWS: usize = 4096;
 
 /// Rows per block when the recursion and the sink share a thread (the block stays in the
 /// first-level caches).
@@ -92,7 +95,13 @@ pub fn simulate_into(cascade: &HysteresisCascade, x: &[f64], h: Option<&[bool]>,
 }
 
 /// [`simulate_into`] for any orders (lengths of A and B known only at run time).
-fn simulate_generic(cascade: &HysteresisCascade, x: &[f64], h: Option<&[bool]>, y: &mut Vec<f64>) {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn simulate_generic(
+    cascade: &HysteresisCascade,
+    x: &[f64],
+    h: Option<&[bool]>,
+    y: &mut Vec<f64>,
+) {
     let ch = &cascade.hysteresis;
     let lin = &cascade.linear;
     let (a, b, k) = (lin.a(), lin.b(), lin.delay());
@@ -230,7 +239,8 @@ impl Block {
 
 /// The recursion on a second thread, its rows handed over in blocks; the sink runs on the
 /// calling thread. Three blocks circulate, so neither side allocates.
-fn pipelined(
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn pipelined(
     cascade: &HysteresisCascade,
     x: &[f64],
     h: Option<&[bool]>,
@@ -285,7 +295,8 @@ fn consume(
 
 /// The sensitivity recursion of the module docs, calling `on_row(t, ŷ(t), ∂ŷ(t)/∂θ_free)`
 /// for every sample; returns the first sample whose output is not finite.
-fn recursion(
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn recursion(
     cascade: &HysteresisCascade,
     x: &[f64],
     h: Option<&[bool]>,
@@ -299,7 +310,8 @@ fn recursion(
 }
 
 /// [`recursion`] for any shape (widths known only at run time).
-fn recursion_generic(
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn recursion_generic(
     cascade: &HysteresisCascade,
     x: &[f64],
     h: Option<&[bool]>,
@@ -356,123 +368,4 @@ fn recursion_generic(
         on_row(t, yhat, &row);
     });
     failed
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::experiments::voros::CascadeExample;
-    use crate::model::coleman_hodgdon::simulate_switched;
-
-    /// The in-place simulation is bit-identical to the hysteresis simulation followed by the
-    /// linear block, with and without a frozen switching.
-    #[test]
-    fn simulation_matches_the_model_bit_for_bit() {
-        for n in [1, 2] {
-            let ex = CascadeExample::number(n).unwrap();
-            let x = ex.generate(5, false).unwrap().x;
-            let h: Vec<bool> = x
-                .iter()
-                .map(|v| v.abs() > 0.9 * ex.truth.hysteresis.d())
-                .collect();
-            for frozen in [None, Some(h.as_slice())] {
-                let v = simulate_switched(&ex.truth.hysteresis, &x, 0.0, frozen);
-                let expected = ex.truth.linear.simulate(&v);
-                let mut y = vec![1.0; 3];
-                simulate_into(&ex.truth, &x, frozen, &mut y);
-                assert_eq!(y, expected, "example {n}");
-            }
-        }
-    }
-
-    /// The fixed-width passes are bit-identical to the generic ones for every instantiated
-    /// shape (ch4 and ch6, n ≤ 3, m ≤ 3, delays 1 and 3), with and without a frozen switching,
-    /// and decline the shapes they do not cover (n = 4).
-    #[test]
-    fn fixed_width_passes_equal_generic_passes() {
-        use crate::model::{ColemanHodgdon, LinearBlock};
-        let ex = CascadeExample::example1();
-        let x = ex.generate(7, false).unwrap().x;
-        let h: Vec<bool> = x.iter().map(|v| v.abs() > 2.5).collect();
-        let forms = [
-            ColemanHodgdon::saturated(0.3, 1.0, 0.5, 3.0).unwrap(),
-            ColemanHodgdon::general(0.25, 1.2, 0.15, 0.6, 0.1, 2.0).unwrap(),
-        ];
-        for ch in &forms {
-            for na in 0..=4 {
-                for nb in 1..=3 {
-                    for delay in [1, 3] {
-                        let a = [-0.5, 0.2, -0.05, 0.01][..na].to_vec();
-                        let b = [1.0, 0.4, -0.2][..nb].to_vec();
-                        let cascade = HysteresisCascade::new(
-                            ch.clone(),
-                            LinearBlock::new(a, b, delay).unwrap(),
-                        )
-                        .unwrap();
-                        let p = cascade.params().len();
-                        let free: Vec<usize> = (0..p).rev().step_by(2).collect();
-                        for frozen in [None, Some(h.as_slice())] {
-                            let mut generic = Vec::new();
-                            let g = recursion_generic(&cascade, &x, frozen, &free, |t, y, r| {
-                                generic.push((t, y, r.to_vec()))
-                            });
-                            let mut fast = Vec::new();
-                            let f = fixed::recursion(&cascade, &x, frozen, &free, |t, y, r| {
-                                fast.push((t, y, r.to_vec()))
-                            });
-                            let (mut ys, mut yf) = (Vec::new(), Vec::new());
-                            simulate_generic(&cascade, &x, frozen, &mut ys);
-                            let simulated = fixed::simulate(&cascade, &x, frozen, &mut yf);
-                            if na == 4 {
-                                assert_eq!(f, None);
-                                assert_eq!(simulated, None);
-                                continue;
-                            }
-                            assert_eq!(f, Some(g));
-                            assert!(fast == generic, "{na} {nb} {delay}");
-                            assert_eq!(simulated, Some(()));
-                            assert!(yf == ys, "{na} {nb} {delay}");
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    /// The pipelined pass streams exactly the rows of the sequential one, in order.
-    #[test]
-    fn pipelined_rows_equal_sequential_rows() {
-        let ex = CascadeExample::example1().extended(PIPELINE_SAMPLES + 12_345);
-        let x = ex.generate(2, false).unwrap().x;
-        let free = [0, 2, 3, 5];
-        let mut sequential = Vec::new();
-        recursion(&ex.truth, &x, None, &free, |t, yhat, row| {
-            sequential.push((t, yhat, row.to_vec()))
-        });
-        let mut piped = Vec::new();
-        let failed = pipelined(&ex.truth, &x, None, &free, &mut |block| {
-            for (i, &yhat) in block.yhat.iter().enumerate() {
-                let row: Vec<f64> = (0..free.len()).map(|k| block.column(k)[i]).collect();
-                piped.push((block.start + i, yhat, row));
-            }
-        });
-        assert_eq!(failed, None);
-        assert_eq!(piped.len(), x.len());
-        assert!(piped == sequential);
-    }
-
-    /// A diverging simulation is reported at its first non-finite sample by both paths.
-    #[test]
-    fn divergence_is_reported() {
-        let ex = CascadeExample::example1().extended(PIPELINE_SAMPLES + 10);
-        let mut x = ex.generate(2, false).unwrap().x;
-        x[PIPELINE_SAMPLES + 3] = f64::INFINITY;
-        // ŷ follows x with the delay k = 1, so the first non-finite output is one later.
-        let expected = recursion(&ex.truth, &x, None, &[0, 1], |_, _, _| {});
-        assert_eq!(expected, Some(PIPELINE_SAMPLES + 4));
-        let mut count = 0;
-        let err = stream_sensitivities(&ex.truth, &x, None, &[0, 1], &mut |_, _, _| count += 1);
-        assert!(matches!(err, Err(Error::Diverged { index, .. }) if Some(index) == expected));
-        assert_eq!(count, x.len());
-    }
 }

@@ -524,6 +524,3 @@ impl OutputErrorModel for Structure {
         Ok(())
     }
 }
-
-#[cfg(test)]
-mod tests;

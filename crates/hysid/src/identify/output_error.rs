@@ -31,7 +31,8 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::Mutex;
 
-mod gram;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod gram;
 use gram::Accumulator;
 
 /// Receives one sample of simulated outputs and their sensitivities:

@@ -13,3 +13,4 @@ mod greybox;
 mod hysteresis_alone;
 mod preprocessing;
 mod properties;
+mod unit;

@@ -148,7 +148,8 @@ fn simulate_fixed<const NA: usize, const M: usize>(
 
 /// Runs the fixed-width sensitivity recursion when the cascade's shape has an instance
 /// (ch4 or ch6, n ≤ 3, m ≤ 3): `Some(first non-finite sample)`, else `None`.
-pub(super) fn recursion(
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn recursion(
     cascade: &HysteresisCascade,
     x: &[f64],
     h: Option<&[bool]>,
@@ -193,7 +194,8 @@ pub(super) fn recursion(
 
 /// Runs the fixed-width simulation when n ≤ 3 and m ≤ 3; `None` (and `y` untouched)
 /// otherwise.
-pub(super) fn simulate(
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn simulate(
     cascade: &HysteresisCascade,
     x: &[f64],
     h: Option<&[bool]>,

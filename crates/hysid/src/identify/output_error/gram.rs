@@ -14,10 +14,12 @@ use crate::numerics::levenberg_marquardt::NormalEquations;
 use nalgebra::{DMatrix, DVector};
 
 /// Rows per block.
-pub(super) const BLOCK_ROWS: usize = 512;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub const BLOCK_ROWS: usize = 512;
 
 /// Accumulates JᵀJ, Jᵀr and Σr² row by row (see the module docs).
-pub(super) struct Accumulator {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub struct Accumulator {
     /// Number of columns (free parameters).
     p: usize,
     /// Rows held in the current block.
@@ -33,7 +35,8 @@ pub(super) struct Accumulator {
 
 impl Accumulator {
     /// An empty accumulator for `p` columns.
-    pub(super) fn new(p: usize) -> Self {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn new(p: usize) -> Self {
         Self {
             p,
             rows: 0,
@@ -47,7 +50,8 @@ impl Accumulator {
 
     /// Adds the row `scale · row` of J with residual `r`, written straight into the block.
     #[inline]
-    pub(super) fn add_scaled(&mut self, scale: f64, row: &[f64], r: f64) {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn add_scaled(&mut self, scale: f64, row: &[f64], r: f64) {
         let columns = self.block.chunks_exact_mut(BLOCK_ROWS);
         for (column, v) in columns.zip(row) {
             column[self.rows] = scale * v;
@@ -63,14 +67,8 @@ impl Accumulator {
     /// Adds the rows `from … from + r.len() − 1` of the column-major rows `columns` (column
     /// k at `k · stride`), each scaled by `scale`, with residuals `r`: the same rows as that
     /// many calls of [`add_scaled`](Self::add_scaled), copied a column at a time.
-    pub(super) fn add_rows(
-        &mut self,
-        scale: f64,
-        columns: &[f64],
-        stride: usize,
-        from: usize,
-        r: &[f64],
-    ) {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn add_rows(&mut self, scale: f64, columns: &[f64], stride: usize, from: usize, r: &[f64]) {
         let mut done = 0;
         while done < r.len() {
             let take = (BLOCK_ROWS - self.rows).min(r.len() - done);
@@ -115,7 +113,8 @@ impl Accumulator {
     }
 
     /// The accumulated normal equations.
-    pub(super) fn finish(mut self) -> NormalEquations {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn finish(mut self) -> NormalEquations {
         self.flush();
         NormalEquations {
             jtj: DMatrix::from_row_slice(self.p, self.p, &self.jtj),
@@ -144,82 +143,4 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
         res += x * y;
     }
     res
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::rngs::Xoshiro256PlusPlus;
-    use rand::{RngExt, SeedableRng};
-
-    /// The accumulated normal equations equal, bit for bit, those of nalgebra's block
-    /// products (the accumulator they replaced) on random rows, with a partial last block.
-    #[test]
-    fn normal_equations_equal_block_products() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(13);
-        for p in [1, 3, 7, 11] {
-            let n = 3 * BLOCK_ROWS + 37;
-            let rows: Vec<Vec<f64>> = (0..n)
-                .map(|_| (0..p).map(|_| rng.random_range(-1.0..1.0)).collect())
-                .collect();
-            let res: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let mut acc = Accumulator::new(p);
-            for (row, &r) in rows.iter().zip(&res) {
-                acc.add_scaled(-0.75, row, r);
-            }
-            let got = acc.finish();
-            let (mut jtj, mut jtr) = (DMatrix::zeros(p, p), DVector::zeros(p));
-            for start in (0..n).step_by(BLOCK_ROWS) {
-                let len = BLOCK_ROWS.min(n - start);
-                let j = DMatrix::from_fn(len, p, |i, k| -0.75 * rows[start + i][k]);
-                let r = DVector::from_column_slice(&res[start..start + len]);
-                jtj.gemm_tr(1.0, &j, &j, 1.0);
-                jtr.gemv_tr(1.0, &j, &r, 1.0);
-            }
-            let cost = res.iter().fold(0.0, |s, r| s + r * r);
-            assert_eq!(got.jtj, jtj, "p = {p}");
-            assert_eq!(got.jtr, jtr, "p = {p}");
-            assert_eq!(got.cost, cost, "p = {p}");
-        }
-    }
-
-    /// Rows added a column-major block at a time (blocks of uneven lengths, the first rows of
-    /// one left out, a stride longer than the block) give the normal equations of the same
-    /// rows added one by one, bit for bit.
-    #[test]
-    fn block_rows_equal_single_rows() {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(29);
-        for p in [1, 4, 7] {
-            let n = 2 * BLOCK_ROWS + 301;
-            let rows: Vec<Vec<f64>> = (0..n)
-                .map(|_| (0..p).map(|_| rng.random_range(-1.0..1.0)).collect())
-                .collect();
-            let res: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
-            let skip = 5;
-            let mut single = Accumulator::new(p);
-            for (row, &r) in rows.iter().zip(&res).skip(skip) {
-                single.add_scaled(-0.5, row, r);
-            }
-            let mut blocks = Accumulator::new(p);
-            let (mut start, mut len) = (0, 7);
-            while start < n {
-                let end = (start + len).min(n);
-                let stride = end - start + 3;
-                let mut columns = vec![f64::NAN; p * stride];
-                for (i, row) in rows[start..end].iter().enumerate() {
-                    for (k, v) in row.iter().enumerate() {
-                        columns[k * stride + i] = *v;
-                    }
-                }
-                let from = skip.saturating_sub(start).min(end - start);
-                blocks.add_rows(-0.5, &columns, stride, from, &res[start + from..end]);
-                start = end;
-                len = len * 3 + 1;
-            }
-            let (a, b) = (single.finish(), blocks.finish());
-            assert_eq!(a.jtj, b.jtj, "p = {p}");
-            assert_eq!(a.jtr, b.jtr, "p = {p}");
-            assert_eq!(a.cost, b.cost, "p = {p}");
-        }
-    }
 }

@@ -44,7 +44,8 @@ const DPHI: f64 = 1e-6;
 
 /// The layout of a state carrying forward sensitivities: z = [x (n), S (n × q, row-major)].
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Sensitivities {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub struct Sensitivities {
     /// States.
     pub n: usize,
     /// Sensitivity columns.
@@ -53,14 +54,16 @@ pub(crate) struct Sensitivities {
 
 /// RK4 steps on a state of dimension `dim` that stop at friction-velocity zero crossings:
 /// the classical stages of [`Rk4`] plus the buffer of a trial step.
-pub(crate) struct StickSlip {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub struct StickSlip {
     rk4: Rk4,
     trial: Vec<f64>,
 }
 
 impl StickSlip {
     /// Buffers for states of dimension `dim`.
-    pub(crate) fn new(dim: usize) -> Self {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn new(dim: usize) -> Self {
         Self {
             rk4: Rk4::new(dim),
             trial: vec![0.0; dim],
@@ -73,7 +76,8 @@ impl StickSlip {
     /// `direction` when it is Some. With `velocity` = Some(i), state i is the friction
     /// velocity and the step stops at its zero crossing (see the module docs). With
     /// `sensitivities`, x carries S and the event is differentiated.
-    pub(crate) fn step<F>(
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn step<F>(
         &mut self,
         rate: &mut F,
         x: &mut [f64],
@@ -227,56 +231,5 @@ fn add_outer(z: &mut [f64], layout: Sensitivities, a: &[f64], b: &[f64]) {
         for (c, bc) in b.iter().enumerate() {
             z[n + i * q + c] += ai * bc;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A unit mass with Coulomb friction 1 under a constant force f.
-    fn block(f: f64) -> impl FnMut(Stage, &[f64], Option<f64>, &mut [f64]) {
-        move |_: Stage, x: &[f64], held: Option<f64>, dx: &mut [f64]| {
-            let friction = match held {
-                Some(d) => d,
-                None if x[1] != 0.0 => sign0(x[1]),
-                None => f.clamp(-1.0, 1.0),
-            };
-            dx[0] = x[1];
-            dx[1] = f - friction;
-        }
-    }
-
-    fn run(f: f64, h: f64, steps: usize, velocity: Option<usize>) -> [f64; 2] {
-        let mut rk = StickSlip::new(2);
-        let mut rate = block(f);
-        let mut x = [0.0, 1.0];
-        for _ in 0..steps {
-            rk.step(&mut rate, &mut x, h, velocity, None);
-        }
-        x
-    }
-
-    #[test]
-    fn a_sliding_block_stops_and_sticks() {
-        // Deceleration 0.5 from speed 1: stops after 2 s, having moved 1.
-        let x = run(0.5, 0.3, 20, Some(1));
-        assert_eq!(x[1], 0.0);
-        assert!((x[0] - 1.0).abs() < 1e-12, "{}", x[0]);
-    }
-
-    #[test]
-    fn without_events_rk4_chatters() {
-        let x = run(0.5, 0.3, 20, None);
-        assert!(x[1] != 0.0);
-    }
-
-    #[test]
-    fn a_force_beyond_friction_reverses_the_block() {
-        // Deceleration 3 until rest at t = 1/3 (x = 1/6), then acceleration −1.
-        let x = run(-2.0, 0.05, 40, Some(1));
-        let t: f64 = 2.0 - 1.0 / 3.0;
-        assert!((x[1] + t).abs() < 1e-12, "{}", x[1]);
-        assert!((x[0] - (1.0 / 6.0 - 0.5 * t * t)).abs() < 1e-12, "{}", x[0]);
     }
 }

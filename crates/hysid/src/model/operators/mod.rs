@@ -54,7 +54,8 @@ pub(crate) mod gpi;
 pub mod jiles_atherton;
 pub(crate) mod maxwell_slip;
 pub(crate) mod pi;
-pub(crate) mod preisach;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod preisach;
 
 pub use any::{OperatorModel, OPERATOR_FAMILIES};
 pub use backlash::Backlash;

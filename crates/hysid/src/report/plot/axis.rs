@@ -52,7 +52,8 @@ impl Bounds {
 /// Widens `(lo, hi)` by `frac` of its span on each side; a (numerically)
 /// constant range is widened to ±10 % of its value, or ±1 around zero, so
 /// the flat line sits mid-plot and tick labels stay meaningful.
-pub(super) fn pad_range((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn pad_range((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
     let lo = lo.clamp(-AXIS_LIMIT, AXIS_LIMIT);
     let hi = hi.clamp(-AXIS_LIMIT, AXIS_LIMIT);
     let span = hi - lo;
@@ -83,14 +84,24 @@ pub(super) fn x_is_monotone(series: &[Series]) -> bool {
 /// How tick values on one axis are printed: a common power of ten (shown
 /// in the axis label, as engineering notation) and a fixed decimal count so
 /// all labels line up ("0.0 0.5 1.0", not "0 0.5 1").
-pub(super) struct AxisFormat {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub struct AxisFormat {
     pub(super) exp: i32,
     decimals: usize,
     ticks: Vec<f64>,
 }
 
 impl AxisFormat {
-    pub(super) fn new((lo, hi): (f64, f64), n_ticks: usize) -> AxisFormat {
+    /// The power of ten factored out of the tick labels.
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn exp(&self) -> i32 {
+        self.exp
+    }
+}
+
+impl AxisFormat {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn new((lo, hi): (f64, f64), n_ticks: usize) -> AxisFormat {
         let ticks = RangedCoordf64::from(lo..hi).key_points(n_ticks.max_num_points());
         let exp = engineering_exponent(lo.abs().max(hi.abs()));
         let scale = 10f64.powi(-exp);
@@ -102,7 +113,8 @@ impl AxisFormat {
         }
     }
 
-    pub(super) fn format(&self, v: f64) -> String {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn format(&self, v: f64) -> String {
         let s = v * 10f64.powi(-self.exp);
         let text = format!("{:.*}", self.decimals, s);
         // Rounding can yield "-0.0", which looks like a bug to a reader.
@@ -117,7 +129,8 @@ impl AxisFormat {
         self.ticks.iter().map(|&t| self.format(t)).collect()
     }
 
-    pub(super) fn describe(&self, label: &str) -> String {
+    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    pub fn describe(&self, label: &str) -> String {
         if self.exp == 0 {
             label.to_string()
         } else {
@@ -152,29 +165,4 @@ fn decimals_for(ticks: &[f64]) -> usize {
             ticks.iter().all(|t| ((t * p).round() / p - t).abs() <= tol)
         })
         .unwrap_or(12)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn constant_and_degenerate_ranges_are_padded() {
-        assert_eq!(pad_range((0.0, 0.0), 0.05), (-1.0, 1.0));
-        let (lo, hi) = pad_range((5.0, 5.0), 0.05);
-        assert!(lo < 5.0 && hi > 5.0);
-        let (lo, hi) = pad_range((-f64::MAX, f64::MAX), 0.05);
-        assert!((hi - lo).is_finite());
-    }
-
-    #[test]
-    fn tick_labels_share_decimals() {
-        let f = AxisFormat::new((0.0, 1.0), 6);
-        assert_eq!(f.format(0.5), "0.5");
-        assert_eq!(f.format(0.0), "0.0");
-        let f = AxisFormat::new((0.0, 2e-6), 6);
-        assert_eq!(f.exp, -6);
-        assert!(f.describe("k [N/m]").contains("1e-6"));
-        assert_eq!(AxisFormat::new((-1.0, 1.0), 5).format(-1e-12), "0.0");
-    }
 }

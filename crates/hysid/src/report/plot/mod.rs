@@ -16,10 +16,12 @@
 //! figures get a "no data" note, constant series get a padded axis, and very long series are
 //! decimated for drawing while keeping their extremes.
 
-mod axis;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod axis;
 pub mod figure;
 mod legend;
-mod prepare;
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod prepare;
 pub mod sets;
 mod svg;
 
@@ -39,6 +41,3 @@ pub struct Svg {
     /// The SVG document.
     pub svg: String,
 }
-
-#[cfg(test)]
-mod render_tests;

@@ -44,7 +44,8 @@ pub(super) fn prepare<'s>(s: &'s Series, color: RGBColor) -> Prepared<'s> {
 /// Maximal runs of consecutive points whose coordinates are both finite.
 /// Values are clamped to the axis limit: plotters maps a point far outside
 /// the axis range to a pixel with unchecked `i32` arithmetic and overflows.
-pub(super) fn finite_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn finite_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
     let clamp = |v: f64| v.clamp(-AXIS_LIMIT, AXIS_LIMIT);
     let mut runs = Vec::new();
     let mut current = Vec::new();
@@ -63,7 +64,8 @@ pub(super) fn finite_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
 
 /// Points per decimation bucket (1 = no decimation). Markers cost more SVG
 /// than polyline vertices, so they get fewer buckets.
-pub(super) fn bucket_len(total: usize, style: Style) -> usize {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn bucket_len(total: usize, style: Style) -> usize {
     if total <= DECIMATE_ABOVE {
         return 1;
     }
@@ -76,7 +78,8 @@ pub(super) fn bucket_len(total: usize, style: Style) -> usize {
 /// coordinates' extremes preserves the envelope of time plots *and* the
 /// corners of hysteresis loops. The run's first and last points are kept so
 /// the line spans the full range.
-pub(super) fn decimate(run: &[(f64, f64)], bucket: usize) -> Vec<(f64, f64)> {
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn decimate(run: &[(f64, f64)], bucket: usize) -> Vec<(f64, f64)> {
     if bucket <= 1 || run.len() <= 4 {
         return run.to_vec();
     }
@@ -115,39 +118,4 @@ fn extreme_indices(chunk: &[(f64, f64)]) -> Vec<usize> {
         }
     }
     idx.to_vec()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn decimation_keeps_extremes_in_order() {
-        let run: Vec<(f64, f64)> = (0..100_000)
-            .map(|i| (i as f64, ((i * 7919) % 1000) as f64))
-            .collect();
-        let d = decimate(&run, bucket_len(run.len(), Style::Line));
-        assert!(d.len() <= 2_000 * 4 + 2);
-        assert!(d.windows(2).all(|w| w[0].0 < w[1].0), "order preserved");
-        let ymax = d.iter().map(|p| p.1).fold(f64::MIN, f64::max);
-        let ymin = d.iter().map(|p| p.1).fold(f64::MAX, f64::min);
-        assert_eq!((ymin, ymax), (0.0, 999.0));
-        assert_eq!(d.first(), run.first());
-        assert_eq!(d.last(), run.last());
-    }
-
-    #[test]
-    fn runs_break_at_non_finite() {
-        let x = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0];
-        let y = [1.0, f64::NAN, 2.0, 3.0, f64::INFINITY, 4.0];
-        let runs = finite_runs(&x, &y);
-        assert_eq!(
-            runs,
-            vec![
-                vec![(0.0, 1.0)],
-                vec![(2.0, 2.0), (3.0, 3.0)],
-                vec![(5.0, 4.0)]
-            ]
-        );
-    }
 }

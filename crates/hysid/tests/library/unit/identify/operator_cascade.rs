@@ -1,6 +1,12 @@
-use super::*;
-use crate::model::operators::{BoucWen, Orientation};
-use crate::numerics::metrics;
+//! Tests of `hysid::identify::operator_cascade`.
+
+use hysid::data::IdData;
+use hysid::identify::operator_cascade::*;
+use hysid::model::operators::BoucWen;
+use hysid::model::operators::{Backlash, Orientation, PrandtlIshlinskii};
+use hysid::model::{CascadeOperator, LinearBlock, OperatorCascade};
+use hysid::numerics::metrics;
+use hysid::numerics::Control;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};

@@ -1,6 +1,14 @@
+//! Tests of `hysid::data`.
+
+mod csv_io;
+mod mat5;
+mod mat_io;
+
 use proptest::prelude::*;
 
-use super::*;
+use hysid::data::*;
+use hysid::error::{Error, Result};
+use std::fmt;
 
 /// Every error message must fit on one line.
 fn assert_one_line(error: &Error) {
@@ -325,8 +333,13 @@ fn merge_rejects_different_channels() {
         "{message}"
     );
 
-    let mut b = a.clone();
-    b.outputs[0].unit = "m".into();
+    let b = IdData::new(
+        0.1,
+        vec![Channel::new("u")],
+        vec![Channel::new("y").with_unit("m")],
+        vec![Experiment::new("exp1", vec![vec![1.0]], vec![vec![1.0]]).unwrap()],
+    )
+    .unwrap();
     let message = invalid_message(a.merge(b));
     assert!(message.contains("(y and y [m])"), "{message}");
 }

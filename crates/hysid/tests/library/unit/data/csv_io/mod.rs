@@ -1,8 +1,16 @@
+//! Tests of `hysid::data::csv_io`.
+
+mod float;
+mod pipeline;
+
 use std::fs;
 
 use tempfile::TempDir;
 
-use super::*;
+use hysid::data::csv_io::*;
+use hysid::data::{Channel, IdData};
+use hysid::error::{Error, Result};
+use std::path::PathBuf;
 
 /// A temporary directory holding one file, `data.csv`, with `content`.
 struct Fixture {

@@ -1,8 +1,13 @@
+//! Tests of `hysid::data::mat_io`.
+
 //! The MAT-file reader against the fixture written by `tools/reference/mat_fixture.py`
 //! (SciPy's level-5 writer, compressed) from the piezo CSV record.
 
-use super::*;
-use crate::data::read_columns;
+use hysid::data::read_columns;
+use hysid::data::{CsvSpec, IdData};
+use hysid::error::{Error, Result};
+use std::fs;
+use std::path::Path;
 use std::path::PathBuf;
 
 fn fixture() -> PathBuf {

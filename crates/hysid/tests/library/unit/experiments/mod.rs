@@ -1,0 +1,3 @@
+//! Tests of `hysid::experiments`.
+
+mod actuator_rig;

@@ -1,0 +1,76 @@
+//! Tests of `hysid::identify::operators::family`.
+
+use hysid::identify::operators::family::*;
+use hysid::model::operators::{HysteresisOperator, PrandtlIshlinskii};
+use hysid::model::operators::{OperatorModel, Orientation};
+use hysid::model::saved::FittedModel;
+
+#[test]
+fn names_round_trip() {
+    for f in Family::ALL {
+        assert_eq!(Family::parse(f.name()).unwrap(), f);
+    }
+    assert_eq!(Family::parse("Maxwell_Slip").unwrap(), Family::MaxwellSlip);
+    let e = Family::parse("pii").unwrap_err().to_string();
+    assert!(e.contains("unknown hysteresis family 'pii'") && !e.contains('\n'));
+    assert_eq!(Family::parse_list("all").unwrap().len(), 11);
+    assert_eq!(
+        Family::parse_list("pi,preisach,pi").unwrap(),
+        vec![Family::Pi, Family::Preisach]
+    );
+}
+
+#[test]
+fn options_ranges_are_checked() {
+    let bad_grid = FamilyOptions {
+        threshold_grid: Some(vec![0.2, 0.1]),
+        ..FamilyOptions::default()
+    };
+    assert!(bad_grid.validate().is_err());
+    let zero = FamilyOptions {
+        thresholds: 0,
+        ..FamilyOptions::default()
+    };
+    assert!(zero.validate().unwrap_err().to_string().contains("1..=200"));
+}
+
+/// PI data with known weights: fit_operator recovers them through the registry, and the
+/// saved model simulates to the fit's own output.
+#[test]
+fn pi_through_the_registry() {
+    let r = vec![0.1, 0.2, 0.3, 0.4];
+    let truth = PrandtlIshlinskii::new(
+        0.5,
+        vec![0.4, 0.3, 0.2, 0.1],
+        r.clone(),
+        0.2,
+        Orientation::default(),
+    )
+    .unwrap();
+    let u: Vec<f64> = (0..2000)
+        .map(|k| {
+            let t = k as f64 / 2000.0;
+            (1.0 - 0.6 * t) * (2.0 * std::f64::consts::PI * 5.0 * t).sin()
+        })
+        .collect();
+    let y = truth.simulate(&u).unwrap();
+    let options = FamilyOptions {
+        threshold_grid: Some(r),
+        orientation: Some(Orientation::default()),
+        ..FamilyOptions::default()
+    };
+    let fitted = fit_operator(Family::Pi, &u, &y, &options).unwrap();
+    let FittedModel::Operator {
+        model: OperatorModel::Pi(pi),
+        ..
+    } = &fitted.fit.model
+    else {
+        panic!("not a PI model")
+    };
+    for (a, b) in pi.weights().iter().zip(truth.weights()) {
+        assert!((a - b).abs() < 1e-6 * b, "{a} vs {b}");
+    }
+    let back = FittedModel::from_file(&fitted.fit.model.to_file()).unwrap();
+    let yhat = back.simulate(&[&u], 1.0, None).unwrap();
+    assert_eq!(yhat[0], fitted.fit.simulated);
+}

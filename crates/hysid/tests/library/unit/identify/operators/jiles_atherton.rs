@@ -1,0 +1,101 @@
+//! Tests of `hysid::identify::operators::jiles_atherton`.
+
+use crate::unit::test_signals::{nested_loops, with_noise};
+use hysid::identify::operators::jiles_atherton::*;
+use hysid::model::operators::{HysteresisOperator, JilesAtherton, LoopOrientation};
+
+/// A soft ferrite of the order of the vendored Mn-Zn loops.
+fn truth(orientation: LoopOrientation) -> JilesAtherton {
+    let mut m = JilesAtherton::new(2.5e5, 8.0, 5.0, 0.3, 5e-6).unwrap();
+    m.orientation = orientation;
+    m.m0 = 1e4;
+    m
+}
+
+fn check_recovery(m: &JilesAtherton) {
+    let u = nested_loops(800, 60.0);
+    let y = m.simulate(&u).unwrap();
+    let fit = fit(&u, &y, &JilesAthertonOptions::default()).unwrap();
+    assert!(fit.termination.converged(), "{:?}", fit.termination);
+    for (p, q) in m.parameters().iter().zip(fit.parameters.iter()) {
+        assert!(
+            (p.value - q.value).abs() <= 1e-4 * p.value.abs().max(1e-12),
+            "{}: {} vs {}",
+            p.name,
+            q.value,
+            p.value
+        );
+    }
+}
+
+#[test]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
+fn recovers_both_orientations_without_noise() {
+    check_recovery(&truth(LoopOrientation::CounterClockwise));
+    check_recovery(&truth(LoopOrientation::Clockwise));
+}
+
+#[test]
+#[ignore = "long (several seconds): run by `cargo test --release -- --ignored` and CI"]
+fn noisy_estimates_lie_within_three_sigma() {
+    let m = truth(LoopOrientation::CounterClockwise);
+    let u = nested_loops(800, 60.0);
+    let y = m.simulate(&u).unwrap();
+    let (mut inside, mut total) = (0, 0);
+    for seed in 30..35 {
+        let noisy = with_noise(&y, 40.0, seed);
+        let fit = fit(&u, &noisy, &JilesAthertonOptions::default()).unwrap();
+        for ((p, q), s) in m
+            .parameters()
+            .iter()
+            .zip(fit.parameters.iter())
+            .zip(&fit.std)
+        {
+            if let Some(s) = s {
+                total += 1;
+                inside += usize::from((p.value - q.value).abs() <= 3.0 * s);
+            }
+        }
+    }
+    assert_eq!(total, 30);
+    assert!(inside * 10 >= total * 9, "{inside}/{total}");
+}
+
+#[test]
+fn inverse_follows_a_reachable_reference() {
+    for o in [
+        LoopOrientation::CounterClockwise,
+        LoopOrientation::Clockwise,
+    ] {
+        let m = truth(o);
+        let r = m.simulate(&nested_loops(400, 60.0)).unwrap();
+        let inv = m.invert(&r).unwrap();
+        assert!(inv.clipped.is_empty(), "{:?}", inv.clipped);
+        let y = m.simulate(&inv.u).unwrap();
+        let scale = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let worst = y
+            .iter()
+            .zip(&r)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-6 * scale, "{worst}");
+    }
+}
+
+#[test]
+fn sampling_does_not_change_the_result() {
+    // The same path given coarsely and finely ends in the same state.
+    let m = truth(LoopOrientation::CounterClockwise);
+    let coarse = [0.0, 60.0, -20.0, 10.0];
+    let mut fine = Vec::new();
+    for w in coarse.windows(2) {
+        fine.extend((0..500).map(|k| w[0] + (w[1] - w[0]) * k as f64 / 500.0));
+    }
+    fine.push(10.0);
+    let yc = m.simulate(&coarse).unwrap();
+    let yf = m.simulate(&fine).unwrap();
+    assert!(
+        (yc[3] - yf[yf.len() - 1]).abs() < 1e-8 * yc[1].abs(),
+        "{yc:?}"
+    );
+}

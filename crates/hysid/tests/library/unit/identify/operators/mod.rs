@@ -1,0 +1,13 @@
+//! Tests of `hysid::identify::operators`.
+
+mod backlash;
+mod bouc_wen;
+mod compare;
+mod dahl;
+mod duhem;
+mod family;
+mod gpi;
+mod jiles_atherton;
+mod maxwell_slip;
+mod pi;
+mod preisach;

@@ -1,0 +1,3 @@
+//! Tests of `hysid::identify::output_error`.
+
+mod gram;

@@ -1,0 +1,9 @@
+//! Tests of `hysid::model::greybox`.
+
+mod discrete;
+mod equation_kernel;
+mod equation_model;
+mod models;
+mod sensitivity;
+mod simulate;
+mod stick_slip;

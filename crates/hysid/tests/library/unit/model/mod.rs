@@ -1,0 +1,10 @@
+//! Tests of `hysid::model`.
+
+mod coleman_hodgdon;
+mod compensate;
+mod greybox;
+mod linear;
+mod operator_cascade;
+mod operators;
+mod record_filters;
+mod saved;

@@ -1,0 +1,14 @@
+//! Tests of `hysid::model::operators`.
+
+mod any;
+mod backlash;
+mod bouc_wen;
+mod dahl;
+mod differential;
+mod duhem;
+mod elementary;
+mod gpi;
+mod jiles_atherton;
+mod maxwell_slip;
+mod pi;
+mod preisach;

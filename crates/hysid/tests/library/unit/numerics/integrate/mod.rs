@@ -1,0 +1,3 @@
+//! Tests of `hysid::numerics::integrate`.
+
+mod rk4;

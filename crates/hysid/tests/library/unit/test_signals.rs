@@ -1,0 +1,25 @@
+//! Test signals shared by the operators' tests.
+
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+use rand_distr::Normal;
+
+/// A decaying sine with a faster ripple that reverses the direction inside the big loops
+/// (nested minor loops): u(t) = A·((1 − 0.7t)·sin 6πt + 0.25·sin 34πt), t ∈ [0, 1).
+pub fn nested_loops(n: usize, amplitude: f64) -> Vec<f64> {
+    (0..n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let tau = std::f64::consts::TAU;
+            amplitude * ((1.0 - 0.7 * t) * (tau * 3.0 * t).sin() + 0.25 * (tau * 17.0 * t).sin())
+        })
+        .collect()
+}
+
+/// `y` plus white Gaussian noise at the given SNR (dB) relative to y's spread, seeded.
+pub fn with_noise(y: &[f64], snr_db: f64, seed: u64) -> Vec<f64> {
+    let sd = hysid::numerics::metrics::std_dev(y) * 10f64.powf(-snr_db / 20.0);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let normal = Normal::new(0.0, sd).unwrap();
+    y.iter().map(|v| v + rng.sample(normal)).collect()
+}
