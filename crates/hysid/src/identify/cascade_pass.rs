@@ -45,8 +45,7 @@ pub mod fixed;
 pub const PIPELINE_SAMPLES: usize = 1 << 16;
 
 /// Rows handed from the recursion thread to the sink per block.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
-pub const BLOCK_ROWS: usize = 4096;
+const BLOCK_ROWS: usize = 4096;
 
 /// Rows per block when the recursion and the sink share a thread (the block stays in the
 /// first-level caches).

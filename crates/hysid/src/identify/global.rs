@@ -328,8 +328,7 @@ impl GlobalSearch {
     }
 
     /// The regressor matrix [−s(t−1…n), ψᵢ(t−k−j+1)] for rows t ≥ t0.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
-    pub fn regressors(&self, s: &[f64], psi: &[Vec<f64>], t0: usize) -> DMatrix<f64> {
+    fn regressors(&self, s: &[f64], psi: &[Vec<f64>], t0: usize) -> DMatrix<f64> {
         let nl = psi.len();
         let cols = self.na + self.nb * nl;
         DMatrix::from_fn(s.len() - t0, cols, |r, c| {
