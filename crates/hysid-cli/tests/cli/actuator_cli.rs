@@ -1,7 +1,7 @@
 //! `hysid actuator`, `hysid demo actuator` and `hysid rigid-body ls` end to end, and their
 //! one-line errors.
 
-use crate::common::{hysid, one_line_error, Assert};
+use crate::common::{hysid, one_line_error, read_json, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
@@ -38,7 +38,7 @@ fn parameter<'a>(r: &'a serde_json::Value, name: &str) -> &'a serde_json::Value 
 }
 
 fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
+    read_json(path)
 }
 
 fn emps() -> PathBuf {

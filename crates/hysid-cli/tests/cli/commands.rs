@@ -1,7 +1,7 @@
 //! Command-line tests: the commands work end to end, and bad input gives one clear line on
 //! stderr, a non-zero exit, no panic and no output file.
 
-use crate::common::{hysid, Assert};
+use crate::common::{hysid, read_json, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -130,8 +130,7 @@ fn demo_reports_every_parameter_and_writes_plots() {
     ] {
         assert!(stdout.contains(name), "missing {name} in:\n{stdout}");
     }
-    let report: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     assert_eq!(report["model"]["kind"], "ch_cascade");
     assert!(param(&report, "alpha")["value"].as_f64().unwrap() > 0.29);
     assert!(param(&report, "alpha")["std"].as_f64().unwrap() > 0.0);
@@ -180,8 +179,7 @@ fn identified_model_file_simulates_the_data() {
         .arg(&sim)
         .assert()
         .success();
-    let report: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(&report).unwrap()).unwrap();
+    let report = read_json(&report);
     assert!(
         report["fit"]["fit_percent"].as_f64().unwrap() > 99.9999,
         "{report}"
@@ -225,8 +223,7 @@ fn hysteresis_alone_is_identified_from_a_csv_file() {
         .arg(&json)
         .assert()
         .success();
-    let report: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     assert_eq!(report["model"]["kind"], "coleman_hodgdon");
     let d = param(&report, "d")["value"].as_f64().unwrap();
     assert!((d - 2.0).abs() < 1e-6, "{d}");
@@ -408,8 +405,7 @@ fn benchmark_fits_the_training_record_and_scores_a_generated_test_set() {
         .arg(&json)
         .assert()
         .success();
-    let report: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     assert_eq!(report["model"]["kind"], "bouc_wen");
     let alpha = param(&report, "alpha")["value"].as_f64().unwrap();
     assert!((alpha / 5e4 - 1.0).abs() < 0.01, "{alpha}");
@@ -465,8 +461,7 @@ fn greybox_fit_writes_a_model_that_simulate_loads() {
         .arg(&json)
         .assert()
         .success();
-    let report: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     let rmse = report["fit"]["rmse"].as_f64().unwrap();
     assert!((rmse - 7.37e-6).abs() < 0.3e-6, "{rmse}");
 }

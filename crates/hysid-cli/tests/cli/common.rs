@@ -3,6 +3,7 @@
 //! expression engine into the test build for the handful of checks these tests make.
 
 use std::ffi::OsStr;
+use std::path::Path;
 use std::process::{Command, Output};
 
 /// `identify cascade` of Example 1's structure (4-parameter hysteresis, n = m = 2, delay 1)
@@ -23,6 +24,13 @@ pub const IDENTIFY_CASCADE: [&str; 14] = [
     "--delay",
     "1",
 ];
+
+/// The JSON document (a report or a model file) the run wrote at `path`.
+pub fn read_json(path: impl AsRef<Path>) -> serde_json::Value {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
 
 /// A command running the `hysid` binary that Cargo built for these tests.
 pub fn hysid() -> Command {

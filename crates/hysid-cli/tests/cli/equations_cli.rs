@@ -2,7 +2,7 @@
 //! on the benchmark's estimation record, saved, and re-simulated by `hysid simulate` on the
 //! validation record; and the one-line errors of a bad file or of two models.
 
-use crate::common::{hysid, one_line_error, Assert};
+use crate::common::{hysid, one_line_error, read_json, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
@@ -12,7 +12,7 @@ fn root() -> PathBuf {
 }
 
 fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
+    read_json(path)
 }
 
 /// Fit with multi-start, sensitivity table, residual tests, plots, report and model file;

@@ -1,7 +1,7 @@
 //! The exit-code table (0 success, 1 bad input, 2 usage, 3 numerical failure, 4 I/O) and
 //! one-line errors, usage errors included; `simulate`'s all-or-nothing outputs.
 
-use crate::common::{fails_with, hysid, Assert};
+use crate::common::{fails_with, hysid, read_json, Assert};
 use std::fs;
 use std::path::Path;
 
@@ -184,8 +184,7 @@ fn simulate_refuses_to_write_over_its_input_and_commits_both_outputs() {
         .arg(&json)
         .assert()
         .success();
-    let report: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     assert_eq!(report["data"]["samples"], 300);
     // The true model on its own noisy data: the fit is that of Example 1 (SNR 50).
     let fit = report["fit"]["fit_percent"].as_f64().unwrap();

@@ -3,7 +3,7 @@
 //! invalid physics, progress goes to stderr only, and `--time-limit` stops a search with its
 //! best result reported as such.
 
-use crate::common::{fails_with, hysid, Assert, IDENTIFY_CASCADE};
+use crate::common::{fails_with, hysid, read_json, Assert, IDENTIFY_CASCADE};
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -251,7 +251,7 @@ fn a_time_limit_keeps_the_best_result_and_says_so() {
     assert_eq!(out.status.code(), Some(0), "{stderr}");
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(stderr.starts_with("warning: the time limit"), "{stderr}");
-    let report: serde_json::Value = serde_json::from_slice(&fs::read(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     assert_eq!(report["search"]["termination"]["code"], "time_limit");
     assert_eq!(report["search"]["termination"]["converged"], false);
 }
@@ -291,7 +291,7 @@ fn a_time_limit_stops_an_operator_fit_and_a_comparison() {
                 .any(|l| l.starts_with("warning: the time limit")),
             "{command:?}: {stderr}"
         );
-        let report: serde_json::Value = serde_json::from_slice(&fs::read(&json).unwrap()).unwrap();
+        let report = read_json(&json);
         if command[0] == "compare" {
             // No single search: the family the limit stopped says so in its row.
             let rows = report["details"]["families"].as_array().unwrap();
@@ -331,7 +331,7 @@ fn a_time_limit_stops_the_cascade_grid_with_a_result() {
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert_eq!(out.status.code(), Some(0), "{stderr}");
     assert!(stderr.starts_with("warning: the time limit"), "{stderr}");
-    let report: serde_json::Value = serde_json::from_slice(&fs::read(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     assert_eq!(report["search"]["termination"]["code"], "time_limit");
     assert!(report["fit"]["fit_percent"].as_f64().unwrap().is_finite());
 }
@@ -396,7 +396,7 @@ fn the_cascade_estimate_keeps_alpha_inside_the_rate_limit_of_its_data() {
         .arg(&json)
         .assert()
         .success();
-    let report: serde_json::Value = serde_json::from_slice(&fs::read(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     let alpha = report["model"]["parameters"]
         .as_array()
         .unwrap()

@@ -1,7 +1,7 @@
 //! `hysid identify cascade --hysteresis FAMILY` with an operator family: a simulated backlash
 //! cascade is recovered, its model file simulates to the report's fit, bad names are one line.
 
-use crate::common::{hysid, Assert};
+use crate::common::{hysid, read_json, Assert};
 use hysid::model::operators::{Backlash, Orientation};
 use hysid::model::{CascadeOperator, LinearBlock, OperatorCascade};
 use std::fs;
@@ -10,7 +10,7 @@ use std::process::Command;
 use tempfile::TempDir;
 
 fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
+    read_json(path)
 }
 
 /// Backlash (g = 1.7, r = 0.437, c = −0.3) followed by y(t) = 1.2 y(t−1) − 0.5 y(t−2) +

@@ -2,7 +2,7 @@
 //! that `hysid simulate` reproduces, `compare` on the piezo record, `compensate`, and bad input
 //! (one line on stderr, the documented exit code, no panic).
 
-use crate::common::{hysid, Assert};
+use crate::common::{hysid, read_json, Assert};
 use hysid::model::operators::{Dahl, HysteresisOperator};
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -16,10 +16,6 @@ fn repo_data(rel: &str) -> PathBuf {
 
 fn piezo() -> PathBuf {
     repo_data("piezo/piezo_150V_1Hz.csv")
-}
-
-fn read_json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&fs::read_to_string(path).unwrap()).unwrap()
 }
 
 /// A clockwise friction loop from a known Dahl operator (σ = 12, F_c = 2, i = 1.8) over the
