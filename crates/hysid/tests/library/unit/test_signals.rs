@@ -1,5 +1,6 @@
-//! Test signals shared by the operators' tests.
+//! Test signals and checks shared by the operators' tests.
 
+use hysid::model::ParameterSet;
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 use rand_distr::Normal;
@@ -22,4 +23,21 @@ pub fn with_noise(y: &[f64], snr_db: f64, seed: u64) -> Vec<f64> {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let normal = Normal::new(0.0, sd).unwrap();
     y.iter().map(|v| v + rng.sample(normal)).collect()
+}
+
+/// Of the fitted parameters that have a standard deviation, how many lie within 3σ of the
+/// truth: (inside, with a standard deviation).
+pub fn within_three_sigma(
+    truth: &ParameterSet,
+    fitted: &ParameterSet,
+    std: &[Option<f64>],
+) -> (usize, usize) {
+    let mut counts = (0, 0);
+    for ((p, q), s) in truth.iter().zip(fitted.iter()).zip(std) {
+        if let Some(s) = s {
+            counts.1 += 1;
+            counts.0 += usize::from((p.value - q.value).abs() <= 3.0 * s);
+        }
+    }
+    counts
 }

@@ -27,7 +27,7 @@ fn check_recovery(m: &Dahl) {
     }
 }
 
-use crate::unit::test_signals::{nested_loops, with_noise};
+use crate::unit::test_signals::{nested_loops, with_noise, within_three_sigma};
 
 #[test]
 fn recovers_both_orientations_without_noise() {
@@ -43,17 +43,9 @@ fn noisy_estimates_lie_within_three_sigma() {
     let (mut inside, mut total) = (0, 0);
     for seed in 20..25 {
         let fit = fit(&u, &with_noise(&y, 40.0, seed), &DahlOptions::default()).unwrap();
-        for ((p, q), s) in m
-            .parameters()
-            .iter()
-            .zip(fit.parameters.iter())
-            .zip(&fit.std)
-        {
-            if let Some(s) = s {
-                total += 1;
-                inside += usize::from((p.value - q.value).abs() <= 3.0 * s);
-            }
-        }
+        let (i, n) = within_three_sigma(&m.parameters(), &fit.parameters, &fit.std);
+        inside += i;
+        total += n;
     }
     assert_eq!(total, 20);
     assert!(inside * 10 >= total * 9, "{inside}/{total}");

@@ -1,6 +1,6 @@
 //! Tests of `hysid::identify::operators::jiles_atherton`.
 
-use crate::unit::test_signals::{nested_loops, with_noise};
+use crate::unit::test_signals::{nested_loops, with_noise, within_three_sigma};
 use hysid::identify::operators::jiles_atherton::*;
 use hysid::model::operators::{HysteresisOperator, JilesAtherton, LoopOrientation};
 
@@ -45,17 +45,9 @@ fn noisy_estimates_lie_within_three_sigma() {
     for seed in 30..35 {
         let noisy = with_noise(&y, 40.0, seed);
         let fit = fit(&u, &noisy, &JilesAthertonOptions::default()).unwrap();
-        for ((p, q), s) in m
-            .parameters()
-            .iter()
-            .zip(fit.parameters.iter())
-            .zip(&fit.std)
-        {
-            if let Some(s) = s {
-                total += 1;
-                inside += usize::from((p.value - q.value).abs() <= 3.0 * s);
-            }
-        }
+        let (i, n) = within_three_sigma(&m.parameters(), &fit.parameters, &fit.std);
+        inside += i;
+        total += n;
     }
     assert_eq!(total, 30);
     assert!(inside * 10 >= total * 9, "{inside}/{total}");
