@@ -143,13 +143,9 @@ pub fn stream_sensitivities(
     free: &[usize],
     sink: &mut SensitivitySink<'_>,
 ) -> Result<()> {
-    let mut row = vec![0.0; free.len()];
     stream_sensitivity_blocks(cascade, x, h, free, &mut |block| {
-        for (i, yhat) in block.yhat.iter().enumerate() {
-            for (k, r) in row.iter_mut().enumerate() {
-                *r = block.columns[k * block.stride + i];
-            }
-            sink(block.start + i, std::slice::from_ref(yhat), &row);
+        for (i, row) in block.rows.chunks_exact(block.width).enumerate() {
+            sink(block.start + i, &row[..1], &row[1..]);
         }
     })
 }
@@ -169,16 +165,7 @@ pub fn stream_sensitivity_blocks(
         pipelined(cascade, x, h, free, sink)
     } else {
         let mut block = Block::new(free.len(), SEQUENTIAL_ROWS);
-        let failed = recursion(cascade, x, h, free, |t, yhat, row| {
-            if block.push(t, yhat, row) {
-                sink(&block.view());
-                block.len = 0;
-            }
-        });
-        if block.len > 0 {
-            sink(&block.view());
-        }
-        failed
+        recursion_into_blocks(cascade, x, h, free, &mut block, &mut |b| sink(&b.view()))
     };
     match failed {
         None => Ok(()),
@@ -189,15 +176,14 @@ pub fn stream_sensitivity_blocks(
     }
 }
 
-/// Rows `[ŷ, ∂ŷ/∂θ_free]` of consecutive samples gathered column by column, the storage
-/// behind a [`SensitivityBlock`]: the receiver then copies whole columns instead of one
-/// short row per sample.
+/// Rows `[ŷ, ∂ŷ/∂θ_free]` of consecutive samples, one after the other: the storage behind
+/// a [`SensitivityBlock`].
 struct Block {
     start: usize,
     len: usize,
     capacity: usize,
-    yhat: Vec<f64>,
-    columns: Vec<f64>,
+    width: usize,
+    rows: Vec<f64>,
 }
 
 impl Block {
@@ -207,8 +193,8 @@ impl Block {
             start: 0,
             len: 0,
             capacity,
-            yhat: vec![0.0; capacity],
-            columns: vec![0.0; capacity * width],
+            width: 1 + width,
+            rows: vec![0.0; capacity * (1 + width)],
         }
     }
 
@@ -218,20 +204,26 @@ impl Block {
         if self.len == 0 {
             self.start = t;
         }
-        self.yhat[self.len] = yhat;
-        for (k, &v) in row.iter().enumerate() {
-            self.columns[k * self.capacity + self.len] = v;
-        }
+        let at = self.len * self.width;
+        self.rows[at] = yhat;
+        self.rows[at + 1..at + self.width].copy_from_slice(row);
         self.len += 1;
         self.len == self.capacity
+    }
+
+    /// Calls `on_row(t, ŷ(t), ∂ŷ(t)/∂θ_free)` for every row held.
+    fn each_row(&self, on_row: &mut impl FnMut(usize, f64, &[f64])) {
+        let rows = self.rows[..self.len * self.width].chunks_exact(self.width);
+        for (i, row) in rows.enumerate() {
+            on_row(self.start + i, row[0], &row[1..]);
+        }
     }
 
     fn view(&self) -> SensitivityBlock<'_> {
         SensitivityBlock {
             start: self.start,
-            yhat: &self.yhat[..self.len],
-            columns: &self.columns,
-            stride: self.capacity,
+            rows: &self.rows[..self.len * self.width],
+            width: self.width,
         }
     }
 }
@@ -253,17 +245,11 @@ pub fn pipelined(
         let producer = scope.spawn(move || {
             let fresh = || Block::new(width, BLOCK_ROWS);
             let mut block = empty_rx.recv().unwrap_or_else(|_| fresh());
-            let failed = recursion(cascade, x, h, free, |t, yhat, row| {
-                if block.push(t, yhat, row) {
-                    let next = empty_rx.recv().unwrap_or_else(|_| fresh());
-                    // A send fails only when the consumer is gone; the rows are then unwanted.
-                    let _ = full_tx.send(std::mem::replace(&mut block, next));
-                }
-            });
-            if block.len > 0 {
-                let _ = full_tx.send(block);
-            }
-            failed
+            recursion_into_blocks(cascade, x, h, free, &mut block, &mut |full| {
+                let next = empty_rx.recv().unwrap_or_else(|_| fresh());
+                // A send fails only when the consumer is gone; the rows are then unwanted.
+                let _ = full_tx.send(std::mem::replace(full, next));
+            })
         });
         consume(full_rx, empty_tx, width, sink);
         match producer.join() {
@@ -302,10 +288,36 @@ pub fn recursion(
     free: &[usize],
     mut on_row: impl FnMut(usize, f64, &[f64]),
 ) -> Option<usize> {
-    match fixed::recursion(cascade, x, h, free, &mut on_row) {
-        Some(failed) => failed,
-        None => recursion_generic(cascade, x, h, free, on_row),
+    let mut block = Block::new(free.len(), SEQUENTIAL_ROWS);
+    recursion_into_blocks(cascade, x, h, free, &mut block, &mut |b| {
+        b.each_row(&mut on_row)
+    })
+}
+
+/// The sensitivity recursion written into `block`, every full block (and the last one)
+/// handed to `on_block`, which may replace it by an empty one; returns the first sample
+/// whose output is not finite.
+fn recursion_into_blocks(
+    cascade: &HysteresisCascade,
+    x: &[f64],
+    h: Option<&[bool]>,
+    free: &[usize],
+    block: &mut Block,
+    on_block: &mut dyn FnMut(&mut Block),
+) -> Option<usize> {
+    if let Some(failed) = fixed::recursion_blocks(cascade, x, h, free, block, on_block) {
+        return failed;
     }
+    let failed = recursion_generic(cascade, x, h, free, |t, yhat, row| {
+        if block.push(t, yhat, row) {
+            on_block(block);
+            block.len = 0;
+        }
+    });
+    if block.len > 0 {
+        on_block(block);
+    }
+    failed
 }
 
 /// [`recursion`] for any shape (widths known only at run time).

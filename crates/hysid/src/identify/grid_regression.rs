@@ -150,40 +150,10 @@ impl<'a> EquationError<'a> {
 
     /// ψ, one signal after the other (ψᵢ(t) at `psi[i·N + t]`), as in the module docs.
     fn basis_signals(&self, alpha: f64, d: f64, psi: &mut [f64]) {
-        let (x, n) = (self.x, self.len());
-        let mut past = [0.0; 4];
-        let mut u = [0.0; 4];
-        for i in 0..self.nl {
-            psi[i * n] = 0.0;
-        }
-        for t in 1..n {
-            let dx = x[t] - x[t - 1];
-            let adx = dx.abs();
-            let h = switching(x[t], d);
-            let sgn = if x[t] > 0.0 {
-                1.0
-            } else if x[t] < 0.0 {
-                -1.0
-            } else {
-                0.0
-            };
-            let decay = 1.0 - alpha * adx;
-            match self.form {
-                ChForm::Saturated4 => {
-                    u[0] = alpha * adx * (x[t] * (1.0 - h) + d * sgn * h);
-                    u[1] = (1.0 - h) * dx;
-                }
-                ChForm::General6 => {
-                    u[0] = alpha * adx * (x[t] * (1.0 - h) + d * sgn * h);
-                    u[1] = alpha * adx * (x[t] * h - d * sgn * h);
-                    u[2] = (1.0 - h) * dx;
-                    u[3] = h * dx;
-                }
-            }
-            for (i, (p, ui)) in past[..self.nl].iter_mut().zip(&u).enumerate() {
-                *p = decay * *p + ui;
-                psi[i * n + t] = *p;
-            }
+        let x = &self.x[..self.len()];
+        match self.form {
+            ChForm::Saturated4 => basis_signals::<2>(x, alpha, d, psi),
+            ChForm::General6 => basis_signals::<4>(x, alpha, d, psi),
         }
     }
 
@@ -239,6 +209,45 @@ impl<'a> EquationError<'a> {
             }
         }
         dot(r, r)
+    }
+}
+
+/// ψ of the module docs for NL = 2 (ch4) or 4 (ch6) material coefficients, signal i at
+/// `psi[i·N + t]`. NL is a constant so that the recursions' states stay in registers.
+fn basis_signals<const NL: usize>(x: &[f64], alpha: f64, d: f64, psi: &mut [f64]) {
+    let n = x.len();
+    let mut columns = psi.chunks_exact_mut(n);
+    let mut columns: [&mut [f64]; NL] =
+        std::array::from_fn(|_| columns.next().expect("NL signals"));
+    let mut past = [0.0; NL];
+    for column in &mut columns {
+        column[0] = 0.0;
+    }
+    for t in 1..n {
+        let dx = x[t] - x[t - 1];
+        let adx = dx.abs();
+        let h = switching(x[t], d);
+        let sgn = if x[t] > 0.0 {
+            1.0
+        } else if x[t] < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        let decay = 1.0 - alpha * adx;
+        let mut u = [0.0; NL];
+        u[0] = alpha * adx * (x[t] * (1.0 - h) + d * sgn * h);
+        if NL == 2 {
+            u[1] = (1.0 - h) * dx;
+        } else {
+            u[1] = alpha * adx * (x[t] * h - d * sgn * h);
+            u[2] = (1.0 - h) * dx;
+            u[3] = h * dx;
+        }
+        for ((p, ui), column) in past.iter_mut().zip(&u).zip(&mut columns) {
+            *p = decay * *p + ui;
+            column[t] = *p;
+        }
     }
 }
 

@@ -39,35 +39,32 @@ use gram::Accumulator;
 /// `(t, ŷ(t) [n_y], ∂ŷ(t)/∂θ_free [n_y × n_free, row-major])`.
 pub type SensitivitySink<'a> = dyn FnMut(usize, &[f64], &[f64]) + 'a;
 
-/// Consecutive samples of a single-output model's simulation with its sensitivities, column
-/// by column: the same rows a [`SensitivitySink`] would see one at a time, handed over in
-/// blocks so that the receiver works on contiguous columns (a vectorised copy into the
-/// Gram block) instead of a call per sample.
+/// Consecutive samples of a single-output model's simulation with its sensitivities: the
+/// same rows a [`SensitivitySink`] would see one at a time, handed over in blocks so that the
+/// receiver works on a run of rows instead of a call per sample.
 pub struct SensitivityBlock<'a> {
     /// Sample index of the block's first row.
     pub start: usize,
-    /// ŷ(t) for t = start … start + len − 1.
-    pub yhat: &'a [f64],
-    /// ∂ŷ(t)/∂θ_free\[k\] at `columns[k · stride + t − start]`.
-    pub columns: &'a [f64],
-    /// Distance between consecutive columns in `columns` (≥ the number of rows).
-    pub stride: usize,
+    /// The rows `[ŷ(t), ∂ŷ(t)/∂θ_free]` for t = start, start + 1, …, one after the other.
+    pub rows: &'a [f64],
+    /// Length of a row: 1 + the number of free parameters.
+    pub width: usize,
 }
 
 impl SensitivityBlock<'_> {
     /// Number of rows (samples) in the block.
     pub fn len(&self) -> usize {
-        self.yhat.len()
+        self.rows.len() / self.width
     }
 
     /// True when the block has no rows.
     pub fn is_empty(&self) -> bool {
-        self.yhat.is_empty()
+        self.rows.is_empty()
     }
 
-    /// The sensitivities to free parameter `k` over the block's rows.
-    pub fn column(&self, k: usize) -> &[f64] {
-        &self.columns[k * self.stride..k * self.stride + self.len()]
+    /// ŷ of row `i` (sample `start + i`).
+    pub fn yhat(&self, i: usize) -> f64 {
+        self.rows[i * self.width]
     }
 }
 
@@ -663,13 +660,17 @@ impl<'a> OutputErrorProblem<'a> {
             r.extend(
                 y[t0..block.start + block.len()]
                     .iter()
-                    .zip(&block.yhat[first..])
+                    .zip(
+                        block.rows[first * block.width..]
+                            .iter()
+                            .step_by(block.width),
+                    )
                     .map(|(y, yhat)| w * (y - yhat)),
             );
             if let Some(out) = residuals.as_deref_mut() {
                 out[t0 - skip..t0 - skip + r.len()].copy_from_slice(&r);
             }
-            acc.add_rows(-w, block.columns, block.stride, first, &r);
+            acc.add_rows(-w, block.rows, block.width, first, &r);
         };
         let outcome = self
             .model

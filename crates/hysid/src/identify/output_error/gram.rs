@@ -64,19 +64,21 @@ impl Accumulator {
         }
     }
 
-    /// Adds the rows `from … from + r.len() − 1` of the column-major rows `columns` (column
-    /// k at `k · stride`), each scaled by `scale`, with residuals `r`: the same rows as that
-    /// many calls of [`add_scaled`](Self::add_scaled), copied a column at a time.
+    /// Adds the rows `from … from + r.len() − 1` of `rows` (row-major, `width` values per
+    /// row, of which the last p are the row of J), each scaled by `scale`, with residuals
+    /// `r`: the same rows as that many calls of [`add_scaled`](Self::add_scaled).
     #[doc(hidden)] // reached by the white-box tests in tests/library/unit
-    pub fn add_rows(&mut self, scale: f64, columns: &[f64], stride: usize, from: usize, r: &[f64]) {
+    pub fn add_rows(&mut self, scale: f64, rows: &[f64], width: usize, from: usize, r: &[f64]) {
+        let lead = width - self.p;
         let mut done = 0;
         while done < r.len() {
             let take = (BLOCK_ROWS - self.rows).min(r.len() - done);
             let (at, src) = (self.rows, from + done);
-            for (k, column) in self.block.chunks_exact_mut(BLOCK_ROWS).enumerate() {
-                let source = &columns[k * stride + src..k * stride + src + take];
-                for (d, v) in column[at..at + take].iter_mut().zip(source) {
-                    *d = scale * v;
+            let source = rows[src * width..(src + take) * width].chunks_exact(width);
+            for (i, row) in source.enumerate() {
+                let columns = self.block.chunks_exact_mut(BLOCK_ROWS);
+                for (column, v) in columns.zip(&row[lead..]) {
+                    column[at + i] = scale * v;
                 }
             }
             for (d, &v) in self.residuals[at..at + take]

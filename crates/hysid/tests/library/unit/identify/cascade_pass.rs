@@ -91,9 +91,8 @@ fn pipelined_rows_equal_sequential_rows() {
     });
     let mut piped = Vec::new();
     let failed = pipelined(&ex.truth, &x, None, &free, &mut |block| {
-        for (i, &yhat) in block.yhat.iter().enumerate() {
-            let row: Vec<f64> = (0..free.len()).map(|k| block.column(k)[i]).collect();
-            piped.push((block.start + i, yhat, row));
+        for (i, row) in block.rows.chunks_exact(block.width).enumerate() {
+            piped.push((block.start + i, row[0], row[1..].to_vec()));
         }
     });
     assert_eq!(failed, None);

@@ -57,15 +57,14 @@ fn block_rows_equal_single_rows() {
         let (mut start, mut len) = (0, 7);
         while start < n {
             let end = (start + len).min(n);
-            let stride = end - start + 3;
-            let mut columns = vec![f64::NAN; p * stride];
-            for (i, row) in rows[start..end].iter().enumerate() {
-                for (k, v) in row.iter().enumerate() {
-                    columns[k * stride + i] = *v;
-                }
+            // Two leading values per row that are not part of J (as ŷ in a sensitivity block).
+            let width = p + 2;
+            let mut block = vec![f64::NAN; width * (end - start)];
+            for (out, row) in block.chunks_exact_mut(width).zip(&rows[start..end]) {
+                out[2..].copy_from_slice(row);
             }
             let from = skip.saturating_sub(start).min(end - start);
-            blocks.add_rows(-0.5, &columns, stride, from, &res[start + from..end]);
+            blocks.add_rows(-0.5, &block, width, from, &res[start + from..end]);
             start = end;
             len = len * 3 + 1;
         }
