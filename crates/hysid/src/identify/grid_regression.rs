@@ -176,18 +176,26 @@ impl<'a> EquationError<'a> {
     fn normal_equations(&self, s: &mut Scratch) {
         let (na, cols) = (self.na, self.cols());
         let target = &self.y[self.t0..self.len()];
+        let mut partners: Vec<&[f64]> = Vec::with_capacity(cols + 1);
+        let mut products = vec![0.0; cols + 1];
         for c in 0..cols {
             let (col, sign) = self.column(c, &s.psi);
-            for c2 in c.max(na)..cols {
-                let (col2, sign2) = self.column(c2, &s.psi);
-                let g = sign * sign2 * dot(col, col2);
+            // Column c against every later ψ column, and against y once c is a ψ column.
+            partners.clear();
+            partners.extend((c.max(na)..cols).map(|c2| self.column(c2, &s.psi).0));
+            if c >= na {
+                partners.push(target);
+            }
+            dots(col, &partners, &mut products[..partners.len()]);
+            for (c2, &product) in (c.max(na)..cols).zip(&products) {
+                let g = sign * self.column(c2, &s.psi).1 * product;
                 s.gram[c * cols + c2] = g;
                 s.gram[c2 * cols + c] = g;
             }
             s.rhs[c] = if c < na {
                 self.lag_rhs[c]
             } else {
-                dot(col, target)
+                products[partners.len() - 1]
             };
         }
         for a in 0..na {
@@ -253,20 +261,46 @@ fn basis_signals<const NL: usize>(x: &[f64], alpha: f64, d: f64, psi: &mut [f64]
 
 /// Σ aᵢbᵢ with four partial sums (independent chains the compiler can vectorise).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = ca
-        .remainder()
-        .iter()
-        .zip(cb.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    for (x, y) in ca.zip(cb) {
-        for ((acc, x), y) in acc.iter_mut().zip(x).zip(y) {
-            *acc += x * y;
+    dot_group::<1>(a, [b])[0]
+}
+
+/// `out[j]` = [`dot`]`(a, b[j])`, the dot products taken four at a time: a is read once for
+/// four of them and their partial sums are sixteen independent chains. Each product is
+/// summed exactly as [`dot`] sums it.
+fn dots(a: &[f64], b: &[&[f64]], out: &mut [f64]) {
+    let mut quads = b.chunks_exact(4);
+    let mut results = out.chunks_exact_mut(4);
+    for (group, result) in quads.by_ref().zip(results.by_ref()) {
+        result.copy_from_slice(&dot_group::<4>(a, [group[0], group[1], group[2], group[3]]));
+    }
+    for (b, result) in quads.remainder().iter().zip(results.into_remainder()) {
+        *result = dot(a, b);
+    }
+}
+
+/// [`dot`] of `a` with each of K vectors, in one pass over a.
+#[inline(always)]
+fn dot_group<const K: usize>(a: &[f64], b: [&[f64]; K]) -> [f64; K] {
+    let n = b.iter().fold(a.len(), |n, b| n.min(b.len()));
+    let body = n / 4 * 4;
+    let mut acc = [[0.0; 4]; K];
+    for i in (0..body).step_by(4) {
+        let x: &[f64; 4] = a[i..i + 4].try_into().expect("four values");
+        for (acc, b) in acc.iter_mut().zip(&b) {
+            let y: &[f64; 4] = b[i..i + 4].try_into().expect("four values");
+            for ((acc, x), y) in acc.iter_mut().zip(x).zip(y) {
+                *acc += x * y;
+            }
         }
     }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+    std::array::from_fn(|k| {
+        let tail: f64 = a[body..n]
+            .iter()
+            .zip(&b[k][body..n])
+            .map(|(x, y)| x * y)
+            .sum();
+        (acc[k][0] + acc[k][1]) + (acc[k][2] + acc[k][3]) + tail
+    })
 }
 
 /// Solves A z = b in place (b becomes z) for a symmetric positive definite `n × n` row-major
