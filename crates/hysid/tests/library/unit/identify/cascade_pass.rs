@@ -28,8 +28,8 @@ fn simulation_matches_the_model_bit_for_bit() {
 }
 
 /// The fixed-width passes are bit-identical to the generic ones for every instantiated
-/// shape (ch4 and ch6, n ≤ 3, m ≤ 3, delays 1 and 3), with and without a frozen switching,
-/// and decline the shapes they do not cover (n = 4).
+/// shape (ch4 and ch6, n ≤ 3, m ≤ 3, delays 1 and 3), with every parameter free or some,
+/// with and without a frozen switching, and decline the shapes they do not cover (n = 4).
 #[test]
 fn fixed_width_passes_equal_generic_passes() {
     use hysid::model::{ColemanHodgdon, LinearBlock};
@@ -50,14 +50,17 @@ fn fixed_width_passes_equal_generic_passes() {
                         HysteresisCascade::new(ch.clone(), LinearBlock::new(a, b, delay).unwrap())
                             .unwrap();
                     let p = cascade.params().len();
-                    let free: Vec<usize> = (0..p).rev().step_by(2).collect();
-                    for frozen in [None, Some(h.as_slice())] {
+                    // Every parameter free (rows written whole) and some (columns picked).
+                    let all: Vec<usize> = (0..p).collect();
+                    let some: Vec<usize> = (0..p).rev().step_by(2).collect();
+                    for (free, frozen) in [(&all, None), (&some, None), (&some, Some(h.as_slice()))]
+                    {
                         let mut generic = Vec::new();
-                        let g = recursion_generic(&cascade, &x, frozen, &free, |t, y, r| {
+                        let g = recursion_generic(&cascade, &x, frozen, free, |t, y, r| {
                             generic.push((t, y, r.to_vec()))
                         });
                         let mut fast = Vec::new();
-                        let f = fixed::recursion(&cascade, &x, frozen, &free, |t, y, r| {
+                        let f = fixed::recursion(&cascade, &x, frozen, free, |t, y, r| {
                             fast.push((t, y, r.to_vec()))
                         });
                         let (mut ys, mut yf) = (Vec::new(), Vec::new());
@@ -79,25 +82,28 @@ fn fixed_width_passes_equal_generic_passes() {
     }
 }
 
-/// The pipelined pass streams exactly the rows of the sequential one, in order.
+/// The pipelined pass streams exactly the rows of the sequential one, in order, with every
+/// parameter free and with some.
 #[test]
 fn pipelined_rows_equal_sequential_rows() {
     let ex = CascadeExample::example1().extended(PIPELINE_SAMPLES + 12_345);
     let x = ex.generate(2, false).unwrap().x;
-    let free = [0, 2, 3, 5];
-    let mut sequential = Vec::new();
-    recursion(&ex.truth, &x, None, &free, |t, yhat, row| {
-        sequential.push((t, yhat, row.to_vec()))
-    });
-    let mut piped = Vec::new();
-    let failed = pipelined(&ex.truth, &x, None, &free, &mut |block| {
-        for (i, row) in block.rows.chunks_exact(block.width).enumerate() {
-            piped.push((block.start + i, row[0], row[1..].to_vec()));
-        }
-    });
-    assert_eq!(failed, None);
-    assert_eq!(piped.len(), x.len());
-    assert!(piped == sequential);
+    let all: Vec<usize> = (0..ex.truth.params().len()).collect();
+    for free in [&all[..], &[0, 2, 3, 5]] {
+        let mut sequential = Vec::new();
+        recursion(&ex.truth, &x, None, free, |t, yhat, row| {
+            sequential.push((t, yhat, row.to_vec()))
+        });
+        let mut piped = Vec::new();
+        let failed = pipelined(&ex.truth, &x, None, free, &mut |block| {
+            for (i, row) in block.rows.chunks_exact(block.width).enumerate() {
+                piped.push((block.start + i, row[0], row[1..].to_vec()));
+            }
+        });
+        assert_eq!(failed, None);
+        assert_eq!(piped.len(), x.len());
+        assert!(piped == sequential);
+    }
 }
 
 /// A diverging simulation is reported at its first non-finite sample by both paths.
