@@ -3,9 +3,13 @@
 //! A decimal w·10^e with an integer w ≤ 2⁵³ and |e| ≤ 22 is the correctly rounded quotient
 //! (or product) of two doubles that are both exact, and IEEE 754 division and multiplication
 //! round correctly: one operation gives the same double as a full decimal-to-binary
-//! conversion (Clinger, "How to read floating point numbers accurately", PLDI 1990). Every
-//! other text (more digits, large exponents, `nan`, `inf`, a stray character) is left to the
-//! standard library's parser by returning `None`.
+//! conversion (Clinger, "How to read floating point numbers accurately", PLDI 1990). A wider
+//! w (the 17-digit numbers of full-precision output, up to 19 digits) is converted with
+//! exact integer arithmetic and one rounding instead (see `wide`). Every other text (more
+//! digits, large exponents, `nan`, `inf`, a stray character) is left to the standard
+//! library's parser by returning `None`.
+//!
+//! A double has one correctly rounded value, so every path gives the standard parser's bits.
 
 /// 10⁰ … 10²², all exact in binary64.
 const POWERS_OF_TEN: [f64; 23] = [
@@ -30,7 +34,7 @@ pub fn parse_fast(text: &[u8]) -> Option<f64> {
         Some((b'.', frac)) => digits(frac, mantissa)?,
         _ => (mantissa, 0, rest),
     };
-    if int_digits + frac_digits == 0 || mantissa > MAX_EXACT {
+    if int_digits + frac_digits == 0 {
         return None;
     }
     let exponent = match rest.split_first() {
@@ -39,14 +43,58 @@ pub fn parse_fast(text: &[u8]) -> Option<f64> {
         Some(_) => return None,
     };
     let e10 = exponent - frac_digits as i64;
-    let w = mantissa as f64;
-    let magnitude = match e10 {
-        0 => w,
-        1..=22 => w * POWERS_OF_TEN[e10 as usize],
-        -22..=-1 => w / POWERS_OF_TEN[(-e10) as usize],
-        _ => return None,
+    let magnitude = if mantissa <= MAX_EXACT {
+        clinger(mantissa, e10)?
+    } else {
+        wide(mantissa, e10)?
     };
     Some(if negative { -magnitude } else { magnitude })
+}
+
+/// w·10^e10 for w ≤ 2⁵³: one correctly rounded operation on exact doubles.
+fn clinger(w: u64, e10: i64) -> Option<f64> {
+    let w = w as f64;
+    match e10 {
+        0 => Some(w),
+        1..=22 => Some(w * POWERS_OF_TEN[e10 as usize]),
+        -22..=-1 => Some(w / POWERS_OF_TEN[(-e10) as usize]),
+        _ => None,
+    }
+}
+
+/// w·10^e10 correctly rounded for w > 2⁵³, where w itself is not exact as a double and one
+/// floating-point operation would round twice: the exact value is formed in integers and
+/// rounded once, by the conversion of a `u128` to `f64` (to nearest, ties to even).
+///
+/// For e10 ≥ 0 that is the product w·10^e10, when it fits in 128 bits. For e10 = −k < 0,
+/// w/10^k = (w/5^k)·2^−k: the quotient q = ⌊w·2^s / 5^k⌋ is taken with w·2^s ∈ [2¹²⁷, 2¹²⁸),
+/// so q ≥ 2¹²⁷/5²² > 2⁷⁵ has at least 22 bits below the 53 kept; a remainder is OR-ed into
+/// its last bit (sticky), which then rounds as the exact quotient would (that bit is below
+/// the half-unit the rounding compares with, and a nonzero remainder tips an exact tie up
+/// just as the true value does). Scaling by 2^−(s+k) is exact: the results lie far inside
+/// the normal range.
+fn wide(w: u64, e10: i64) -> Option<f64> {
+    match e10 {
+        0..=22 => {
+            let product = u128::from(w).checked_mul(10u128.pow(e10 as u32))?;
+            Some(product as f64)
+        }
+        -22..=-1 => {
+            let k = (-e10) as u32;
+            let shift = w.leading_zeros() + 64;
+            let scaled = u128::from(w) << shift;
+            let five_k = u128::from(5u64.pow(k));
+            let quotient = scaled / five_k;
+            let sticky = u128::from(scaled - quotient * five_k != 0);
+            Some((quotient | sticky) as f64 * power_of_two(-((shift + k) as i32)))
+        }
+        _ => None,
+    }
+}
+
+/// 2^e as a double, for a normal 2^e (|e| < 1023).
+fn power_of_two(e: i32) -> f64 {
+    f64::from_bits(((1023 + e) as u64) << 52)
 }
 
 /// Reads decimal digits onto `mantissa`: the new mantissa, the digit count and the rest.
