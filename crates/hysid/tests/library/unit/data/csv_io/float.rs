@@ -34,24 +34,32 @@ fn agrees_with_the_standard_parser() {
     );
 }
 
-/// Every group of eight digits, and groups with one non-digit anywhere, against the
-/// digit-by-digit value.
+/// Eight bytes starting with 0 to 8 digits, then anything, against the byte-by-byte count and
+/// value.
 #[test]
-fn eight_digit_groups() {
+fn digit_prefixes() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
-    for _ in 0..100_000 {
-        let n: u64 = rng.random_range(0..100_000_000);
-        let text = format!("{n:08}");
-        assert_eq!(eight_digits(text.as_bytes()), Some(n), "{text}");
-        let mut bad = text.into_bytes();
-        let at = rng.random_range(0..8);
-        bad[at] = *[b'/', b':', b'.', b'e', b' ', 0xB5]
-            .get(rng.random_range(0..6))
-            .unwrap();
-        assert_eq!(eight_digits(&bad), None, "{bad:?}");
+    let others = [b'/', b':', b'.', b'e', b' ', b',', 0x00, 0xB5, 0xFA, 0xFF];
+    for _ in 0..200_000 {
+        let n = rng.random_range(0..=8);
+        let bytes: [u8; 8] = std::array::from_fn(|i| {
+            if i < n || (i > n && rng.random::<bool>()) {
+                b'0' + rng.random_range(0..10u8)
+            } else {
+                others[rng.random_range(0..others.len())]
+            }
+        });
+        let value = bytes[..n]
+            .iter()
+            .fold(0, |v, &b| 10 * v + u64::from(b - b'0'));
+        let word = u64::from_le_bytes(bytes);
+        assert_eq!(digit_prefix(word), (value, n), "{bytes:?}");
     }
-    assert_eq!(eight_digits(b"99999999"), Some(99_999_999));
-    assert_eq!(eight_digits(b"00000000"), Some(0));
+    assert_eq!(
+        digit_prefix(u64::from_le_bytes(*b"99999999")),
+        (99_999_999, 8)
+    );
+    assert_eq!(digit_prefix(u64::from_le_bytes(*b"00000000")), (0, 8));
 }
 
 #[test]
@@ -156,11 +164,12 @@ fn midpoint(v: f64) -> (u128, usize) {
     }
 }
 
-/// Decimals w·10⁻²² whose quotient q = ⌊w·2⁶⁴/5²²⌋ (as the wide path forms it for w ≥ 2⁶³)
-/// lies exactly on a tie between two doubles while the remainder r is not zero: only the
-/// sticky bit rounds them up, as the exact value demands.
+/// Decimals w·10⁻²² just above a tie between two doubles, by less than 2⁻²² of the gap
+/// between them: truncated to 64 bits (or to anything short of 75), their quotient lands
+/// exactly on the tie, and only the sticky bit rounds them up, as the exact value demands.
 ///
-/// q ends in a one and t − 1 zeros (t the bits below the 53 kept) exactly when
+/// They are found through q = ⌊w·2⁶⁴/5²²⌋ for w ≥ 2⁶³ (76 or 77 bits, t of them below the
+/// 53 kept): q ends in a one and t − 1 zeros while the remainder r ≠ 0 exactly when
 /// r ≡ 2^(t−1) (mod 2^t), as w·2⁶⁴ ≡ 0 there and 5²² is odd; and r = w·2⁶⁴ mod 5²², so
 /// w ≡ r·(2⁶⁴)⁻¹ (mod 5²²).
 #[test]
@@ -199,4 +208,54 @@ fn inverse_mod(a: u128, m: u128) -> u128 {
     }
     assert_eq!(r0, 1);
     s0.rem_euclid(m as i128) as u128
+}
+
+/// Read in place, a number followed by a byte that cannot continue it (and anything after
+/// that) is what `parse_fast` makes of it alone; a number that runs on is not taken for the
+/// cell.
+#[test]
+fn prefixes_read_as_the_whole_cell() {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(17);
+    let cells = [
+        "0.4528957186046694",
+        "-0.05937734741544166",
+        "123456",
+        "9007199254740993",
+        "1.5e-7",
+        "+2E+22",
+        "7.",
+        ".5",
+        "1e",
+        "1e12345",
+        "12345678901234567890",
+        "1x",
+        "--1",
+        "",
+    ];
+    let enders = [",", "\n", "\r\n", " ", "\t", "\"", ";", "x"];
+    for _ in 0..20_000 {
+        let cell = if rng.random::<bool>() {
+            cells[rng.random_range(0..cells.len())].to_owned()
+        } else {
+            let v: f64 = (rng.random::<f64>() - 0.5) * 10f64.powi(rng.random_range(-9..9));
+            [format!("{v}"), format!("{v:e}"), format!("{v:.3}")][rng.random_range(0..3)].clone()
+        };
+        let ender = enders[rng.random_range(0..enders.len())];
+        // Digits after the ender fill the eight-byte words read past the cell.
+        let text = format!("{cell}{ender}{}", rng.random_range(0..u64::MAX));
+        let whole = parse_fast(cell.as_bytes());
+        let in_place = parse_prefix(text.as_bytes(), 0);
+        if let Some(v) = whole {
+            assert_eq!(
+                in_place.map(|(v, end)| (v.to_bits(), end)),
+                Some((v.to_bits(), cell.len())),
+                "{text:?}"
+            );
+        }
+        if let Some((v, end)) = in_place {
+            if end == cell.len() {
+                assert_eq!(whole.map(f64::to_bits), Some(v.to_bits()), "{text:?}");
+            }
+        }
+    }
 }
