@@ -36,16 +36,23 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use super::float;
+
 /// Data regions shorter than this are read sequentially: that takes a few milliseconds at
 /// most, and an unusual file would be read twice (chunks, then records) for nothing.
 #[doc(hidden)] // reached by the white-box tests in tests/library/unit
 pub const MIN_BYTES: u64 = 4 << 20;
 
-/// Bytes per chunk: large enough that the per-chunk costs (one read, one lock, a few small
-/// vectors) vanish next to the parsing, small enough to keep two threads evenly loaded and
-/// the chunks in flight a small fraction of the columns' memory.
+/// Bytes per chunk: large enough that the per-chunk costs (two reads, one lock) vanish next
+/// to the parsing, small enough that a chunk read stays in the core's cache until it is
+/// parsed, that the threads stay evenly loaded, and that the chunks in flight are a small
+/// fraction of the columns' memory.
 #[doc(hidden)] // reached by the white-box tests in tests/library/unit
-pub const CHUNK_BYTES: usize = 1 << 20;
+pub const CHUNK_BYTES: usize = 256 << 10;
+
+/// How far past its end a chunk reads first, which is enough to finish its last line unless
+/// that line is longer than this.
+const TAIL: usize = 4 << 10;
 
 /// How far past its end a chunk reads to finish its last line. A line that does not end by
 /// then (a row of more than 64 KiB) sends the file to the sequential path, which has no limit.
@@ -164,24 +171,20 @@ impl Chunks<'_> {
         let threads = rayon::current_num_threads().clamp(1, count);
         (0..threads).into_par_iter().for_each(|_| {
             let mut buffer = vec![0; self.chunk_bytes as usize + MAX_LINE + 2];
-            // Chunks hold about as many rows as the one before: reserving that many (and a
-            // little more) saves growing the vectors row by row.
-            let mut rows_hint = 0;
+            let mut part = vec![Vec::new(); self.line.wanted.len()];
             while !failed.load(Ordering::Relaxed) {
                 let index = next.fetch_add(1, Ordering::Relaxed);
                 if index >= count {
                     return;
                 }
-                match self.parse(index, &mut buffer, rows_hint) {
-                    Some(part) => {
-                        rows_hint = part.first().map_or(0, |c| c.len() + c.len() / 16);
-                        assembly
-                            .lock()
-                            .unwrap_or_else(|e| e.into_inner())
-                            .add(index, part);
-                    }
-                    None => failed.store(true, Ordering::Relaxed),
+                if self.parse(index, &mut buffer, &mut part).is_none() {
+                    failed.store(true, Ordering::Relaxed);
+                    return;
                 }
+                part = assembly
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .add(index, part);
             }
         });
         if failed.into_inner() {
@@ -192,43 +195,82 @@ impl Chunks<'_> {
         Some(assembly.columns)
     }
 
-    /// The wanted columns of the lines chunk `index` owns, read through `buffer` (at least
-    /// `chunk_bytes + MAX_LINE + 2` long); `rows_hint` rows are reserved.
-    fn parse(&self, index: usize, buffer: &mut [u8], rows_hint: usize) -> Option<Vec<Vec<f64>>> {
+    /// Pushes the wanted columns of the lines chunk `index` owns onto `columns` (empty), read
+    /// through `buffer` (at least `chunk_bytes + MAX_LINE + 2` long); None when the chunk is
+    /// not plain.
+    fn parse(&self, index: usize, buffer: &mut [u8], columns: &mut [Vec<f64>]) -> Option<()> {
+        let Some(window) = self.read(index, buffer)? else {
+            return Some(());
+        };
+        let mut at = window.first;
+        while at < window.owned {
+            at = self.line.parse(window.text, at, window.at_eof, columns)?;
+        }
+        Some(())
+    }
+
+    /// Reads chunk `index` into `buffer`, from one byte before it (none for the first chunk)
+    /// to past the end of its last line: its window, or `Some(None)` when no line starts in
+    /// it (it lies inside the file's last line, or inside a long one, which the chunk where
+    /// that line starts reads), or None when the read fails, the file has changed length or
+    /// the last line runs more than [`MAX_LINE`] bytes past the chunk.
+    fn read<'b>(&self, index: usize, buffer: &'b mut [u8]) -> Option<Option<Window<'b>>> {
         let begin = self.start + index as u64 * self.chunk_bytes;
         let end = (begin + self.chunk_bytes).min(self.len);
         // One byte before the chunk tells whether its first byte starts a line.
         let from = if index == 0 { begin } else { begin - 1 };
-        let to = (end + MAX_LINE as u64).min(self.len);
-        let at_eof = to == self.len;
-        // Reaching the end, ask for one byte more than the file should have: getting it
-        // means the file grew, and the sequential path is the one to read it.
-        let expected = (to - from) as usize;
-        let asked = expected + usize::from(at_eof);
-        let got = read_full(self.file, &mut buffer[..asked], from).ok()?;
-        if got != expected {
-            return None;
-        }
-        let text = &buffer[..expected];
         let owned = (end - from) as usize;
-        // (Not vec![…; n]: a clone of a vector does not keep its capacity.)
-        let mut columns: Vec<Vec<f64>> = (0..self.line.wanted.len())
-            .map(|_| Vec::with_capacity(rows_hint))
-            .collect();
-        // A chunk in which no line starts (it lies inside the file's last line, or inside a
-        // long one) owns nothing: the chunk where that line starts reads it.
-        let mut at = match index {
+        // A short reach past the end almost always holds the end of the last line; the rest
+        // of MAX_LINE is read only when it does not.
+        let mut filled = self.fill(buffer, from, 0, end + TAIL as u64)?;
+        let first = match index {
             0 => 0,
-            _ => match text.iter().position(|&b| b == b'\n') {
+            _ => match buffer[..owned].iter().position(|&b| b == b'\n') {
                 Some(newline) => newline + 1,
-                None => return Some(columns),
+                None => return Some(None),
             },
         };
-        while at < owned {
-            at = self.line.parse(text, at, at_eof, &mut columns)?;
+        // The chunk's last line is complete once a \n follows its last byte (or the file ends).
+        let finished = |text: &[u8]| {
+            from + text.len() as u64 == self.len || text[owned - 1..].contains(&b'\n')
+        };
+        if !finished(&buffer[..filled]) {
+            filled = self.fill(buffer, from, filled, end + MAX_LINE as u64)?;
+            if !finished(&buffer[..filled]) {
+                return None;
+            }
         }
-        Some(columns)
+        Some(Some(Window {
+            text: &buffer[..filled],
+            first,
+            owned,
+            at_eof: from + filled as u64 == self.len,
+        }))
     }
+
+    /// Reads the file from `from + filled` up to `to` (or its end) into `buffer[filled..]`,
+    /// where the bytes from `from` on go: the new number of bytes in `buffer`, or None when
+    /// the read fails or the file is not the length it was.
+    fn fill(&self, buffer: &mut [u8], from: u64, filled: usize, to: u64) -> Option<usize> {
+        let to = to.min(self.len);
+        let expected = (to - from) as usize;
+        // Reaching the end, ask for one byte more than the file should have: getting it
+        // means the file grew, and the sequential path is the one to read it.
+        let asked = expected + usize::from(to == self.len);
+        let got = read_full(self.file, &mut buffer[filled..asked], from + filled as u64).ok()?;
+        (filled + got == expected).then_some(expected)
+    }
+}
+
+/// The bytes a chunk reads: from the byte before it to past the end of its last line.
+struct Window<'b> {
+    text: &'b [u8],
+    /// Offset in `text` of the first line the chunk owns.
+    first: usize,
+    /// Offset in `text` of the chunk's end: the chunk owns the lines that start before it.
+    owned: usize,
+    /// Whether `text` runs to the end of the file, so the last line may end there.
+    at_eof: bool,
 }
 
 /// What a plain data line holds: its number of fields and the ones to parse.
@@ -255,34 +297,57 @@ impl Line<'_> {
         let mut next_wanted = 0;
         for field in 0..self.fields {
             let last = field + 1 == self.fields;
-            // Where the cell ends, and where what follows it begins.
-            let (cell_end, after) = match find_special(text, cell_start) {
-                Some(stop) => {
-                    match (text[stop], last) {
-                        (b',', false) | (b'\n', true) => (stop, stop + 1),
-                        (b'\r', true) if text.get(stop + 1) == Some(&b'\n') => (stop, stop + 2),
-                        // A quote, a bare \r, too many or too few fields.
-                        _ => return None,
-                    }
-                }
-                None if at_eof && last => (text.len(), text.len()),
-                // A line too long for the chunk, or too few fields in the file's last line.
-                None => return None,
+            let wanted = self.wanted.get(next_wanted) == Some(&field);
+            // Most wanted cells are a bare number: read in place, it ends where the cell does,
+            // and is then what csv_io::number gives for the cell (see float::parse_prefix).
+            let in_place = match wanted {
+                true => float::parse_prefix(text, cell_start).and_then(|(value, stop)| {
+                    let after = cell_end(text, stop, last, at_eof)?;
+                    value.is_finite().then_some((value, after))
+                }),
+                false => None,
             };
-            if self.wanted.get(next_wanted) == Some(&field) {
-                let cell = text[cell_start..cell_end].trim_ascii();
-                let value = super::number(cell).filter(|v| v.is_finite())?;
-                columns[next_wanted].push(value);
-                next_wanted += 1;
-            }
+            let after = match in_place {
+                Some((value, after)) => {
+                    columns[next_wanted].push(value);
+                    after
+                }
+                None => {
+                    // Find the cell's end, then (if wanted) trim and parse it as csv_io does.
+                    let stop = find_special(text, cell_start).unwrap_or(text.len());
+                    let after = cell_end(text, stop, last, at_eof)?;
+                    if wanted {
+                        let cell = text[cell_start..stop].trim_ascii();
+                        columns[next_wanted].push(super::number(cell).filter(|v| v.is_finite())?);
+                    }
+                    // csv skips empty lines, and so rows and line numbers part: not plain.
+                    if last && stop == at {
+                        return None;
+                    }
+                    after
+                }
+            };
+            next_wanted += usize::from(wanted);
             if last {
-                // csv skips empty lines, and so rows and line numbers part: not plain.
-                return (cell_end > at).then_some(after);
+                return Some(after);
             }
             cell_start = after;
         }
         // A header has at least one field.
         None
+    }
+}
+
+/// Where what follows a cell that stops at `text[stop]` begins, if it ends there as a plain
+/// cell does: at a `,` when it is not the line's last, else at a `\n`, a `\r\n` or, when
+/// `at_eof`, the end of `text`. None for anything else (a quote, a bare `\r`, a stray byte
+/// after a number, too many or too few fields, a line running past the buffer).
+fn cell_end(text: &[u8], stop: usize, last: bool, at_eof: bool) -> Option<usize> {
+    match (text.get(stop), last) {
+        (Some(b','), false) | (Some(b'\n'), true) => Some(stop + 1),
+        (Some(b'\r'), true) if text.get(stop + 1) == Some(&b'\n') => Some(stop + 2),
+        (None, true) if at_eof => Some(stop),
+        _ => None,
     }
 }
 
@@ -330,6 +395,9 @@ struct Assembly {
     next: usize,
     /// Finished chunks after `next`, waiting for it.
     waiting: BTreeMap<usize, Vec<Vec<f64>>>,
+    /// Appended chunks' vectors, emptied, for the next chunks to fill: reused, they keep
+    /// their memory, which freed and allocated again would be new pages to fault in.
+    spare: Vec<Vec<Vec<f64>>>,
 }
 
 impl Assembly {
@@ -339,18 +407,23 @@ impl Assembly {
             columns: vec![Vec::new(); width],
             next: 0,
             waiting: BTreeMap::new(),
+            spare: Vec::new(),
         }
     }
 
     /// Takes chunk `index`'s columns; appends them, and any waiting chunks now next in
-    /// line, freeing each as it goes.
-    fn add(&mut self, index: usize, part: Vec<Vec<f64>>) {
+    /// line. Returns empty vectors for the caller's next chunk.
+    fn add(&mut self, index: usize, part: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
+        let width = part.len();
         self.waiting.insert(index, part);
-        while let Some(part) = self.waiting.remove(&self.next) {
-            for (column, values) in self.columns.iter_mut().zip(part) {
-                column.extend_from_slice(&values);
+        while let Some(mut part) = self.waiting.remove(&self.next) {
+            for (column, values) in self.columns.iter_mut().zip(&mut part) {
+                column.extend_from_slice(values);
+                values.clear();
             }
+            self.spare.push(part);
             self.next += 1;
         }
+        self.spare.pop().unwrap_or_else(|| vec![Vec::new(); width])
     }
 }
