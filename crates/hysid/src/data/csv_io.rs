@@ -9,6 +9,10 @@
 //! number in the file, except [`Error::NonFinite`] (a cell reading `nan`, `inf`, ...),
 //! which names the column as `channel` and the zero-based data-row index as `index`: for a
 //! file without blank lines or multi-line quoted cells, that is the line number minus two.
+//!
+//! Long files of plain rows (one per line, no quotes) are read in parallel chunks; any other
+//! file, and any file with a bad row, is read record by record. Both give the same values,
+//! bit for bit, and the same errors.
 
 use std::fmt::Write as _;
 use std::fs::File;
@@ -160,13 +164,39 @@ impl IdData {
 /// Names are matched exactly first, then case-insensitively; a name that matches several
 /// columns is an error. See the [module documentation](self) for errors.
 pub fn read_columns(path: &Path, names: &[&str]) -> Result<(Vec<String>, Vec<Vec<f64>>)> {
+    let (header, columns, _) = read_columns_by(path, names, Rows::Auto)?;
+    Ok((header, columns))
+}
+
+/// Which way [`read_columns_by`] reads the rows.
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rows {
+    /// As [`read_columns`]: in parallel chunks when the file is long, rayon has two threads
+    /// or more and the platform has positioned reads; else sequentially.
+    Auto,
+    /// Sequentially (csv records), whatever the file.
+    Sequential,
+    /// In chunks of this many bytes whatever the file's length and the number of threads,
+    /// falling back to the sequential path as usual.
+    Chunked(usize),
+}
+
+/// [`read_columns`] the given way; also says whether the chunks read the rows (true) or the
+/// sequential path (false).
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub fn read_columns_by(
+    path: &Path,
+    names: &[&str],
+    rows: Rows,
+) -> Result<(Vec<String>, Vec<Vec<f64>>, bool)> {
     let mut table = Table::open(path)?;
     let indices = names
         .iter()
         .map(|name| table.find(name))
         .collect::<Result<Vec<_>>>()?;
-    let columns = table.read(&indices)?;
-    Ok((table.header, columns))
+    let (columns, chunked) = table.read_by(&indices, rows)?;
+    Ok((table.header, columns, chunked))
 }
 
 /// Writes `columns` under `headers` as a CSV file, replacing `path` atomically through the
@@ -269,6 +299,47 @@ impl Table {
 
     /// Parses the given columns of every remaining row.
     fn read(&mut self, indices: &[usize]) -> Result<Vec<Vec<f64>>> {
+        Ok(self.read_by(indices, Rows::Auto)?.0)
+    }
+
+    /// [`Self::read`] the given way: the columns, and whether the chunks read them.
+    fn read_by(&mut self, indices: &[usize], rows: Rows) -> Result<(Vec<Vec<f64>>, bool)> {
+        match self.read_chunks(indices, rows) {
+            Some(columns) => Ok((columns, true)),
+            None => Ok((self.read_records(indices)?, false)),
+        }
+    }
+
+    /// The columns read by [`chunks`], or None when that path does not apply or gives up;
+    /// the csv reader is left after the header either way.
+    #[cfg(unix)]
+    fn read_chunks(&self, indices: &[usize], rows: Rows) -> Option<Vec<Vec<f64>>> {
+        let (chunk_bytes, min_bytes) = match rows {
+            Rows::Auto if rayon::current_num_threads() >= 2 => {
+                (chunks::CHUNK_BYTES, chunks::MIN_BYTES)
+            }
+            Rows::Chunked(chunk_bytes) => (chunk_bytes, 0),
+            Rows::Auto | Rows::Sequential => return None,
+        };
+        chunks::read(
+            self.reader.get_ref(),
+            self.reader.position().byte(),
+            self.header.len(),
+            indices,
+            chunk_bytes,
+            min_bytes,
+        )
+    }
+
+    /// Without positioned reads, every file takes the sequential path.
+    #[cfg(not(unix))]
+    fn read_chunks(&self, _indices: &[usize], _rows: Rows) -> Option<Vec<Vec<f64>>> {
+        None
+    }
+
+    /// Parses the given columns of every remaining csv record: the sequential path, which
+    /// reads any file and gives every error.
+    fn read_records(&mut self, indices: &[usize]) -> Result<Vec<Vec<f64>>> {
         let mut columns = vec![Vec::new(); indices.len()];
         // Records are reused batch after batch: no allocation per row.
         let mut row = 0;
@@ -304,15 +375,12 @@ impl Table {
         row: usize,
     ) -> Result<f64> {
         let cell = record.get(col).unwrap_or_default().trim_ascii();
-        // Most cells take the exact fast path; the rest (and every error) the full parser.
-        let value = float::parse_fast(cell)
-            .or_else(|| std::str::from_utf8(cell).ok()?.parse::<f64>().ok())
-            .ok_or_else(|| Error::NotNumeric {
-                path: path.to_path_buf(),
-                line: record.position().map_or(0, |p| p.line()),
-                column: one_line(&header[col]).into_owned(),
-                text: one_line(&String::from_utf8_lossy(cell)).into_owned(),
-            })?;
+        let value = number(cell).ok_or_else(|| Error::NotNumeric {
+            path: path.to_path_buf(),
+            line: record.position().map_or(0, |p| p.line()),
+            column: one_line(&header[col]).into_owned(),
+            text: one_line(&String::from_utf8_lossy(cell)).into_owned(),
+        })?;
         if !value.is_finite() {
             return Err(Error::NonFinite {
                 channel: one_line(&header[col]).into_owned(),
@@ -322,6 +390,13 @@ impl Table {
         }
         Ok(value)
     }
+}
+
+/// The number a trimmed cell holds, if any: the one parser of both reading paths, so that
+/// they give the same bits. Most cells take the exact fast path; the rest (and every error)
+/// the full parser.
+fn number(cell: &[u8]) -> Option<f64> {
+    float::parse_fast(cell).or_else(|| std::str::from_utf8(cell).ok()?.parse::<f64>().ok())
 }
 
 /// The mean step of a strictly increasing, uniform time column.
@@ -477,6 +552,9 @@ fn push_f64(out: &mut String, value: f64) {
     written.expect("writing to a String cannot fail");
 }
 
+#[cfg(unix)]
+#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+pub mod chunks;
 #[doc(hidden)] // reached by the white-box tests in tests/library/unit
 pub mod float;
 #[doc(hidden)] // reached by the white-box tests in tests/library/unit

@@ -1,5 +1,7 @@
 //! Tests of `hysid::data::csv_io`.
 
+#[cfg(unix)]
+mod chunks;
 mod float;
 mod pipeline;
 
