@@ -102,38 +102,14 @@ impl Accumulator {
         if n == 0 {
             return;
         }
-        let block = &self.block;
-        let column = |k: usize| &block[k * BLOCK_ROWS..k * BLOCK_ROWS + n];
+        let column = |k: usize| &self.block[k * BLOCK_ROWS..k * BLOCK_ROWS + n];
         for i in 0..p {
-            // Column i against its partners, two at a time: columns i … p − 1, then the
-            // residuals (partner p − i).
-            let partner = |m: usize| {
-                if i + m < p {
-                    column(i + m)
-                } else {
-                    &self.residuals[..n]
-                }
-            };
-            let mut m = 0;
-            while m <= p - i {
-                let width = if m < p - i { 2 } else { 1 };
-                let products = if width == 2 {
-                    dot_pair(column(i), [partner(m), partner(m + 1)])
-                } else {
-                    [dot(column(i), partner(m)), 0.0]
-                };
-                for (m, &product) in (m..m + width).zip(&products) {
-                    if i + m < p {
-                        let j = i + m;
-                        let g = product + self.jtj[i * p + j];
-                        self.jtj[i * p + j] = g;
-                        self.jtj[j * p + i] = g;
-                    } else {
-                        self.jtr[i] += product;
-                    }
-                }
-                m += width;
+            for j in i..p {
+                let g = dot(column(i), column(j)) + self.jtj[i * p + j];
+                self.jtj[i * p + j] = g;
+                self.jtj[j * p + i] = g;
             }
+            self.jtr[i] += dot(column(i), &self.residuals[..n]);
         }
         self.rows = 0;
     }
@@ -152,35 +128,21 @@ impl Accumulator {
 
 /// Σ aᵢbᵢ in the summation order of nalgebra's `Matrix::dot` (see the module docs).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    dot_pair(a, [b, b])[0]
-}
-
-/// [`dot`] of `a` with two vectors in one pass over a: sixteen independent partial sums
-/// instead of eight, each product summed exactly as [`dot`] sums it.
-#[inline(always)]
-fn dot_pair(a: &[f64], b: [&[f64]; 2]) -> [f64; 2] {
-    let n = a.len().min(b[0].len()).min(b[1].len());
-    let body = n / 8 * 8;
-    let mut acc = [[0.0; 8]; 2];
-    for i in (0..body).step_by(8) {
-        let x: &[f64; 8] = a[i..i + 8].try_into().expect("eight values");
-        for (acc, b) in acc.iter_mut().zip(&b) {
-            let y: &[f64; 8] = b[i..i + 8].try_into().expect("eight values");
-            for ((s, x), y) in acc.iter_mut().zip(x).zip(y) {
-                *s += x * y;
-            }
+    let mut acc = [0.0; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for ((s, x), y) in acc.iter_mut().zip(x).zip(y) {
+            *s += x * y;
         }
     }
-    std::array::from_fn(|k| {
-        let s = &acc[k];
-        let mut res = 0.0;
-        res += s[0] + s[4];
-        res += s[1] + s[5];
-        res += s[2] + s[6];
-        res += s[3] + s[7];
-        for (x, y) in a[body..n].iter().zip(&b[k][body..n]) {
-            res += x * y;
-        }
-        res
-    })
+    let mut res = 0.0;
+    res += acc[0] + acc[4];
+    res += acc[1] + acc[5];
+    res += acc[2] + acc[6];
+    res += acc[3] + acc[7];
+    for (x, y) in ra.iter().zip(rb) {
+        res += x * y;
+    }
+    res
 }
