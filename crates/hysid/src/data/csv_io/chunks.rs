@@ -73,11 +73,13 @@ pub(super) fn read(
     chunk_bytes: usize,
     min_bytes: u64,
 ) -> Option<Vec<Vec<f64>>> {
+    // The length first: a short file, a pipe or a device (length 0) goes no further.
     let len = file.metadata().ok()?.len();
-    let start = data_start(file, after_header)?;
-    if len.checked_sub(start)? < min_bytes.max(1) {
+    if len.saturating_sub(after_header) < min_bytes.max(1) {
         return None;
     }
+    let start = data_start(file, after_header)?;
+    let data_bytes = len.checked_sub(start).filter(|&bytes| bytes > 0)?;
     // Each column once, in field order: a line is then parsed in one pass over its fields.
     let mut wanted = indices.to_vec();
     wanted.sort_unstable();
@@ -86,7 +88,8 @@ pub(super) fn read(
         file,
         start,
         len,
-        chunk_bytes: chunk_bytes.max(1) as u64,
+        // No chunk longer than the data (nor a buffer for one).
+        chunk_bytes: (chunk_bytes as u64).clamp(1, data_bytes),
         line: Line {
             fields,
             wanted: &wanted,

@@ -157,7 +157,8 @@ fn digits(
         mantissa = mantissa * DIGIT_SCALES[n] + value;
         count += n;
         at += n;
-        if n < 8 {
+        // A run often ends right after a whole word (16-digit fractions): one byte says so.
+        if n < 8 || !text.get(at).is_some_and(u8::is_ascii_digit) {
             return Some((mantissa, count, at));
         }
     }
