@@ -41,8 +41,7 @@
 //! Hammerstein–Wiener nonlinear systems", Automatica 34(3), 1998 (over-parameterisation and
 //! rank-one factorisation).
 
-use super::grid_regression::EquationError;
-use crate::model::coleman_hodgdon::switching;
+use super::grid_regression::{self, EquationError};
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::numerics::nelder_mead::nelder_mead;
 use crate::numerics::Observer;
@@ -460,35 +459,10 @@ fn material_count(form: ChForm) -> usize {
 /// The basis signals ψᵢ (see the module docs) for fixed α and d.
 pub fn basis_signals(form: ChForm, x: &[f64], alpha: f64, d: f64) -> Vec<Vec<f64>> {
     let nl = material_count(form);
-    let mut psi = vec![vec![0.0; x.len()]; nl];
-    let mut u = vec![0.0; nl];
-    for t in 1..x.len() {
-        let dx = x[t] - x[t - 1];
-        let adx = dx.abs();
-        let h = switching(x[t], d);
-        let sgn = if x[t] > 0.0 {
-            1.0
-        } else if x[t] < 0.0 {
-            -1.0
-        } else {
-            0.0
-        };
-        let decay = 1.0 - alpha * adx;
-        match form {
-            ChForm::Saturated4 => {
-                u[0] = alpha * adx * (x[t] * (1.0 - h) + d * sgn * h);
-                u[1] = (1.0 - h) * dx;
-            }
-            ChForm::General6 => {
-                u[0] = alpha * adx * (x[t] * (1.0 - h) + d * sgn * h);
-                u[1] = alpha * adx * (x[t] * h - d * sgn * h);
-                u[2] = (1.0 - h) * dx;
-                u[3] = h * dx;
-            }
-        }
-        for (signal, ui) in psi.iter_mut().zip(&u) {
-            signal[t] = decay * signal[t - 1] + ui;
-        }
+    if x.is_empty() {
+        return vec![Vec::new(); nl];
     }
-    psi
+    let mut psi = vec![0.0; nl * x.len()];
+    grid_regression::basis_signals(form, x, alpha, d, &mut psi);
+    psi.chunks_exact(x.len()).map(<[f64]>::to_vec).collect()
 }

@@ -150,11 +150,7 @@ impl<'a> EquationError<'a> {
 
     /// ψ, one signal after the other (ψᵢ(t) at `psi[i·N + t]`), as in the module docs.
     fn basis_signals(&self, alpha: f64, d: f64, psi: &mut [f64]) {
-        let x = &self.x[..self.len()];
-        match self.form {
-            ChForm::Saturated4 => basis_signals::<2>(x, alpha, d, psi),
-            ChForm::General6 => basis_signals::<4>(x, alpha, d, psi),
-        }
+        basis_signals(self.form, &self.x[..self.len()], alpha, d, psi);
     }
 
     /// Column c of Φ over the rows t0…N−1, as a slice of y or ψ and the sign it carries
@@ -220,9 +216,18 @@ impl<'a> EquationError<'a> {
     }
 }
 
-/// ψ of the module docs for NL = 2 (ch4) or 4 (ch6) material coefficients, signal i at
-/// `psi[i·N + t]`. NL is a constant so that the recursions' states stay in registers.
-fn basis_signals<const NL: usize>(x: &[f64], alpha: f64, d: f64, psi: &mut [f64]) {
+/// ψ of the module docs for the hysteresis `form` over the non-empty input `x`, signal i at
+/// `psi[i·N + t]` (N = x.len(); `psi` holds 2 or 4 signals).
+pub(super) fn basis_signals(form: ChForm, x: &[f64], alpha: f64, d: f64, psi: &mut [f64]) {
+    match form {
+        ChForm::Saturated4 => basis_signals_of::<2>(x, alpha, d, psi),
+        ChForm::General6 => basis_signals_of::<4>(x, alpha, d, psi),
+    }
+}
+
+/// [`basis_signals`] for NL = 2 (ch4) or 4 (ch6) material coefficients. NL is a constant so
+/// that the recursions' states stay in registers.
+fn basis_signals_of<const NL: usize>(x: &[f64], alpha: f64, d: f64, psi: &mut [f64]) {
     let n = x.len();
     let mut columns = psi.chunks_exact_mut(n);
     let mut columns: [&mut [f64]; NL] =
