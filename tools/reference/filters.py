@@ -7,7 +7,7 @@ Generated with SciPy/NumPy, which implement MATLAB's definitions:
                                           == MATLAB filtfilt(b, a, x)
   * numpy.gradient(x, h)                  == MATLAB gradient(x, h)
 
-Run:  python3 tools/reference/filters.py > crates/hysid/tests/data/filter_reference.json
+Run:  python3 tools/reference/filters.py > crates/hysid-tests/tests/data/filter_reference.json
 Versions used for the committed file are written into it.
 """
 import json

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """MAT-file fixtures for hysid's .mat reader, made with SciPy's writer (MATLAB level 5 format).
 
-Writes crates/hysid/tests/data/piezo_150V_1Hz.mat from data/piezo/piezo_150V_1Hz.csv (the
+Writes crates/hysid-tests/tests/data/piezo_150V_1Hz.mat from data/piezo/piezo_150V_1Hz.csv (the
 real piezo record, see data/README.md for its source), compressed as MATLAB's default `save`
 (-v7) does, with:
   * t_s, voltage_V, displacement_um  the three columns as N×1 double vectors;
@@ -19,7 +19,7 @@ from scipy import io
 data = np.loadtxt("data/piezo/piezo_150V_1Hz.csv", delimiter=",", skiprows=1)
 t, v, d = data[:, 0], data[:, 1], data[:, 2]
 io.savemat(
-    "crates/hysid/tests/data/piezo_150V_1Hz.mat",
+    "crates/hysid-tests/tests/data/piezo_150V_1Hz.mat",
     {
         "t_s": t.reshape(-1, 1),
         "voltage_V": v.reshape(-1, 1),

@@ -599,7 +599,7 @@ fn mat_files_identify_like_the_csv_record() {
         let text = fs::read_to_string(json).unwrap();
         serde_json::from_str::<serde_json::Value>(&text).unwrap()
     };
-    let mat = root.join("crates/hysid/tests/data/piezo_150V_1Hz.mat");
+    let mat = root.join("crates/hysid-tests/tests/data/piezo_150V_1Hz.mat");
     let from_mat = identify(mat.clone(), "record(:,3)", &dir.path().join("m.json"));
     let from_csv = identify(
         root.join("data/piezo/piezo_150V_1Hz.csv"),

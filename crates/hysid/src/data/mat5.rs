@@ -171,21 +171,21 @@ impl<'a> Cursor<'a> {
     }
 }
 
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const INT8: u32 = 1;
 const UINT8: u32 = 2;
 const INT16: u32 = 3;
 const UINT16: u32 = 4;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const INT32: u32 = 5;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const UINT32: u32 = 6;
 const SINGLE: u32 = 7;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const DOUBLE: u32 = 9;
 const INT64: u32 = 12;
 const UINT64: u32 = 13;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const MATRIX: u32 = 14;
 const COMPRESSED: u32 = 15;
 

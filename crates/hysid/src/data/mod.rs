@@ -28,7 +28,7 @@ pub use mat_io::is_mat;
 const TS_MERGE_RTOL: f64 = 1e-9;
 
 /// Name given to the single experiment built by the convenience constructors.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const DEFAULT_EXPERIMENT_NAME: &str = "exp1";
 
 /// A named signal channel with a unit (`""` when unknown).
@@ -543,7 +543,7 @@ fn invalid(message: String) -> Error {
 
 /// `text` with control characters (newlines in particular) escaped, so that error messages
 /// built from names and cells found in files stay on one line.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn one_line(text: &str) -> Cow<'_, str> {
     if !text.chars().any(char::is_control) {
         return Cow::Borrowed(text);

@@ -314,7 +314,7 @@ impl CascadeIdentification {
     /// Stages 2–4 one after the other: the paper's iteration beside the grid candidates'
     /// refinement (independent, so side by side), the iteration's result refined, the best
     /// candidate's final fit.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn search_then_fit(
         &self,
         data: &IdData,
@@ -341,7 +341,7 @@ impl CascadeIdentification {
     /// (the first of equal minima is kept, and it comes last); only then is the early final
     /// fit dropped and the fit made again from it. The early fit reports its iterations to
     /// `callback` either way.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn search_and_fit_overlapped(
         &self,
         data: &IdData,
@@ -427,7 +427,7 @@ impl CascadeIdentification {
     }
 
     /// The first `window` samples of the first experiment.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn window_data(&self, data: &IdData) -> Result<IdData> {
         let exp = data.experiment(0);
         let n = exp.len().min(self.window.max(100));

@@ -36,12 +36,12 @@ use crate::model::HysteresisCascade;
 use crate::{Error, Result};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod fixed;
 
 /// Records at least this long are pipelined over two threads (shorter ones are not worth a
 /// thread: the window fits run hundreds of them, already in parallel).
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const PIPELINE_SAMPLES: usize = 1 << 16;
 
 /// Rows handed from the recursion thread to the sink per block.
@@ -94,7 +94,7 @@ pub fn simulate_into(cascade: &HysteresisCascade, x: &[f64], h: Option<&[bool]>,
 }
 
 /// [`simulate_into`] for any orders (lengths of A and B known only at run time).
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn simulate_generic(
     cascade: &HysteresisCascade,
     x: &[f64],
@@ -230,7 +230,7 @@ impl Block {
 
 /// The recursion on a second thread, its rows handed over in blocks; the sink runs on the
 /// calling thread. Three blocks circulate, so neither side allocates.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn pipelined(
     cascade: &HysteresisCascade,
     x: &[f64],
@@ -280,7 +280,7 @@ fn consume(
 
 /// The sensitivity recursion of the module docs, calling `on_row(t, ŷ(t), ∂ŷ(t)/∂θ_free)`
 /// for every sample; returns the first sample whose output is not finite.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn recursion(
     cascade: &HysteresisCascade,
     x: &[f64],
@@ -321,7 +321,7 @@ fn recursion_into_blocks(
 }
 
 /// [`recursion`] for any shape (widths known only at run time).
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn recursion_generic(
     cascade: &HysteresisCascade,
     x: &[f64],

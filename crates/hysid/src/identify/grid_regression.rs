@@ -310,7 +310,7 @@ fn dot_group<const K: usize>(a: &[f64], b: [&[f64]; K]) -> [f64; K] {
 
 /// Solves A z = b in place (b becomes z) for a symmetric positive definite `n × n` row-major
 /// A, overwritten by its Cholesky factor; None when A is not positive definite.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn cholesky_solve(a: &mut [f64], b: &mut [f64], n: usize) -> Option<()> {
     for j in 0..n {
         let mut diag = a[j * n + j];

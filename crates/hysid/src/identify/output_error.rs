@@ -31,7 +31,7 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use std::sync::Mutex;
 
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod gram;
 use gram::Accumulator;
 

@@ -127,7 +127,7 @@ fn conditional_shift(report: &LmReport, fixed: usize, delta: f64) -> Vec<(usize,
 }
 
 /// Mean and standard deviation of N(μ, s²) truncated to [a, b].
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn truncated_normal(mu: f64, s: f64, a: f64, b: f64) -> (f64, f64) {
     if s.is_nan() || s <= 0.0 || !s.is_finite() {
         return (mu.clamp(a, b), 0.0);
@@ -186,7 +186,7 @@ fn normal_pdf(z: f64) -> f64 {
 
 /// Φ(z) through erfc (Chebyshev fit of Press et al., Numerical Recipes §6.2, relative error
 /// below 1.2e-7 everywhere; ample for a standard deviation).
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn normal_cdf(z: f64) -> f64 {
     0.5 * erfc(-z / std::f64::consts::SQRT_2)
 }

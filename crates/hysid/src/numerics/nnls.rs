@@ -143,7 +143,7 @@ fn dual(g: &DMatrix<f64>, b: &DVector<f64>, x: &[f64]) -> Vec<f64> {
 
 /// The solution of G_PP z_P = b_P with z = 0 outside P (Cholesky; a minimum-norm SVD solve
 /// when G_PP is singular).
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn solve_passive(g: &DMatrix<f64>, b: &DVector<f64>, passive: &[bool]) -> Vec<f64> {
     let idx: Vec<usize> = (0..b.len()).filter(|&i| passive[i]).collect();
     let mut z = vec![0.0; b.len()];

@@ -40,14 +40,14 @@ use super::float;
 
 /// Data regions shorter than this are read sequentially: that takes a few milliseconds at
 /// most, and an unusual file would be read twice (chunks, then records) for nothing.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const MIN_BYTES: u64 = 4 << 20;
 
 /// Bytes per chunk: large enough that the per-chunk costs (two reads, one lock) vanish next
 /// to the parsing, small enough that a chunk read stays in the core's cache until it is
 /// parsed, that the threads stay evenly loaded, and that the chunks in flight are a small
 /// fraction of the columns' memory.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const CHUNK_BYTES: usize = 256 << 10;
 
 /// How far past its end a chunk reads first, which is enough to finish its last line unless
@@ -56,7 +56,7 @@ const TAIL: usize = 4 << 10;
 
 /// How far past its end a chunk reads to finish its last line. A line that does not end by
 /// then (a row of more than 64 KiB) sends the file to the sequential path, which has no limit.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const MAX_LINE: usize = 64 << 10;
 
 /// The values of columns `indices` (in that order) of every data row, or `None` when the file
@@ -360,7 +360,7 @@ const SPECIAL: [u8; 4] = [b',', b'\n', b'\r', b'"'];
 /// Offset of the first [`SPECIAL`] byte of `text` from `from` on. Eight bytes at a time
 /// (SWAR): scanning for cell ends is, with the numbers, most of the work, and cells are
 /// mostly longer than eight bytes.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn find_special(text: &[u8], from: usize) -> Option<usize> {
     let mut at = from;
     while let Some(word) = text.get(at..at + 8) {

@@ -34,7 +34,7 @@ const MAX_EXACT: u64 = 1 << 53;
 /// The value of `[+-]digits[.digits][(e|E)[+-]digits]` when it has at most 19 digits and
 /// an exponent this module converts exactly, else None (the caller then parses the text in
 /// full).
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn parse_fast(text: &[u8]) -> Option<f64> {
     match parse_prefix(text, 0)? {
         (value, end) if end == text.len() => Some(value),
@@ -50,7 +50,7 @@ pub fn parse_fast(text: &[u8]) -> Option<f64> {
 /// its first non-digit). So when the byte at the returned offset ends the cell, the value is
 /// exactly [`parse_fast`] of the cell, and [`parse_fast`] is this function on a cell that
 /// must be read to its end.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 #[inline(always)]
 pub fn parse_prefix(text: &[u8], at: usize) -> Option<(f64, usize)> {
     let (negative, at) = match text.get(at)? {
@@ -196,7 +196,7 @@ const DIGIT_SCALES: [u64; 9] = [
 /// The number of ASCII decimal digits that eight bytes (a little-endian word: the first byte
 /// lowest) start with, 0 to 8, and their value (most significant first). SWAR: one word
 /// operation per step for all eight bytes instead of one step per byte.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn digit_prefix(word: u64) -> (u64, usize) {
     const HIGH_NIBBLES: u64 = 0xF0F0_F0F0_F0F0_F0F0;
     const ZEROS: u64 = 0x3030_3030_3030_3030;

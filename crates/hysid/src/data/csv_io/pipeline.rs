@@ -10,7 +10,7 @@ use std::io::Read;
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 
 /// Records per batch.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const BATCH: usize = 4096;
 
 /// A batch of records: the first `len` are filled; `error` ends the file after them.

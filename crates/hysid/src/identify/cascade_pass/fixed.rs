@@ -333,7 +333,7 @@ pub(super) fn recursion_blocks(
 }
 
 /// [`recursion_blocks`] row by row: `on_row(t, ŷ(t), ∂ŷ(t)/∂θ_free)` for every sample.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn recursion(
     cascade: &HysteresisCascade,
     x: &[f64],
@@ -349,7 +349,7 @@ pub fn recursion(
 
 /// Runs the fixed-width simulation when n ≤ 3 and m ≤ 3; `None` (and `y` untouched)
 /// otherwise.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn simulate(
     cascade: &HysteresisCascade,
     x: &[f64],

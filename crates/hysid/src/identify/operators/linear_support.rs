@@ -76,7 +76,7 @@ pub(crate) fn range(x: &[f64]) -> (f64, f64) {
 
 /// The default threshold grid rᵢ = i·(max x − min x)/(2(n + 1)), i = 1 … n: a play of
 /// half-width ≥ half the input range would never move after its first reversal.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn threshold_grid(x: &[f64], n: usize) -> Result<Vec<f64>> {
     if n == 0 {
         return Err(Error::invalid_option(

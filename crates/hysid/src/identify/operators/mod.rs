@@ -32,7 +32,7 @@ pub mod duhem;
 pub mod family;
 pub mod gpi;
 pub mod jiles_atherton;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod linear_support;
 pub mod maxwell_slip;
 pub mod pi;

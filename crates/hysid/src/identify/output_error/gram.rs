@@ -14,11 +14,11 @@ use crate::numerics::levenberg_marquardt::NormalEquations;
 use nalgebra::{DMatrix, DVector};
 
 /// Rows per block.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const BLOCK_ROWS: usize = 512;
 
 /// Accumulates JᵀJ, Jᵀr and Σr² row by row (see the module docs).
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub struct Accumulator {
     /// Number of columns (free parameters).
     p: usize,
@@ -35,7 +35,7 @@ pub struct Accumulator {
 
 impl Accumulator {
     /// An empty accumulator for `p` columns.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn new(p: usize) -> Self {
         Self {
             p,
@@ -50,7 +50,7 @@ impl Accumulator {
 
     /// Adds the row `scale · row` of J with residual `r`, written straight into the block.
     #[inline]
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn add_scaled(&mut self, scale: f64, row: &[f64], r: f64) {
         let columns = self.block.chunks_exact_mut(BLOCK_ROWS);
         for (column, v) in columns.zip(row) {
@@ -67,7 +67,7 @@ impl Accumulator {
     /// Adds the rows `from … from + r.len() − 1` of `rows` (row-major, `width` values per
     /// row, of which the last p are the row of J), each scaled by `scale`, with residuals
     /// `r`: the same rows as that many calls of [`add_scaled`](Self::add_scaled).
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn add_rows(&mut self, scale: f64, rows: &[f64], width: usize, from: usize, r: &[f64]) {
         let lead = width - self.p;
         let mut done = 0;
@@ -115,7 +115,7 @@ impl Accumulator {
     }
 
     /// The accumulated normal equations.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn finish(mut self) -> NormalEquations {
         self.flush();
         NormalEquations {

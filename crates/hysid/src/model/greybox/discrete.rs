@@ -68,7 +68,7 @@ pub(crate) fn simulate(
 /// `on_sample(k, x[k], S[k])` with S row-major n × q. Ok(false) without simulating when the
 /// model has no analytic Jacobians.
 #[allow(clippy::too_many_arguments)]
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn simulate_sensitivities(
     model: &dyn StateSpaceModel,
     theta: &[f64],

@@ -44,7 +44,7 @@ const DPHI: f64 = 1e-6;
 
 /// The layout of a state carrying forward sensitivities: z = [x (n), S (n × q, row-major)].
 #[derive(Clone, Copy, Debug)]
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub struct Sensitivities {
     /// States.
     pub n: usize,
@@ -54,7 +54,7 @@ pub struct Sensitivities {
 
 /// RK4 steps on a state of dimension `dim` that stop at friction-velocity zero crossings:
 /// the classical stages of [`Rk4`] plus the buffer of a trial step.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub struct StickSlip {
     rk4: Rk4,
     trial: Vec<f64>,
@@ -62,7 +62,7 @@ pub struct StickSlip {
 
 impl StickSlip {
     /// Buffers for states of dimension `dim`.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn new(dim: usize) -> Self {
         Self {
             rk4: Rk4::new(dim),
@@ -76,7 +76,7 @@ impl StickSlip {
     /// `direction` when it is Some. With `velocity` = Some(i), state i is the friction
     /// velocity and the step stops at its zero crossing (see the module docs). With
     /// `sensitivities`, x carries S and the event is differentiated.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn step<F>(
         &mut self,
         rate: &mut F,

@@ -54,7 +54,7 @@ pub(crate) mod gpi;
 pub mod jiles_atherton;
 pub(crate) mod maxwell_slip;
 pub(crate) mod pi;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod preisach;
 
 pub use any::{OperatorModel, OPERATOR_FAMILIES};

@@ -35,7 +35,7 @@ use serde::{Deserialize, Serialize};
 
 /// The grid of a discrete Preisach plane: N equal intervals over [x₀, x_N].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub struct Grid {
     pub lower: f64,
     pub upper: f64,
@@ -89,14 +89,14 @@ impl Grid {
 /// The staircase memory: alternating extrema [m₀ = x₀, M₁, m₁, M₂, …, current input], the input
 /// clamped to the grid.
 #[derive(Clone, Debug, PartialEq)]
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub struct Memory {
     points: Vec<f64>,
 }
 
 impl Memory {
     /// The stored extrema, oldest first (the staircase's corners).
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn points(&self) -> &[f64] {
         &self.points
     }
@@ -282,7 +282,7 @@ impl Preisach {
         self.grid.n
     }
     /// The plane's grid of cells.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn grid(&self) -> &Grid {
         &self.grid
     }
@@ -351,7 +351,7 @@ fn prefix_sums(grid: &Grid, w: &[f64]) -> Vec<f64> {
 }
 
 /// The regressors φ_{ij} = 2·(area in S⁺)/(cell area) − 1 of every cell for a memory.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn regressors(grid: &Grid, memory: &Memory, phi: &mut [f64]) {
     phi.iter_mut().for_each(|p| *p = -1.0);
     for (m_prev, m_next, big) in memory.strips() {

@@ -52,7 +52,7 @@ impl Bounds {
 /// Widens `(lo, hi)` by `frac` of its span on each side; a (numerically)
 /// constant range is widened to ±10 % of its value, or ±1 around zero, so
 /// the flat line sits mid-plot and tick labels stay meaningful.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn pad_range((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
     let lo = lo.clamp(-AXIS_LIMIT, AXIS_LIMIT);
     let hi = hi.clamp(-AXIS_LIMIT, AXIS_LIMIT);
@@ -84,7 +84,7 @@ pub(super) fn x_is_monotone(series: &[Series]) -> bool {
 /// How tick values on one axis are printed: a common power of ten (shown
 /// in the axis label, as engineering notation) and a fixed decimal count so
 /// all labels line up ("0.0 0.5 1.0", not "0 0.5 1").
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub struct AxisFormat {
     pub(super) exp: i32,
     decimals: usize,
@@ -93,14 +93,14 @@ pub struct AxisFormat {
 
 impl AxisFormat {
     /// The power of ten factored out of the tick labels.
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn exp(&self) -> i32 {
         self.exp
     }
 }
 
 impl AxisFormat {
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn new((lo, hi): (f64, f64), n_ticks: usize) -> AxisFormat {
         let ticks = RangedCoordf64::from(lo..hi).key_points(n_ticks.max_num_points());
         let exp = engineering_exponent(lo.abs().max(hi.abs()));
@@ -113,7 +113,7 @@ impl AxisFormat {
         }
     }
 
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn format(&self, v: f64) -> String {
         let s = v * 10f64.powi(-self.exp);
         let text = format!("{:.*}", self.decimals, s);
@@ -129,7 +129,7 @@ impl AxisFormat {
         self.ticks.iter().map(|&t| self.format(t)).collect()
     }
 
-    #[doc(hidden)] // reached by the white-box tests in tests/library/unit
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn describe(&self, label: &str) -> String {
         if self.exp == 0 {
             label.to_string()

@@ -16,11 +16,11 @@
 //! figures get a "no data" note, constant series get a padded axis, and very long series are
 //! decimated for drawing while keeping their extremes.
 
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod axis;
 pub mod figure;
 mod legend;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod prepare;
 pub mod sets;
 mod svg;

@@ -44,7 +44,7 @@ pub(super) fn prepare<'s>(s: &'s Series, color: RGBColor) -> Prepared<'s> {
 /// Maximal runs of consecutive points whose coordinates are both finite.
 /// Values are clamped to the axis limit: plotters maps a point far outside
 /// the axis range to a pixel with unchecked `i32` arithmetic and overflows.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn finite_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
     let clamp = |v: f64| v.clamp(-AXIS_LIMIT, AXIS_LIMIT);
     let mut runs = Vec::new();
@@ -64,7 +64,7 @@ pub fn finite_runs(x: &[f64], y: &[f64]) -> Vec<Vec<(f64, f64)>> {
 
 /// Points per decimation bucket (1 = no decimation). Markers cost more SVG
 /// than polyline vertices, so they get fewer buckets.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn bucket_len(total: usize, style: Style) -> usize {
     if total <= DECIMATE_ABOVE {
         return 1;
@@ -78,7 +78,7 @@ pub fn bucket_len(total: usize, style: Style) -> usize {
 /// coordinates' extremes preserves the envelope of time plots *and* the
 /// corners of hysteresis loops. The run's first and last points are kept so
 /// the line spans the full range.
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn decimate(run: &[(f64, f64)], bucket: usize) -> Vec<(f64, f64)> {
     if bucket <= 1 || run.len() <= 4 {
         return run.to_vec();

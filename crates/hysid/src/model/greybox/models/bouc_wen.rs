@@ -52,7 +52,7 @@ pub(super) const KL: usize = 2;
 pub(super) const ALPHA: usize = 3;
 pub(super) const BG: usize = 4;
 pub(super) const BD: usize = 5;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub const NU: usize = 6;
 
 impl StateSpaceModel for BoucWen {

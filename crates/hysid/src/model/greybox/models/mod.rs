@@ -7,7 +7,7 @@
 //!   Gunnar et al. (2006), saddle fixed and free.
 
 mod actuator;
-#[doc(hidden)] // reached by the white-box tests in tests/library/unit
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod bouc_wen;
 mod bouc_wen_kernel;
 mod rigid_body;
