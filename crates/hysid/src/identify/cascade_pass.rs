@@ -343,11 +343,21 @@ pub fn recursion_generic(
         let slot = hyst.row_mut(t);
         slot[0] = v;
         slot[1..].copy_from_slice(s);
-        u.iter_mut().for_each(|ui| *ui = 0.0);
+        // ŷ(t) as the simulation computes it (A's terms, then B's): the same bits.
         let mut yhat = 0.0;
+        for (i, &ai) in lin.a().iter().enumerate() {
+            if let Some(past) = out.get(t, i + 1) {
+                yhat -= ai * past[0];
+            }
+        }
         for (j, &bj) in lin.b().iter().enumerate() {
             if let Some(past) = hyst.get(t, k + j) {
                 yhat += bj * past[0];
+            }
+        }
+        u.iter_mut().for_each(|ui| *ui = 0.0);
+        for (j, &bj) in lin.b().iter().enumerate() {
+            if let Some(past) = hyst.get(t, k + j) {
                 for (ui, si) in u[..nh].iter_mut().zip(&past[1..]) {
                     *ui += bj * si;
                 }
@@ -360,7 +370,6 @@ pub fn recursion_generic(
         let dy = &mut u;
         for (i, &ai) in lin.a().iter().enumerate() {
             if let Some(past) = out.get(t, i + 1) {
-                yhat -= ai * past[0];
                 dy[nh + m - 1 + i] -= past[0];
                 for (d, pd) in dy.iter_mut().zip(&past[1..]) {
                     *d -= ai * pd;

@@ -119,6 +119,19 @@ pub trait OutputErrorModel: Sync {
     fn speculative_sensitivities(&self) -> bool {
         false
     }
+
+    /// Whether the output ŷ of the sensitivity pass ([`simulate_sensitivities`] and
+    /// [`simulate_sensitivity_blocks`]) is bit for bit the output of [`simulate`] at the same
+    /// θ. Then a long record's trial points take their residuals from that pass, whose
+    /// normal equations serve the step that follows (see [`OutputErrorProblem::overlap`]),
+    /// and no plain simulation runs beside it. `false` (the default) when unsure.
+    ///
+    /// [`simulate_sensitivities`]: Self::simulate_sensitivities
+    /// [`simulate_sensitivity_blocks`]: Self::simulate_sensitivity_blocks
+    /// [`simulate`]: Self::simulate
+    fn pass_output_is_simulation(&self) -> bool {
+        false
+    }
 }
 
 /// Settings of the output-error estimator (MATLAB `nlgreyestOptions`).
@@ -320,15 +333,18 @@ pub struct OutputErrorProblem<'a> {
     overlap: Option<KeptSystem>,
 }
 
-/// Records at least this long (residuals) get their trial points' normal equations computed
-/// side by side with the trial simulation: on the core the simulation leaves idle
-/// ([`rayon::join`]), kept for the engine's request that follows when the point is accepted.
+/// Records at least this long (residuals) get every trial point's normal equations computed
+/// with its residuals, kept for the engine's request that follows when the point is accepted
+/// ([`OutputErrorProblem::overlap`]).
 ///
-/// Unlike [`Speculation`], the residuals still come from the plain simulation and the normal
-/// equations from the model's own pass, so every number is the one the sequential engine
-/// computes; only the order in time changes. A rejected trial point wastes its normal
-/// equations (CPU time on the idle core), which is rare from the good starts of long-record
-/// fits. The engine's evaluation counts are those of its requests, as without the overlap.
+/// For a model whose sensitivity pass outputs its simulation bit for bit, the residuals come
+/// from that pass (a [`Speculation`] without split columns); otherwise from a plain simulation
+/// run beside the pass ([`rayon::join`], on the core the simulation leaves idle). Either way
+/// the residuals are those of the plain simulation and the normal equations those of the
+/// model's own pass, so every number is the one the sequential engine computes; only the work
+/// and its order in time change. A rejected trial point wastes its normal equations, which is
+/// rare from the good starts of long-record fits. Side by side, the engine's evaluation counts
+/// are those of its requests; from the pass, the report counts the passes actually run.
 const OVERLAP_RESIDUALS: usize = 1 << 16;
 
 /// Normal equations computed ahead of the engine's request, at trial point θ for the free
@@ -370,7 +386,9 @@ impl KeptSystem {
 /// rejected points. When the search runs alone (not inside a parallel multi-start) and the
 /// experiments leave a core idle, the sensitivity columns are split between two threads
 /// ([`rayon::join`]), each integrating the state with half of the columns: the state is
-/// integrated twice, the sensitivities once.
+/// integrated twice, the sensitivities once. Without the split (`split` false: a long record
+/// whose model pipelines its own pass, see [`OVERLAP_RESIDUALS`]) each trial point is one
+/// whole pass.
 struct Speculation {
     split: bool,
     kept: KeptSystem,
@@ -445,11 +463,26 @@ impl<'a> OutputErrorProblem<'a> {
         });
     }
 
-    /// Turns on the overlap of trial simulations and normal equations for the parameters
-    /// `free` when the record is long (at least 2¹⁶ residuals) and a core is idle: each
-    /// trial point's normal equations are then computed beside its plain simulation.
+    /// Turns on, for the parameters `free`, the early normal equations of long records (at
+    /// least 2¹⁶ residuals) when a core is idle: each trial point's normal equations are
+    /// computed with its residuals, kept for the step that follows when the point is
+    /// accepted. When the model's sensitivity pass outputs its simulation bit for bit
+    /// ([`OutputErrorModel::pass_output_is_simulation`]) the residuals come from that pass
+    /// (a [`Speculation`] without split columns: one pass per trial point, pipelined over
+    /// the two cores by the model); otherwise from a plain simulation beside it.
     pub fn overlap(&mut self, free: &[usize]) {
-        if self.has_idle_core() && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty() {
+        if !(self.has_idle_core() && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty()) {
+            return;
+        }
+        if self.model.pass_output_is_simulation() {
+            self.speculation = Some(Speculation {
+                split: false,
+                kept: KeptSystem::new(free),
+                with_sensitivities: 0.into(),
+                without: 0.into(),
+                disabled: false.into(),
+            });
+        } else {
             self.overlap = Some(KeptSystem::new(free));
         }
     }

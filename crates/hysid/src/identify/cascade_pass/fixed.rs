@@ -87,13 +87,24 @@ fn row<const WARM: bool, const NH: usize, const NA: usize, const M: usize, const
     }
     rings.v[t & mask] = c.v;
     rings.s[t & mask] = c.s;
-    let mut u = [0.0; P];
+    // ŷ(t) with the operations of the simulation, in its order (A's terms, then B's), so
+    // that the pass's ŷ is the simulated output bit for bit and can serve as the residuals.
     let mut yhat = 0.0;
+    for (i, &ai) in a.iter().enumerate() {
+        if !WARM || t > i {
+            yhat -= ai * c.y_lag[i];
+        }
+    }
+    for (j, &bj) in b.iter().enumerate() {
+        if !WARM || t >= k + j {
+            yhat += bj * rings.v[(t - k - j) & mask];
+        }
+    }
+    let mut u = [0.0; P];
     for (j, &bj) in b.iter().enumerate() {
         if !WARM || t >= k + j {
             let slot = (t - k - j) & mask;
             let past_v = rings.v[slot];
-            yhat += bj * past_v;
             for (ui, si) in u[..NH].iter_mut().zip(&rings.s[slot]) {
                 *ui += bj * si;
             }
@@ -106,7 +117,6 @@ fn row<const WARM: bool, const NH: usize, const NA: usize, const M: usize, const
     for (i, &ai) in a.iter().enumerate() {
         if !WARM || t > i {
             let past_y = c.y_lag[i];
-            yhat -= ai * past_y;
             u[NH + M - 1 + i] -= past_y;
             for (d, pd) in u.iter_mut().zip(&c.dy_lag[i]) {
                 *d -= ai * pd;
