@@ -5,17 +5,24 @@ use nalgebra::{DMatrix, DVector};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
-/// The accumulated normal equations equal, bit for bit, those of nalgebra's block
-/// products (the accumulator they replaced) on random rows, with a partial last block.
+/// Random rows of J (p columns) and residuals, n of them.
+fn random_rows(seed: u64, p: usize, n: usize) -> (Vec<Vec<f64>>, Vec<f64>) {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let rows: Vec<Vec<f64>> = (0..n)
+        .map(|_| (0..p).map(|_| rng.random_range(-1.0..1.0)).collect())
+        .collect();
+    let res: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+    (rows, res)
+}
+
+/// The accumulated normal equations are, bit for bit, the sums in the order the module
+/// documents (row after row within a block of `BLOCK_ROWS`, block after block), written out
+/// here by hand, with a partial last block; S is summed row by row.
 #[test]
-fn normal_equations_equal_block_products() {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(13);
-    for p in [1, 3, 7, 11] {
+fn normal_equations_are_the_documented_sums() {
+    for p in [1, 3, 7, 11, 13] {
         let n = 3 * BLOCK_ROWS + 37;
-        let rows: Vec<Vec<f64>> = (0..n)
-            .map(|_| (0..p).map(|_| rng.random_range(-1.0..1.0)).collect())
-            .collect();
-        let res: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let (rows, res) = random_rows(13, p, n);
         let mut acc = Accumulator::new(p);
         for (row, &r) in rows.iter().zip(&res) {
             acc.add_scaled(-0.75, row, r);
@@ -23,12 +30,20 @@ fn normal_equations_equal_block_products() {
         let got = acc.finish();
         let (mut jtj, mut jtr) = (DMatrix::zeros(p, p), DVector::zeros(p));
         for start in (0..n).step_by(BLOCK_ROWS) {
-            let len = BLOCK_ROWS.min(n - start);
-            let j = DMatrix::from_fn(len, p, |i, k| -0.75 * rows[start + i][k]);
-            let r = DVector::from_column_slice(&res[start..start + len]);
-            jtj.gemm_tr(1.0, &j, &j, 1.0);
-            jtr.gemv_tr(1.0, &j, &r, 1.0);
+            let (mut block, mut block_r) = (DMatrix::zeros(p, p), DVector::zeros(p));
+            for t in start..(start + BLOCK_ROWS).min(n) {
+                let z: Vec<f64> = rows[t].iter().map(|v| -0.75 * v).collect();
+                for i in 0..p {
+                    for j in i..p {
+                        block[(i, j)] += z[i] * z[j];
+                    }
+                    block_r[i] += z[i] * res[t];
+                }
+            }
+            jtj += block;
+            jtr += block_r;
         }
+        let jtj = DMatrix::from_fn(p, p, |i, j| jtj[(i.min(j), i.max(j))]);
         let cost = res.iter().fold(0.0, |s, r| s + r * r);
         assert_eq!(got.jtj, jtj, "p = {p}");
         assert_eq!(got.jtr, jtr, "p = {p}");
@@ -36,18 +51,44 @@ fn normal_equations_equal_block_products() {
     }
 }
 
-/// Rows added a column-major block at a time (blocks of uneven lengths, the first rows of
-/// one left out, a stride longer than the block) give the normal equations of the same
-/// rows added one by one, bit for bit.
+/// The normal equations agree with nalgebra's products JᵀJ, Jᵀr of the whole matrix within
+/// the bound of two summation orders, 2·n·ε·Σ|aᵢbᵢ| per entry.
+#[test]
+fn normal_equations_agree_with_matrix_products() {
+    for p in [1, 4, 7, 11] {
+        let n = 5 * BLOCK_ROWS + 11;
+        let (rows, res) = random_rows(17, p, n);
+        let mut acc = Accumulator::new(p);
+        for (row, &r) in rows.iter().zip(&res) {
+            acc.add_scaled(-1.5, row, r);
+        }
+        let got = acc.finish();
+        let j = DMatrix::from_fn(n, p, |t, k| -1.5 * rows[t][k]);
+        let r = DVector::from_column_slice(&res);
+        let (jtj, jtr) = (j.tr_mul(&j), j.tr_mul(&r));
+        let (ja, ra) = (j.abs(), r.abs());
+        let (bound_jtj, bound_jtr) = (ja.tr_mul(&ja), ja.tr_mul(&ra));
+        let tol = 2.0 * n as f64 * f64::EPSILON;
+        for i in 0..p {
+            for k in 0..p {
+                let e = (got.jtj[(i, k)] - jtj[(i, k)]).abs();
+                assert!(e <= tol * bound_jtj[(i, k)], "p = {p}, ({i}, {k}): {e:e}");
+            }
+            let e = (got.jtr[i] - jtr[i]).abs();
+            assert!(e <= tol * bound_jtr[i], "p = {p}, {i}: {e:e}");
+        }
+    }
+}
+
+/// Rows added a row-major block at a time (blocks of uneven lengths, the first rows of one
+/// left out, a stride longer than the row of J) give the normal equations of the same rows
+/// added one by one, bit for bit: the fixed-width kernels (p ≤ 12) and the general path
+/// (p = 13).
 #[test]
 fn block_rows_equal_single_rows() {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(29);
-    for p in [1, 4, 7] {
+    for p in [1, 4, 7, 11, 13] {
         let n = 2 * BLOCK_ROWS + 301;
-        let rows: Vec<Vec<f64>> = (0..n)
-            .map(|_| (0..p).map(|_| rng.random_range(-1.0..1.0)).collect())
-            .collect();
-        let res: Vec<f64> = (0..n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let (rows, res) = random_rows(29, p, n);
         let skip = 5;
         let mut single = Accumulator::new(p);
         for (row, &r) in rows.iter().zip(&res).skip(skip) {
