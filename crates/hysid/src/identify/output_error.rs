@@ -468,8 +468,9 @@ impl<'a> OutputErrorProblem<'a> {
     /// computed with its residuals, kept for the step that follows when the point is
     /// accepted. When the model's sensitivity pass outputs its simulation bit for bit
     /// ([`OutputErrorModel::pass_output_is_simulation`]) the residuals come from that pass
-    /// (speculative sensitivities without split columns: one pass per trial point, pipelined over
-    /// the two cores by the model); otherwise from a plain simulation beside it.
+    /// (speculative sensitivities without split columns: one pass per trial point,
+    /// pipelined over the two cores by the model); otherwise from a plain simulation
+    /// beside it.
     pub fn overlap(&mut self, free: &[usize]) {
         if !(self.has_idle_core() && self.n_residuals >= OVERLAP_RESIDUALS && !free.is_empty()) {
             return;
