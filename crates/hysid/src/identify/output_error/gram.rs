@@ -57,20 +57,11 @@ impl Accumulator {
     #[inline]
     #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn add_scaled(&mut self, scale: f64, row: &[f64], r: f64) {
-        let (p, w) = (self.p, self.p + 1);
         for (z, v) in self.z.iter_mut().zip(row) {
             *z = scale * v;
         }
-        self.z[p] = r;
-        for i in 0..p {
-            let zi = self.z[i];
-            for (g, zj) in self.block[i * w + i..(i + 1) * w]
-                .iter_mut()
-                .zip(&self.z[i..])
-            {
-                *g += zi * zj;
-            }
-        }
+        self.z[self.p] = r;
+        add_outer(&mut self.block, &self.z);
         self.cost += r * r;
         self.rows += 1;
         if self.rows == BLOCK_ROWS {
@@ -126,21 +117,13 @@ impl Accumulator {
             (11, 12),
             (12, 13)
         );
-        let (p, w) = (self.p, self.p + 1);
+        let p = self.p;
         for (row, &rt) in rows.chunks_exact(width).zip(r) {
             for (z, v) in self.z.iter_mut().zip(&row[width - p..]) {
                 *z = scale * v;
             }
             self.z[p] = rt;
-            for i in 0..p {
-                let zi = self.z[i];
-                for (g, zj) in self.block[i * w + i..(i + 1) * w]
-                    .iter_mut()
-                    .zip(&self.z[i..])
-                {
-                    *g += zi * zj;
-                }
-            }
+            add_outer(&mut self.block, &self.z);
         }
     }
 
@@ -163,6 +146,18 @@ impl Accumulator {
             jtj: DMatrix::from_fn(p, p, |i, j| g[i.min(j) * w + i.max(j)]),
             jtr: DVector::from_fn(p, |i, _| g[i * w + p]),
             cost: self.cost,
+        }
+    }
+}
+
+/// Adds the outer product of the row z = [J, r] (p + 1 values) to the upper rows of the
+/// block sums (p × (p + 1), row-major): entry (i, j), j ≥ i, gains zᵢ·zⱼ.
+fn add_outer(block: &mut [f64], z: &[f64]) {
+    let w = z.len();
+    for i in 0..w - 1 {
+        let zi = z[i];
+        for (g, zj) in block[i * w + i..(i + 1) * w].iter_mut().zip(&z[i..]) {
+            *g += zi * zj;
         }
     }
 }
