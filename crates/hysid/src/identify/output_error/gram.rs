@@ -34,7 +34,7 @@ pub struct Accumulator {
     block: Vec<f64>,
     /// The totals of the finished blocks, laid out as `block`.
     total: Vec<f64>,
-    /// The current row z = [scale·J, r] of [`add_scaled`](Self::add_scaled).
+    /// The current row z = [scale·J, r] of the row-by-row path (`add_to_block`).
     z: Vec<f64>,
     cost: f64,
 }
@@ -57,11 +57,7 @@ impl Accumulator {
     #[inline]
     #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
     pub fn add_scaled(&mut self, scale: f64, row: &[f64], r: f64) {
-        for (z, v) in self.z.iter_mut().zip(row) {
-            *z = scale * v;
-        }
-        self.z[self.p] = r;
-        add_outer(&mut self.block, &self.z);
+        self.add_to_block(scale, row, r);
         self.cost += r * r;
         self.rows += 1;
         if self.rows == BLOCK_ROWS {
@@ -117,13 +113,25 @@ impl Accumulator {
             (11, 12),
             (12, 13)
         );
-        let p = self.p;
         for (row, &rt) in rows.chunks_exact(width).zip(r) {
-            for (z, v) in self.z.iter_mut().zip(&row[width - p..]) {
-                *z = scale * v;
+            self.add_to_block(scale, &row[width - self.p..], rt);
+        }
+    }
+
+    /// Adds the outer product of z = [scale · j, r] to the upper rows of the block sums:
+    /// entry (i, k), k ≥ i, gains zᵢ·zₖ.
+    fn add_to_block(&mut self, scale: f64, j: &[f64], r: f64) {
+        let (p, z) = (self.p, &mut self.z);
+        for (z, v) in z.iter_mut().zip(j) {
+            *z = scale * v;
+        }
+        z[p] = r;
+        let w = p + 1;
+        for i in 0..p {
+            let zi = z[i];
+            for (g, zk) in self.block[i * w + i..(i + 1) * w].iter_mut().zip(&z[i..]) {
+                *g += zi * zk;
             }
-            self.z[p] = rt;
-            add_outer(&mut self.block, &self.z);
         }
     }
 
@@ -146,18 +154,6 @@ impl Accumulator {
             jtj: DMatrix::from_fn(p, p, |i, j| g[i.min(j) * w + i.max(j)]),
             jtr: DVector::from_fn(p, |i, _| g[i * w + p]),
             cost: self.cost,
-        }
-    }
-}
-
-/// Adds the outer product of the row z = [J, r] (p + 1 values) to the upper rows of the
-/// block sums (p × (p + 1), row-major): entry (i, j), j ≥ i, gains zᵢ·zⱼ.
-fn add_outer(block: &mut [f64], z: &[f64]) {
-    let w = z.len();
-    for i in 0..w - 1 {
-        let zi = z[i];
-        for (g, zj) in block[i * w + i..(i + 1) * w].iter_mut().zip(&z[i..]) {
-            *g += zi * zj;
         }
     }
 }
@@ -192,6 +188,7 @@ fn kernel_avx<const P: usize, const W: usize>(
     kernel_body::<P, W>(block, scale, rows, width, r);
 }
 
+/// The kernel's loop: each row's products with the sums in locals (registers).
 #[inline(always)]
 fn kernel_body<const P: usize, const W: usize>(
     block: &mut [f64],
