@@ -397,6 +397,19 @@ struct Speculation {
     disabled: std::sync::atomic::AtomicBool,
 }
 
+impl Speculation {
+    /// Speculation for the parameters `free`, with split columns or not, nothing counted yet.
+    fn new(split: bool, free: &[usize]) -> Self {
+        Self {
+            split,
+            kept: KeptSystem::new(free),
+            with_sensitivities: 0.into(),
+            without: 0.into(),
+            disabled: false.into(),
+        }
+    }
+}
+
 /// Simulated outputs `[experiment][output][t]`.
 type Simulations = Vec<Vec<Vec<f64>>>;
 
@@ -454,13 +467,7 @@ impl<'a> OutputErrorProblem<'a> {
         if !(self.has_idle_core() && free.len() >= 2) {
             return;
         }
-        self.speculation = Some(Speculation {
-            split: true,
-            kept: KeptSystem::new(free),
-            with_sensitivities: 0.into(),
-            without: 0.into(),
-            disabled: false.into(),
-        });
+        self.speculation = Some(Speculation::new(true, free));
     }
 
     /// Turns on, for the parameters `free`, the early normal equations of long records (at
@@ -476,13 +483,7 @@ impl<'a> OutputErrorProblem<'a> {
             return;
         }
         if self.model.pass_output_is_simulation() {
-            self.speculation = Some(Speculation {
-                split: false,
-                kept: KeptSystem::new(free),
-                with_sensitivities: 0.into(),
-                without: 0.into(),
-                disabled: false.into(),
-            });
+            self.speculation = Some(Speculation::new(false, free));
         } else {
             self.overlap = Some(KeptSystem::new(free));
         }
@@ -519,25 +520,41 @@ impl<'a> OutputErrorProblem<'a> {
         r: &mut [f64],
     ) -> Option<Result<NormalEquations>> {
         let ny = self.model.n_outputs();
-        let mut chunks: Vec<(usize, &mut [f64])> = Vec::new();
+        // Without split columns the pass's outputs are the simulation's (the only way here,
+        // see `overlap`): they are kept as the last simulation, which the fit statistics at
+        // the final point then reuse instead of simulating once more.
+        let mut sims: Simulations = if split {
+            Vec::new()
+        } else {
+            self.data
+                .experiments()
+                .iter()
+                .map(|exp| vec![vec![0.0; exp.len()]; ny])
+                .collect()
+        };
+        let mut outputs = sims.iter_mut();
+        let mut chunks = Vec::new();
         let mut rest = r;
         for e in 0..self.data.n_experiments() {
             let len = ny * (self.data.experiment(e).len() - self.skip);
             let (chunk, tail) = std::mem::take(&mut rest).split_at_mut(len);
-            chunks.push((e, chunk));
+            chunks.push((e, chunk, outputs.next()));
             rest = tail;
         }
         let parts: Vec<Option<Result<NormalEquations>>> = chunks
             .into_par_iter()
-            .map(|(e, chunk)| {
-                if split {
-                    self.experiment_split(theta, free, e, chunk)
-                } else {
-                    self.experiment_normal_equations(theta, free, e, Some(chunk))
+            .map(|(e, chunk, outputs)| match outputs {
+                None => self.experiment_split(theta, free, e, chunk),
+                Some(outputs) => {
+                    self.experiment_normal_equations(theta, free, e, Some(chunk), Some(outputs))
                 }
             })
             .collect();
-        sum_normal_equations(parts)
+        let total = sum_normal_equations(parts);
+        if !split && matches!(total, Some(Ok(_))) {
+            *self.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((theta.to_vec(), sims));
+        }
+        total
     }
 
     /// One experiment's residuals and normal equations with the sensitivity columns split
@@ -633,16 +650,24 @@ impl<'a> OutputErrorProblem<'a> {
         }
     }
 
-    /// Streams one experiment's sensitivities into normal equations, and its residuals into
-    /// `residuals` when given.
+    /// Streams one experiment's sensitivities into normal equations, its residuals into
+    /// `residuals` and the pass's outputs ŷ (`[output][t]`) into `outputs` when given.
     fn experiment_normal_equations(
         &self,
         theta: &[f64],
         free: &[usize],
         e: usize,
         mut residuals: Option<&mut [f64]>,
+        mut outputs: Option<&mut Vec<Vec<f64>>>,
     ) -> Option<Result<NormalEquations>> {
-        if let Some(system) = self.experiment_blocks(theta, free, e, residuals.as_deref_mut()) {
+        let blocks = self.experiment_blocks(
+            theta,
+            free,
+            e,
+            residuals.as_deref_mut(),
+            outputs.as_deref_mut(),
+        );
+        if let Some(system) = blocks {
             return Some(system);
         }
         let p = free.len();
@@ -652,6 +677,11 @@ impl<'a> OutputErrorProblem<'a> {
         let skip = self.skip;
         let weights = &self.weights;
         let mut sink = |t: usize, yhat: &[f64], dyhat: &[f64]| {
+            if let Some(outputs) = outputs.as_deref_mut() {
+                for (out, &v) in outputs.iter_mut().zip(yhat) {
+                    out[t] = v;
+                }
+            }
             if t < skip {
                 return;
             }
@@ -678,6 +708,7 @@ impl<'a> OutputErrorProblem<'a> {
         free: &[usize],
         e: usize,
         mut residuals: Option<&mut [f64]>,
+        mut outputs: Option<&mut Vec<Vec<f64>>>,
     ) -> Option<Result<NormalEquations>> {
         let [w] = self.weights[..] else {
             return None;
@@ -703,6 +734,12 @@ impl<'a> OutputErrorProblem<'a> {
             );
             if let Some(out) = residuals.as_deref_mut() {
                 out[t0 - skip..t0 - skip + r.len()].copy_from_slice(&r);
+            }
+            if let Some(outputs) = outputs.as_deref_mut() {
+                let out = &mut outputs[0][block.start..block.start + block.len()];
+                for (o, row) in out.iter_mut().zip(block.rows.chunks_exact(block.width)) {
+                    *o = row[0];
+                }
             }
             acc.add_rows(-w, block.rows, block.width, first, &r);
         };
@@ -819,7 +856,7 @@ impl OutputErrorProblem<'_> {
     ) -> Option<Result<NormalEquations>> {
         let parts: Vec<Option<Result<NormalEquations>>> = (0..self.data.n_experiments())
             .into_par_iter()
-            .map(|e| self.experiment_normal_equations(theta, free, e, None))
+            .map(|e| self.experiment_normal_equations(theta, free, e, None, None))
             .collect();
         sum_normal_equations(parts)
     }
