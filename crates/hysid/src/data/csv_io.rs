@@ -169,7 +169,7 @@ pub fn read_columns(path: &Path, names: &[&str]) -> Result<(Vec<String>, Vec<Vec
 }
 
 /// Which way [`read_columns_by`] reads the rows.
-#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit and the csv bench
+#[doc(hidden)] // reached by the white-box tests (crates/hysid-tests) and the csv bench
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rows {
     /// As [`read_columns`]: in parallel chunks when the file is long, rayon has two threads
@@ -184,7 +184,7 @@ pub enum Rows {
 
 /// [`read_columns`] the given way; also says whether the chunks read the rows (true) or the
 /// sequential path (false).
-#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit and the csv bench
+#[doc(hidden)] // reached by the white-box tests (crates/hysid-tests) and the csv bench
 pub fn read_columns_by(
     path: &Path,
     names: &[&str],
