@@ -31,6 +31,9 @@
 use crate::model::coleman_hodgdon::switching;
 use crate::model::ChForm;
 
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
+pub mod simd;
+
 /// The record and structure of one global search, with the (α, d)-independent part of the
 /// normal equations.
 pub struct EquationError<'a> {
@@ -182,7 +185,12 @@ impl<'a> EquationError<'a> {
             if c >= na {
                 partners.push(target);
             }
-            dots(col, &partners, &mut products[..partners.len()]);
+            dots(
+                col,
+                &partners,
+                &mut products[..partners.len()],
+                simd::available(),
+            );
             for (c2, &product) in (c.max(na)..cols).zip(&products) {
                 let g = sign * self.column(c2, &s.psi).1 * product;
                 s.gram[c * cols + c2] = g;
@@ -201,19 +209,47 @@ impl<'a> EquationError<'a> {
         }
     }
 
-    /// Σ (y(t) − φ(t)ᵀθ)², the residual built column by column in `r`.
+    /// Σ (y(t) − φ(t)ᵀθ)² (see [`residual_squares`]); `r` is the portable path's buffer.
     fn residual_sum(&self, psi: &[f64], theta: &[f64], r: &mut Vec<f64>) -> f64 {
-        r.clear();
-        r.extend_from_slice(&self.y[self.t0..self.len()]);
-        for (c, &th) in theta.iter().enumerate() {
-            let (col, sign) = self.column(c, psi);
-            let w = sign * th;
-            for (ri, ci) in r.iter_mut().zip(col) {
-                *ri -= w * ci;
-            }
-        }
-        dot(r, r)
+        let columns: Vec<(&[f64], f64)> = theta
+            .iter()
+            .enumerate()
+            .map(|(c, &th)| {
+                let (col, sign) = self.column(c, psi);
+                (col, sign * th)
+            })
+            .collect();
+        residual_squares(&self.y[self.t0..self.len()], &columns, r, simd::available())
     }
+}
+
+/// Σₜ (y(t) − Σ_c w_c·col_c(t))² over the rows of `target`, each residual formed in column
+/// order and the squares summed as [`dot`] sums them. The portable path builds the residual
+/// vector in `r` column by column, then takes its dot product with itself; with `simd` (AVX,
+/// see [`simd::available`]) one pass forms four residuals at a time in registers and sums
+/// their squares in the four partial sums of [`dot`] — the same operations in the same
+/// order, so the same bits.
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
+pub fn residual_squares(
+    target: &[f64],
+    columns: &[(&[f64], f64)],
+    r: &mut Vec<f64>,
+    simd: bool,
+) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if simd {
+        // SAFETY: `simd` is only set when the processor has AVX.
+        return unsafe { simd::residual_squares(target, columns) };
+    }
+    let _ = simd;
+    r.clear();
+    r.extend_from_slice(target);
+    for &(col, w) in columns {
+        for (ri, ci) in r.iter_mut().zip(col) {
+            *ri -= w * ci;
+        }
+    }
+    dot(r, r)
 }
 
 /// ψ of the module docs for the hysteresis `form` over the non-empty input `x`, signal i at
@@ -266,26 +302,48 @@ fn basis_signals_of<const NL: usize>(x: &[f64], alpha: f64, d: f64, psi: &mut [f
 
 /// Σ aᵢbᵢ with four partial sums (independent chains the compiler can vectorise).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    dot_group::<1>(a, [b])[0]
+    dot_group_portable::<1>(a, [b])[0]
 }
 
-/// `out[j]` = [`dot`]`(a, b[j])`, the dot products taken four at a time: a is read once for
-/// four of them and their partial sums are sixteen independent chains. Each product is
-/// summed exactly as [`dot`] sums it.
-fn dots(a: &[f64], b: &[&[f64]], out: &mut [f64]) {
+/// `out[j]` = [`dot`]`(a, b[j])`, the dot products taken four at a time (the last two or
+/// three together too): a is read once per group and the group's partial sums are
+/// independent chains. Each product is summed exactly as [`dot`] sums it, also with `simd`
+/// (AVX, see [`simd::available`]), where a product's four partial sums are the four lanes of
+/// one register.
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
+pub fn dots(a: &[f64], b: &[&[f64]], out: &mut [f64], simd: bool) {
     let mut quads = b.chunks_exact(4);
     let mut results = out.chunks_exact_mut(4);
     for (group, result) in quads.by_ref().zip(results.by_ref()) {
-        result.copy_from_slice(&dot_group::<4>(a, [group[0], group[1], group[2], group[3]]));
+        result.copy_from_slice(&dot_group::<4>(
+            a,
+            [group[0], group[1], group[2], group[3]],
+            simd,
+        ));
     }
-    for (b, result) in quads.remainder().iter().zip(results.into_remainder()) {
-        *result = dot(a, b);
+    match (quads.remainder(), results.into_remainder()) {
+        ([b0, b1, b2], result) => result.copy_from_slice(&dot_group::<3>(a, [b0, b1, b2], simd)),
+        ([b0, b1], result) => result.copy_from_slice(&dot_group::<2>(a, [b0, b1], simd)),
+        ([b0], [result]) => *result = dot_group::<1>(a, [b0], simd)[0],
+        _ => {}
     }
 }
 
-/// [`dot`] of `a` with each of K vectors, in one pass over a.
+/// [`dot`] of `a` with each of K vectors, in one pass over a (with AVX when `simd`).
+fn dot_group<const K: usize>(a: &[f64], b: [&[f64]; K], simd: bool) -> [f64; K] {
+    #[cfg(target_arch = "x86_64")]
+    if simd {
+        // SAFETY: `simd` is only set when the processor has AVX.
+        return unsafe { simd::dot_group(a, b) };
+    }
+    let _ = simd;
+    dot_group_portable(a, b)
+}
+
+/// [`dot`] of `a` with each of K vectors, in one pass over a: the portable code, the
+/// definition of the summation order.
 #[inline(always)]
-fn dot_group<const K: usize>(a: &[f64], b: [&[f64]; K]) -> [f64; K] {
+fn dot_group_portable<const K: usize>(a: &[f64], b: [&[f64]; K]) -> [f64; K] {
     let n = b.iter().fold(a.len(), |n, b| n.min(b.len()));
     let body = n / 4 * 4;
     let mut acc = [[0.0; 4]; K];

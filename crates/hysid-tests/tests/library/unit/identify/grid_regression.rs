@@ -52,3 +52,86 @@ fn cholesky_solves_a_known_system() {
     let mut singular = [1.0, 1.0, 1.0, 1.0];
     assert!(cholesky_solve(&mut singular, &mut b, 2).is_none());
 }
+
+/// Seeded values of mixed signs and magnitudes (so the order of summation shows in the bits).
+fn random_values(seed: u64, n: usize) -> Vec<f64> {
+    use rand::rngs::Xoshiro256PlusPlus;
+    use rand::{RngExt, SeedableRng};
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    (0..n)
+        .map(|_| rng.random_range(-1.0..1.0) * 10f64.powi(rng.random_range(-3..4)))
+        .collect()
+}
+
+/// The AVX dot products (when the processor has AVX) are the portable ones bit for bit, for
+/// groups of one to seven products and every length of tail; the portable ones equal a
+/// plain sum in the documented order (lanes i mod 4, then (s₀ + s₁) + (s₂ + s₃) + tail).
+#[test]
+fn dot_products_are_the_same_bits_with_and_without_simd() {
+    for n in [0, 1, 3, 4, 5, 6, 7, 8, 101, 1000] {
+        let a = random_values(n as u64, n);
+        let bs: Vec<Vec<f64>> = (0..7)
+            .map(|k| random_values(100 + k, n + k as usize))
+            .collect();
+        for k in 1..=7 {
+            let b: Vec<&[f64]> = bs[..k].iter().map(|b| b.as_slice()).collect();
+            let mut portable = vec![0.0; k];
+            dots(&a, &b, &mut portable, false);
+            for (j, b) in b.iter().enumerate() {
+                let body = n / 4 * 4;
+                let mut s = [0.0; 4];
+                for i in 0..body {
+                    s[i % 4] += a[i] * b[i];
+                }
+                let tail: f64 = (body..n).map(|i| a[i] * b[i]).sum();
+                let expected = (s[0] + s[1]) + (s[2] + s[3]) + tail;
+                assert_eq!(
+                    portable[j].to_bits(),
+                    expected.to_bits(),
+                    "n {n}, k {k}, j {j}"
+                );
+            }
+            if simd::available() {
+                let mut fast = vec![0.0; k];
+                dots(&a, &b, &mut fast, true);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&portable), "n {n}, k {k}");
+            }
+        }
+    }
+}
+
+/// The one-pass AVX residual sum of squares (when the processor has AVX) is the portable
+/// two-step one (residual vector, then its dot product) bit for bit.
+#[test]
+fn residual_squares_are_the_same_bits_with_and_without_simd() {
+    for n in [0, 1, 2, 3, 4, 5, 9, 1000, 1003] {
+        let target = random_values(7 + n as u64, n);
+        let cols: Vec<Vec<f64>> = (0..6).map(|c| random_values(50 + c, n + 2)).collect();
+        let weights = random_values(99, 6);
+        for used in 0..=6 {
+            let columns: Vec<(&[f64], f64)> = cols[..used]
+                .iter()
+                .zip(&weights)
+                .map(|(c, &w)| (c.as_slice(), w))
+                .collect();
+            let mut r = Vec::new();
+            let portable = residual_squares(&target, &columns, &mut r, false);
+            let mut residual = target.clone();
+            for (c, w) in &columns {
+                for (ri, ci) in residual.iter_mut().zip(c.iter()) {
+                    *ri -= w * ci;
+                }
+            }
+            let plain: f64 = residual.iter().map(|r| r * r).sum();
+            assert!(
+                (portable - plain).abs() <= 1e-12 * plain.abs().max(1e-300),
+                "n {n}"
+            );
+            if simd::available() {
+                let fast = residual_squares(&target, &columns, &mut r, true);
+                assert_eq!(fast.to_bits(), portable.to_bits(), "n {n}, {used} columns");
+            }
+        }
+    }
+}
