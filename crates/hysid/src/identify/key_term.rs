@@ -30,7 +30,7 @@
 
 use crate::data::IdData;
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
-use crate::numerics::least_squares::least_squares;
+use crate::numerics::least_squares::least_squares_estimate;
 use crate::numerics::{Observer, Termination};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
@@ -128,9 +128,10 @@ impl KeyTermSeparation {
                 break;
             }
             let (phi, target) = self.rows(x, y, &v, hysteresis.d());
-            let ls = least_squares(&phi, &target, &[])?;
-            costs.push(ls.residual_ss);
-            let estimate = match self.physical(ls.theta.as_slice()) {
+            // Only the estimate is used: the solver skips the covariance and the explicit Q.
+            let (ls_theta, residual_ss) = least_squares_estimate(&phi, &target, &[])?;
+            costs.push(residual_ss);
+            let estimate = match self.physical(ls_theta.as_slice()) {
                 Ok(p) => p,
                 Err(e) => {
                     termination = Termination::Diverged {
@@ -217,37 +218,55 @@ impl KeyTermSeparation {
         self.na.max(self.delay + 1).max(self.delay + self.nb - 1)
     }
 
-    /// The regression rows with the internal variables v̂ and ĥ(d̂).
+    /// The regression rows with the internal variables v̂ and ĥ(d̂), built column by column
+    /// (Φ is column-major): the hysteresis regressors in one pass over the samples, the lagged
+    /// v̂ and −y columns as shifted copies.
     fn rows(&self, x: &[f64], y: &[f64], v: &[f64], d: f64) -> (DMatrix<f64>, Vec<f64>) {
         let nh = self.form.n_params();
         let k = self.delay;
         let p = nh + self.nb - 1 + self.na;
         let t0 = self.first_row();
         let n = x.len().saturating_sub(t0);
-        let mut phi = DMatrix::zeros(n, p);
-        let mut target = Vec::with_capacity(n);
-        let mut buf = vec![0.0; nh];
+        if n == 0 {
+            return (DMatrix::zeros(0, p), Vec::new());
+        }
+        let mut phi = vec![0.0; n * p];
+        let (hysteresis, rest) = phi.split_at_mut(n * nh);
+        let mut buf = [0.0; 6];
         for (r, t) in (t0..x.len()).enumerate() {
+            let b = &mut buf[..nh];
             ColemanHodgdon::separated_regressor(
                 self.form,
                 d,
                 x[t - k - 1],
                 x[t - k],
                 v[t - k - 1],
-                &mut buf,
+                b,
             );
-            for (c, b) in buf.iter().enumerate() {
-                phi[(r, c)] = *b;
+            for (column, value) in hysteresis.chunks_exact_mut(n).zip(b.iter()) {
+                column[r] = *value;
             }
-            for j in 2..=self.nb {
-                phi[(r, nh + j - 2)] = v[t - k - j + 1];
-            }
-            for i in 1..=self.na {
-                phi[(r, nh + self.nb - 1 + i - 1)] = -y[t - i];
-            }
-            target.push(y[t] - v[t - k - 1]);
         }
-        (phi, target)
+        let mut columns = rest.chunks_exact_mut(n);
+        for j in 2..=self.nb {
+            let lag = k + j - 1;
+            if let Some(column) = columns.next() {
+                column.copy_from_slice(&v[t0 - lag..x.len() - lag]);
+            }
+        }
+        for i in 1..=self.na {
+            if let Some(column) = columns.next() {
+                for (c, y) in column.iter_mut().zip(&y[t0 - i..x.len() - i]) {
+                    *c = -y;
+                }
+            }
+        }
+        let target = y[t0..x.len()]
+            .iter()
+            .zip(&v[t0 - k - 1..x.len() - k - 1])
+            .map(|(y, v)| y - v)
+            .collect();
+        (DMatrix::from_vec(n, p, phi), target)
     }
 
     /// Physical parameters from the regression estimate.
