@@ -28,3 +28,58 @@ fn dependent_columns_are_named() {
     let msg = err.to_string();
     assert!(msg.contains("'x'") && msg.contains("'2x'"), "{msg}");
 }
+
+/// The estimate-only solver (Qᵀy by reflections) agrees with the full solver to rounding on
+/// a badly scaled, moderately conditioned problem, recovers an exact fit, and refuses what
+/// the full solver refuses with the same message.
+#[test]
+fn estimate_only_agrees_with_the_full_solver() {
+    let n = 400;
+    let phi = DMatrix::from_fn(n, 4, |i, j| {
+        let t = i as f64 * 0.01;
+        match j {
+            0 => 1e3,
+            1 => (3.0 * t).sin(),
+            2 => 1e-4 * (t * t),
+            _ => (7.0 * t).cos() + 0.5 * (3.0 * t).sin(),
+        }
+    });
+    let truth = [0.002, -1.5, 3e4, 0.25];
+    let noise = |i: usize| 1e-3 * (((i * 37) % 11) as f64 - 5.0);
+    let y: Vec<f64> = (0..n)
+        .map(|i| (0..4).map(|j| phi[(i, j)] * truth[j]).sum::<f64>() + noise(i))
+        .collect();
+    let full = least_squares(&phi, &y, &[]).unwrap();
+    let (theta, rss) = least_squares_estimate(&phi, &y, &[]).unwrap();
+    for j in 0..4 {
+        let scale = full.theta[j].abs();
+        assert!(
+            (theta[j] - full.theta[j]).abs() <= 1e-11 * scale,
+            "θ{j}: {} vs {}",
+            theta[j],
+            full.theta[j]
+        );
+    }
+    assert!((rss - full.residual_ss).abs() <= 1e-11 * full.residual_ss);
+    // Without noise the fit is exact.
+    let exact: Vec<f64> = (0..n)
+        .map(|i| (0..4).map(|j| phi[(i, j)] * truth[j]).sum::<f64>())
+        .collect();
+    let (theta, _) = least_squares_estimate(&phi, &exact, &[]).unwrap();
+    for j in 0..4 {
+        assert!(
+            (theta[j] - truth[j]).abs() <= 1e-9 * truth[j].abs(),
+            "θ{j} = {}",
+            theta[j]
+        );
+    }
+    let dependent = DMatrix::from_fn(10, 3, |i, j| match j {
+        0 => 1.0,
+        1 => i as f64,
+        _ => 2.0 * i as f64,
+    });
+    let names = ["c", "x", "2x"];
+    let a = least_squares(&dependent, &[0.0; 10], &names).unwrap_err();
+    let b = least_squares_estimate(&dependent, &[0.0; 10], &names).unwrap_err();
+    assert_eq!(a.to_string(), b.to_string());
+}
