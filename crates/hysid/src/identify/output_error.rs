@@ -195,6 +195,21 @@ impl OutputErrorFit {
     }
 }
 
+/// The normal equations at the start of a fit, computed ahead of it by
+/// [`OutputError::start`].
+pub struct FitStart {
+    theta: Vec<f64>,
+    free: Vec<usize>,
+    system: NormalEquations,
+}
+
+impl FitStart {
+    /// S = Σ r² at the start: the fit's criterion there.
+    pub fn cost(&self) -> f64 {
+        self.system.cost
+    }
+}
+
 impl OutputError {
     /// Default settings: 100 iterations, tight tolerances.
     pub fn new() -> Self {
@@ -228,15 +243,49 @@ impl OutputError {
         params: &ParameterSet,
         callback: &mut dyn FnMut(&IterationRecord) -> Control,
     ) -> Result<OutputErrorFit> {
-        params.validate()?;
-        check_outputs_vary(data)?;
-        let mut problem =
-            OutputErrorProblem::new(model, data, self.weights(model.n_outputs())?, self.skip)?;
-        let free = params.free_indices();
-        if model.speculative_sensitivities() {
-            problem.speculate(&free);
-        } else {
-            problem.overlap(&free);
+        self.estimate_from(model, data, params, None, callback)
+    }
+
+    /// The normal equations a fit of `model` from `params` starts with, computed ahead of
+    /// the fit, when the fit would pipeline its passes over a long record (see
+    /// [`OutputErrorProblem::overlap`]); `None` otherwise. Their S is the criterion at the
+    /// start, so a caller that needs that value before deciding to fit gets it from the pass
+    /// the fit needs anyway, and hands the start to [`estimate_from`](Self::estimate_from).
+    pub fn start(
+        &self,
+        model: &dyn OutputErrorModel,
+        data: &IdData,
+        params: &ParameterSet,
+    ) -> Result<Option<FitStart>> {
+        let (problem, free) = self.problem(model, data, params)?;
+        if !problem.pipelines() {
+            return Ok(None);
+        }
+        let theta = params.values();
+        match problem.normal_equations(&theta, &free) {
+            Some(system) => Ok(Some(FitStart {
+                theta,
+                free,
+                system: system?,
+            })),
+            None => Ok(None),
+        }
+    }
+
+    /// [`estimate`](Self::estimate) with the normal equations at the start computed ahead
+    /// by [`start`](Self::start) (counted as the fit's first pass); a start made for other
+    /// parameters is ignored.
+    pub fn estimate_from(
+        &self,
+        model: &dyn OutputErrorModel,
+        data: &IdData,
+        params: &ParameterSet,
+        start: Option<FitStart>,
+        callback: &mut dyn FnMut(&IterationRecord) -> Control,
+    ) -> Result<OutputErrorFit> {
+        let (problem, free) = self.problem(model, data, params)?;
+        if let Some(start) = start {
+            problem.seed(start);
         }
         if problem.n_residuals() <= free.len() {
             return Err(Error::TooFewSamples {
@@ -260,6 +309,27 @@ impl OutputError {
         let mut parameters = params.clone();
         parameters.set_values(&report.theta);
         summarize(&problem, parameters, report)
+    }
+
+    /// The least-squares problem of a fit of `model` from `params`, set up for the record's
+    /// length, and the free parameters.
+    fn problem<'a>(
+        &self,
+        model: &'a dyn OutputErrorModel,
+        data: &'a IdData,
+        params: &ParameterSet,
+    ) -> Result<(OutputErrorProblem<'a>, Vec<usize>)> {
+        params.validate()?;
+        check_outputs_vary(data)?;
+        let mut problem =
+            OutputErrorProblem::new(model, data, self.weights(model.n_outputs())?, self.skip)?;
+        let free = params.free_indices();
+        if model.speculative_sensitivities() {
+            problem.speculate(&free);
+        } else {
+            problem.overlap(&free);
+        }
+        Ok((problem, free))
     }
 
     fn weights(&self, n_outputs: usize) -> Result<Vec<f64>> {
@@ -331,6 +401,8 @@ pub struct OutputErrorProblem<'a> {
     /// Normal equations computed beside every trial point's plain simulation (see
     /// [`OVERLAP_RESIDUALS`]).
     overlap: Option<KeptSystem>,
+    /// The start's normal equations computed ahead of the fit ([`OutputError::start`]).
+    seed: Mutex<Option<FitStart>>,
 }
 
 /// Records at least this long (residuals) get every trial point's normal equations computed
@@ -456,6 +528,7 @@ impl<'a> OutputErrorProblem<'a> {
             last: Mutex::new(None),
             speculation: None,
             overlap: None,
+            seed: Mutex::new(None),
         })
     }
 
@@ -487,6 +560,31 @@ impl<'a> OutputErrorProblem<'a> {
         } else {
             self.overlap = Some(KeptSystem::new(free));
         }
+    }
+
+    /// True when every pass of the fit is one pipelined pass over a long record (see
+    /// [`overlap`](Self::overlap)).
+    fn pipelines(&self) -> bool {
+        self.speculation.as_ref().is_some_and(|s| !s.split)
+    }
+
+    /// Keeps the start's normal equations computed ahead for the engine's first request.
+    fn seed(&self, start: FitStart) {
+        *self.seed.lock().unwrap_or_else(|p| p.into_inner()) = Some(start);
+    }
+
+    /// The seeded start's normal equations when asked for exactly its point and parameters;
+    /// a speculating fit counts them as one of its passes (the engine counts its requests).
+    fn take_seed(&self, theta: &[f64], free: &[usize]) -> Option<NormalEquations> {
+        let seed = self.seed.lock().unwrap_or_else(|p| p.into_inner()).take();
+        let system = seed
+            .filter(|s| s.theta == theta && s.free == free)
+            .map(|s| s.system)?;
+        if let Some(spec) = &self.speculation {
+            spec.with_sensitivities
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        Some(system)
     }
 
     /// True when the search runs alone (inside a rayon job, a multi-start, the other core is
@@ -760,6 +858,47 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 
     fn residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
+        self.speculative_residuals(theta, r).map(|_| ())
+    }
+
+    fn residuals_and_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
+        // The pass's S is Σ r² summed row by row, the engine's order, when the residuals are
+        // one experiment's (several are summed experiment by experiment).
+        match self.speculative_residuals(theta, r)? {
+            Some(cost) if self.data.n_experiments() == 1 && cost.is_finite() => Ok(cost),
+            _ => {
+                if let Some(i) = r.iter().position(|v| !v.is_finite()) {
+                    return Err(Error::Diverged {
+                        index: i,
+                        reason: "a residual is not finite".into(),
+                    });
+                }
+                Ok(r.iter().map(|v| v * v).sum())
+            }
+        }
+    }
+
+    fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
+        if let Some(system) = self.take_seed(theta, free) {
+            return Some(Ok(system));
+        }
+        if let Some(system) = self.overlap.as_ref().and_then(|o| o.take(theta, free)) {
+            return Some(Ok(system));
+        }
+        self.speculative_or_direct_normal_equations(theta, free)
+    }
+
+    fn cost_floor(&self) -> f64 {
+        // Residuals at the 1e-13 relative level are round-off: the fit is exact.
+        1e-26 * self.data_scale
+    }
+}
+
+impl OutputErrorProblem<'_> {
+    /// The residuals at θ into `r`, from a sensitivity pass when speculating (its normal
+    /// equations kept for the engine's request that follows; returns the pass's S), else
+    /// from a simulation (returns None).
+    fn speculative_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<Option<f64>> {
         use std::sync::atomic::Ordering::Relaxed;
         if let Some(spec) = self
             .speculation
@@ -769,8 +908,10 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
             match self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, r) {
                 Some(system) => {
                     spec.with_sensitivities.fetch_add(1, Relaxed);
-                    spec.kept.keep(theta, system?);
-                    return Ok(());
+                    let system = system?;
+                    let cost = system.cost;
+                    spec.kept.keep(theta, system);
+                    return Ok(Some(cost));
                 }
                 None => spec.disabled.store(true, Relaxed),
             }
@@ -778,6 +919,12 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         if let Some(spec) = &self.speculation {
             spec.without.fetch_add(1, Relaxed);
         }
+        self.plain_or_overlapped_residuals(theta, r).map(|()| None)
+    }
+
+    /// The residuals from a plain simulation, with the normal equations computed beside it
+    /// when overlapping (see [`OVERLAP_RESIDUALS`]).
+    fn plain_or_overlapped_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
         if let Some(overlap) = &self.overlap {
             let (plain, system) = rayon::join(
                 || self.plain_residuals(theta, r),
@@ -792,20 +939,6 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         self.plain_residuals(theta, r)
     }
 
-    fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
-        if let Some(system) = self.overlap.as_ref().and_then(|o| o.take(theta, free)) {
-            return Some(Ok(system));
-        }
-        self.speculative_or_direct_normal_equations(theta, free)
-    }
-
-    fn cost_floor(&self) -> f64 {
-        // Residuals at the 1e-13 relative level are round-off: the fit is exact.
-        1e-26 * self.data_scale
-    }
-}
-
-impl OutputErrorProblem<'_> {
     /// The residuals from a plain simulation (kept as the last simulation).
     fn plain_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
         let sims = self.simulate_all(theta)?;

@@ -60,6 +60,21 @@ pub trait LeastSquaresProblem: Sync {
     /// non-finite value, marks θ as a point where the model cannot be evaluated.
     fn residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()>;
 
+    /// Writes r(θ) into `r` and returns S(θ) = Σ rᵢ², summed in order; an error where the
+    /// model cannot be evaluated or a residual is not finite. The default sums the squares of
+    /// [`residuals`](Self::residuals); a problem whose residual pass sums them itself, in the
+    /// same order, may return that sum and spare the engine a pass over a long record.
+    fn residuals_and_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
+        self.residuals(theta, r)?;
+        match r.iter().position(|v| !v.is_finite()) {
+            None => Ok(r.iter().map(|v| v * v).sum()),
+            Some(i) => Err(Error::Diverged {
+                index: i,
+                reason: "a residual is not finite".into(),
+            }),
+        }
+    }
+
     /// Optionally the normal equations at θ for the parameters `free`, computed analytically.
     /// `None` (the default) makes the engine use finite differences.
     fn normal_equations(&self, _theta: &[f64], _free: &[usize]) -> Option<Result<NormalEquations>> {
@@ -474,11 +489,9 @@ impl<'a> State<'a> {
             let predicted = self.predicted_decrease(&candidate);
             self.fevals += 1;
             self.plain_evals += 1;
-            let cost = match self.problem.residuals(&candidate, trial) {
-                Ok(()) if trial.iter().all(|r| r.is_finite()) => {
-                    trial.iter().map(|r| r * r).sum::<f64>()
-                }
-                _ => {
+            let cost = match self.problem.residuals_and_cost(&candidate, trial) {
+                Ok(cost) => cost,
+                Err(_) => {
                     self.rejected += 1;
                     self.grow_damping();
                     continue;
