@@ -615,36 +615,43 @@ impl<'a> OutputErrorProblem<'a> {
         theta: &[f64],
         free: &[usize],
         split: bool,
-        r: &mut [f64],
+        r: Option<&mut [f64]>,
     ) -> Option<Result<NormalEquations>> {
-        let ny = self.model.n_outputs();
         // Without split columns the pass's outputs are the simulation's (the only way here,
         // see `overlap`): they are kept as the last simulation, which the fit statistics at
         // the final point then reuse instead of simulating once more.
         let mut sims: Simulations = if split {
             Vec::new()
         } else {
-            self.data
-                .experiments()
-                .iter()
-                .map(|exp| vec![vec![0.0; exp.len()]; ny])
-                .collect()
+            self.simulation_buffers()
         };
         let mut outputs = sims.iter_mut();
+        let mut scratch = Vec::new();
+        let mut rest = match (r, split) {
+            (Some(r), _) => Some(r),
+            // The split columns' path writes residuals: into scratch when none are wanted.
+            (None, true) => {
+                scratch.resize(self.n_residuals, 0.0);
+                Some(&mut scratch[..])
+            }
+            (None, false) => None,
+        };
         let mut chunks = Vec::new();
-        let mut rest = r;
         for e in 0..self.data.n_experiments() {
-            let len = ny * (self.data.experiment(e).len() - self.skip);
-            let (chunk, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            let len = self.model.n_outputs() * (self.data.experiment(e).len() - self.skip);
+            let chunk = rest.take().map(|all| {
+                let (chunk, tail) = all.split_at_mut(len);
+                rest = Some(tail);
+                chunk
+            });
             chunks.push((e, chunk, outputs.next()));
-            rest = tail;
         }
         let parts: Vec<Option<Result<NormalEquations>>> = chunks
             .into_par_iter()
-            .map(|(e, chunk, outputs)| match outputs {
-                None => self.experiment_split(theta, free, e, chunk),
-                Some(outputs) => {
-                    self.experiment_normal_equations(theta, free, e, Some(chunk), Some(outputs))
+            .map(|(e, chunk, outputs)| match (outputs, chunk) {
+                (None, Some(chunk)) => self.experiment_split(theta, free, e, chunk),
+                (outputs, chunk) => {
+                    self.experiment_normal_equations(theta, free, e, chunk, outputs)
                 }
             })
             .collect();
@@ -653,6 +660,28 @@ impl<'a> OutputErrorProblem<'a> {
             *self.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((theta.to_vec(), sims));
         }
         total
+    }
+
+    /// Buffers for a pass's outputs `[experiment][output][t]`: the last simulation's, which
+    /// a new pass makes stale (reused, their pages need not be faulted in again; every value
+    /// is written over), else new ones.
+    fn simulation_buffers(&self) -> Simulations {
+        let ny = self.model.n_outputs();
+        let experiments = self.data.experiments();
+        let fits = |sims: &Simulations| {
+            sims.len() == experiments.len()
+                && sims.iter().zip(experiments).all(|(outputs, exp)| {
+                    outputs.len() == ny && outputs.iter().all(|y| y.len() == exp.len())
+                })
+        };
+        let last = self.last.lock().unwrap_or_else(|e| e.into_inner()).take();
+        match last {
+            Some((_, sims)) if fits(&sims) => sims,
+            _ => experiments
+                .iter()
+                .map(|exp| vec![vec![0.0; exp.len()]; ny])
+                .collect(),
+        }
     }
 
     /// One experiment's residuals and normal equations with the sensitivity columns split
@@ -861,6 +890,35 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         self.speculative_residuals(theta, r).map(|_| ())
     }
 
+    fn trial_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
+        use std::sync::atomic::Ordering::Relaxed;
+        // A long record's trial point is one pipelined pass (see `overlap`); its S, summed as
+        // the engine sums, is all the engine reads, so the residuals are not written out.
+        let pass = self
+            .speculation
+            .as_ref()
+            .filter(|s| !s.split && !s.disabled.load(Relaxed) && self.data.n_experiments() == 1);
+        if let Some(spec) = pass {
+            match self.residuals_with_normal_equations(theta, &spec.kept.free, false, None) {
+                Some(system) => {
+                    spec.with_sensitivities.fetch_add(1, Relaxed);
+                    let system = system?;
+                    let cost = system.cost;
+                    spec.kept.keep(theta, system);
+                    return match cost.is_finite() {
+                        true => Ok(cost),
+                        false => Err(Error::Diverged {
+                            index: 0,
+                            reason: "the criterion is not finite".into(),
+                        }),
+                    };
+                }
+                None => spec.disabled.store(true, Relaxed),
+            }
+        }
+        self.residuals_and_cost(theta, r)
+    }
+
     fn residuals_and_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
         // The pass's S is Σ r² summed row by row, the engine's order, when the residuals are
         // one experiment's (several are summed experiment by experiment).
@@ -905,7 +963,8 @@ impl OutputErrorProblem<'_> {
             .as_ref()
             .filter(|s| !s.disabled.load(Relaxed))
         {
-            match self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, r) {
+            match self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, Some(r))
+            {
                 Some(system) => {
                     spec.with_sensitivities.fetch_add(1, Relaxed);
                     let system = system?;
@@ -973,8 +1032,7 @@ impl OutputErrorProblem<'_> {
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 if spec.split && spec.kept.free == free {
                     // The start: the engine asks for the normal equations first.
-                    let mut r = vec![0.0; self.n_residuals];
-                    return self.residuals_with_normal_equations(theta, free, true, &mut r);
+                    return self.residuals_with_normal_equations(theta, free, true, None);
                 }
             }
         }

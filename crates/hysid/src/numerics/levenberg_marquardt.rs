@@ -75,6 +75,14 @@ pub trait LeastSquaresProblem: Sync {
         }
     }
 
+    /// S(θ) at a trial point of an engine that has its normal equations from
+    /// [`normal_equations`](Self::normal_equations) and so never reads the residuals
+    /// themselves: `r` is scratch and may be left unwritten. The default is
+    /// [`residuals_and_cost`](Self::residuals_and_cost).
+    fn trial_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
+        self.residuals_and_cost(theta, r)
+    }
+
     /// Optionally the normal equations at θ for the parameters `free`, computed analytically.
     /// `None` (the default) makes the engine use finite differences.
     fn normal_equations(&self, _theta: &[f64], _free: &[usize]) -> Option<Result<NormalEquations>> {
@@ -299,6 +307,10 @@ struct State<'a> {
     /// The residuals of trial points (reused from step to step: a long record's buffer is
     /// megabytes, page-faulted afresh if allocated per step).
     trial: Vec<f64>,
+    /// True while the normal equations come from the problem: the residual values are then
+    /// never read, and trial points ask for their cost alone
+    /// ([`LeastSquaresProblem::trial_cost`]).
+    analytic: bool,
     system: NormalEquations,
     initial_cost: f64,
     lambda: f64,
@@ -349,6 +361,7 @@ impl<'a> State<'a> {
             upper: upper.to_vec(),
             theta: theta0.to_vec(),
             trial: vec![0.0; residuals.len()],
+            analytic: analytic.is_some(),
             residuals,
             system: NormalEquations {
                 jtj: DMatrix::zeros(0, 0),
@@ -489,7 +502,11 @@ impl<'a> State<'a> {
             let predicted = self.predicted_decrease(&candidate);
             self.fevals += 1;
             self.plain_evals += 1;
-            let cost = match self.problem.residuals_and_cost(&candidate, trial) {
+            let evaluated = match self.analytic {
+                true => self.problem.trial_cost(&candidate, trial),
+                false => self.problem.residuals_and_cost(&candidate, trial),
+            };
+            let cost = match evaluated {
                 Ok(cost) => cost,
                 Err(_) => {
                     self.rejected += 1;
@@ -613,6 +630,11 @@ impl<'a> State<'a> {
                 });
             }
             return Ok(system);
+        }
+        if self.analytic {
+            // Finite differences need the residuals at θ, which trial costs did not write.
+            self.analytic = false;
+            self.problem.residuals(&self.theta, &mut self.residuals)?;
         }
         self.finite_difference_system()
     }
