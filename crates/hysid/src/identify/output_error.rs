@@ -512,10 +512,8 @@ impl<'a> OutputErrorProblem<'a> {
             }
             n_residuals += ny * (exp.len() - skip);
             for (o, w) in weights.iter().enumerate() {
-                data_scale += exp.output(o)[skip..]
-                    .iter()
-                    .map(|v| (w * v).powi(2))
-                    .sum::<f64>();
+                // A scale for the exact-fit floor (see cost_floor), nothing more.
+                data_scale += w * w * metrics::sum_of_squares(&exp.output(o)[skip..]);
             }
         }
         Ok(Self {
@@ -890,7 +888,7 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         self.speculative_residuals(theta, r).map(|_| ())
     }
 
-    fn trial_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
+    fn trial_cost(&self, theta: &[f64], r: &mut Vec<f64>) -> Result<f64> {
         use std::sync::atomic::Ordering::Relaxed;
         // A long record's trial point is one pipelined pass (see `overlap`); its S, summed as
         // the engine sums, is all the engine reads, so the residuals are not written out.
@@ -916,6 +914,7 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
                 None => spec.disabled.store(true, Relaxed),
             }
         }
+        r.resize(self.n_residuals, 0.0);
         self.residuals_and_cost(theta, r)
     }
 

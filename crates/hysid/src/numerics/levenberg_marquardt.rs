@@ -77,9 +77,11 @@ pub trait LeastSquaresProblem: Sync {
 
     /// S(θ) at a trial point of an engine that has its normal equations from
     /// [`normal_equations`](Self::normal_equations) and so never reads the residuals
-    /// themselves: `r` is scratch and may be left unwritten. The default is
+    /// themselves: `r` is scratch, to be sized by whoever needs it (a long record's is
+    /// megabytes, not worth touching when unused). The default sizes it and calls
     /// [`residuals_and_cost`](Self::residuals_and_cost).
-    fn trial_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
+    fn trial_cost(&self, theta: &[f64], r: &mut Vec<f64>) -> Result<f64> {
+        r.resize(self.n_residuals(), 0.0);
         self.residuals_and_cost(theta, r)
     }
 
@@ -341,11 +343,13 @@ impl<'a> State<'a> {
         upper: &[f64],
         config: &'a LmConfig,
     ) -> Result<Self> {
-        let mut residuals = vec![0.0; problem.n_residuals()];
         // Analytic normal equations carry the cost S(θ₀): the residuals themselves are then
-        // needed only as a buffer, and computing them would cost one more simulation per fit.
+        // not needed, and computing them would cost one more simulation per fit. Their
+        // buffers are sized when first needed (a long record's are megabytes).
+        let mut residuals = Vec::new();
         let analytic = problem.normal_equations(theta0, free);
         if analytic.is_none() {
+            residuals.resize(problem.n_residuals(), 0.0);
             problem
                 .residuals(theta0, &mut residuals)
                 .map_err(initial_error)?;
@@ -360,7 +364,7 @@ impl<'a> State<'a> {
             lower: lower.to_vec(),
             upper: upper.to_vec(),
             theta: theta0.to_vec(),
-            trial: vec![0.0; residuals.len()],
+            trial: Vec::new(),
             analytic: analytic.is_some(),
             residuals,
             system: NormalEquations {
@@ -504,7 +508,10 @@ impl<'a> State<'a> {
             self.plain_evals += 1;
             let evaluated = match self.analytic {
                 true => self.problem.trial_cost(&candidate, trial),
-                false => self.problem.residuals_and_cost(&candidate, trial),
+                false => {
+                    trial.resize(self.problem.n_residuals(), 0.0);
+                    self.problem.residuals_and_cost(&candidate, trial)
+                }
             };
             let cost = match evaluated {
                 Ok(cost) => cost,
@@ -634,6 +641,7 @@ impl<'a> State<'a> {
         if self.analytic {
             // Finite differences need the residuals at θ, which trial costs did not write.
             self.analytic = false;
+            self.residuals.resize(self.problem.n_residuals(), 0.0);
             self.problem.residuals(&self.theta, &mut self.residuals)?;
         }
         self.finite_difference_system()
@@ -677,7 +685,7 @@ impl<'a> State<'a> {
             free: self.free,
             cost: self.system.cost,
             initial_cost: self.initial_cost,
-            n_residuals: self.residuals.len(),
+            n_residuals: self.problem.n_residuals(),
             iterations: self.iterations,
             function_evaluations: self.fevals,
             residual_evaluations: self.plain_evals,

@@ -135,9 +135,7 @@ impl FitSummary {
     /// The fit of simulated outputs `yhat` against measured `y`, one pair per experiment
     /// (`names` name them); errors when a figure is not finite (the simulation failed).
     pub fn of(names: &[String], y: &[&[f64]], yhat: &[&[f64]]) -> Result<Self> {
-        let stacked = |s: &[&[f64]]| s.iter().flat_map(|v| v.iter().copied()).collect();
-        let (ys, yhs): (Vec<f64>, Vec<f64>) = (stacked(y), stacked(yhat));
-        let per_experiment = names
+        let per_experiment: Vec<ExperimentFit> = names
             .iter()
             .zip(y.iter().zip(yhat))
             .map(|(name, (y, yh))| ExperimentFit {
@@ -147,9 +145,18 @@ impl FitSummary {
                 rmse: metrics::rmse(y, yh),
             })
             .collect();
+        // Stacked over the experiments; one experiment is its own stack.
+        let (fit_percent, rmse) = match (y, yhat, &per_experiment[..]) {
+            ([y], [yh], [one]) if y.len() == yh.len() => (one.fit_percent, one.rmse),
+            _ => {
+                let stacked = |s: &[&[f64]]| s.iter().flat_map(|v| v.iter().copied()).collect();
+                let (ys, yhs): (Vec<f64>, Vec<f64>) = (stacked(y), stacked(yhat));
+                (metrics::fit_percent(&ys, &yhs), metrics::rmse(&ys, &yhs))
+            }
+        };
         let summary = Self {
-            fit_percent: metrics::fit_percent(&ys, &yhs),
-            rmse: metrics::rmse(&ys, &yhs),
+            fit_percent,
+            rmse,
             loss: None,
             fpe: None,
             aic: None,
