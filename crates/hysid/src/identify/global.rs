@@ -463,6 +463,7 @@ pub fn basis_signals(form: ChForm, x: &[f64], alpha: f64, d: f64) -> Vec<Vec<f64
         return vec![Vec::new(); nl];
     }
     let mut psi = vec![0.0; nl * x.len()];
-    grid_regression::basis_signals(form, x, alpha, d, &mut psi);
+    let mut decay = vec![0.0; x.len()];
+    grid_regression::basis_signals(form, x, alpha, d, &mut psi, &mut decay);
     psi.chunks_exact(x.len()).map(<[f64]>::to_vec).collect()
 }

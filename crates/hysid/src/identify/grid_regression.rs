@@ -56,6 +56,8 @@ pub struct EquationError<'a> {
 /// Buffers of one evaluation, reused from grid point to grid point.
 pub struct Scratch {
     psi: Vec<f64>,
+    /// 1 − α|Δx(t)|, the basis signals' common decay.
+    decay: Vec<f64>,
     residual: Vec<f64>,
     gram: Vec<f64>,
     rhs: Vec<f64>,
@@ -108,6 +110,7 @@ impl<'a> EquationError<'a> {
         let cols = self.cols();
         Scratch {
             psi: vec![0.0; self.len() * self.nl],
+            decay: vec![0.0; self.len()],
             residual: Vec::with_capacity(self.len()),
             gram: vec![0.0; cols * cols],
             rhs: vec![0.0; cols],
@@ -130,7 +133,7 @@ impl<'a> EquationError<'a> {
         if n.checked_sub(self.t0)? <= cols || s.psi.len() != n * self.nl {
             return None;
         }
-        self.basis_signals(alpha, d, &mut s.psi);
+        self.basis_signals(alpha, d, &mut s.psi, &mut s.decay);
         self.normal_equations(s);
         for c in 0..cols {
             s.scale[c] = s.gram[c * cols + c].sqrt();
@@ -152,8 +155,8 @@ impl<'a> EquationError<'a> {
     }
 
     /// ψ, one signal after the other (ψᵢ(t) at `psi[i·N + t]`), as in the module docs.
-    fn basis_signals(&self, alpha: f64, d: f64, psi: &mut [f64]) {
-        basis_signals(self.form, &self.x[..self.len()], alpha, d, psi);
+    fn basis_signals(&self, alpha: f64, d: f64, psi: &mut [f64], decay: &mut [f64]) {
+        basis_signals(self.form, &self.x[..self.len()], alpha, d, psi, decay);
     }
 
     /// Column c of Φ over the rows t0…N−1, as a slice of y or ψ and the sign it carries
@@ -253,25 +256,91 @@ pub fn residual_squares(
 }
 
 /// ψ of the module docs for the hysteresis `form` over the non-empty input `x`, signal i at
-/// `psi[i·N + t]` (N = x.len(); `psi` holds 2 or 4 signals).
-pub(super) fn basis_signals(form: ChForm, x: &[f64], alpha: f64, d: f64, psi: &mut [f64]) {
+/// `psi[i·N + t]` (N = x.len(); `psi` holds 2 or 4 signals); `decay` (N values) is scratch.
+///
+/// Two passes: the inputs uᵢ(t) and the decay 1 − α|Δx(t)| of every sample first (no
+/// dependence between samples, so the loop runs four samples at a time with AVX when the
+/// processor has it), then the recursions, whose only work per sample is then one multiply
+/// and one add per signal. The operations are the formula's, in its order: the same bits
+/// as one pass.
+pub(super) fn basis_signals(
+    form: ChForm,
+    x: &[f64],
+    alpha: f64,
+    d: f64,
+    psi: &mut [f64],
+    decay: &mut [f64],
+) {
     match form {
-        ChForm::Saturated4 => basis_signals_of::<2>(x, alpha, d, psi),
-        ChForm::General6 => basis_signals_of::<4>(x, alpha, d, psi),
+        ChForm::Saturated4 => basis_signals_of::<2>(x, alpha, d, psi, decay),
+        ChForm::General6 => basis_signals_of::<4>(x, alpha, d, psi, decay),
     }
 }
 
 /// [`basis_signals`] for NL = 2 (ch4) or 4 (ch6) material coefficients. NL is a constant so
 /// that the recursions' states stay in registers.
-fn basis_signals_of<const NL: usize>(x: &[f64], alpha: f64, d: f64, psi: &mut [f64]) {
+fn basis_signals_of<const NL: usize>(
+    x: &[f64],
+    alpha: f64,
+    d: f64,
+    psi: &mut [f64],
+    decay: &mut [f64],
+) {
     let n = x.len();
+    let decay = &mut decay[..n];
+    let psi = &mut psi[..NL * n];
+    #[cfg(target_arch = "x86_64")]
+    if simd::available() {
+        // SAFETY: the processor has AVX, the only requirement of `basis_inputs_avx`.
+        unsafe { basis_inputs_avx::<NL>(x, alpha, d, psi, decay) };
+    } else {
+        basis_inputs::<NL>(x, alpha, d, psi, decay);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    basis_inputs::<NL>(x, alpha, d, psi, decay);
     let mut columns = psi.chunks_exact_mut(n);
     let mut columns: [&mut [f64]; NL] =
         std::array::from_fn(|_| columns.next().expect("NL signals"));
     let mut past = [0.0; NL];
+    for t in 1..n {
+        let decay = decay[t];
+        for (p, column) in past.iter_mut().zip(&mut columns) {
+            *p = decay * *p + column[t];
+            column[t] = *p;
+        }
+    }
+}
+
+/// [`basis_inputs`] compiled for AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn basis_inputs_avx<const NL: usize>(
+    x: &[f64],
+    alpha: f64,
+    d: f64,
+    psi: &mut [f64],
+    decay: &mut [f64],
+) {
+    basis_inputs::<NL>(x, alpha, d, psi, decay);
+}
+
+/// uᵢ(t) into `psi` (signal i at `psi[i·N + t]`, uᵢ(0) = 0) and 1 − α|Δx(t)| into `decay`.
+#[inline(always)]
+fn basis_inputs<const NL: usize>(
+    x: &[f64],
+    alpha: f64,
+    d: f64,
+    psi: &mut [f64],
+    decay: &mut [f64],
+) {
+    let n = x.len();
+    let mut columns = psi.chunks_exact_mut(n);
+    let mut columns: [&mut [f64]; NL] =
+        std::array::from_fn(|_| columns.next().expect("NL signals"));
     for column in &mut columns {
         column[0] = 0.0;
     }
+    decay[0] = 1.0;
     for t in 1..n {
         let dx = x[t] - x[t - 1];
         let adx = dx.abs();
@@ -283,19 +352,14 @@ fn basis_signals_of<const NL: usize>(x: &[f64], alpha: f64, d: f64, psi: &mut [f
         } else {
             0.0
         };
-        let decay = 1.0 - alpha * adx;
-        let mut u = [0.0; NL];
-        u[0] = alpha * adx * (x[t] * (1.0 - h) + d * sgn * h);
+        decay[t] = 1.0 - alpha * adx;
+        columns[0][t] = alpha * adx * (x[t] * (1.0 - h) + d * sgn * h);
         if NL == 2 {
-            u[1] = (1.0 - h) * dx;
+            columns[1][t] = (1.0 - h) * dx;
         } else {
-            u[1] = alpha * adx * (x[t] * h - d * sgn * h);
-            u[2] = (1.0 - h) * dx;
-            u[3] = h * dx;
-        }
-        for ((p, ui), column) in past.iter_mut().zip(&u).zip(&mut columns) {
-            *p = decay * *p + ui;
-            column[t] = *p;
+            columns[1][t] = alpha * adx * (x[t] * h - d * sgn * h);
+            columns[2][t] = (1.0 - h) * dx;
+            columns[3][t] = h * dx;
         }
     }
 }

@@ -181,11 +181,9 @@ impl OutputErrorFit {
     pub fn at(&self, model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<Self> {
         let weights = vec![1.0; model.n_outputs()];
         let problem = OutputErrorProblem::new(model, data, weights, 0)?;
-        let mut r = vec![0.0; problem.n_residuals()];
-        problem.residuals(theta, &mut r)?;
         let mut report = self.report.clone();
         report.theta = theta.to_vec();
-        report.cost = r.iter().map(|v| v * v).sum();
+        report.cost = problem.plain_cost(theta)?;
         let mut parameters = self.parameters.clone();
         parameters.set_values(theta);
         let covariance = self.covariance.clone();
@@ -995,6 +993,25 @@ impl OutputErrorProblem<'_> {
             return plain;
         }
         self.plain_residuals(theta, r)
+    }
+
+    /// S(θ) = Σ r² from a plain simulation (kept as the last simulation), summed in the
+    /// order of the residual vector without writing it out.
+    fn plain_cost(&self, theta: &[f64]) -> Result<f64> {
+        let sims = self.simulate_all(theta)?;
+        let mut cost = 0.0;
+        for (e, sim) in sims.iter().enumerate() {
+            let exp = self.data.experiment(e);
+            for (o, yhat) in sim.iter().enumerate() {
+                let w = self.weights[o];
+                for (y, yh) in exp.output(o)[self.skip..].iter().zip(&yhat[self.skip..]) {
+                    let r = w * (y - yh);
+                    cost += r * r;
+                }
+            }
+        }
+        *self.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((theta.to_vec(), sims));
+        Ok(cost)
     }
 
     /// The residuals from a plain simulation (kept as the last simulation).

@@ -170,7 +170,7 @@ impl Chunks<'_> {
         // for an earlier one, and few are held besides the growing columns.
         let next = AtomicUsize::new(0);
         let failed = AtomicBool::new(false);
-        let assembly = Mutex::new(Assembly::new(self.line.wanted.len()));
+        let assembly = Mutex::new(Assembly::new(self.line.wanted.len(), count));
         let threads = rayon::current_num_threads().clamp(1, count);
         (0..threads).into_par_iter().for_each(|_| {
             let mut buffer = vec![0; self.chunk_bytes as usize + MAX_LINE + 2];
@@ -401,16 +401,19 @@ struct Assembly {
     /// Appended chunks' vectors, emptied, for the next chunks to fill: reused, they keep
     /// their memory, which freed and allocated again would be new pages to fault in.
     spare: Vec<Vec<Vec<f64>>>,
+    /// Number of chunks in the file.
+    chunks: usize,
 }
 
 impl Assembly {
-    /// Nothing appended yet, to `width` columns.
-    fn new(width: usize) -> Self {
+    /// Nothing appended yet, to `width` columns of a file of `chunks` chunks.
+    fn new(width: usize, chunks: usize) -> Self {
         Self {
             columns: vec![Vec::new(); width],
             next: 0,
             waiting: BTreeMap::new(),
             spare: Vec::new(),
+            chunks,
         }
     }
 
@@ -420,6 +423,17 @@ impl Assembly {
         let width = part.len();
         self.waiting.insert(index, part);
         while let Some(mut part) = self.waiting.remove(&self.next) {
+            if self.next == 0 {
+                // The first chunk's rows times the chunks, and a sixteenth more: the columns
+                // are then allocated once instead of growing by doubling (each step a copy
+                // and fresh pages). Chunks hold equal bytes, so rows differ only with the
+                // lines' lengths; a longer file part just grows the columns as before.
+                let rows = part.first().map_or(0, Vec::len);
+                let expected = rows.saturating_mul(self.chunks);
+                for column in &mut self.columns {
+                    column.reserve(expected.saturating_add(expected / 16));
+                }
+            }
             for (column, values) in self.columns.iter_mut().zip(&mut part) {
                 column.extend_from_slice(values);
                 values.clear();

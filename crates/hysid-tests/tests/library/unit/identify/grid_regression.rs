@@ -135,3 +135,51 @@ fn residual_squares_are_the_same_bits_with_and_without_simd() {
         }
     }
 }
+
+/// The two-pass basis signals (inputs first, then the recursions) are bit for bit the
+/// one-pass recursion of the module docs, for both forms, with samples at zero and exactly
+/// at the threshold.
+#[test]
+fn basis_signals_are_the_one_pass_recursion() {
+    let mut x = random_values(3, 2003);
+    x[10] = 0.0;
+    x[11] = 0.0;
+    x[500] = 0.7;
+    x[501] = -0.7;
+    for (form, nl) in [(ChForm::Saturated4, 2), (ChForm::General6, 4)] {
+        for (alpha, d) in [(0.01, 0.7), (0.2, 0.05), (1e-4, 3.0)] {
+            let psi = basis_signals(form, &x, alpha, d);
+            let mut past = vec![0.0; nl];
+            for t in 1..x.len() {
+                let dx = x[t] - x[t - 1];
+                let adx = dx.abs();
+                let h = if x[t].abs() > d { 1.0 } else { 0.0 };
+                let sgn = if x[t] > 0.0 {
+                    1.0
+                } else if x[t] < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                };
+                let u = if nl == 2 {
+                    vec![
+                        alpha * adx * (x[t] * (1.0 - h) + d * sgn * h),
+                        (1.0 - h) * dx,
+                    ]
+                } else {
+                    vec![
+                        alpha * adx * (x[t] * (1.0 - h) + d * sgn * h),
+                        alpha * adx * (x[t] * h - d * sgn * h),
+                        (1.0 - h) * dx,
+                        h * dx,
+                    ]
+                };
+                for i in 0..nl {
+                    past[i] = (1.0 - alpha * adx) * past[i] + u[i];
+                    assert_eq!(psi[i][t].to_bits(), past[i].to_bits(), "{form:?} ψ{i}({t})");
+                }
+            }
+            assert!(psi.iter().all(|s| s[0] == 0.0));
+        }
+    }
+}
