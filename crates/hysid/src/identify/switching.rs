@@ -298,12 +298,13 @@ fn fixed_point<M: OutputErrorModel>(
         if best.as_ref().is_some_and(|(c, _)| actual >= *c) {
             break;
         }
-        best = Some((actual, fit.clone()));
+        // The fit itself is kept, not copied: its simulated outputs are a record's length.
+        current = fit.parameters.clone();
+        best = Some((actual, fit));
         visited.push(std::mem::replace(&mut h, h_new));
         if visited.contains(&h) {
             break;
         }
-        current = fit.parameters;
     }
     let (_, fit) = best.expect("at least one fit ran");
     Ok(SwitchedFit {
