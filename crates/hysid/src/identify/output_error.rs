@@ -361,8 +361,9 @@ fn summarize(
         let mut mses = Vec::new();
         for (o, yhat) in sims.iter().enumerate() {
             let y = &exp.output(o)[skip..];
-            fits.push(metrics::fit_percent(y, &yhat[skip..]));
-            mses.push(metrics::mse(y, &yhat[skip..]));
+            let (fit, mse) = metrics::fit_percent_and_mse(y, &yhat[skip..]);
+            fits.push(fit);
+            mses.push(mse);
         }
         fit_percent.push(fits);
         mse.push(mses);

@@ -58,14 +58,48 @@ pub fn std_dev(y: &[f64]) -> f64 {
 
 /// NRMSE = ‖y − ŷ‖₂ / ‖y − ȳ‖₂ (infinite when y is constant and ŷ ≠ y).
 pub fn nrmse(y: &[f64], yhat: &[f64]) -> f64 {
+    nrmse_of(squares(y, yhat))
+}
+
+/// ‖y − ŷ‖₂² and ‖y − ȳ‖₂² over the common length, in one pass after the mean (each summed
+/// as the module docs say, so each is what a pass of its own gives).
+fn squares(y: &[f64], yhat: &[f64]) -> (f64, f64) {
     let m = mean(y);
-    let err = sum_pairs(y, yhat, |a, b| (a - b).powi(2));
-    let var = sum_of(y, |a| (a - m).powi(2));
+    let n = y.len().min(yhat.len());
+    let (y, yhat) = (&y[..n], &yhat[..n]);
+    let mut err = [0.0; 8];
+    let mut var = [0.0; 8];
+    let (y8, h8) = (y.chunks_exact(8), yhat.chunks_exact(8));
+    let (y_tail, h_tail) = (y8.remainder(), h8.remainder());
+    let add = |err: &mut [f64; 8], var: &mut [f64; 8], ys: &[f64], hs: &[f64]| {
+        for (((e, v), a), b) in err.iter_mut().zip(var.iter_mut()).zip(ys).zip(hs) {
+            *e += (a - b).powi(2);
+            *v += (a - m).powi(2);
+        }
+    };
+    for (ys, hs) in y8.zip(h8) {
+        add(&mut err, &mut var, ys, hs);
+    }
+    add(&mut err, &mut var, y_tail, h_tail);
+    let total = |s: [f64; 8]| ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+    (total(err), total(var))
+}
+
+/// NRMSE from ‖y − ŷ‖₂² and ‖y − ȳ‖₂².
+fn nrmse_of((err, var): (f64, f64)) -> f64 {
     if err == 0.0 {
         0.0
     } else {
         (err / var).sqrt()
     }
+}
+
+/// [`fit_percent`] and [`mse`] of one output, from one pass over y and ŷ after the mean:
+/// the same values as the two functions give.
+pub fn fit_percent_and_mse(y: &[f64], yhat: &[f64]) -> (f64, f64) {
+    let (err, var) = squares(y, yhat);
+    let fit = 100.0 * (1.0 - nrmse_of((err, var)));
+    (fit, err / y.len().max(1) as f64)
 }
 
 /// fit % = 100·(1 − ‖y − ŷ‖₂ / ‖y − ȳ‖₂) (Gunnar et al. 2006 eq. 14; MATLAB `compare`).

@@ -138,11 +138,14 @@ impl FitSummary {
         let per_experiment: Vec<ExperimentFit> = names
             .iter()
             .zip(y.iter().zip(yhat))
-            .map(|(name, (y, yh))| ExperimentFit {
-                experiment: name.clone(),
-                samples: y.len(),
-                fit_percent: metrics::fit_percent(y, yh),
-                rmse: metrics::rmse(y, yh),
+            .map(|(name, (y, yh))| {
+                let (fit_percent, mse) = metrics::fit_percent_and_mse(y, yh);
+                ExperimentFit {
+                    experiment: name.clone(),
+                    samples: y.len(),
+                    fit_percent,
+                    rmse: mse.sqrt(),
+                }
             })
             .collect();
         // Stacked over the experiments; one experiment is its own stack.
