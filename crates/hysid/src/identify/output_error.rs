@@ -511,8 +511,10 @@ impl<'a> OutputErrorProblem<'a> {
             }
             n_residuals += ny * (exp.len() - skip);
             for (o, w) in weights.iter().enumerate() {
-                // A scale for the exact-fit floor (see cost_floor), nothing more.
-                data_scale += w * w * metrics::sum_of_squares(&exp.output(o)[skip..]);
+                data_scale += exp.output(o)[skip..]
+                    .iter()
+                    .map(|v| (w * v).powi(2))
+                    .sum::<f64>();
             }
         }
         Ok(Self {
@@ -952,8 +954,8 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
 
 impl OutputErrorProblem<'_> {
     /// The residuals at θ into `r`, from a sensitivity pass when speculating (its normal
-    /// equations kept for the engine's request that follows; returns the pass's S), else
-    /// from a simulation (returns None).
+    /// equations kept for the engine's request that follows; returns the pass's S when it
+    /// was accumulated row by row), else from a simulation (returns None).
     fn speculative_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<Option<f64>> {
         use std::sync::atomic::Ordering::Relaxed;
         if let Some(spec) = self
@@ -966,9 +968,11 @@ impl OutputErrorProblem<'_> {
                 Some(system) => {
                     spec.with_sensitivities.fetch_add(1, Relaxed);
                     let system = system?;
-                    let cost = system.cost;
+                    // The accumulated S (no split columns) is summed row by row, as the
+                    // engine sums; the split columns' product is not.
+                    let cost = (!spec.split).then_some(system.cost);
                     spec.kept.keep(theta, system);
-                    return Ok(Some(cost));
+                    return Ok(cost);
                 }
                 None => spec.disabled.store(true, Relaxed),
             }

@@ -5,10 +5,12 @@
 //! * FPE = V·(1 + p/N)/(1 − p/N), with the loss V = mean squared residual (Akaike)
 //! * AIC = N·ln V + 2p + N·(ln 2π + 1) (MATLAB's `aic` for one output)
 //!
-//! The sums run over eight partial sums (value i goes to sum i mod 8, the sums are then added
-//! pairwise): independent chains, so a 10⁶-sample record is summed at the machine's rate
-//! rather than one addition's latency per value, and in a fixed order, so the figures are
-//! reproducible (and, like pairwise summation, more accurate than one running sum).
+//! The sums of squares behind fit %, NRMSE and MSE run over eight partial sums (value i goes
+//! to sum i mod 8, the sums are then added pairwise): independent chains, so a 10⁶-sample
+//! record is summed at the machine's rate rather than one addition's latency per value, and
+//! in a fixed order, so the figures are reproducible. The mean and standard deviation keep
+//! one running sum: they shift and scale data (mean removal, noise levels), whose rounding
+//! every later figure inherits.
 
 /// Σ f(aᵢ, bᵢ) over the common length, in the order of the module docs.
 #[inline(always)]
@@ -30,30 +32,20 @@ fn sum_pairs(a: &[f64], b: &[f64], f: impl Fn(f64, f64) -> f64) -> f64 {
     ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))
 }
 
-/// Σ f(aᵢ) in the order of the module docs.
-#[inline(always)]
-fn sum_of(a: &[f64], f: impl Fn(f64) -> f64) -> f64 {
-    sum_pairs(a, a, |x, _| f(x))
-}
-
-/// Σ yᵢ² (summed as the module docs say).
-pub fn sum_of_squares(y: &[f64]) -> f64 {
-    sum_of(y, |v| v * v)
-}
-
-/// Arithmetic mean (0 for an empty slice).
+/// Arithmetic mean (0 for an empty slice), summed in order: it shifts data (mean removal),
+/// so its rounding is kept as it always was.
 pub fn mean(y: &[f64]) -> f64 {
     if y.is_empty() {
         0.0
     } else {
-        sum_of(y, |v| v) / y.len() as f64
+        y.iter().sum::<f64>() / y.len() as f64
     }
 }
 
-/// Population standard deviation (divides by N).
+/// Population standard deviation (divides by N), summed in order like [`mean`].
 pub fn std_dev(y: &[f64]) -> f64 {
     let m = mean(y);
-    (sum_of(y, |v| (v - m).powi(2)) / y.len().max(1) as f64).sqrt()
+    (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / y.len().max(1) as f64).sqrt()
 }
 
 /// NRMSE = ‖y − ŷ‖₂ / ‖y − ȳ‖₂ (infinite when y is constant and ŷ ≠ y).
