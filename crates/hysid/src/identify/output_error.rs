@@ -25,7 +25,7 @@ use crate::numerics::levenberg_marquardt::{
     minimize, Control, Covariance, IterationRecord, LeastSquaresProblem, LmConfig, LmReport,
     NormalEquations,
 };
-use crate::numerics::metrics;
+use crate::numerics::{levenberg_marquardt, metrics};
 use crate::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -924,15 +924,7 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
         // one experiment's (several are summed experiment by experiment).
         match self.speculative_residuals(theta, r)? {
             Some(cost) if self.data.n_experiments() == 1 && cost.is_finite() => Ok(cost),
-            _ => {
-                if let Some(i) = r.iter().position(|v| !v.is_finite()) {
-                    return Err(Error::Diverged {
-                        index: i,
-                        reason: "a residual is not finite".into(),
-                    });
-                }
-                Ok(r.iter().map(|v| v * v).sum())
-            }
+            _ => levenberg_marquardt::sum_of_squares(r),
         }
     }
 
@@ -1003,24 +995,19 @@ impl OutputErrorProblem<'_> {
     /// S(θ) = Σ r² from a plain simulation (kept as the last simulation), summed in the
     /// order of the residual vector without writing it out.
     fn plain_cost(&self, theta: &[f64]) -> Result<f64> {
-        let sims = self.simulate_all(theta)?;
         let mut cost = 0.0;
-        for (e, sim) in sims.iter().enumerate() {
-            let exp = self.data.experiment(e);
-            for (o, yhat) in sim.iter().enumerate() {
-                let w = self.weights[o];
-                for (y, yh) in exp.output(o)[self.skip..].iter().zip(&yhat[self.skip..]) {
-                    let r = w * (y - yh);
-                    cost += r * r;
-                }
-            }
-        }
-        *self.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((theta.to_vec(), sims));
+        self.each_plain_residual(theta, |_, r| cost += r * r)?;
         Ok(cost)
     }
 
     /// The residuals from a plain simulation (kept as the last simulation).
     fn plain_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
+        self.each_plain_residual(theta, |k, value| r[k] = value)
+    }
+
+    /// Simulates at θ (kept as the last simulation) and hands every residual, with its
+    /// index in the stacked residual vector, to `each`, in that order.
+    fn each_plain_residual(&self, theta: &[f64], mut each: impl FnMut(usize, f64)) -> Result<()> {
         let sims = self.simulate_all(theta)?;
         let mut k = 0;
         for (e, sim) in sims.iter().enumerate() {
@@ -1028,7 +1015,7 @@ impl OutputErrorProblem<'_> {
             for (o, yhat) in sim.iter().enumerate() {
                 let w = self.weights[o];
                 for (y, yh) in exp.output(o)[self.skip..].iter().zip(&yhat[self.skip..]) {
-                    r[k] = w * (y - yh);
+                    each(k, w * (y - yh));
                     k += 1;
                 }
             }

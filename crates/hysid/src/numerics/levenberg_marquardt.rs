@@ -66,13 +66,7 @@ pub trait LeastSquaresProblem: Sync {
     /// same order, may return that sum and spare the engine a pass over a long record.
     fn residuals_and_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
         self.residuals(theta, r)?;
-        match r.iter().position(|v| !v.is_finite()) {
-            None => Ok(r.iter().map(|v| v * v).sum()),
-            Some(i) => Err(Error::Diverged {
-                index: i,
-                reason: "a residual is not finite".into(),
-            }),
-        }
+        sum_of_squares(r)
     }
 
     /// S(θ) at a trial point of an engine that has its normal equations from
@@ -94,6 +88,18 @@ pub trait LeastSquaresProblem: Sync {
     /// The sum of squares below which the fit is exact to working precision (default 0).
     fn cost_floor(&self) -> f64 {
         0.0
+    }
+}
+
+/// S = Σ rᵢ², summed in order: the engine's criterion, or an error at the first residual that
+/// is not finite.
+pub fn sum_of_squares(r: &[f64]) -> Result<f64> {
+    match r.iter().position(|v| !v.is_finite()) {
+        None => Ok(r.iter().map(|v| v * v).sum()),
+        Some(i) => Err(Error::Diverged {
+            index: i,
+            reason: "a residual is not finite".into(),
+        }),
     }
 }
 
