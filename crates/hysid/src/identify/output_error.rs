@@ -400,8 +400,6 @@ pub struct OutputErrorProblem<'a> {
     /// Normal equations computed beside every trial point's plain simulation (see
     /// [`OVERLAP_RESIDUALS`]).
     overlap: Option<KeptSystem>,
-    /// The start's normal equations computed ahead of the fit ([`OutputError::start`]).
-    seed: Mutex<Option<FitStart>>,
 }
 
 /// Records at least this long (residuals) get every trial point's normal equations computed
@@ -527,7 +525,6 @@ impl<'a> OutputErrorProblem<'a> {
             last: Mutex::new(None),
             speculation: None,
             overlap: None,
-            seed: Mutex::new(None),
         })
     }
 
@@ -567,23 +564,19 @@ impl<'a> OutputErrorProblem<'a> {
         self.speculation.as_ref().is_some_and(|s| !s.split)
     }
 
-    /// Keeps the start's normal equations computed ahead for the engine's first request.
+    /// Hands the start's normal equations computed ahead ([`OutputError::start`], made only
+    /// for pipelining fits) to the engine's first request, as a trial pass's are kept; the
+    /// fit counts them as one of its passes.
     fn seed(&self, start: FitStart) {
-        *self.seed.lock().unwrap_or_else(|p| p.into_inner()) = Some(start);
-    }
-
-    /// The seeded start's normal equations when asked for exactly its point and parameters;
-    /// a speculating fit counts them as one of its passes (the engine counts its requests).
-    fn take_seed(&self, theta: &[f64], free: &[usize]) -> Option<NormalEquations> {
-        let seed = self.seed.lock().unwrap_or_else(|p| p.into_inner()).take();
-        let system = seed
-            .filter(|s| s.theta == theta && s.free == free)
-            .map(|s| s.system)?;
-        if let Some(spec) = &self.speculation {
+        if let Some(spec) = self
+            .speculation
+            .as_ref()
+            .filter(|s| s.kept.free == start.free)
+        {
             spec.with_sensitivities
                 .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            spec.kept.keep(&start.theta, start.system);
         }
-        Some(system)
     }
 
     /// True when the search runs alone (inside a rayon job, a multi-start, the other core is
@@ -890,29 +883,17 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 
     fn trial_cost(&self, theta: &[f64], r: &mut Vec<f64>) -> Result<f64> {
-        use std::sync::atomic::Ordering::Relaxed;
         // A long record's trial point is one pipelined pass (see `overlap`); its S, summed as
         // the engine sums, is all the engine reads, so the residuals are not written out.
-        let pass = self
-            .speculation
-            .as_ref()
-            .filter(|s| !s.split && !s.disabled.load(Relaxed) && self.data.n_experiments() == 1);
-        if let Some(spec) = pass {
-            match self.residuals_with_normal_equations(theta, &spec.kept.free, false, None) {
-                Some(system) => {
-                    spec.with_sensitivities.fetch_add(1, Relaxed);
-                    let system = system?;
-                    let cost = system.cost;
-                    spec.kept.keep(theta, system);
-                    return match cost.is_finite() {
-                        true => Ok(cost),
-                        false => Err(Error::Diverged {
-                            index: 0,
-                            reason: "the criterion is not finite".into(),
-                        }),
-                    };
-                }
-                None => spec.disabled.store(true, Relaxed),
+        if self.pipelines() && self.data.n_experiments() == 1 {
+            if let Some(pass) = self.speculative_pass(theta, None) {
+                return match pass? {
+                    Some(cost) if cost.is_finite() => Ok(cost),
+                    _ => Err(Error::Diverged {
+                        index: 0,
+                        reason: "the criterion is not finite".into(),
+                    }),
+                };
             }
         }
         r.resize(self.n_residuals, 0.0);
@@ -929,9 +910,6 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 
     fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
-        if let Some(system) = self.take_seed(theta, free) {
-            return Some(Ok(system));
-        }
         if let Some(system) = self.overlap.as_ref().and_then(|o| o.take(theta, free)) {
             return Some(Ok(system));
         }
@@ -945,34 +923,45 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
 }
 
 impl OutputErrorProblem<'_> {
-    /// The residuals at θ into `r`, from a sensitivity pass when speculating (its normal
-    /// equations kept for the engine's request that follows; returns the pass's S when it
-    /// was accumulated row by row), else from a simulation (returns None).
+    /// The residuals at θ into `r`, from a sensitivity pass when speculating (see
+    /// [`speculative_pass`](Self::speculative_pass)), else from a simulation (returns None).
     fn speculative_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<Option<f64>> {
-        use std::sync::atomic::Ordering::Relaxed;
-        if let Some(spec) = self
-            .speculation
-            .as_ref()
-            .filter(|s| !s.disabled.load(Relaxed))
-        {
-            match self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, Some(r))
-            {
-                Some(system) => {
-                    spec.with_sensitivities.fetch_add(1, Relaxed);
-                    let system = system?;
-                    // The accumulated S (no split columns) is summed row by row, as the
-                    // engine sums; the split columns' product is not.
-                    let cost = (!spec.split).then_some(system.cost);
-                    spec.kept.keep(theta, system);
-                    return Ok(cost);
-                }
-                None => spec.disabled.store(true, Relaxed),
-            }
+        if let Some(pass) = self.speculative_pass(theta, Some(&mut *r)) {
+            return pass;
         }
         if let Some(spec) = &self.speculation {
-            spec.without.fetch_add(1, Relaxed);
+            spec.without
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         self.plain_or_overlapped_residuals(theta, r).map(|()| None)
+    }
+
+    /// One speculative pass at θ, its residuals into `r` when given: its normal equations
+    /// are kept for the engine's request that follows, and it returns its S when that was
+    /// accumulated row by row (no split columns; the split columns' product sums otherwise).
+    /// None when not speculating, or when the model turns out to have no pass.
+    fn speculative_pass(
+        &self,
+        theta: &[f64],
+        r: Option<&mut [f64]>,
+    ) -> Option<Result<Option<f64>>> {
+        use std::sync::atomic::Ordering::Relaxed;
+        let spec = self
+            .speculation
+            .as_ref()
+            .filter(|s| !s.disabled.load(Relaxed))?;
+        let Some(system) =
+            self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, r)
+        else {
+            spec.disabled.store(true, Relaxed);
+            return None;
+        };
+        spec.with_sensitivities.fetch_add(1, Relaxed);
+        Some(system.map(|system| {
+            let cost = (!spec.split).then_some(system.cost);
+            spec.kept.keep(theta, system);
+            cost
+        }))
     }
 
     /// The residuals from a plain simulation, with the normal equations computed beside it
