@@ -9,14 +9,18 @@
 //! sensitivity pass) and whichever instruction set runs it, so the result is the same bits.
 //!
 //! Why this layout: the rows arrive row-major from the sensitivity pass. Updating the
-//! accumulators of a whole row at once touches each value once, in registers (the row's p
-//! products per parameter are one vector operation per four of them), where dot products
-//! over columns first had to transpose the rows and then ran p(p + 3)/2 dependent chains. On
-//! x86-64 processors with AVX the block kernel runs four lanes wide (detected at run time;
-//! no fused multiply–add, so the lanes round exactly as the scalar code).
+//! accumulators of a whole row at once touches each value once (the row's p products per
+//! parameter are one vector operation per four of them), where dot products over columns
+//! first had to transpose the rows and then ran p(p + 3)/2 dependent chains. On x86-64
+//! processors with AVX (detected at run time) the block kernel is [`tiles`]: the sums swept
+//! in tiles that fit the registers, four lanes wide, with no fused multiply–add, so the
+//! lanes round exactly as the portable kernel.
 
 use crate::numerics::levenberg_marquardt::NormalEquations;
 use nalgebra::{DMatrix, DVector};
+
+#[cfg(target_arch = "x86_64")]
+mod tiles;
 
 /// Rows per block.
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
@@ -37,6 +41,8 @@ pub struct Accumulator {
     /// The current row z = [scale·J, r] of the row-by-row path (`add_to_block`).
     z: Vec<f64>,
     cost: f64,
+    /// Whether blocks of rows go to the AVX tiles (the processor has AVX).
+    simd: bool,
 }
 
 impl Accumulator {
@@ -50,7 +56,16 @@ impl Accumulator {
             total: vec![0.0; p * (p + 1)],
             z: vec![0.0; p + 1],
             cost: 0.0,
+            simd: avx(),
         }
+    }
+
+    /// The same accumulator with the portable block kernel even where the processor has
+    /// AVX: the definition the AVX tiles are tested against.
+    #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
+    pub fn portable(mut self) -> Self {
+        self.simd = false;
+        self
     }
 
     /// Adds the row `scale · row` of J with residual `r`.
@@ -77,9 +92,6 @@ impl Accumulator {
             let src = from + done;
             let part = &r[done..done + take];
             self.block_rows(scale, &rows[src * width..(src + take) * width], width, part);
-            for &v in part {
-                self.cost += v * v;
-            }
             self.rows += take;
             done += take;
             if self.rows == BLOCK_ROWS {
@@ -88,13 +100,14 @@ impl Accumulator {
         }
     }
 
-    /// Sums the rows `rows` (`r.len()` of them, `width` apart) into the block: with a
-    /// fixed-width kernel for p ≤ 12, else row by row.
+    /// Sums the rows `rows` (`r.len()` of them, `width` apart) into the block and their r²
+    /// into S: with the AVX tiles or a fixed-width kernel for p ≤ 12, else row by row.
     fn block_rows(&mut self, scale: f64, rows: &[f64], width: usize, r: &[f64]) {
+        let (block, cost, simd) = (&mut self.block, &mut self.cost, self.simd);
         macro_rules! kernels {
             ($(($p:literal, $w:literal)),*) => {
                 match self.p {
-                    $($p => return kernel::<$p, $w>(&mut self.block, scale, rows, width, r),)*
+                    $($p => return kernel::<$p, $w>(block, cost, simd, scale, rows, width, r),)*
                     _ => {}
                 }
             };
@@ -115,6 +128,7 @@ impl Accumulator {
         );
         for (row, &rt) in rows.chunks_exact(width).zip(r) {
             self.add_to_block(scale, &row[width - self.p..], rt);
+            self.cost += rt * rt;
         }
     }
 
@@ -158,40 +172,43 @@ impl Accumulator {
     }
 }
 
-/// The block kernel for P columns (W = P + 1): the block's sums in registers while the rows
-/// stream by. Runs with AVX when the processor has it (see the module docs).
+/// True when the processor has AVX (the check is cached by the standard library).
+fn avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// The block kernel for P columns (W = P + 1): the AVX tiles with `simd`, else
+/// [`kernel_portable`].
 fn kernel<const P: usize, const W: usize>(
     block: &mut [f64],
+    cost: &mut f64,
+    simd: bool,
     scale: f64,
     rows: &[f64],
     width: usize,
     r: &[f64],
 ) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx") {
-        // SAFETY: the processor has AVX, the only requirement of `kernel_avx`.
-        return unsafe { kernel_avx::<P, W>(block, scale, rows, width, r) };
+    if simd {
+        // SAFETY: `simd` is only set when the processor has AVX.
+        return unsafe { tiles::accumulate::<P>(block, cost, scale, rows, width, r) };
     }
-    kernel_body::<P, W>(block, scale, rows, width, r);
+    let _ = simd;
+    kernel_portable::<P, W>(block, cost, scale, rows, width, r);
 }
 
-/// [`kernel_body`] compiled for AVX.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx")]
-fn kernel_avx<const P: usize, const W: usize>(
+/// The portable block kernel: each row's products added to the block's sums in locals,
+/// and r² to S, row after row (see the module docs).
+fn kernel_portable<const P: usize, const W: usize>(
     block: &mut [f64],
-    scale: f64,
-    rows: &[f64],
-    width: usize,
-    r: &[f64],
-) {
-    kernel_body::<P, W>(block, scale, rows, width, r);
-}
-
-/// The kernel's loop: each row's products with the sums in locals (registers).
-#[inline(always)]
-fn kernel_body<const P: usize, const W: usize>(
-    block: &mut [f64],
+    cost: &mut f64,
     scale: f64,
     rows: &[f64],
     width: usize,
@@ -213,6 +230,7 @@ fn kernel_body<const P: usize, const W: usize>(
             *z = scale * v;
         }
         z[P] = rt;
+        *cost += rt * rt;
         // Entries j ≥ i are the sums; the few below them in the same group of four are
         // computed too (whole vectors) and never read.
         for (i, a) in acc.iter_mut().enumerate() {

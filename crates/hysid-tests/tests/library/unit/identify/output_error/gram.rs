@@ -115,3 +115,38 @@ fn block_rows_equal_single_rows() {
         assert_eq!(a.cost, b.cost, "p = {p}");
     }
 }
+
+/// The block kernels give the same bits on every instruction set: blocks of rows through
+/// the AVX tiles (where the processor has AVX) and through the portable kernel, for every
+/// fixed width p ≤ 12, chunk boundaries and a partial last block included.
+#[test]
+fn avx_tiles_equal_portable_kernel() {
+    for p in 1..=12 {
+        let n = 2 * BLOCK_ROWS + 77;
+        let (rows, res) = random_rows(31 + p as u64, p, n);
+        let width = p + 1;
+        let mut block = vec![f64::NAN; width * n];
+        for (out, row) in block.chunks_exact_mut(width).zip(&rows) {
+            out[1..].copy_from_slice(row);
+        }
+        let (mut tiles, mut portable) = (Accumulator::new(p), Accumulator::new(p).portable());
+        for acc in [&mut tiles, &mut portable] {
+            let mut start = 0;
+            for len in [1, 63, 64, 65, 700, 5, n] {
+                let end = (start + len).min(n);
+                acc.add_rows(
+                    -0.25,
+                    &block[start * width..end * width],
+                    width,
+                    0,
+                    &res[start..end],
+                );
+                start = end;
+            }
+        }
+        let (a, b) = (tiles.finish(), portable.finish());
+        assert_eq!(a.jtj, b.jtj, "p = {p}");
+        assert_eq!(a.jtr, b.jtr, "p = {p}");
+        assert_eq!(a.cost, b.cost, "p = {p}");
+    }
+}
