@@ -43,6 +43,9 @@ pub struct Accumulator {
     cost: f64,
     /// Whether blocks of rows go to the AVX tiles (the processor has AVX).
     simd: bool,
+    /// The AVX tiles' buffers, made on first use.
+    #[cfg(target_arch = "x86_64")]
+    tiles: Option<Box<tiles::Scratch>>,
 }
 
 impl Accumulator {
@@ -57,6 +60,8 @@ impl Accumulator {
             z: vec![0.0; p + 1],
             cost: 0.0,
             simd: avx(),
+            #[cfg(target_arch = "x86_64")]
+            tiles: None,
         }
     }
 
@@ -103,11 +108,29 @@ impl Accumulator {
     /// Sums the rows `rows` (`r.len()` of them, `width` apart) into the block and their r²
     /// into S: with the AVX tiles or a fixed-width kernel for p ≤ 12, else row by row.
     fn block_rows(&mut self, scale: f64, rows: &[f64], width: usize, r: &[f64]) {
-        let (block, cost, simd) = (&mut self.block, &mut self.cost, self.simd);
+        let (block, cost) = (&mut self.block, &mut self.cost);
+        #[cfg(target_arch = "x86_64")]
+        if self.simd && self.p <= tiles::MAX_P {
+            let scratch = self
+                .tiles
+                .get_or_insert_with(|| Box::new(tiles::Scratch::new()));
+            macro_rules! tiled {
+                ($($p:literal),*) => {
+                    match self.p {
+                        // SAFETY: `simd` is only set when the processor has AVX.
+                        $($p => return unsafe {
+                            tiles::accumulate::<$p>(scratch, block, cost, scale, rows, width, r)
+                        },)*
+                        _ => {}
+                    }
+                };
+            }
+            tiled!(1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12);
+        }
         macro_rules! kernels {
             ($(($p:literal, $w:literal)),*) => {
                 match self.p {
-                    $($p => return kernel::<$p, $w>(block, cost, simd, scale, rows, width, r),)*
+                    $($p => return kernel::<$p, $w>(block, cost, scale, rows, width, r),)*
                     _ => {}
                 }
             };
@@ -184,29 +207,9 @@ fn avx() -> bool {
     }
 }
 
-/// The block kernel for P columns (W = P + 1): the AVX tiles with `simd`, else
-/// [`kernel_portable`].
+/// The portable block kernel for P columns (W = P + 1): each row's products added to the
+/// block's sums in locals, and r² to S, row after row (see the module docs).
 fn kernel<const P: usize, const W: usize>(
-    block: &mut [f64],
-    cost: &mut f64,
-    simd: bool,
-    scale: f64,
-    rows: &[f64],
-    width: usize,
-    r: &[f64],
-) {
-    #[cfg(target_arch = "x86_64")]
-    if simd {
-        // SAFETY: `simd` is only set when the processor has AVX.
-        return unsafe { tiles::accumulate::<P>(block, cost, scale, rows, width, r) };
-    }
-    let _ = simd;
-    kernel_portable::<P, W>(block, cost, scale, rows, width, r);
-}
-
-/// The portable block kernel: each row's products added to the block's sums in locals,
-/// and r² to S, row after row (see the module docs).
-fn kernel_portable<const P: usize, const W: usize>(
     block: &mut [f64],
     cost: &mut f64,
     scale: f64,

@@ -22,15 +22,32 @@ pub(super) const MAX_P: usize = 12;
 /// Values per row of z and of the padded sums: p + 1 ≤ 13 rounded up to whole registers.
 const Z: usize = 16;
 
-/// Rows of z formed at a time (8 KB on the stack, in the first-level cache while the tiles
-/// sweep it).
+/// Rows of z formed at a time (8 KB, in the first-level cache while the tiles sweep it).
 const CHUNK: usize = 64;
+
+/// The tiles' buffers, kept by the accumulator from block to block: rows of z, and the
+/// block sums padded to whole registers. Entries past p + 1 stay zero, so the padding lanes
+/// only ever add 0·zᵢ.
+pub(super) struct Scratch {
+    z: Vec<[f64; Z]>,
+    sums: [f64; MAX_P * Z],
+}
+
+impl Scratch {
+    pub(super) fn new() -> Self {
+        Self {
+            z: vec![[0.0; Z]; CHUNK],
+            sums: [0.0; MAX_P * Z],
+        }
+    }
+}
 
 /// Adds the rows of J in `rows` (`width` ≥ P values per row, J the last P of them), each
 /// scaled by `scale`, with residuals `r`, to the row-major P × (P + 1) block sums `block`,
 /// and r² to `cost`, row by row. Requires P ≤ [`MAX_P`] and AVX.
 #[target_feature(enable = "avx")]
 pub(super) fn accumulate<const P: usize>(
+    scratch: &mut Scratch,
     block: &mut [f64],
     cost: &mut f64,
     scale: f64,
@@ -41,12 +58,11 @@ pub(super) fn accumulate<const P: usize>(
     const { assert!(P <= MAX_P) };
     let (p, w) = (P, P + 1);
     let registers = w.div_ceil(4);
-    let mut sums = [0.0; MAX_P * Z];
+    let Scratch { z, sums } = scratch;
     for (padded, sums) in sums.chunks_exact_mut(Z).zip(block.chunks_exact(w)) {
         padded[..w].copy_from_slice(sums);
     }
-    // Entries past p + 1 stay zero, so the padding lanes only ever add 0·zᵢ.
-    let mut z = [[0.0; Z]; CHUNK];
+    let mut s = *cost;
     for (rows, r) in rows.chunks(CHUNK * width).zip(r.chunks(CHUNK)) {
         let z = &mut z[..r.len()];
         for ((zt, row), &rt) in z.iter_mut().zip(rows.chunks_exact(width)).zip(r) {
@@ -57,7 +73,7 @@ pub(super) fn accumulate<const P: usize>(
                 *zc = scale * j;
             }
             zt[p] = rt;
-            *cost += rt * rt;
+            s += rt * rt;
         }
         // Gram rows 4g … 4g + 3 from register g on (the sums left of the diagonal's register
         // are never needed), at most three registers per sweep.
@@ -66,7 +82,7 @@ pub(super) fn accumulate<const P: usize>(
             let mut register = first_row / 4;
             while register < registers {
                 let here = (registers - register).min(3);
-                sweep(&mut sums, z, first_row, rows_here, register, here);
+                sweep(sums, z, first_row, rows_here, register, here);
                 register += here;
             }
         }
@@ -74,6 +90,7 @@ pub(super) fn accumulate<const P: usize>(
     for (sums, padded) in block.chunks_exact_mut(w).zip(sums.chunks_exact(Z)) {
         sums.copy_from_slice(&padded[..w]);
     }
+    *cost = s;
 }
 
 /// One tile: Gram rows `first_row …` (`rows` of them) × registers `register …` (`count` of
