@@ -12,9 +12,9 @@
 //! accumulators of a whole row at once touches each value once (the row's p products per
 //! parameter are one vector operation per four of them), where dot products over columns
 //! first had to transpose the rows and then ran p(p + 3)/2 dependent chains. On x86-64
-//! processors with AVX (detected at run time) the block kernel is [`tiles`]: the sums swept
-//! in tiles that fit the registers, four lanes wide, with no fused multiply–add, so the
-//! lanes round exactly as the portable kernel.
+//! processors with AVX (detected at run time) the block kernel is `gram/tiles.rs`: the
+//! sums swept in tiles that fit the registers, four lanes wide, with no fused multiply–add,
+//! so the lanes round exactly as the portable kernel.
 
 use crate::numerics::levenberg_marquardt::NormalEquations;
 use nalgebra::{DMatrix, DVector};
