@@ -33,7 +33,7 @@ use crate::model::{ChForm, ColemanHodgdon};
 use crate::model::{Parameter, ParameterSet};
 use crate::numerics::least_squares::{least_squares, LsSolution};
 use crate::numerics::levenberg_marquardt::{Control, IterationRecord, LmConfig};
-use crate::numerics::Termination;
+use crate::numerics::{metrics, Termination};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 
@@ -212,7 +212,7 @@ pub(crate) fn max_increment(data: &IdData) -> f64 {
         .map(|e| {
             let x = e.input(0);
             let n = x.len().saturating_sub(1);
-            largest(&x[x.len() - n..], &x[..n], |a, b| (a - b).abs())
+            metrics::largest(&x[x.len() - n..], &x[..n], |a, b| (a - b).abs())
         })
         .fold(0.0, f64::max)
 }
@@ -221,30 +221,8 @@ pub(crate) fn max_increment(data: &IdData) -> f64 {
 pub(crate) fn max_abs_input(data: &IdData) -> f64 {
     data.experiments()
         .iter()
-        .map(|e| largest(e.input(0), e.input(0), |a, _| a.abs()))
+        .map(|e| metrics::largest(e.input(0), e.input(0), |a, _| a.abs()))
         .fold(0.0, f64::max)
-}
-
-/// The largest f(aᵢ, bᵢ) over the common length, and 0: the same as folding with
-/// `f64::max` (NaN values are passed over either way), in eight lanes so that a long
-/// record's scan runs at the machine's rate; a maximum does not depend on the order.
-fn largest(a: &[f64], b: &[f64], f: impl Fn(f64, f64) -> f64) -> f64 {
-    let n = a.len().min(b.len());
-    let (a8, b8) = (a[..n].chunks_exact(8), b[..n].chunks_exact(8));
-    let mut lanes = [0.0f64; 8];
-    for (x, y) in a8.remainder().iter().zip(b8.remainder()) {
-        lanes[0] = lanes[0].max(f(*x, *y));
-    }
-    for (x, y) in a8.zip(b8) {
-        for ((lane, x), y) in lanes.iter_mut().zip(x).zip(y) {
-            let v = f(*x, *y);
-            // `v > lane` keeps the lane for a NaN, as f64::max does, and vectorises.
-            if v > *lane {
-                *lane = v;
-            }
-        }
-    }
-    lanes.into_iter().fold(0.0, f64::max)
 }
 
 /// Result of the separated regression.

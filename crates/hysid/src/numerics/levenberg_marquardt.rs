@@ -89,6 +89,13 @@ pub trait LeastSquaresProblem: Sync {
     fn cost_floor(&self) -> f64 {
         0.0
     }
+
+    /// True when S = `cost` is at or below [`cost_floor`](Self::cost_floor). A problem
+    /// whose floor takes a pass over a long record to compute may first rule it out with a
+    /// cheaper upper bound of the floor (the answer must be the same).
+    fn is_exact_fit(&self, cost: f64) -> bool {
+        cost <= self.cost_floor()
+    }
 }
 
 /// S = Σ rᵢ², summed in order: the engine's criterion, or an error at the first residual that
@@ -418,7 +425,7 @@ impl<'a> State<'a> {
             return Ok(Termination::NothingToEstimate);
         }
         loop {
-            if self.system.cost <= self.problem.cost_floor() {
+            if self.problem.is_exact_fit(self.system.cost) {
                 return Ok(Termination::ZeroResidual);
             }
             if self.gradient_is_small() {

@@ -132,3 +132,25 @@ pub fn aic(loss: f64, n: usize, p: usize) -> f64 {
     let n = n as f64;
     n * loss.ln() + 2.0 * p as f64 + n * ((2.0 * std::f64::consts::PI).ln() + 1.0)
 }
+
+/// The largest f(aᵢ, bᵢ) over the common length, and 0: the same as folding with
+/// `f64::max` (NaN values are passed over either way), in eight lanes so that a long
+/// record's scan runs at the machine's rate; a maximum does not depend on the order.
+pub fn largest(a: &[f64], b: &[f64], f: impl Fn(f64, f64) -> f64) -> f64 {
+    let n = a.len().min(b.len());
+    let (a8, b8) = (a[..n].chunks_exact(8), b[..n].chunks_exact(8));
+    let mut lanes = [0.0f64; 8];
+    for (x, y) in a8.remainder().iter().zip(b8.remainder()) {
+        lanes[0] = lanes[0].max(f(*x, *y));
+    }
+    for (x, y) in a8.zip(b8) {
+        for ((lane, x), y) in lanes.iter_mut().zip(x).zip(y) {
+            let v = f(*x, *y);
+            // `v > lane` keeps the lane for a NaN, as f64::max does, and vectorises.
+            if v > *lane {
+                *lane = v;
+            }
+        }
+    }
+    lanes.into_iter().fold(0.0, f64::max)
+}
