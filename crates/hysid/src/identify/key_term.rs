@@ -122,12 +122,16 @@ impl KeyTermSeparation {
         // The internal variable v̂ of the current hysteresis estimate; each iteration's check
         // of the new estimate simulates the next one.
         let mut v = hysteresis.simulate_unchecked(x, 0.0);
+        // The regression's storage, written over in every iteration (every entry is).
+        let rows = x.len().saturating_sub(self.first_row());
+        let mut phi = DMatrix::zeros(rows, nh + self.nb - 1 + self.na);
+        let mut target = Vec::with_capacity(rows);
         for iteration in 0..self.max_iterations {
             if iteration > 0 && self.observer.should_stop("key-term iteration") {
                 termination = Termination::Stopped;
                 break;
             }
-            let (phi, target) = self.rows(x, y, &v, hysteresis.d());
+            self.rows(x, y, &v, hysteresis.d(), &mut phi, &mut target);
             // Only the estimate is used: the solver skips the covariance and the explicit Q.
             let (ls_theta, residual_ss) = least_squares_estimate(&phi, &target, &[])?;
             costs.push(residual_ss);
@@ -218,20 +222,28 @@ impl KeyTermSeparation {
         self.na.max(self.delay + 1).max(self.delay + self.nb - 1)
     }
 
-    /// The regression rows with the internal variables v̂ and ĥ(d̂), built column by column
-    /// (Φ is column-major): the hysteresis regressors in one pass over the samples, the lagged
-    /// v̂ and −y columns as shifted copies.
-    fn rows(&self, x: &[f64], y: &[f64], v: &[f64], d: f64) -> (DMatrix<f64>, Vec<f64>) {
+    /// The regression rows with the internal variables v̂ and ĥ(d̂) written over `phi`
+    /// (N × p) and `target`, built column by column (Φ is column-major): the hysteresis
+    /// regressors in one pass over the samples, the lagged v̂ and −y columns as shifted
+    /// copies.
+    fn rows(
+        &self,
+        x: &[f64],
+        y: &[f64],
+        v: &[f64],
+        d: f64,
+        phi: &mut DMatrix<f64>,
+        target: &mut Vec<f64>,
+    ) {
         let nh = self.form.n_params();
         let k = self.delay;
-        let p = nh + self.nb - 1 + self.na;
         let t0 = self.first_row();
         let n = x.len().saturating_sub(t0);
+        target.clear();
         if n == 0 {
-            return (DMatrix::zeros(0, p), Vec::new());
+            return;
         }
-        let mut phi = vec![0.0; n * p];
-        let (hysteresis, rest) = phi.split_at_mut(n * nh);
+        let (hysteresis, rest) = phi.as_mut_slice().split_at_mut(n * nh);
         let mut buf = [0.0; 6];
         for (r, t) in (t0..x.len()).enumerate() {
             let b = &mut buf[..nh];
@@ -261,12 +273,12 @@ impl KeyTermSeparation {
                 }
             }
         }
-        let target = y[t0..x.len()]
-            .iter()
-            .zip(&v[t0 - k - 1..x.len() - k - 1])
-            .map(|(y, v)| y - v)
-            .collect();
-        (DMatrix::from_vec(n, p, phi), target)
+        target.extend(
+            y[t0..x.len()]
+                .iter()
+                .zip(&v[t0 - k - 1..x.len() - k - 1])
+                .map(|(y, v)| y - v),
+        );
     }
 
     /// Physical parameters from the regression estimate.
