@@ -177,17 +177,23 @@ impl OutputErrorFit {
 
     /// The same fit moved to the parameter vector `theta` (e.g. a constrained correction):
     /// outputs, fit % and losses are recomputed by simulating `model`; the covariance and the
-    /// optimiser's history are kept.
-    pub fn at(&self, model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<Self> {
+    /// optimiser's history are kept. The fit's simulated outputs are written over by the new
+    /// simulation (a long record's pages are not faulted in again).
+    pub fn at(self, model: &dyn OutputErrorModel, data: &IdData, theta: &[f64]) -> Result<Self> {
+        let OutputErrorFit {
+            parameters: mut moved_parameters,
+            covariance,
+            mut report,
+            simulated,
+            ..
+        } = self;
         let weights = vec![1.0; model.n_outputs()];
         let problem = OutputErrorProblem::new(model, data, weights, 0)?;
-        let mut report = self.report.clone();
+        problem.recycle(simulated);
         report.theta = theta.to_vec();
         report.cost = problem.plain_cost(theta)?;
-        let mut parameters = self.parameters.clone();
-        parameters.set_values(theta);
-        let covariance = self.covariance.clone();
-        let mut moved = summarize(&problem, parameters, report)?;
+        moved_parameters.set_values(theta);
+        let mut moved = summarize(&problem, moved_parameters, report)?;
         moved.covariance = covariance;
         Ok(moved)
     }
@@ -658,6 +664,11 @@ impl<'a> OutputErrorProblem<'a> {
     /// a new pass makes stale (reused, their pages need not be faulted in again; every value
     /// is written over), else new ones.
     fn simulation_buffers(&self) -> Simulations {
+        self.stale_buffers().unwrap_or_else(|| self.new_buffers())
+    }
+
+    /// The last simulation's outputs (taken) when they have the shape of this problem's.
+    fn stale_buffers(&self) -> Option<Simulations> {
         let ny = self.model.n_outputs();
         let experiments = self.data.experiments();
         let fits = |sims: &Simulations| {
@@ -667,13 +678,17 @@ impl<'a> OutputErrorProblem<'a> {
                 })
         };
         let last = self.last.lock().unwrap_or_else(|e| e.into_inner()).take();
-        match last {
-            Some((_, sims)) if fits(&sims) => sims,
-            _ => experiments
-                .iter()
-                .map(|exp| vec![vec![0.0; exp.len()]; ny])
-                .collect(),
-        }
+        last.map(|(_, sims)| sims).filter(fits)
+    }
+
+    /// Zeroed outputs `[experiment][output][t]` for this problem's data.
+    fn new_buffers(&self) -> Simulations {
+        let ny = self.model.n_outputs();
+        self.data
+            .experiments()
+            .iter()
+            .map(|exp| vec![vec![0.0; exp.len()]; ny])
+            .collect()
     }
 
     /// One experiment's residuals and normal equations with the sensitivity columns split
@@ -745,15 +760,25 @@ impl<'a> OutputErrorProblem<'a> {
         if let Some(sims) = self.take_last(theta) {
             return Ok(sims);
         }
-        (0..self.data.n_experiments())
-            .into_par_iter()
-            .map(|e| {
-                let len = self.data.experiment(e).len();
-                let mut y = vec![vec![0.0; len]; self.model.n_outputs()];
-                self.model.simulate(theta, self.data, e, &mut y)?;
-                Ok(y)
-            })
-            .collect()
+        let mut sims = match self.stale_buffers() {
+            // A model may write only part of its outputs: they start from zero either way.
+            Some(mut stale) => {
+                stale.par_iter_mut().flatten().for_each(|y| y.fill(0.0));
+                stale
+            }
+            None => self.new_buffers(),
+        };
+        sims.par_iter_mut()
+            .enumerate()
+            .try_for_each(|(e, y)| self.model.simulate(theta, self.data, e, y))?;
+        Ok(sims)
+    }
+
+    /// Hands over simulated outputs that no longer match any θ (a fit's that is being moved)
+    /// as storage for the next simulation.
+    fn recycle(&self, sims: Simulations) {
+        // θ = [] matches no parameter vector.
+        *self.last.lock().unwrap_or_else(|e| e.into_inner()) = Some((Vec::new(), sims));
     }
 
     /// The kept simulation when it was made at exactly `theta` (the same θ simulates to the
