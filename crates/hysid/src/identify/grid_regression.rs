@@ -298,9 +298,7 @@ fn basis_signals_of<const NL: usize>(
     }
     #[cfg(not(target_arch = "x86_64"))]
     basis_inputs::<NL>(x, alpha, d, psi, decay);
-    let mut columns = psi.chunks_exact_mut(n);
-    let mut columns: [&mut [f64]; NL] =
-        std::array::from_fn(|_| columns.next().expect("NL signals"));
+    let mut columns = signals::<NL>(psi, n);
     let mut past = [0.0; NL];
     for t in 1..n {
         let decay = decay[t];
@@ -309,6 +307,12 @@ fn basis_signals_of<const NL: usize>(
             column[t] = *p;
         }
     }
+}
+
+/// The NL signals of `psi` (signal i at `psi[i·N + t]`, N = `n`), one slice each.
+fn signals<const NL: usize>(psi: &mut [f64], n: usize) -> [&mut [f64]; NL] {
+    let mut columns = psi.chunks_exact_mut(n);
+    std::array::from_fn(|_| columns.next().expect("NL signals"))
 }
 
 /// [`basis_inputs`] compiled for AVX.
@@ -334,9 +338,7 @@ fn basis_inputs<const NL: usize>(
     decay: &mut [f64],
 ) {
     let n = x.len();
-    let mut columns = psi.chunks_exact_mut(n);
-    let mut columns: [&mut [f64]; NL] =
-        std::array::from_fn(|_| columns.next().expect("NL signals"));
+    let mut columns = signals::<NL>(psi, n);
     for column in &mut columns {
         column[0] = 0.0;
     }

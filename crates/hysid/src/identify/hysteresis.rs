@@ -221,7 +221,7 @@ pub(crate) fn max_increment(data: &IdData) -> f64 {
 pub(crate) fn max_abs_input(data: &IdData) -> f64 {
     data.experiments()
         .iter()
-        .map(|e| metrics::largest(e.input(0), e.input(0), |a, _| a.abs()))
+        .map(|e| metrics::max_abs(e.input(0)))
         .fold(0.0, f64::max)
 }
 

@@ -983,7 +983,7 @@ impl OutputErrorProblem<'_> {
             for exp in self.data.experiments() {
                 for (o, w) in self.weights.iter().enumerate() {
                     let y = &exp.output(o)[self.skip..];
-                    let largest = w * metrics::largest(y, y, |v, _| v.abs());
+                    let largest = w * metrics::max_abs(y);
                     bound += 2.0 * y.len() as f64 * largest * largest;
                 }
             }

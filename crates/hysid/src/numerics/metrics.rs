@@ -15,21 +15,37 @@
 /// Σ f(aᵢ, bᵢ) over the common length, in the order of the module docs.
 #[inline(always)]
 fn sum_pairs(a: &[f64], b: &[f64], f: impl Fn(f64, f64) -> f64) -> f64 {
+    let [sum] = sums_of_pairs(a, b, |x, y| [f(x, y)]);
+    sum
+}
+
+/// The K sums Σ fₖ(aᵢ, bᵢ) over the common length from one pass, each in the order of the
+/// module docs.
+#[inline(always)]
+fn sums_of_pairs<const K: usize>(
+    a: &[f64],
+    b: &[f64],
+    f: impl Fn(f64, f64) -> [f64; K],
+) -> [f64; K] {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
-    let mut lanes = [0.0; 8];
+    let mut lanes = [[0.0; 8]; K];
+    let mut add = |lane: usize, x: f64, y: f64| {
+        for (sum, value) in lanes.iter_mut().zip(f(x, y)) {
+            sum[lane] += value;
+        }
+    };
     let (a8, b8) = (a.chunks_exact(8), b.chunks_exact(8));
     let (a_tail, b_tail) = (a8.remainder(), b8.remainder());
     for (x, y) in a8.zip(b8) {
-        for ((lane, x), y) in lanes.iter_mut().zip(x).zip(y) {
-            *lane += f(*x, *y);
+        for (lane, (x, y)) in x.iter().zip(y).enumerate() {
+            add(lane, *x, *y);
         }
     }
-    for ((lane, x), y) in lanes.iter_mut().zip(a_tail).zip(b_tail) {
-        *lane += f(*x, *y);
+    for (lane, (x, y)) in a_tail.iter().zip(b_tail).enumerate() {
+        add(lane, *x, *y);
     }
-    let [s0, s1, s2, s3, s4, s5, s6, s7] = lanes;
-    ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7))
+    lanes.map(|[s0, s1, s2, s3, s4, s5, s6, s7]| ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)))
 }
 
 /// Arithmetic mean (0 for an empty slice), summed in order: it shifts data (mean removal),
@@ -57,24 +73,8 @@ pub fn nrmse(y: &[f64], yhat: &[f64]) -> f64 {
 /// as the module docs say, so each is what a pass of its own gives).
 fn squares(y: &[f64], yhat: &[f64]) -> (f64, f64) {
     let m = mean(y);
-    let n = y.len().min(yhat.len());
-    let (y, yhat) = (&y[..n], &yhat[..n]);
-    let mut err = [0.0; 8];
-    let mut var = [0.0; 8];
-    let (y8, h8) = (y.chunks_exact(8), yhat.chunks_exact(8));
-    let (y_tail, h_tail) = (y8.remainder(), h8.remainder());
-    let add = |err: &mut [f64; 8], var: &mut [f64; 8], ys: &[f64], hs: &[f64]| {
-        for (((e, v), a), b) in err.iter_mut().zip(var.iter_mut()).zip(ys).zip(hs) {
-            *e += (a - b).powi(2);
-            *v += (a - m).powi(2);
-        }
-    };
-    for (ys, hs) in y8.zip(h8) {
-        add(&mut err, &mut var, ys, hs);
-    }
-    add(&mut err, &mut var, y_tail, h_tail);
-    let total = |s: [f64; 8]| ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
-    (total(err), total(var))
+    let [err, var] = sums_of_pairs(y, yhat, |a, b| [(a - b).powi(2), (a - m).powi(2)]);
+    (err, var)
 }
 
 /// NRMSE from ‖y − ŷ‖₂² and ‖y − ȳ‖₂².
@@ -153,4 +153,9 @@ pub fn largest(a: &[f64], b: &[f64], f: impl Fn(f64, f64) -> f64) -> f64 {
         }
     }
     lanes.into_iter().fold(0.0, f64::max)
+}
+
+/// max |yᵢ| (0 when empty), by [`largest`].
+pub fn max_abs(y: &[f64]) -> f64 {
+    largest(y, y, |v, _| v.abs())
 }

@@ -16,6 +16,7 @@
 //! * [`termination`]: why an iterative method stopped.
 //! * [`progress`]: progress of the phases of a recipe, reported to an observer.
 
+pub mod cpu;
 pub mod integrate;
 pub mod least_squares;
 pub mod levenberg_marquardt;

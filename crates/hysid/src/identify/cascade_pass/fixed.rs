@@ -181,7 +181,7 @@ fn recursion_fixed<const NH: usize, const NA: usize, const M: usize, const P: us
 ) -> Option<Option<usize>> {
     #[cfg(target_arch = "x86_64")]
     {
-        if !std::arch::is_x86_feature_detected!("avx") {
+        if !crate::numerics::cpu::has_avx() {
             return None;
         }
         // SAFETY: the processor has AVX, the only requirement of `recursion_fixed_avx`.

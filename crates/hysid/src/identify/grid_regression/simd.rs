@@ -11,18 +11,7 @@
 //! (one register holding lanes of two different sums, shuffled every iteration) instead of
 //! keeping each product's four sums in one register.
 
-/// True when the processor has AVX (the check is cached by the standard library).
-#[inline]
-pub fn available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
+pub use crate::numerics::cpu::has_avx as available;
 
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::{

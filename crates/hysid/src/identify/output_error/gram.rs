@@ -16,11 +16,18 @@
 //! sums swept in tiles that fit the registers, four lanes wide, with no fused multiply–add,
 //! so the lanes round exactly as the portable kernel.
 
+use crate::numerics::cpu::has_avx;
 use crate::numerics::levenberg_marquardt::NormalEquations;
 use nalgebra::{DMatrix, DVector};
 
 #[cfg(target_arch = "x86_64")]
 mod tiles;
+
+/// The AVX tiles' buffers (nothing on other architectures, which have no tiles).
+#[cfg(target_arch = "x86_64")]
+type TileScratch = tiles::Scratch;
+#[cfg(not(target_arch = "x86_64"))]
+type TileScratch = ();
 
 /// Rows per block.
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
@@ -44,8 +51,7 @@ pub struct Accumulator {
     /// Whether blocks of rows go to the AVX tiles (the processor has AVX).
     simd: bool,
     /// The AVX tiles' buffers, made on first use.
-    #[cfg(target_arch = "x86_64")]
-    tiles: Option<Box<tiles::Scratch>>,
+    tiles: Option<Box<TileScratch>>,
 }
 
 impl Accumulator {
@@ -59,8 +65,7 @@ impl Accumulator {
             total: vec![0.0; p * (p + 1)],
             z: vec![0.0; p + 1],
             cost: 0.0,
-            simd: avx(),
-            #[cfg(target_arch = "x86_64")]
+            simd: has_avx(),
             tiles: None,
         }
     }
@@ -109,28 +114,14 @@ impl Accumulator {
     /// into S: with the AVX tiles or a fixed-width kernel for p ≤ 12, else row by row.
     fn block_rows(&mut self, scale: f64, rows: &[f64], width: usize, r: &[f64]) {
         let (block, cost) = (&mut self.block, &mut self.cost);
-        #[cfg(target_arch = "x86_64")]
-        if self.simd && self.p <= tiles::MAX_P {
-            let scratch = self
-                .tiles
-                .get_or_insert_with(|| Box::new(tiles::Scratch::new()));
-            macro_rules! tiled {
-                ($($p:literal),*) => {
-                    match self.p {
-                        // SAFETY: `simd` is only set when the processor has AVX.
-                        $($p => return unsafe {
-                            tiles::accumulate::<$p>(scratch, block, cost, scale, rows, width, r)
-                        },)*
-                        _ => {}
-                    }
-                };
-            }
-            tiled!(1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12);
-        }
+        let tiles = match self.simd {
+            true => Some(&mut **self.tiles.get_or_insert_with(Box::default)),
+            false => None,
+        };
         macro_rules! kernels {
             ($(($p:literal, $w:literal)),*) => {
                 match self.p {
-                    $($p => return kernel::<$p, $w>(block, cost, scale, rows, width, r),)*
+                    $($p => return kernel::<$p, $w>(tiles, block, cost, scale, rows, width, r),)*
                     _ => {}
                 }
             };
@@ -195,21 +186,11 @@ impl Accumulator {
     }
 }
 
-/// True when the processor has AVX (the check is cached by the standard library).
-fn avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
-/// The portable block kernel for P columns (W = P + 1): each row's products added to the
-/// block's sums in locals, and r² to S, row after row (see the module docs).
+/// The block kernel for P columns (W = P + 1): the AVX tiles when given their buffers,
+/// else each row's products added to the block's sums in locals, and r² to S, row after
+/// row (the portable kernel, see the module docs).
 fn kernel<const P: usize, const W: usize>(
+    tiled: Option<&mut TileScratch>,
     block: &mut [f64],
     cost: &mut f64,
     scale: f64,
@@ -218,6 +199,13 @@ fn kernel<const P: usize, const W: usize>(
     r: &[f64],
 ) {
     const { assert!(W == P + 1) };
+    #[cfg(target_arch = "x86_64")]
+    if let Some(scratch) = tiled {
+        // SAFETY: the buffers are made only when the processor has AVX (`simd`).
+        return unsafe { tiles::accumulate::<P>(scratch, block, cost, scale, rows, width, r) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = tiled;
     let mut acc = [[0.0; W]; P];
     for (i, a) in acc.iter_mut().enumerate() {
         a.copy_from_slice(&block[i * W..(i + 1) * W]);

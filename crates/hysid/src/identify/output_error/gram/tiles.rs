@@ -17,7 +17,7 @@ use std::arch::x86_64::{
 };
 
 /// The largest number of columns p the tiles handle.
-pub(super) const MAX_P: usize = 12;
+const MAX_P: usize = 12;
 
 /// Values per row of z and of the padded sums: p + 1 ≤ 13 rounded up to whole registers.
 const Z: usize = 16;
@@ -33,8 +33,8 @@ pub(super) struct Scratch {
     sums: [f64; MAX_P * Z],
 }
 
-impl Scratch {
-    pub(super) fn new() -> Self {
+impl Default for Scratch {
+    fn default() -> Self {
         Self {
             z: vec![[0.0; Z]; CHUNK],
             sums: [0.0; MAX_P * Z],
