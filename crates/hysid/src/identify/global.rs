@@ -106,11 +106,11 @@ impl GlobalSearch {
         self.search_observed(x, y, &Observer::none())
     }
 
-    /// [`search`](Self::search), asking `observer` before every grid point and every local
-    /// refinement: once it answers [`Control::Stop`](crate::numerics::Control::Stop) the
-    /// remaining points are skipped and the best of those scored are returned (how a time
-    /// limit is honoured). Errors with [`Error::Cancelled`] when it stops the grid before any
-    /// point was scored.
+    /// [`search`](Self::search), asking `observer` before every batch of grid points (at most
+    /// [`grid_regression::BATCH`]) and every local refinement: once it answers
+    /// [`Control::Stop`](crate::numerics::Control::Stop) the remaining points are skipped and
+    /// the best of those scored are returned (how a time limit is honoured). Errors with
+    /// [`Error::Cancelled`] when it stops the grid before any point was scored.
     pub fn search_observed(
         &self,
         x: &[f64],
@@ -120,18 +120,30 @@ impl GlobalSearch {
         let grid = self.grid(x)?;
         // Stage A: plain equation error over the whole grid. Its *cost* ranks (α, d) well even
         // with output noise; its linear estimates are what the noise biases.
+        // The points of one α are scored a few at a time (their ψ recursions interleaved,
+        // see `grid_regression`), each batch's in grid order.
         let regression = EquationError::new(self.form, self.na, self.nb, self.delay, x, y);
-        let mut ranked: Vec<(f64, f64, f64)> = grid
+        let batches: Vec<&[(f64, f64)]> = grid
+            .chunk_by(|a, b| a.0 == b.0)
+            .flat_map(|same_alpha| same_alpha.chunks(grid_regression::BATCH))
+            .collect();
+        let mut ranked: Vec<(f64, f64, f64)> = batches
             .par_iter()
             .enumerate()
             .map_init(
                 || regression.scratch(),
-                |s, (i, &(alpha, d))| {
-                    // The first point is scored even then: a stopped search keeps a result.
+                |s, (i, batch)| {
+                    // The first batch is scored even then: a stopped search keeps a result.
                     if i > 0 && observer.should_stop("grid") {
-                        return None;
+                        return Vec::new();
                     }
-                    Some((alpha, d, regression.cost(alpha, d, s)?))
+                    let ds: Vec<f64> = batch.iter().map(|&(_, d)| d).collect();
+                    let costs = regression.costs(batch[0].0, &ds, s);
+                    batch
+                        .iter()
+                        .zip(costs)
+                        .filter_map(|(&(alpha, d), cost)| Some((alpha, d, cost?)))
+                        .collect::<Vec<_>>()
                 },
             )
             .flatten()

@@ -183,3 +183,40 @@ fn basis_signals_are_the_one_pass_recursion() {
         }
     }
 }
+
+/// Scoring up to `BATCH` thresholds of one α together (their ψ recursions interleaved) gives
+/// every point the bits of scoring it alone, for both forms, full and partial batches, and
+/// points whose regression fails (d beyond the input: a column vanishes).
+#[test]
+fn batched_costs_are_the_single_point_costs_bit_for_bit() {
+    let x: Vec<f64> = (0..2500)
+        .map(|t| 4.0 * (t as f64 * 0.041).sin() * (1.0 + 0.4 * (t as f64 * 0.0047).cos()))
+        .collect();
+    let y: Vec<f64> = (0..x.len())
+        .map(|t| (t as f64 * 0.029).sin() + 0.3 * (t as f64 * 0.13).cos())
+        .collect();
+    for form in [ChForm::Saturated4, ChForm::General6] {
+        let reg = EquationError::new(form, 2, 2, 1, &x, &y);
+        let (mut single, mut batch) = (reg.scratch(), reg.scratch());
+        let ds = [0.4, 1.1, 2.3, 3.2, 9.0];
+        for alpha in [0.02, 0.3] {
+            for len in 1..=BATCH {
+                for start in 0..=ds.len() - len {
+                    let chunk = &ds[start..start + len];
+                    let costs = reg.costs(alpha, chunk, &mut batch);
+                    for (b, &d) in chunk.iter().enumerate() {
+                        let alone = reg.cost(alpha, d, &mut single);
+                        assert_eq!(
+                            costs[b].map(f64::to_bits),
+                            alone.map(f64::to_bits),
+                            "{form:?} alpha {alpha} d {d} in a batch of {len}"
+                        );
+                    }
+                    assert!(costs[len..].iter().all(Option::is_none));
+                }
+            }
+        }
+        assert!(reg.costs(0.3, &[], &mut batch).iter().all(Option::is_none));
+        assert!(reg.costs(0.3, &[1.0; BATCH + 1], &mut batch).iter().all(Option::is_none));
+    }
+}
