@@ -145,16 +145,22 @@ fn fill<const WARM: bool, const NH: usize, const NA: usize, const M: usize, cons
     (x, h): (&[f64], Option<&[bool]>),
     t0: usize,
     rows: &mut [f64],
-) {
+) -> bool {
     let mut c = *carry;
+    // Whether every ŷ is finite, noted as the rows are made: a search of the block afterwards
+    // would read it all again (a megabyte, out of the first-level caches) on the side of the
+    // pass that bounds it.
+    let mut finite = true;
     for (i, out) in rows.chunks_exact_mut(1 + P).enumerate() {
         let t = t0 + i;
         let outside = constants.ch.outside_at(x, t, h);
         let (yhat, u) = row::<WARM, NH, NA, M, P>(&mut c, rings, constants, x, t, outside);
+        finite &= yhat.is_finite();
         out[0] = yhat;
         out[1..].copy_from_slice(&u);
     }
     *carry = c;
+    finite
 }
 
 /// The sensitivity recursion of the parent module for a fixed shape: NH hysteresis
@@ -254,9 +260,18 @@ fn recursion_fixed_body<const NH: usize, const NA: usize, const M: usize, const 
         };
         let cold = warm.saturating_sub(t0).min(n);
         let (head, tail) = rows.split_at_mut(cold * (1 + P));
-        fill::<true, NH, NA, M, P>(&mut carry, &mut rings, &constants, (x, h), t0, head);
-        fill::<false, NH, NA, M, P>(&mut carry, &mut rings, &constants, (x, h), t0 + cold, tail);
-        if failed.is_none() {
+        let signals = (x, h);
+        let warm_finite =
+            fill::<true, NH, NA, M, P>(&mut carry, &mut rings, &constants, signals, t0, head);
+        let finite = fill::<false, NH, NA, M, P>(
+            &mut carry,
+            &mut rings,
+            &constants,
+            signals,
+            t0 + cold,
+            tail,
+        );
+        if failed.is_none() && !(warm_finite && finite) {
             failed = rows
                 .iter()
                 .step_by(1 + P)

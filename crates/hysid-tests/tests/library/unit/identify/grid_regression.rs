@@ -217,6 +217,9 @@ fn batched_costs_are_the_single_point_costs_bit_for_bit() {
             }
         }
         assert!(reg.costs(0.3, &[], &mut batch).iter().all(Option::is_none));
-        assert!(reg.costs(0.3, &[1.0; BATCH + 1], &mut batch).iter().all(Option::is_none));
+        assert!(reg
+            .costs(0.3, &[1.0; BATCH + 1], &mut batch)
+            .iter()
+            .all(Option::is_none));
     }
 }
