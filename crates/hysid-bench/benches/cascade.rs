@@ -1,6 +1,7 @@
 //! Criterion benchmarks of the cascade: one simulation, one set of normal equations (the
 //! Jacobian work of one Levenberg–Marquardt iteration), one point of the global (α, d) grid
-//! on 10⁶ samples, and full identifications (the examples, and 10⁶ samples as
+//! on 10⁶ samples, the thresholds of one α scored one and four at a time on the 10⁴-sample
+//! window, and full identifications (the examples, and 10⁶ samples as
 //! `hysid identify cascade` runs them).
 //!
 //! Run with `cargo bench -p hysid-bench --bench cascade`.
@@ -8,7 +9,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use hysid::experiments::voros::CascadeExample;
 use hysid::identify::cascade::{CascadeIdentification, CascadeStructure};
-use hysid::identify::grid_regression::EquationError;
+use hysid::identify::grid_regression::{EquationError, BATCH};
 use hysid::identify::output_error::OutputErrorProblem;
 use hysid::numerics::levenberg_marquardt::LeastSquaresProblem;
 use hysid::numerics::Control;
@@ -84,6 +85,33 @@ fn grid_point(c: &mut Criterion) {
     });
 }
 
+/// Stage A of the global search scores every threshold of one α: one point at a time against
+/// four at a time (their ψ recursions interleaved), on the identification's 10⁴-sample window.
+fn grid_thresholds(c: &mut Criterion) {
+    let ex = CascadeExample::example1().extended(10_000);
+    let gen = ex.generate(1, true).unwrap();
+    let h = &ex.truth.hysteresis;
+    let regression = EquationError::new(h.form(), 2, 2, 1, &gen.x, &gen.y);
+    let mut scratch = regression.scratch();
+    let ds: Vec<f64> = (1..=64).map(|j| 2.0 * h.d() * j as f64 / 65.0).collect();
+    let mut group = c.benchmark_group("cascade grid, 64 thresholds of one alpha, 1e4 samples");
+    group.bench_function("one at a time", |b| {
+        b.iter(|| {
+            for &d in &ds {
+                black_box(regression.cost(black_box(h.alpha()), d, &mut scratch));
+            }
+        })
+    });
+    group.bench_function("four at a time", |b| {
+        b.iter(|| {
+            for batch in ds.chunks(BATCH) {
+                black_box(regression.costs(black_box(h.alpha()), batch, &mut scratch));
+            }
+        })
+    });
+    group.finish();
+}
+
 fn identification_1e6(c: &mut Criterion) {
     let mut group = c.benchmark_group("identification");
     group.sample_size(10);
@@ -102,6 +130,7 @@ criterion_group!(
     simulation,
     normal_equations,
     grid_point,
+    grid_thresholds,
     identification,
     identification_1e6
 );
