@@ -63,7 +63,8 @@ pub const BATCH: usize = 4;
 
 /// Buffers of one evaluation, reused from grid point to grid point.
 pub struct Scratch {
-    /// ψ of up to [`BATCH`] points: point b's signal i at `psi[(b·NL + i)·N + t]`.
+    /// ψ of up to [`BATCH`] points: point b's signal i at `psi[(b·NL + i)·N + t]` (room
+    /// for one point at first, grown by the first batch of more).
     psi: Vec<f64>,
     /// 1 − α|Δx(t)|, the basis signals' common decay.
     decay: Vec<f64>,
@@ -118,7 +119,7 @@ impl<'a> EquationError<'a> {
     pub fn scratch(&self) -> Scratch {
         let cols = self.cols();
         Scratch {
-            psi: vec![0.0; BATCH * self.len() * self.nl],
+            psi: vec![0.0; self.len() * self.nl],
             decay: vec![0.0; self.len()],
             residual: Vec::with_capacity(self.len()),
             gram: vec![0.0; cols * cols],
@@ -149,8 +150,13 @@ impl<'a> EquationError<'a> {
         let (n, cols) = (self.len(), self.cols());
         let block = n * self.nl;
         let enough_rows = n.checked_sub(self.t0).is_some_and(|rows| rows > cols);
-        if !enough_rows || ds.is_empty() || ds.len() > BATCH || s.psi.len() != BATCH * block {
+        // A scratch made for a record of another length is refused, as is a batch too large.
+        let fits = s.decay.len() == n && s.gram.len() == cols * cols;
+        if !enough_rows || !fits || ds.is_empty() || ds.len() > BATCH {
             return costs;
+        }
+        if s.psi.len() < ds.len() * block {
+            s.psi.resize(ds.len() * block, 0.0);
         }
         let psi = &mut s.psi[..ds.len() * block];
         basis_signals_batch(self.form, &self.x[..n], alpha, ds, psi, &mut s.decay);

@@ -223,3 +223,21 @@ fn batched_costs_are_the_single_point_costs_bit_for_bit() {
             .all(Option::is_none));
     }
 }
+
+/// A scratch made for another regression (another length or other orders) is refused: the
+/// costs are None, nothing indexes past its buffers.
+#[test]
+fn a_scratch_of_another_regression_is_refused() {
+    let x: Vec<f64> = (0..600).map(|t| 3.0 * (t as f64 * 0.07).sin()).collect();
+    let y: Vec<f64> = (0..600).map(|t| (t as f64 * 0.05).cos()).collect();
+    let reg = EquationError::new(ChForm::Saturated4, 2, 2, 1, &x, &y);
+    let shorter = EquationError::new(ChForm::Saturated4, 2, 2, 1, &x[..500], &y[..500]);
+    let other_orders = EquationError::new(ChForm::Saturated4, 3, 2, 1, &x, &y);
+    assert!(reg.cost(0.3, 1.0, &mut reg.scratch()).is_some());
+    for mut foreign in [shorter.scratch(), other_orders.scratch()] {
+        assert!(reg
+            .costs(0.3, &[1.0, 2.0], &mut foreign)
+            .iter()
+            .all(Option::is_none));
+    }
+}
