@@ -313,9 +313,12 @@ impl ColemanHodgdon {
             return y;
         }
         y.push(y0);
-        for t in 1..x.len() {
-            let next = self.step(y[t - 1], x[t - 1], x[t]);
-            y.push(next);
+        // y(t−1) carried in a register: read back from `y`, it put a store-to-load
+        // forwarding on the recursion's chain (a third of the time per sample).
+        let mut prev = y0;
+        for w in x.windows(2) {
+            prev = self.step(prev, w[0], w[1]);
+            y.push(prev);
         }
         y
     }
