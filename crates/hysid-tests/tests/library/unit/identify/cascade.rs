@@ -93,14 +93,7 @@ fn block_normal_equations_equal_row_normal_equations() {
             .unwrap()
             .id_data()
             .unwrap();
-        let lin = &ex.truth.linear;
-        let structure = CascadeStructure {
-            form: ex.truth.hysteresis.form(),
-            na: lin.na(),
-            nb: lin.nb(),
-            delay: lin.delay(),
-            switching: None,
-        };
+        let structure = super::true_structure(&ex);
         let theta: Vec<f64> = ex.truth.params().iter().map(|v| v * 1.01).collect();
         let free = [0, 1, 3, 4, 6];
         for skip in [0, 9] {

@@ -16,3 +16,19 @@ mod rigid_body;
 mod rls;
 mod switching;
 mod validate;
+
+use hysid::experiments::voros::CascadeExample;
+use hysid::identify::cascade::CascadeStructure;
+
+/// The output-error structure of an example's true cascade: its form and orders, the
+/// switching following d.
+fn true_structure(ex: &CascadeExample) -> CascadeStructure {
+    let lin = &ex.truth.linear;
+    CascadeStructure {
+        form: ex.truth.hysteresis.form(),
+        na: lin.na(),
+        nb: lin.nb(),
+        delay: lin.delay(),
+        switching: None,
+    }
+}

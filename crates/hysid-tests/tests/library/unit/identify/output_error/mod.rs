@@ -3,7 +3,6 @@
 mod gram;
 
 use hysid::experiments::voros::CascadeExample;
-use hysid::identify::cascade::CascadeStructure;
 use hysid::identify::output_error::OutputErrorProblem;
 use hysid::numerics::levenberg_marquardt::LeastSquaresProblem;
 
@@ -14,14 +13,7 @@ use hysid::numerics::levenberg_marquardt::LeastSquaresProblem;
 fn exact_fit_test_is_the_cost_floor_comparison() {
     let ex = CascadeExample::example1();
     let data = ex.generate(3, true).unwrap().id_data().unwrap();
-    let lin = &ex.truth.linear;
-    let structure = CascadeStructure {
-        form: ex.truth.hysteresis.form(),
-        na: lin.na(),
-        nb: lin.nb(),
-        delay: lin.delay(),
-        switching: None,
-    };
+    let structure = super::true_structure(&ex);
     for (weight, skip) in [(1.0, 0), (3.5, 7), (1e-150, 2), (1e140, 0)] {
         let new = || OutputErrorProblem::new(&structure, &data, vec![weight], skip).unwrap();
         let floor = new().cost_floor();
