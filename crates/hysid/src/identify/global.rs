@@ -133,20 +133,21 @@ impl GlobalSearch {
             .map_init(
                 || regression.scratch(),
                 |s, (i, batch)| {
+                    let mut scored = [None; grid_regression::BATCH];
                     // The first batch is scored even then: a stopped search keeps a result.
                     if i > 0 && observer.should_stop("grid") {
-                        return Vec::new();
+                        return scored;
                     }
-                    let ds: Vec<f64> = batch.iter().map(|&(_, d)| d).collect();
-                    let costs = regression.costs(batch[0].0, &ds, s);
-                    batch
-                        .iter()
-                        .zip(costs)
-                        .filter_map(|(&(alpha, d), cost)| Some((alpha, d, cost?)))
-                        .collect::<Vec<_>>()
+                    let ds: [f64; grid_regression::BATCH] =
+                        std::array::from_fn(|k| batch.get(k).map_or(0.0, |&(_, d)| d));
+                    let costs = regression.costs(batch[0].0, &ds[..batch.len()], s);
+                    for ((out, &(alpha, d)), cost) in scored.iter_mut().zip(*batch).zip(costs) {
+                        *out = cost.map(|cost| (alpha, d, cost));
+                    }
+                    scored
                 },
             )
-            .flatten()
+            .flat_map_iter(|scored| scored.into_iter().flatten())
             .collect();
         if ranked.is_empty() && observer.should_stop("grid") {
             return Err(Error::Cancelled(

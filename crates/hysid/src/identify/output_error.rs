@@ -959,16 +959,7 @@ impl OutputErrorProblem<'_> {
     /// order.
     fn data_scale(&self) -> f64 {
         *self.data_scale.get_or_init(|| {
-            let mut scale = 0.0;
-            for exp in self.data.experiments() {
-                for (o, w) in self.weights.iter().enumerate() {
-                    scale += exp.output(o)[self.skip..]
-                        .iter()
-                        .map(|v| (w * v).powi(2))
-                        .sum::<f64>();
-                }
-            }
-            scale
+            self.sum_over_outputs(|y, w| y.iter().map(|v| (w * v).powi(2)).sum::<f64>())
         })
     }
 
@@ -979,16 +970,23 @@ impl OutputErrorProblem<'_> {
     /// [`data_scale`]: Self::data_scale
     fn data_scale_bound(&self) -> f64 {
         *self.data_scale_bound.get_or_init(|| {
-            let mut bound = 0.0;
-            for exp in self.data.experiments() {
-                for (o, w) in self.weights.iter().enumerate() {
-                    let y = &exp.output(o)[self.skip..];
-                    let largest = w * metrics::max_abs(y);
-                    bound += 2.0 * y.len() as f64 * largest * largest;
-                }
-            }
-            bound
+            self.sum_over_outputs(|y, w| {
+                let largest = w * metrics::max_abs(y);
+                2.0 * y.len() as f64 * largest * largest
+            })
         })
+    }
+
+    /// Σ `per_output(y, w)` over the experiments and their outputs, in that order: y an
+    /// output's samples in the criterion, w its weight.
+    fn sum_over_outputs(&self, per_output: impl Fn(&[f64], f64) -> f64) -> f64 {
+        let mut total = 0.0;
+        for exp in self.data.experiments() {
+            for (o, &w) in self.weights.iter().enumerate() {
+                total += per_output(&exp.output(o)[self.skip..], w);
+            }
+        }
+        total
     }
 
     /// The residuals at θ into `r`, from a sensitivity pass when speculating (see
