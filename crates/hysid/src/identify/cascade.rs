@@ -120,11 +120,12 @@ impl OutputErrorModel for CascadeStructure {
         data: &IdData,
         exp: usize,
         free: &[usize],
+        threads: usize,
         sink: &mut BlockSink<'_>,
     ) -> Option<Result<()>> {
         Some(self.cascade(theta).and_then(|cascade| {
             let (x, h) = self.pass_inputs(data, exp);
-            stream_sensitivity_blocks(&cascade, x, h, free, sink)
+            stream_sensitivity_blocks(&cascade, x, h, free, threads, sink)
         }))
     }
 

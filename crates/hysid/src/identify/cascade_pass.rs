@@ -147,7 +147,7 @@ pub fn stream_sensitivities(
     free: &[usize],
     sink: &mut SensitivitySink<'_>,
 ) -> Result<()> {
-    stream_sensitivity_blocks(cascade, x, h, free, &mut |block| {
+    stream_sensitivity_blocks(cascade, x, h, free, 2, &mut |block| {
         for (i, row) in block.rows.chunks_exact(block.width).enumerate() {
             sink(block.start + i, &row[..1], &row[1..]);
         }
@@ -156,16 +156,18 @@ pub fn stream_sensitivities(
 
 /// Simulates the cascade with its output sensitivities to the parameters `free` and streams
 /// them into `sink` in blocks of consecutive samples, pipelined over two threads on long
-/// records. Fails with [`Error::Diverged`] at the first sample whose simulated output is not
-/// finite.
+/// records when `threads` (the threads the pass may keep busy) and the machine allow.
+/// Fails with [`Error::Diverged`] at the first sample whose simulated output is not finite.
 pub fn stream_sensitivity_blocks(
     cascade: &HysteresisCascade,
     x: &[f64],
     h: Option<&[bool]>,
     free: &[usize],
+    threads: usize,
     sink: &mut BlockSink<'_>,
 ) -> Result<()> {
-    let failed = if x.len() >= PIPELINE_SAMPLES && rayon::current_num_threads() >= 2 {
+    let two = threads >= 2 && rayon::current_num_threads() >= 2;
+    let failed = if x.len() >= PIPELINE_SAMPLES && two {
         pipelined(cascade, x, h, free, sink)
     } else {
         let mut block = Block::new(free.len(), SEQUENTIAL_ROWS);

@@ -21,13 +21,14 @@
 //!    noise-free data only the true interval fits exactly, which is what recovers every
 //!    parameter to working precision.
 
-use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel};
+use super::output_error::{FitStart, OutputError, OutputErrorFit, OutputErrorModel};
 use crate::data::IdData;
 use crate::model::ParameterSet;
 use crate::numerics::levenberg_marquardt::{Control, IterationRecord, LmReport};
 use crate::Result;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
+use std::sync::Mutex;
 
 /// The switching h(t) = (|x(t)| > d) of every experiment, held fixed during a fit.
 pub type Switching = Vec<Vec<bool>>;
@@ -246,7 +247,7 @@ pub struct SwitchedFit {
 /// `make(Some(h))` builds the model with the switching frozen at h, `make(None)` with the
 /// switching following d. `params` must contain a parameter named `d`.
 pub fn fit_with_switching_updates<M: OutputErrorModel>(
-    make: &dyn Fn(Option<Switching>) -> M,
+    make: &(dyn Fn(Option<Switching>) -> M + Sync),
     data: &IdData,
     params: &ParameterSet,
     estimator: &OutputError,
@@ -278,7 +279,7 @@ pub fn fit_with_switching_updates<M: OutputErrorModel>(
 
 /// Step 1 of the module docs.
 fn fixed_point<M: OutputErrorModel>(
-    make: &dyn Fn(Option<Switching>) -> M,
+    make: &(dyn Fn(Option<Switching>) -> M + Sync),
     data: &IdData,
     params: &ParameterSet,
     estimator: &OutputError,
@@ -293,7 +294,16 @@ fn fixed_point<M: OutputErrorModel>(
     let mut start = None;
     for update in 1..=MAX_UPDATES {
         let model = make(Some(h.clone()));
-        let fit = estimator.estimate_from(&model, data, &current, start.take(), callback)?;
+        let ahead = NextStart::new(estimator, make, data, (&current, &h), d_index);
+        let companion = |theta: &[f64], threads: usize| ahead.compute(theta, threads);
+        let fit = estimator.estimate_beside(
+            &model,
+            data,
+            &current,
+            start.take(),
+            Some(&companion),
+            callback,
+        )?;
         let h_new = classify(data, fit.parameters.get(d_index).value);
         if h_new == h {
             return Ok(SwitchedFit {
@@ -305,8 +315,12 @@ fn fixed_point<M: OutputErrorModel>(
         // The true criterion at the estimate is the next fit's criterion at its start (the
         // switching re-classified by the estimated d is the one that fit holds fixed). On a
         // long record that start's pass is the next fit's first anyway: its S is the value
-        // wanted, and the pass is handed on; otherwise one simulation gives it.
-        start = estimator.start(&make(Some(h_new.clone())), data, &fit.parameters)?;
+        // wanted, and the pass is handed on; otherwise one simulation gives it. A long
+        // record's fit has usually computed it beside its last trial pass already.
+        start = match ahead.take(&fit.parameters.values()) {
+            Some(computed) => computed?,
+            None => estimator.start(&make(Some(h_new.clone())), data, &fit.parameters)?,
+        };
         let actual = match &start {
             Some(start) => start.cost(),
             None => true_cost(&make(None), data, &fit.parameters.values())?,
@@ -331,6 +345,66 @@ fn fixed_point<M: OutputErrorModel>(
         fits: visited.len(),
         consistent: false,
     })
+}
+
+/// The next fit's start (`OutputError::start` with the switching re-classified by the
+/// estimated d), computed beside a fit's trial pass that is likely its last (see
+/// [`Companion`](super::output_error::Companion)): the same function of the same θ, so the
+/// same result as when computed after the fit, found earlier.
+struct NextStart<'a, M> {
+    estimator: &'a OutputError,
+    make: &'a (dyn Fn(Option<Switching>) -> M + Sync),
+    data: &'a IdData,
+    /// The fit's start and its frozen switching.
+    current: &'a ParameterSet,
+    h: &'a Switching,
+    d_index: usize,
+    /// The trial point and the start computed there (the last one tried).
+    at: Mutex<Option<(Vec<f64>, StartResult)>>,
+}
+
+/// What `OutputError::start` returns.
+type StartResult = Result<Option<FitStart>>;
+
+impl<'a, M: OutputErrorModel> NextStart<'a, M> {
+    fn new(
+        estimator: &'a OutputError,
+        make: &'a (dyn Fn(Option<Switching>) -> M + Sync),
+        data: &'a IdData,
+        (current, h): (&'a ParameterSet, &'a Switching),
+        d_index: usize,
+    ) -> Self {
+        Self {
+            estimator,
+            make,
+            data,
+            current,
+            h,
+            d_index,
+            at: Mutex::new(None),
+        }
+    }
+
+    /// The start at the trial point `theta` on at most `threads` threads, unless `theta`'s d
+    /// classifies the samples as the fit's switching does (the fixed point is then reached
+    /// and needs no start).
+    fn compute(&self, theta: &[f64], threads: usize) {
+        let h_next = classify(self.data, theta[self.d_index]);
+        if h_next == *self.h {
+            return;
+        }
+        let mut at = self.current.clone();
+        at.set_values(theta);
+        let model = (self.make)(Some(h_next));
+        let start = self.estimator.start_on(&model, self.data, &at, threads);
+        *self.at.lock().unwrap_or_else(|e| e.into_inner()) = Some((theta.to_vec(), start));
+    }
+
+    /// The start computed at exactly `theta`, if any.
+    fn take(&self, theta: &[f64]) -> Option<StartResult> {
+        let kept = self.at.lock().unwrap_or_else(|e| e.into_inner()).take()?;
+        (kept.0 == theta).then_some(kept.1)
+    }
 }
 
 /// Step 2 of the module docs. A coarse pass fits up to [`COARSE_INTERVALS`] intervals spread

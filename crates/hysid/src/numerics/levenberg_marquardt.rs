@@ -79,6 +79,20 @@ pub trait LeastSquaresProblem: Sync {
         self.residuals_and_cost(theta, r)
     }
 
+    /// [`trial_cost`](Self::trial_cost) for a step whose quadratic model predicts S to fall
+    /// by the fraction `predicted` of its current value. An engine near a minimum converges
+    /// quadratically, so a small `predicted` says this trial point is likely the fit's last:
+    /// a problem may start work that only the fit's end needs beside it (the default does
+    /// nothing more). The value returned must be `trial_cost`'s.
+    fn trial_cost_predicted(
+        &self,
+        theta: &[f64],
+        r: &mut Vec<f64>,
+        _predicted: f64,
+    ) -> Result<f64> {
+        self.trial_cost(theta, r)
+    }
+
     /// Optionally the normal equations at θ for the parameters `free`, computed analytically.
     /// `None` (the default) makes the engine use finite differences.
     fn normal_equations(&self, _theta: &[f64], _free: &[usize]) -> Option<Result<NormalEquations>> {
@@ -520,7 +534,11 @@ impl<'a> State<'a> {
             self.fevals += 1;
             self.plain_evals += 1;
             let evaluated = match self.analytic {
-                true => self.problem.trial_cost(&candidate, trial),
+                true => self.problem.trial_cost_predicted(
+                    &candidate,
+                    trial,
+                    predicted / self.system.cost,
+                ),
                 false => {
                     trial.resize(self.problem.n_residuals(), 0.0);
                     self.problem.residuals_and_cost(&candidate, trial)
