@@ -304,7 +304,12 @@ fn fixed_point<M: OutputErrorModel>(
             Some(&companion),
             callback,
         )?;
-        let h_new = classify(data, fit.parameters.get(d_index).value);
+        // A long record's fit has usually classified the samples by its final d and
+        // computed the next start there beside its last trial pass already.
+        let (h_new, start_ahead) = match ahead.take(&fit.parameters.values()) {
+            Some(computed) => (computed.switching, computed.start),
+            None => (classify(data, fit.parameters.get(d_index).value), None),
+        };
         if h_new == h {
             return Ok(SwitchedFit {
                 fit,
@@ -315,9 +320,8 @@ fn fixed_point<M: OutputErrorModel>(
         // The true criterion at the estimate is the next fit's criterion at its start (the
         // switching re-classified by the estimated d is the one that fit holds fixed). On a
         // long record that start's pass is the next fit's first anyway: its S is the value
-        // wanted, and the pass is handed on; otherwise one simulation gives it. A long
-        // record's fit has usually computed it beside its last trial pass already.
-        start = match ahead.take(&fit.parameters.values()) {
+        // wanted, and the pass is handed on; otherwise one simulation gives it.
+        start = match start_ahead {
             Some(computed) => computed?,
             None => estimator.start(&make(Some(h_new.clone())), data, &fit.parameters)?,
         };
@@ -359,12 +363,19 @@ struct NextStart<'a, M> {
     current: &'a ParameterSet,
     h: &'a Switching,
     d_index: usize,
-    /// The trial point and the start computed there (the last one tried).
-    at: Mutex<Option<(Vec<f64>, StartResult)>>,
+    /// What was computed at the last trial point tried.
+    at: Mutex<Option<Computed>>,
 }
 
-/// What `OutputError::start` returns.
-type StartResult = Result<Option<FitStart>>;
+/// What [`NextStart`] computed at one trial point.
+struct Computed {
+    theta: Vec<f64>,
+    /// The switching that θ's d classifies.
+    switching: Switching,
+    /// The start there (`OutputError::start`'s result); None when the switching is the
+    /// fit's own.
+    start: Option<Result<Option<FitStart>>>,
+}
 
 impl<'a, M: OutputErrorModel> NextStart<'a, M> {
     fn new(
@@ -385,25 +396,29 @@ impl<'a, M: OutputErrorModel> NextStart<'a, M> {
         }
     }
 
-    /// The start at the trial point `theta` on at most `threads` threads, unless `theta`'s d
-    /// classifies the samples as the fit's switching does (the fixed point is then reached
-    /// and needs no start).
+    /// The switching that the trial point `theta`'s d classifies, and the start there on at
+    /// most `threads` threads unless that switching is the fit's own (the fixed point is
+    /// then reached and needs no start).
     fn compute(&self, theta: &[f64], threads: usize) {
         let h_next = classify(self.data, theta[self.d_index]);
-        if h_next == *self.h {
-            return;
-        }
-        let mut at = self.current.clone();
-        at.set_values(theta);
-        let model = (self.make)(Some(h_next));
-        let start = self.estimator.start_on(&model, self.data, &at, threads);
-        *self.at.lock().unwrap_or_else(|e| e.into_inner()) = Some((theta.to_vec(), start));
+        let start = (h_next != *self.h).then(|| {
+            let mut at = self.current.clone();
+            at.set_values(theta);
+            let model = (self.make)(Some(h_next.clone()));
+            self.estimator.start_on(&model, self.data, &at, threads)
+        });
+        *self.at.lock().unwrap_or_else(|e| e.into_inner()) = Some(Computed {
+            theta: theta.to_vec(),
+            switching: h_next,
+            start,
+        });
     }
 
-    /// The start computed at exactly `theta`, if any.
-    fn take(&self, theta: &[f64]) -> Option<StartResult> {
-        let kept = self.at.lock().unwrap_or_else(|e| e.into_inner()).take()?;
-        (kept.0 == theta).then_some(kept.1)
+    /// The switching and the start computed at exactly `theta`, if any (no start when the
+    /// switching is the fit's own).
+    fn take(&self, theta: &[f64]) -> Option<Computed> {
+        let computed = self.at.lock().unwrap_or_else(|e| e.into_inner()).take()?;
+        (computed.theta == theta).then_some(computed)
     }
 }
 

@@ -135,11 +135,24 @@ impl FitSummary {
     /// The fit of simulated outputs `yhat` against measured `y`, one pair per experiment
     /// (`names` name them); errors when a figure is not finite (the simulation failed).
     pub fn of(names: &[String], y: &[&[f64]], yhat: &[&[f64]]) -> Result<Self> {
+        Self::with_figures(names, y, yhat, |y, yh, _| {
+            metrics::fit_percent_and_mse(y, yh)
+        })
+    }
+
+    /// [`of`](Self::of) with each experiment's (fit %, MSE) from `figures(y, ŷ, index)`.
+    fn with_figures(
+        names: &[String],
+        y: &[&[f64]],
+        yhat: &[&[f64]],
+        mut figures: impl FnMut(&[f64], &[f64], usize) -> (f64, f64),
+    ) -> Result<Self> {
         let per_experiment: Vec<ExperimentFit> = names
             .iter()
             .zip(y.iter().zip(yhat))
-            .map(|(name, (y, yh))| {
-                let (fit_percent, mse) = metrics::fit_percent_and_mse(y, yh);
+            .enumerate()
+            .map(|(e, (name, (y, yh)))| {
+                let (fit_percent, mse) = figures(y, yh, e);
                 ExperimentFit {
                     experiment: name.clone(),
                     samples: y.len(),
@@ -174,7 +187,16 @@ impl FitSummary {
         let names: Vec<String> = data.experiments().iter().map(|e| e.name.clone()).collect();
         let y: Vec<&[f64]> = data.experiments().iter().map(|e| e.output(0)).collect();
         let yhat: Vec<&[f64]> = fit.simulated.iter().map(|s| s[0].as_slice()).collect();
-        let mut summary = Self::of(&names, &y, &yhat)?;
+        // A fit of one output over every sample (none skipped) summed these very figures
+        // (`fit_percent_and_mse` of y and ŷ): taken over, they spare a pass over the record.
+        let whole = fit.simulated.iter().all(|s| s.len() == 1)
+            && fit.report.n_residuals == y.iter().map(|y| y.len()).sum::<usize>();
+        let mut summary = Self::with_figures(&names, &y, &yhat, |y, yh, e| {
+            match (whole, fit.fit_percent.get(e), fit.mse.get(e)) {
+                (true, Some(f), Some(m)) => (f[0], m[0]),
+                _ => metrics::fit_percent_and_mse(y, yh),
+            }
+        })?;
         summary.loss = Some(fit.loss);
         summary.fpe = fit.fpe.is_finite().then_some(fit.fpe);
         summary.aic = fit.aic.is_finite().then_some(fit.aic);
