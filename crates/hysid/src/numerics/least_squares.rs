@@ -8,6 +8,8 @@
 use crate::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 
+mod streamed;
+
 /// Largest acceptable condition number of the column-scaled regressor matrix.
 pub const MAX_CONDITION: f64 = 1e12;
 
@@ -87,27 +89,41 @@ pub fn least_squares(phi: &DMatrix<f64>, y: &[f64], names: &[&str]) -> Result<Ls
 }
 
 /// θ̂ and the residual sum of squares ‖y − Φθ̂‖² of min ‖Φθ − y‖₂, for iterations that need
-/// nothing else (no covariance). The same column scaling, QR factorisation and rank test as
-/// [`least_squares`], with the same errors, but Qᵀy is formed by applying the p Householder
-/// reflections Hⱼ = I − τⱼvⱼvⱼᵀ to y (Qᵀy = Hₚ⋯H₁y, about 4Np operations) instead of
-/// building the N × p matrix Q first (about 4Np² more); Golub & Van Loan, Matrix
-/// Computations, 4th ed., §5.3.3. The estimate agrees with [`least_squares`]'s to rounding.
+/// nothing else (no covariance), with the errors of [`least_squares`] and the same rank test
+/// on the column-scaled triangular factor.
+///
+/// The factor comes from the Householder QR of the augmented matrix [Φ y] formed block of
+/// rows by block of rows (see the `streamed` module): the record is read once, Qᵀy is the
+/// factor's last column and ‖y − Φθ̂‖² its corner squared (Golub & Van Loan, *Matrix
+/// Computations*, 4th ed., §5.3.3), instead of a column-by-column QR that sweeps the whole
+/// matrix once per column, then Q's reflections applied to y and the residual formed anew.
+/// The column scaling of [`least_squares`] (each column to unit norm) is applied to the
+/// factor (‖Φeⱼ‖ = ‖Reⱼ‖, and R·diag(1/‖Φeⱼ‖) is the factor of the scaled Φ), so the rank
+/// decision is the same. The estimate agrees with [`least_squares`]'s to rounding.
 pub fn least_squares_estimate(
     phi: &DMatrix<f64>,
     y: &[f64],
     names: &[&str],
 ) -> Result<(DVector<f64>, f64)> {
-    let p = phi.ncols();
-    let ScaledQr { qr, r, scale, .. } = factor(phi, names)?;
-    let yv = DVector::from_column_slice(y);
-    let mut qty = yv.clone();
-    qr.q_tr_mul(&mut qty);
-    let theta_scaled = r
-        .solve_upper_triangular(&qty.rows(0, p))
+    let (n, p) = phi.shape();
+    enough_rows(n, p)?;
+    let augmented = streamed::factor_augmented(phi, y);
+    let r = DMatrix::from_fn(p, p, |i, j| if i <= j { augmented.at(i, j) } else { 0.0 });
+    let scale: Vec<f64> = (0..p).map(|j| r.column(j).norm()).collect();
+    let name = column_name(names);
+    excited(&scale, &name)?;
+    let mut scaled = r;
+    for (j, s) in scale.iter().enumerate() {
+        scaled.column_mut(j).unscale_mut(*s);
+    }
+    condition_number(&scaled, &name)?;
+    let qty = DVector::from_fn(p, |i, _| augmented.at(i, p));
+    let theta_scaled = scaled
+        .solve_upper_triangular(&qty)
         .ok_or_else(|| Error::Singular("triangular factor is singular".into()))?;
     let theta = DVector::from_iterator(p, theta_scaled.iter().zip(&scale).map(|(t, s)| t / s));
-    let residual_ss = (&yv - phi * &theta).norm_squared();
-    Ok((theta, residual_ss))
+    let rho = augmented.at(p, p);
+    Ok((theta, rho * rho))
 }
 
 /// The QR factorisation of the column-scaled Φ that passed the rank test, with what the
@@ -125,6 +141,27 @@ struct ScaledQr {
 /// documents.
 fn factor(phi: &DMatrix<f64>, names: &[&str]) -> Result<ScaledQr> {
     let (n, p) = phi.shape();
+    enough_rows(n, p)?;
+    let name = column_name(names);
+    let scale: Vec<f64> = (0..p).map(|j| phi.column(j).norm()).collect();
+    excited(&scale, &name)?;
+    let mut scaled = phi.clone();
+    for (j, s) in scale.iter().enumerate() {
+        scaled.column_mut(j).unscale_mut(*s);
+    }
+    let qr = scaled.qr();
+    let r = qr.r();
+    let condition_number = condition_number(&r, &name)?;
+    Ok(ScaledQr {
+        qr,
+        r,
+        scale,
+        condition_number,
+    })
+}
+
+/// N ≥ p + 1 rows for p parameters, else [`Error::TooFewSamples`].
+fn enough_rows(n: usize, p: usize) -> Result<()> {
     if n < p + 1 {
         return Err(Error::TooFewSamples {
             samples: n,
@@ -132,24 +169,33 @@ fn factor(phi: &DMatrix<f64>, names: &[&str]) -> Result<ScaledQr> {
             needed: p + 1,
         });
     }
-    let name = |j: usize| {
+    Ok(())
+}
+
+/// The name of column j for messages: `names[j]`, else "column j+1".
+fn column_name<'a>(names: &'a [&str]) -> impl Fn(usize) -> String + 'a {
+    move |j| {
         names
             .get(j)
             .map_or_else(|| format!("column {}", j + 1), |s| s.to_string())
-    };
-    let scale: Vec<f64> = (0..p).map(|j| phi.column(j).norm()).collect();
-    if let Some(j) = scale.iter().position(|&s| s == 0.0 || !s.is_finite()) {
-        return Err(Error::Singular(format!(
+    }
+}
+
+/// [`Error::Singular`] naming the first column whose norm (in `scale`) is zero or not finite.
+fn excited(scale: &[f64], name: &dyn Fn(usize) -> String) -> Result<()> {
+    match scale.iter().position(|&s| s == 0.0 || !s.is_finite()) {
+        Some(j) => Err(Error::Singular(format!(
             "regressor '{}' is zero or not finite over the whole record; the data do not excite it",
             name(j)
-        )));
+        ))),
+        None => Ok(()),
     }
-    let mut scaled = phi.clone();
-    for (j, s) in scale.iter().enumerate() {
-        scaled.column_mut(j).unscale_mut(*s);
-    }
-    let qr = scaled.qr();
-    let r = qr.r();
+}
+
+/// The condition number of the column-scaled triangular factor `r` (by its singular
+/// values), or [`Error::Singular`] naming the columns involved when it reaches
+/// [`MAX_CONDITION`].
+fn condition_number(r: &DMatrix<f64>, name: &dyn Fn(usize) -> String) -> Result<f64> {
     let svd = r.clone().svd(false, true);
     let smax = svd.singular_values.max();
     let smin = svd.singular_values.min();
@@ -158,15 +204,10 @@ fn factor(phi: &DMatrix<f64>, names: &[&str]) -> Result<ScaledQr> {
         return Err(Error::Singular(format!(
             "regressors {} are (nearly) linearly dependent (condition number {condition_number:.3e}); \
              the data do not excite the model enough or it has too many parameters",
-            dependent_columns(&svd, &name)
+            dependent_columns(&svd, name)
         )));
     }
-    Ok(ScaledQr {
-        qr,
-        r,
-        scale,
-        condition_number,
-    })
+    Ok(condition_number)
 }
 
 /// Names the columns that dominate the right singular vector of the smallest singular value.
