@@ -460,10 +460,11 @@ pub struct OutputErrorProblem<'a> {
 /// leaves the next step's far below the improvement tolerance). The switching fixed point
 /// (`switching::fixed_point`) computes the next fit's start there, a pass with the switching
 /// re-classified by θ's d. Only pipelining fits (one pass at a time over a long record, see
-/// [`OutputErrorProblem::overlap`]) run it: the trial pass and the companion's then run on one
-/// thread each instead of one after the other on two: a pipelined pass leaves its threads
-/// waiting on each other, and on this project's two-core machines two such passes side by
-/// side take about three quarters of the time of two pipelined ones.
+/// [`OutputErrorProblem::overlap`]) run it. The trial pass and the companion's pass then run
+/// on one thread each, side by side, instead of one after the other on two threads each. A
+/// pipelined pass leaves its two threads waiting on each other part of the time; on this
+/// project's two-core machines two single-thread passes side by side take about three
+/// quarters of the time of two pipelined ones.
 ///
 /// The companion is called with θ and the number of threads its work may keep busy (one:
 /// the trial pass keeps the other).
