@@ -31,7 +31,7 @@
 //! its internal variables).
 
 use super::hysteresis::hysteresis_sensitivities;
-use super::output_error::{BlockSink, SensitivityBlock, SensitivitySink};
+use super::output_error::{BlockSink, SensitivityBlock, SensitivitySink, PASS_THREADS};
 use crate::model::HysteresisCascade;
 use crate::{Error, Result};
 use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
@@ -147,7 +147,7 @@ pub fn stream_sensitivities(
     free: &[usize],
     sink: &mut SensitivitySink<'_>,
 ) -> Result<()> {
-    stream_sensitivity_blocks(cascade, x, h, free, 2, &mut |block| {
+    stream_sensitivity_blocks(cascade, x, h, free, PASS_THREADS, &mut |block| {
         for (i, row) in block.rows.chunks_exact(block.width).enumerate() {
             sink(block.start + i, &row[..1], &row[1..]);
         }

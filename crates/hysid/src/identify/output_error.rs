@@ -266,7 +266,7 @@ impl OutputError {
         data: &IdData,
         params: &ParameterSet,
     ) -> Result<Option<FitStart>> {
-        self.start_on(model, data, params, 2)
+        self.start_on(model, data, params, PASS_THREADS)
     }
 
     /// [`start`](Self::start) with a pass that keeps at most `threads` threads busy (the
@@ -449,7 +449,7 @@ pub struct OutputErrorProblem<'a> {
     /// Work the fit's caller runs beside a trial pass that is likely the fit's last (see
     /// [`Companion`]).
     companion: Option<Companion<'a>>,
-    /// How many threads a sensitivity pass may keep busy: 2, or 1 while a companion runs
+    /// How many threads a sensitivity pass may keep busy: [`PASS_THREADS`], or 1 while a companion runs
     /// beside it (see [`OutputErrorModel::simulate_sensitivity_blocks`]).
     pass_threads: AtomicUsize,
 }
@@ -475,6 +475,11 @@ pub type Companion<'a> = &'a (dyn Fn(&[f64], usize) + Sync);
 /// the 10⁶-sample example the steps predict 8·10⁻⁶, then 3·10⁻¹⁰ (the last), then
 /// 3·10⁻¹⁷ (not taken, below the tolerance of 10⁻¹⁰).
 pub const NEAR_MINIMUM: f64 = 1e-6;
+
+/// The threads a sensitivity pass may keep busy when nothing runs beside it: a model may
+/// pipeline a long record's pass over two (see
+/// [`OutputErrorModel::simulate_sensitivity_blocks`]).
+pub const PASS_THREADS: usize = 2;
 
 /// Records at least this long (residuals) get every trial point's normal equations computed
 /// with its residuals, kept for the engine's request that follows when the point is accepted
@@ -594,7 +599,7 @@ impl<'a> OutputErrorProblem<'a> {
             speculation: None,
             overlap: None,
             companion: None,
-            pass_threads: AtomicUsize::new(2),
+            pass_threads: AtomicUsize::new(PASS_THREADS),
         })
     }
 
@@ -643,8 +648,7 @@ impl<'a> OutputErrorProblem<'a> {
             .as_ref()
             .filter(|s| s.kept.free == start.free)
         {
-            spec.with_sensitivities
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            spec.with_sensitivities.fetch_add(1, Relaxed);
             spec.kept.keep(&start.theta, start.system);
         }
     }
@@ -660,7 +664,6 @@ impl<'a> OutputErrorProblem<'a> {
     /// points were simulated with their sensitivities (the engine counts requests; a request
     /// for normal equations answered from a trial point's pass simulates nothing).
     fn count_simulations(&self, report: &mut LmReport) {
-        use std::sync::atomic::Ordering::Relaxed;
         if let Some(spec) = &self.speculation {
             let with = spec.with_sensitivities.load(Relaxed);
             let without = spec.without.load(Relaxed);
@@ -1003,7 +1006,7 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
                     }
                     cost
                 });
-                self.pass_threads.store(2, Relaxed);
+                self.pass_threads.store(PASS_THREADS, Relaxed);
                 cost
             }
             _ => self.trial_cost(theta, r),
@@ -1081,8 +1084,7 @@ impl OutputErrorProblem<'_> {
             return pass;
         }
         if let Some(spec) = &self.speculation {
-            spec.without
-                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            spec.without.fetch_add(1, Relaxed);
         }
         self.plain_or_overlapped_residuals(theta, r).map(|()| None)
     }
@@ -1096,7 +1098,6 @@ impl OutputErrorProblem<'_> {
         theta: &[f64],
         r: Option<&mut [f64]>,
     ) -> Option<Result<Option<f64>>> {
-        use std::sync::atomic::Ordering::Relaxed;
         let spec = self
             .speculation
             .as_ref()
@@ -1175,9 +1176,8 @@ impl OutputErrorProblem<'_> {
             if let Some(system) = spec.kept.take(theta, free) {
                 return Some(Ok(system));
             }
-            if !spec.disabled.load(std::sync::atomic::Ordering::Relaxed) {
-                spec.with_sensitivities
-                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            if !spec.disabled.load(Relaxed) {
+                spec.with_sensitivities.fetch_add(1, Relaxed);
                 if spec.split && spec.kept.free == free {
                     // The start: the engine asks for the normal equations first.
                     return self.residuals_with_normal_equations(theta, free, true, None);

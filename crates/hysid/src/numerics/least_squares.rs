@@ -112,10 +112,7 @@ pub fn least_squares_estimate(
     let scale: Vec<f64> = (0..p).map(|j| r.column(j).norm()).collect();
     let name = column_name(names);
     excited(&scale, &name)?;
-    let mut scaled = r;
-    for (j, s) in scale.iter().enumerate() {
-        scaled.column_mut(j).unscale_mut(*s);
-    }
+    let scaled = unscaled_columns(r, &scale);
     condition_number(&scaled, &name)?;
     let qty = DVector::from_fn(p, |i, _| augmented.at(i, p));
     let theta_scaled = scaled
@@ -145,11 +142,7 @@ fn factor(phi: &DMatrix<f64>, names: &[&str]) -> Result<ScaledQr> {
     let name = column_name(names);
     let scale: Vec<f64> = (0..p).map(|j| phi.column(j).norm()).collect();
     excited(&scale, &name)?;
-    let mut scaled = phi.clone();
-    for (j, s) in scale.iter().enumerate() {
-        scaled.column_mut(j).unscale_mut(*s);
-    }
-    let qr = scaled.qr();
+    let qr = unscaled_columns(phi.clone(), &scale).qr();
     let r = qr.r();
     let condition_number = condition_number(&r, &name)?;
     Ok(ScaledQr {
@@ -158,6 +151,14 @@ fn factor(phi: &DMatrix<f64>, names: &[&str]) -> Result<ScaledQr> {
         scale,
         condition_number,
     })
+}
+
+/// `m` with column j divided by `scale[j]`.
+fn unscaled_columns(mut m: DMatrix<f64>, scale: &[f64]) -> DMatrix<f64> {
+    for (j, s) in scale.iter().enumerate() {
+        m.column_mut(j).unscale_mut(*s);
+    }
+    m
 }
 
 /// N ≥ p + 1 rows for p parameters, else [`Error::TooFewSamples`].
