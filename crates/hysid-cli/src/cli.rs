@@ -579,17 +579,17 @@ pub struct OutputArgs {
 pub struct CascadeArgs {
     #[command(flatten)]
     pub data: DataArgs,
-    /// Hysteresis: ch4 (saturated Coleman–Hodgdon, 4 parameters), ch6, or an operator family:
-    /// pi, gpi, preisach, jiles-atherton, bouc-wen, duhem, dahl, maxwell-slip, backlash.
-    #[arg(long)]
+    /// Hysteresis: ch4 (saturated Coleman–Hodgdon, 4 parameters), ch6, or an operator family
+    /// (the list is the registry's).
+    #[arg(long, help = crate::cli_zoo::family_help("Hysteresis: ch4 (saturated Coleman–Hodgdon, 4 parameters), ch6, or an operator family"))]
     pub hysteresis: String,
     /// Operator families: number of thresholds of pi and gpi, elements of maxwell-slip (10).
     /// Range 1..=200.
     #[arg(long, value_parser = crate::options::count::<1, 200>)]
     pub thresholds: Option<usize>,
     /// Operator family preisach: intervals of the Preisach grid (10). Range 1..=100.
-    #[arg(long, value_parser = crate::options::count::<1, 100>)]
-    pub levels: Option<usize>,
+    #[arg(long, alias = "levels", value_parser = crate::options::count::<1, 100>)]
+    pub grid: Option<usize>,
     /// Order n of A(q⁻¹). Range 0..=50.
     #[arg(long, value_parser = crate::options::count::<0, 50>)]
     pub na: usize,

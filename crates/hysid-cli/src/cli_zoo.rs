@@ -2,7 +2,18 @@
 //! `compensate` (clap derive; the help text comes from these doc comments).
 
 use clap::Args;
+use hysid::model::operators::Family;
 use std::path::PathBuf;
+
+/// `lead`, then every family of the registry with its model and reference (the help text of
+/// `--family` and `--hysteresis`).
+pub fn family_help(lead: &str) -> String {
+    let families: Vec<String> = Family::ALL
+        .iter()
+        .map(|f| format!("{} ({})", f.name(), f.title()))
+        .collect();
+    format!("{lead}: {}", families.join("; "))
+}
 
 /// The record: one input and one output column.
 #[derive(Debug, Args)]
@@ -46,9 +57,8 @@ pub struct FamilyArgs {
 /// Options of `hysid identify operator`.
 #[derive(Debug, Args)]
 pub struct OperatorArgs {
-    /// The family: pi, gpi, preisach, jiles-atherton, bouc-wen, duhem, dahl, maxwell-slip,
-    /// backlash, ch4 or ch6.
-    #[arg(long)]
+    /// The family (the list is the registry's).
+    #[arg(long, help = family_help("The family"))]
     pub family: String,
     #[command(flatten)]
     pub data: ZooDataArgs,

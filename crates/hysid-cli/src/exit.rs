@@ -101,7 +101,7 @@ const FLAGS: [(&str, &str); 12] = [
     ("start_factor", "--start-factor"),
     ("replicates", "--replicates"),
     ("example", "--example"),
-    ("levels", "--levels"),
+    ("levels", "--grid"),
     ("lambda", "--lambda"),
     ("family", "--family"),
     ("hysteresis", "--hysteresis"),

@@ -7,52 +7,44 @@ use crate::cli::{CascadeArgs, UncertaintyArg};
 use crate::progress::FitProgress;
 use crate::report::{figures, print_table, Row};
 use anyhow::Result;
-use hysid::identify::operator_cascade::{
-    CascadeFamily, OperatorCascadeFit, OperatorCascadeIdentification,
-};
+use hysid::identify::operator_cascade::{OperatorCascadeFit, OperatorCascadeIdentification};
+use hysid::identify::operators::{Family, FamilyOptions};
 use hysid::report::plot::operator_cascade_figures;
 use hysid::report::{operator_cascade_model, operator_cascade_report};
 use serde_json::json;
 
-/// The family named on the command line with its structure options (the lead unifies this
-/// parser with the `Family` enum of `identify operator` at merge).
-fn family_operator(name: &str, args: &CascadeArgs) -> Result<CascadeFamily> {
-    let thresholds = args.thresholds.unwrap_or(10);
-    let family = match name.trim().to_ascii_lowercase().as_str() {
-        "pi" => CascadeFamily::Pi { thresholds },
-        "gpi" => CascadeFamily::Gpi { thresholds },
-        "preisach" => CascadeFamily::Preisach {
-            levels: args.levels.unwrap_or(10),
-        },
-        "jiles-atherton" => CascadeFamily::JilesAtherton,
-        "bouc-wen" => CascadeFamily::BoucWen,
-        "duhem" => CascadeFamily::Duhem,
-        "dahl" => CascadeFamily::Dahl,
-        "maxwell-slip" => CascadeFamily::MaxwellSlip {
-            elements: thresholds,
-        },
-        "backlash" => CascadeFamily::Backlash { profile_points: 60 },
-        other => anyhow::bail!(
-            "unknown --hysteresis '{other}'; use ch4, ch6, pi, gpi, preisach, jiles-atherton, \
-             bouc-wen, duhem, dahl, maxwell-slip or backlash"
-        ),
-    };
-    let uses_thresholds = matches!(
-        family,
-        CascadeFamily::Pi { .. } | CascadeFamily::Gpi { .. } | CascadeFamily::MaxwellSlip { .. }
-    );
+/// The cascade's settings from the command line: the operator family (the registry's, not
+/// ch4/ch6) and the options that apply to it.
+fn identification(args: &CascadeArgs) -> Result<OperatorCascadeIdentification> {
+    let name = &args.hysteresis;
+    let family = Family::parse_operator(name).map_err(|_| {
+        let operators: Vec<&str> = Family::operators().map(Family::name).collect();
+        anyhow::anyhow!(
+            "unknown --hysteresis '{name}'; use ch4, ch6 or an operator family: {}",
+            operators.join(", ")
+        )
+    })?;
+    let uses_thresholds = matches!(family, Family::Pi | Family::Gpi | Family::MaxwellSlip);
     if args.thresholds.is_some() && !uses_thresholds {
         anyhow::bail!("--thresholds applies to pi, gpi and maxwell-slip, not {name}");
     }
-    if args.levels.is_some() && !matches!(family, CascadeFamily::Preisach { .. }) {
-        anyhow::bail!("--levels applies to preisach, not {name}");
+    if args.grid.is_some() && family != Family::Preisach {
+        anyhow::bail!("--grid applies to preisach, not {name}");
     }
-    Ok(family)
+    let mut id = OperatorCascadeIdentification::new(family, args.na, args.nb, args.delay);
+    id.options = FamilyOptions {
+        thresholds: args.thresholds.unwrap_or(10),
+        // A cascade's Preisach plane is smaller than `identify operator`'s: its cells share
+        // the record with the linear block's coefficients.
+        grid: args.grid.unwrap_or(10),
+        ..FamilyOptions::default()
+    };
+    Ok(id)
 }
 
 /// `hysid identify cascade` with an operator family.
 pub fn identify(args: &CascadeArgs) -> Result<()> {
-    let family = family_operator(&args.hysteresis, args)?;
+    let id = identification(args)?;
     anyhow::ensure!(
         args.uncertainty == UncertaintyArg::Asymptotic,
         "--uncertainty bootstrap is available for ch4 and ch6; operator cascades report \
@@ -60,7 +52,6 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
     );
     let out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
-    let id = OperatorCascadeIdentification::new(family, args.na, args.nb, args.delay);
     let fit = {
         let progress = FitProgress::new("identifying cascade");
         let mut callback = progress.callback();

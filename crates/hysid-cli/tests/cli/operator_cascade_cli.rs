@@ -3,7 +3,7 @@
 
 use crate::common::{hysid, read_json, Assert};
 use hysid::model::operators::{Backlash, Orientation};
-use hysid::model::{CascadeOperator, LinearBlock, OperatorCascade};
+use hysid::model::{LinearBlock, OperatorCascade, OperatorModel};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -24,7 +24,7 @@ fn backlash_record(dir: &Path) -> PathBuf {
         .collect();
     let op = Backlash::new(1.7, 0.437, -0.3, Orientation::default()).unwrap();
     let linear = LinearBlock::new(vec![-1.2, 0.5], vec![1.0, 0.4], 1).unwrap();
-    let truth = OperatorCascade::new(CascadeOperator::Backlash(op), linear).unwrap();
+    let truth = OperatorCascade::new(OperatorModel::Backlash(op), linear).unwrap();
     let y = truth.simulate(&u).unwrap().y;
     let mut text = String::from("u,y\n");
     for (a, b) in u.iter().zip(&y) {
@@ -107,7 +107,7 @@ fn unknown_family_and_misplaced_options_are_one_line_errors() {
     let data = backlash_record(dir.path());
     for (family, extra, expected) in [
         ("hammerstein", vec![], "unknown --hysteresis 'hammerstein'"),
-        ("pi", vec!["--levels", "5"], "--levels applies to preisach"),
+        ("pi", vec!["--grid", "5"], "--grid applies to preisach"),
         (
             "backlash",
             vec!["--thresholds", "5"],

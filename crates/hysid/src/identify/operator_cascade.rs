@@ -26,7 +26,7 @@
 //! `duhem`, `dahl`): the family's own recipe fitted to the loop (u, y) gives Γ₀ — its search
 //! over the family's few nonlinear parameters is the grid stage — then an ARX least-squares
 //! fit of y on past y and v₀ = Γ₀\[u\] gives A and an unnormalised B; b1 is moved into Γ by
-//! the family's output scale ([`crate::model::CascadeOperator::scaled`]) where it has one.
+//! the family's output scale ([`OperatorModel::scaled`]) where it has one.
 //!
 //! **Refinement**: output error over every free parameter of both blocks with the bounded
 //! Levenberg–Marquardt engine ([`super::output_error`]), finite-difference sensitivities,
@@ -37,82 +37,24 @@
 //! Automatica 34 (1998) 333–338 (over-parameterisation and the rank-one SVD factorisation);
 //! L. Ljung, *System Identification*, 2nd ed., 1999.
 
-use super::operators::bouc_wen::{self, BoucWenOptions};
-use super::operators::dahl::{self, DahlOptions};
 use super::operators::differential_fit::linear_fit;
-use super::operators::duhem::{self, DuhemOptions};
-use super::operators::gpi::{self, GpiOptions};
-use super::operators::jiles_atherton::{self, JilesAthertonOptions};
-use super::operators::preisach::{self, PreisachOptions};
+use super::operators::family::{self, Family, FamilyOptions};
 use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel};
 use crate::data::IdData;
-use crate::model::operators::{play, stop, Backlash, MaxwellSlip, Orientation, PrandtlIshlinskii};
-use crate::model::{CascadeOperator, LinearBlock, OperatorCascade, ParameterSet};
+use crate::model::operators::{OperatorModel, Orientation};
+use crate::model::{LinearBlock, OperatorCascade, ParameterSet};
 use crate::numerics::{Control, IterationRecord, Termination};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use std::time::Instant;
 
-/// The operator family of the cascade and its structure options.
-#[derive(Clone, Debug, PartialEq)]
-pub enum CascadeFamily {
-    /// Prandtl–Ishlinskii with `thresholds` plays on the input grid.
-    Pi {
-        /// Number of thresholds n.
-        thresholds: usize,
-    },
-    /// Kuhnen's generalised PI (the family recipe's dead-zone grid).
-    Gpi {
-        /// Number of play thresholds n.
-        thresholds: usize,
-    },
-    /// Discrete Preisach plane with `levels` intervals.
-    Preisach {
-        /// Number of grid intervals N.
-        levels: usize,
-    },
-    /// Jiles–Atherton (B in T from H in A/m, Langevin anhysteretic).
-    JilesAtherton,
-    /// Static Bouc–Wen operator (n = 1).
-    BoucWen,
-    /// Duhem / Coleman–Hodgdon operator.
-    Duhem,
-    /// Dahl friction (i = 1).
-    Dahl,
-    /// Maxwell-slip with `elements` elements on the width grid.
-    MaxwellSlip {
-        /// Number of elements n.
-        elements: usize,
-    },
-    /// Backlash (play with gain and offset), `profile_points` values of r profiled.
-    Backlash {
-        /// Points of the profile over r.
-        profile_points: usize,
-    },
-}
-
-impl CascadeFamily {
-    /// The family's command-line name.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Pi { .. } => "pi",
-            Self::Gpi { .. } => "gpi",
-            Self::Preisach { .. } => "preisach",
-            Self::JilesAtherton => "jiles-atherton",
-            Self::BoucWen => "bouc-wen",
-            Self::Duhem => "duhem",
-            Self::Dahl => "dahl",
-            Self::MaxwellSlip { .. } => "maxwell-slip",
-            Self::Backlash { .. } => "backlash",
-        }
-    }
-}
-
 /// Settings of the operator-cascade identification.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OperatorCascadeIdentification {
-    /// The operator family.
-    pub family: CascadeFamily,
+    /// The operator family (an operator family of the registry, not ch4/ch6).
+    pub family: Family,
+    /// The family's settings (thresholds, Preisach grid, …), as for `identify operator`.
+    pub options: FamilyOptions,
     /// Order n of A(q⁻¹).
     pub na: usize,
     /// Number m ≥ 1 of B coefficients (b1 = 1 included).
@@ -156,10 +98,11 @@ pub struct OperatorCascadeFit {
 }
 
 impl OperatorCascadeIdentification {
-    /// Settings with 200 refinement iterations.
-    pub fn new(family: CascadeFamily, na: usize, nb: usize, delay: usize) -> Self {
+    /// Settings with the family's default options and 200 refinement iterations.
+    pub fn new(family: Family, na: usize, nb: usize, delay: usize) -> Self {
         Self {
             family,
+            options: FamilyOptions::default(),
             na,
             nb,
             delay,
@@ -212,6 +155,8 @@ impl OperatorCascadeIdentification {
     }
 
     fn check(&self, data: &IdData) -> Result<()> {
+        Family::parse_operator(self.family.name())?;
+        self.options.validate()?;
         if self.nb == 0 {
             return Err(Error::invalid_option(
                 "nb",
@@ -238,26 +183,14 @@ impl OperatorCascadeIdentification {
         Ok(())
     }
 
-    /// The global initialisation (module doc).
+    /// The global initialisation (module doc): the family's [`Identify::cascade_start`].
     fn initialise(&self, u: &[f64], y: &[f64]) -> Result<(OperatorCascade, &'static str)> {
-        const RANK_ONE: &str = "equation-error least squares, rank-one factorisation";
-        const FAMILY_ARX: &str = "family fit and ARX";
-        let start = match &self.family {
-            CascadeFamily::Pi { thresholds } => (self.pi_start(u, y, *thresholds)?, RANK_ONE),
-            CascadeFamily::MaxwellSlip { elements } => {
-                (self.maxwell_slip_start(u, y, *elements)?, RANK_ONE)
-            }
-            CascadeFamily::Backlash { profile_points } => {
-                (self.backlash_start(u, y, *profile_points)?, RANK_ONE)
-            }
-            other => (self.family_arx_start(other, u, y)?, FAMILY_ARX),
-        };
-        Ok(start)
+        family::cascade_start(self.family, self, u, y, &self.options)
     }
 
     /// Equation-error least squares of y on past y and the lagged basis signals; returns
     /// (a, b with b1 = 1, θ) from the rank-one factorisation, and the residual sum of squares.
-    fn rank_one(&self, y: &[f64], basis: &[Vec<f64>]) -> Result<RankOne> {
+    pub(crate) fn rank_one(&self, y: &[f64], basis: &[Vec<f64>]) -> Result<RankOne> {
         let (na, nb, k) = (self.na, self.nb, self.delay);
         let l = basis.len();
         let mut columns: Vec<Vec<f64>> = (1..=na).map(|i| lagged(y, i, -1.0)).collect();
@@ -303,9 +236,9 @@ impl OperatorCascadeIdentification {
     /// one) has its poles pulled radially inside the unit circle, aᵢ ← aᵢ ρⁱ with
     /// ρ = 0.95/(spectral radius), because output error cannot start from a diverging
     /// simulation.
-    fn cascade(
+    pub(crate) fn cascade(
         &self,
-        operator: CascadeOperator,
+        operator: OperatorModel,
         a: Vec<f64>,
         b: Vec<f64>,
     ) -> Result<OperatorCascade> {
@@ -324,114 +257,15 @@ impl OperatorCascadeIdentification {
         OperatorCascade::new(operator, linear)
     }
 
-    fn pi_start(&self, u: &[f64], y: &[f64], n: usize) -> Result<OperatorCascade> {
-        let grid = threshold_grid(u, n)?;
-        let mut basis = vec![u.to_vec()];
-        basis.extend(grid.iter().map(|&r| play(u, r)));
-        basis.push(vec![1.0; u.len()]);
-        let RankOne { a, b, theta, .. } = self.rank_one(y, &basis)?;
-        let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
-        let (a0, weights) = monotone_weights(theta[0], &theta[1..=n]);
-        let op = PrandtlIshlinskii::new(a0, weights, grid, theta[n + 1], o)?;
-        self.cascade(CascadeOperator::Pi(op), a, b)
-    }
-
-    fn maxwell_slip_start(&self, u: &[f64], y: &[f64], n: usize) -> Result<OperatorCascade> {
-        let widths = threshold_grid(u, n)?;
-        let mut basis = vec![u.to_vec()];
-        basis.extend(widths.iter().map(|&d| stop(u, d)));
-        basis.push(vec![1.0; u.len()]);
-        let RankOne { a, b, theta, .. } = self.rank_one(y, &basis)?;
-        let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
-        let k: Vec<f64> = theta[1..=n].iter().map(|v| v.max(0.0)).collect();
-        let op = MaxwellSlip::new(theta[0].max(0.0), k, widths, theta[n + 1], o)?;
-        self.cascade(CascadeOperator::MaxwellSlip(op), a, b)
-    }
-
-    fn backlash_start(&self, u: &[f64], y: &[f64], points: usize) -> Result<OperatorCascade> {
-        if points < 2 {
-            return Err(Error::invalid_option(
-                "profile_points",
-                points,
-                "backlash: give at least 2 profile points".into(),
-            ));
-        }
-        let (lo, hi) = range(u);
-        let step = (hi - lo) / (2.0 * points as f64);
-        let ones = vec![1.0; u.len()];
-        let mut best: Option<(f64, RankOne)> = None;
-        for i in 0..points {
-            let r = i as f64 * step;
-            let Ok(fit) = self.rank_one(y, &[play(u, r), ones.clone()]) else {
-                continue;
-            };
-            if best.as_ref().is_none_or(|(_, b)| fit.sse < b.sse) {
-                best = Some((r, fit));
-            }
-        }
-        let (r, RankOne { a, b, theta, .. }) = best.ok_or_else(|| Error::NotExciting {
-            channel: "u".into(),
-            reason: "no backlash width gives a regular cascade regression; check the columns"
-                .into(),
-        })?;
-        let (theta, o) = oriented(theta, |t| t[0]);
-        let g = theta[0].max(f64::MIN_POSITIVE.sqrt());
-        let op = Backlash::new(g, r, theta[1], o)?;
-        self.cascade(CascadeOperator::Backlash(op), a, b)
-    }
-
-    /// The family's own fit on (u, y), then ARX on v₀ = Γ₀\[u\].
-    fn family_arx_start(
+    /// The start from an operator Γ₀ fitted to the loop (u, y): an ARX fit of y on past y and
+    /// v₀ = Γ₀\[u\] gives A and an unnormalised B, whose b1 moves into Γ₀'s output scale
+    /// ([`OperatorModel::scaled`]) where it has one.
+    pub fn family_arx_start(
         &self,
-        family: &CascadeFamily,
+        op: OperatorModel,
         u: &[f64],
         y: &[f64],
     ) -> Result<OperatorCascade> {
-        let ccw = Some(Orientation::COUNTER_CLOCKWISE);
-        let op = match family {
-            CascadeFamily::Gpi { thresholds } => CascadeOperator::Gpi(
-                gpi::fit(
-                    u,
-                    y,
-                    &GpiOptions {
-                        thresholds: *thresholds,
-                        orientation: ccw,
-                        ..GpiOptions::default()
-                    },
-                )?
-                .model,
-            ),
-            CascadeFamily::Preisach { levels } => CascadeOperator::Preisach(
-                preisach::fit(
-                    u,
-                    y,
-                    &PreisachOptions {
-                        levels: *levels,
-                        orientation: ccw,
-                        ..PreisachOptions::default()
-                    },
-                )?
-                .model,
-            ),
-            CascadeFamily::JilesAtherton => CascadeOperator::JilesAtherton(
-                jiles_atherton::fit(u, y, &JilesAthertonOptions::default())?.model,
-            ),
-            CascadeFamily::BoucWen => {
-                CascadeOperator::BoucWen(bouc_wen::fit(u, y, &BoucWenOptions::default())?.model)
-            }
-            CascadeFamily::Duhem => {
-                CascadeOperator::Duhem(duhem::fit(u, y, &DuhemOptions::default())?.model)
-            }
-            CascadeFamily::Dahl => {
-                CascadeOperator::Dahl(dahl::fit(u, y, &DahlOptions::default())?.model)
-            }
-            other => {
-                return Err(Error::Unsupported(format!(
-                    "{} has a least-squares start, not a family start",
-                    other.name()
-                )))
-            }
-        };
         let v = op.as_operator().simulate(u)?;
         // With the single basis signal v₀ the factorisation returns b/b1 and θ = b1.
         let RankOne { a, b, theta, .. } = self.rank_one(y, &[v])?;
@@ -440,17 +274,25 @@ impl OperatorCascadeIdentification {
     }
 }
 
+/// How the families linear in their weights start (the over-parameterised equation error and
+/// its rank-one factorisation, module doc).
+pub const RANK_ONE: &str = "equation-error least squares, rank-one factorisation";
+
 /// The rank-one factorisation of the over-parameterised regression: A, B (b1 = 1), the
 /// operator's linear parameters θ and the equation error's residual sum of squares.
-struct RankOne {
-    a: Vec<f64>,
-    b: Vec<f64>,
-    theta: Vec<f64>,
-    sse: f64,
+pub(crate) struct RankOne {
+    /// A's coefficients a1 … an.
+    pub a: Vec<f64>,
+    /// B's coefficients with b1 = 1.
+    pub b: Vec<f64>,
+    /// The operator's linear parameters.
+    pub theta: Vec<f64>,
+    /// The equation error's residual sum of squares.
+    pub sse: f64,
 }
 
 /// (θ, orientation): θ negated with the decreasing orientation when its slope is negative.
-fn oriented(theta: Vec<f64>, slope: impl Fn(&[f64]) -> f64) -> (Vec<f64>, Orientation) {
+pub(crate) fn oriented(theta: Vec<f64>, slope: impl Fn(&[f64]) -> f64) -> (Vec<f64>, Orientation) {
     if slope(&theta) < 0.0 {
         let o = Orientation {
             inverse: false,
@@ -463,7 +305,7 @@ fn oriented(theta: Vec<f64>, slope: impl Fn(&[f64]) -> f64) -> (Vec<f64>, Orient
 }
 
 /// The nearest weights with a₀ ≥ 0 and every partial sum a₀ + … + aᵢ ≥ 0 (a monotone PI).
-fn monotone_weights(a0: f64, weights: &[f64]) -> (f64, Vec<f64>) {
+pub(crate) fn monotone_weights(a0: f64, weights: &[f64]) -> (f64, Vec<f64>) {
     let a0 = a0.max(0.0);
     let mut partial = a0;
     let w = weights
@@ -482,27 +324,6 @@ fn lagged(x: &[f64], lag: usize, s: f64) -> Vec<f64> {
     (0..x.len())
         .map(|t| t.checked_sub(lag).map_or(0.0, |p| s * x[p]))
         .collect()
-}
-
-fn range(x: &[f64]) -> (f64, f64) {
-    x.iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        })
-}
-
-/// The families' threshold grid rᵢ = i·(max u − min u)/(2(n + 1)), i = 1 … n.
-pub fn threshold_grid(u: &[f64], n: usize) -> Result<Vec<f64>> {
-    let (lo, hi) = range(u);
-    if n == 0 || hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
-        return Err(Error::NotExciting {
-            channel: "u".into(),
-            reason: format!("a grid of {n} thresholds needs n >= 1 and an input that varies"),
-        });
-    }
-    Ok((1..=n)
-        .map(|i| i as f64 * (hi - lo) / (2.0 * (n + 1) as f64))
-        .collect())
 }
 
 /// The cascade as an output-error model: the start's structure with free values.

@@ -30,5 +30,6 @@ mod saved_equations;
 pub use cascade::{CascadeOutput, HysteresisCascade};
 pub use coleman_hodgdon::{Admissibility, ChForm, ColemanHodgdon};
 pub use linear::LinearBlock;
-pub use operator_cascade::{CascadeCompensation, CascadeOperator, OperatorCascade};
+pub use operator_cascade::{CascadeCompensation, OperatorCascade};
+pub use operators::OperatorModel;
 pub use parameters::{Parameter, ParameterSet};

@@ -35,236 +35,20 @@
 //! and Sensor Nonlinearities*, Wiley 1996 — inverse compensation of a hysteresis ahead of
 //! linear dynamics.
 
-use super::operators::{
-    Backlash, BoucWen, Dahl, DeadZones, Duhem, GeneralizedPi, HysteresisOperator, JilesAtherton,
-    MaxwellSlip, PrandtlIshlinskii, Preisach,
-};
+use super::operators::OperatorModel;
 use super::{CascadeOutput, LinearBlock, Parameter, ParameterSet};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-/// The operator Γ of an [`OperatorCascade`]: one of the families of [`super::operators`].
-#[allow(missing_docs)] // each variant is the family of the same name
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "family", content = "operator", rename_all = "kebab-case")]
-pub enum CascadeOperator {
-    Pi(PrandtlIshlinskii),
-    Gpi(GeneralizedPi),
-    Preisach(Preisach),
-    JilesAtherton(JilesAtherton),
-    BoucWen(BoucWen),
-    Duhem(Duhem),
-    Dahl(Dahl),
-    MaxwellSlip(MaxwellSlip),
-    Backlash(Backlash),
-}
-
-impl CascadeOperator {
-    /// The operator behind the common interface.
-    pub fn as_operator(&self) -> &dyn HysteresisOperator {
-        match self {
-            Self::Pi(m) => m,
-            Self::Gpi(m) => m,
-            Self::Preisach(m) => m,
-            Self::JilesAtherton(m) => m,
-            Self::BoucWen(m) => m,
-            Self::Duhem(m) => m,
-            Self::Dahl(m) => m,
-            Self::MaxwellSlip(m) => m,
-            Self::Backlash(m) => m,
-        }
-    }
-
-    /// The family's command-line name (`pi`, `backlash`, …).
-    pub fn family(&self) -> &'static str {
-        self.as_operator().family()
-    }
-
-    /// The same operator structure (thresholds, grid, orientation, anhysteretic …) with the
-    /// parameter values `values` in [`HysteresisOperator::parameters`] order, validated.
-    /// Derived values (the Maxwell-slip slip forces Wᵢ = kᵢδᵢ) are recomputed, not read.
-    pub fn with_values(&self, values: &[f64]) -> Result<Self> {
-        let expected = self.as_operator().parameters().len();
-        if values.len() != expected {
-            return Err(Error::InvalidModel(format!(
-                "a {} operator has {expected} parameters, got {}",
-                self.family(),
-                values.len()
-            )));
-        }
-        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: self.as_operator().parameters().get(i).name.clone(),
-                value: values[i],
-                reason: "must be finite".into(),
-            });
-        }
-        Ok(match self {
-            Self::Pi(m) => Self::Pi(pi_with(m, values)?),
-            Self::Gpi(m) => Self::Gpi(gpi_with(m, values)?),
-            Self::Preisach(m) => {
-                let n = m.weights().len();
-                Self::Preisach(Preisach::new(
-                    m.lower(),
-                    m.upper(),
-                    m.levels(),
-                    values[1..=n].to_vec(),
-                    values[0],
-                    values[n + 1],
-                    m.orientation(),
-                )?)
-            }
-            Self::JilesAtherton(m) => {
-                let mut next = m.clone();
-                [next.ms, next.a, next.k, next.c, next.alpha, next.m0] =
-                    [0, 1, 2, 3, 4, 5].map(|i| values[i]);
-                next.validate()?;
-                Self::JilesAtherton(next)
-            }
-            Self::BoucWen(m) => {
-                let mut next = m.clone();
-                [
-                    next.kx, next.kw, next.a, next.beta, next.gamma, next.n, next.w0,
-                ] = [0, 1, 2, 3, 4, 5, 6].map(|i| values[i]);
-                next.validate()?;
-                Self::BoucWen(next)
-            }
-            Self::Duhem(m) => {
-                let mut next = m.clone();
-                [next.alpha, next.a, next.b, next.c, next.y0] = [0, 1, 2, 3, 4].map(|i| values[i]);
-                next.validate()?;
-                Self::Duhem(next)
-            }
-            Self::Dahl(m) => {
-                let mut next = m.clone();
-                [next.sigma, next.fc, next.i, next.f0] = [0, 1, 2, 3].map(|i| values[i]);
-                next.validate()?;
-                Self::Dahl(next)
-            }
-            Self::MaxwellSlip(m) => {
-                let n = m.stiffness().len();
-                Self::MaxwellSlip(MaxwellSlip::new(
-                    values[0],
-                    values[1..=n].to_vec(),
-                    m.widths().to_vec(),
-                    values[2 * n + 1],
-                    m.orientation(),
-                )?)
-            }
-            Self::Backlash(m) => Self::Backlash(Backlash::new(
-                values[0],
-                values[1],
-                values[2],
-                m.orientation(),
-            )?),
-        })
-    }
-
-    /// Indices of the parameters a cascade fit holds fixed besides the family's own fixed ones:
-    /// the shape exponents (Bouc–Wen n, Dahl i, as the family fits do by default) and the
-    /// derived Maxwell-slip slip forces.
-    pub fn held(&self) -> Vec<usize> {
-        match self {
-            Self::BoucWen(_) => vec![5],
-            Self::Dahl(_) => vec![2],
-            Self::MaxwellSlip(m) => {
-                let n = m.stiffness().len();
-                (n + 1..=2 * n).collect()
-            }
-            _ => Vec::new(),
-        }
-    }
-
-    /// The operator whose output is s·Γ\[u\] (s > 0), where the family has an output scale
-    /// that does not touch its shape; None otherwise (inverse-parameterised loops,
-    /// Jiles–Atherton).
-    pub fn scaled(&self, s: f64) -> Option<Self> {
-        if !(s.is_finite() && s > 0.0) {
-            return None;
-        }
-        let p = self.as_operator().parameters().values();
-        let scale = |idx: &[usize]| {
-            let mut v = p.clone();
-            for &i in idx {
-                v[i] *= s;
-            }
-            self.with_values(&v).ok()
-        };
-        match self {
-            Self::Pi(m) if !m.orientation().inverse => {
-                let n = m.weights().len();
-                let mut idx: Vec<usize> = (0..=n).collect();
-                idx.push(2 * n + 1);
-                scale(&idx)
-            }
-            Self::Preisach(m) if !m.orientation().inverse => {
-                scale(&(0..m.weights().len() + 2).collect::<Vec<_>>())
-            }
-            Self::MaxwellSlip(m) if !m.orientation().inverse => {
-                let n = m.stiffness().len();
-                let mut idx: Vec<usize> = (0..=n).collect();
-                idx.push(2 * n + 1);
-                scale(&idx)
-            }
-            Self::Backlash(m) if !m.orientation().inverse => scale(&[0, 2]),
-            Self::BoucWen(_) => scale(&[0, 1]),
-            Self::Duhem(_) => scale(&[1, 2, 3, 4]),
-            Self::Dahl(_) => scale(&[0, 1, 3]),
-            _ => None,
-        }
-    }
-}
-
-fn pi_with(m: &PrandtlIshlinskii, values: &[f64]) -> Result<PrandtlIshlinskii> {
-    let n = m.weights().len();
-    PrandtlIshlinskii::new(
-        values[0],
-        values[1..=n].to_vec(),
-        values[n + 1..=2 * n].to_vec(),
-        values[2 * n + 1],
-        m.orientation(),
-    )
-}
-
-/// GPI values: a0, a1…an, r1…rn, c, d0, dp1…, zp1…, dn1…, zn1… ([`GeneralizedPi`]'s order).
-fn gpi_with(m: &GeneralizedPi, values: &[f64]) -> Result<GeneralizedPi> {
-    let n = m.pi().weights().len();
-    let pi = PrandtlIshlinskii::new(
-        values[0],
-        values[1..=n].to_vec(),
-        values[n + 1..=2 * n].to_vec(),
-        values[2 * n + 1],
-        m.pi().orientation(),
-    )?;
-    let s = m.dead_zones();
-    let mut at = 2 * n + 2;
-    let d0 = values[at];
-    at += 1;
-    let mut side = |count: usize| {
-        let zones: Vec<(f64, f64)> = (0..count)
-            .map(|j| (values[at + count + j], values[at + j]))
-            .collect();
-        at += 2 * count;
-        zones
-    };
-    let upper = side(s.upper().len());
-    let lower = side(s.lower().len());
-    Ok(GeneralizedPi::new(
-        pi,
-        DeadZones::new(d0, upper, lower)?,
-        m.orientation(),
-    ))
-}
-
 /// A hysteresis operator Γ followed by a linear block B/A with b1 = 1 (module doc).
 ///
 /// ```
 /// use hysid::model::operators::{Backlash, Orientation};
-/// use hysid::model::{CascadeOperator, LinearBlock, OperatorCascade};
+/// use hysid::model::{LinearBlock, OperatorCascade, OperatorModel};
 /// let gamma = Backlash::new(2.0, 0.5, 0.0, Orientation::default()).unwrap();
 /// let lin = LinearBlock::new(vec![-0.5], vec![1.0], 1).unwrap();
-/// let cascade = OperatorCascade::new(CascadeOperator::Backlash(gamma), lin).unwrap();
+/// let cascade = OperatorCascade::new(OperatorModel::Backlash(gamma), lin).unwrap();
 /// let out = cascade.simulate(&[0.0, 1.0, 2.0]).unwrap();
 /// assert_eq!(out.v, vec![0.0, 1.0, 3.0]); // 2·F_0.5[u]
 /// assert_eq!(out.y, vec![0.0, 0.0, 1.0]); // y(t) = 0.5 y(t−1) + v(t−1)
@@ -272,14 +56,14 @@ fn gpi_with(m: &GeneralizedPi, values: &[f64]) -> Result<GeneralizedPi> {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OperatorCascade {
     /// The input hysteresis Γ.
-    pub operator: CascadeOperator,
+    pub operator: OperatorModel,
     /// The linear block (b1 = 1).
     pub linear: LinearBlock,
 }
 
 impl OperatorCascade {
     /// Builds a cascade; b1 must be 1 (the normalisation, module doc).
-    pub fn new(operator: CascadeOperator, linear: LinearBlock) -> Result<Self> {
+    pub fn new(operator: OperatorModel, linear: LinearBlock) -> Result<Self> {
         if linear.b()[0] != 1.0 {
             return Err(Error::InvalidModel(format!(
                 "the operator cascade fixes b1 = 1 (the gain sits in the operator), got b1 = {}",
@@ -291,7 +75,7 @@ impl OperatorCascade {
 
     /// The operator's parameter names as the cascade lists them (`op_` prefix on a collision
     /// with a1…, b1…).
-    fn operator_names(operator: &CascadeOperator) -> Vec<String> {
+    fn operator_names(operator: &OperatorModel) -> Vec<String> {
         let names = operator.as_operator().parameters().names();
         let linear_like = |n: &str| {
             let rest = n.strip_prefix('a').or_else(|| n.strip_prefix('b'));
@@ -310,7 +94,7 @@ impl OperatorCascade {
     }
 
     /// The flattened parameters: the operator's (bounds and fixed flags as the family gives
-    /// them, plus [`CascadeOperator::held`]), a1 … an, b1 (fixed at 1), b2 … bm.
+    /// them, plus [`OperatorModel::held`]), a1 … an, b1 (fixed at 1), b2 … bm.
     pub fn parameters(&self) -> ParameterSet {
         let op = self.operator.as_operator().parameters();
         let held = self.operator.held();

@@ -46,7 +46,7 @@ use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::operators::OperatorModel;
 use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
 use crate::model::saved_equations::{equations_from_file, simulate_outputs};
-use crate::model::{CascadeOperator, OperatorCascade};
+use crate::model::OperatorCascade;
 use crate::model::{ChForm, ColemanHodgdon, HysteresisCascade, LinearBlock};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -675,7 +675,7 @@ impl FittedModel {
     /// The fitted model of an operator with standard deviations `std` (NaN: none).
     pub fn operator(model: OperatorModel, std: Vec<f64>) -> Self {
         FittedModel::Operator {
-            family: model.family(),
+            family: model.family().name(),
             model,
             std,
         }
@@ -908,7 +908,7 @@ fn operator_cascade_from_file(file: &ModelFile) -> Result<FittedModel> {
             "an operator_cascade model needs \"operator\" (family and structure)".into(),
         )
     })?;
-    let operator: CascadeOperator = serde_json::from_value(structure).map_err(|e| {
+    let operator: OperatorModel = serde_json::from_value(structure).map_err(|e| {
         Error::InvalidModel(format!("the operator of the operator_cascade model: {e}"))
     })?;
     let delay = file

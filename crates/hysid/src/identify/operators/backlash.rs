@@ -10,9 +10,14 @@
 //!
 //! Reference: M. A. Krasnosel'skii, A. V. Pokrovskii, *Systems with Hysteresis*, Springer 1989.
 
+use super::family::{FamilyOptions, Identify};
 use super::linear_support::{check_data, finish, orientation, range};
 use super::OperatorFit;
-use crate::model::operators::{play_step, Backlash, Orientation};
+use crate::identify::operator_cascade::{
+    oriented, OperatorCascadeIdentification, RankOne, RANK_ONE,
+};
+use crate::model::operators::{play, play_step, Backlash, Orientation};
+use crate::model::OperatorCascade;
 use crate::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
 use std::time::Instant;
@@ -221,4 +226,51 @@ fn jacobian_gram(z: &[f64], s: &[f64], g: f64) -> Matrix3<f64> {
         jtj += j * j.transpose();
     }
     jtj
+}
+
+impl Identify for Backlash {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &BacklashOptions {
+                orientation: options.orientation,
+                ..BacklashOptions::default()
+            },
+        )
+    }
+
+    /// A profile over the half-width r = k·(max u − min u)/(2P), k = 0 … P − 1 (P the default
+    /// profile points): at each r the equation error in the basis F_r\[u\], 1 with a rank-one
+    /// factorisation, keeping the r of least equation error.
+    fn cascade_start(
+        cascade: &OperatorCascadeIdentification,
+        u: &[f64],
+        y: &[f64],
+        _options: &FamilyOptions,
+    ) -> Result<(OperatorCascade, &'static str)> {
+        let points = BacklashOptions::default().profile_points;
+        let (lo, hi) = range(u);
+        let step = (hi - lo) / (2.0 * points as f64);
+        let ones = vec![1.0; u.len()];
+        let mut best: Option<(f64, RankOne)> = None;
+        for i in 0..points {
+            let r = i as f64 * step;
+            let Ok(fit) = cascade.rank_one(y, &[play(u, r), ones.clone()]) else {
+                continue;
+            };
+            if best.as_ref().is_none_or(|(_, b)| fit.sse < b.sse) {
+                best = Some((r, fit));
+            }
+        }
+        let (r, RankOne { a, b, theta, .. }) = best.ok_or_else(|| Error::NotExciting {
+            channel: "u".into(),
+            reason: "no backlash width gives a regular cascade regression; check the columns"
+                .into(),
+        })?;
+        let (theta, o) = oriented(theta, |t| t[0]);
+        let g = theta[0].max(f64::MIN_POSITIVE.sqrt());
+        let op = Backlash::new(g, r, theta[1], o)?;
+        Ok((cascade.cascade(op.into(), a, b)?, RANK_ONE))
+    }
 }

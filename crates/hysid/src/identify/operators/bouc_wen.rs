@@ -13,6 +13,7 @@
 //! [`crate::model::operators::bouc_wen`].
 
 use super::differential_fit::{self as common, Search, Simulated};
+use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
 use crate::model::operators::{BoucWen, HysteresisOperator, InputOde, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
@@ -134,4 +135,17 @@ fn grid_starts(u: &[f64], y: &[f64], n: f64, sign: f64, keep: usize) -> Result<V
         ]);
     }
     Ok(starts)
+}
+
+impl Identify for BoucWen {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &BoucWenOptions {
+                observer: options.observer.clone(),
+                ..BoucWenOptions::default()
+            },
+        )
+    }
 }

@@ -15,6 +15,7 @@
 //! References: Dahl (1968, 1976), see [`crate::model::operators::dahl`].
 
 use super::differential_fit::{self as common, Search, Simulated};
+use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
 use crate::model::operators::{Dahl, HysteresisOperator, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
@@ -140,4 +141,17 @@ fn grid_starts(
         });
     }
     Ok(starts)
+}
+
+impl Identify for Dahl {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &DahlOptions {
+                observer: options.observer.clone(),
+                ..DahlOptions::default()
+            },
+        )
+    }
 }

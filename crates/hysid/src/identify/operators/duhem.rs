@@ -13,6 +13,7 @@
 //! Reference: Coleman & Hodgdon (1986), see [`crate::model::operators::duhem`].
 
 use super::differential_fit::{self as common, Search, Simulated};
+use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
 use crate::model::operators::{Duhem, HysteresisOperator};
 use crate::numerics::levenberg_marquardt::LmConfig;
@@ -108,4 +109,17 @@ fn grid_starts(u: &[f64], y: &[f64], keep: usize) -> Result<Vec<Vec<f64>>> {
         });
     }
     Ok(starts)
+}
+
+impl Identify for Duhem {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &DuhemOptions {
+                observer: options.observer.clone(),
+                ..DuhemOptions::default()
+            },
+        )
+    }
 }

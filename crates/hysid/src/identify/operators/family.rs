@@ -1,134 +1,28 @@
 //! The family registry: every hysteresis family by its name, and one function that fits any
 //! of them to a measured input u and output y.
 //!
-//! | name | model | recipe |
-//! |---|---|---|
-//! | `pi` | Prandtl–Ishlinskii (Krejčí & Kuhnen 2001) | [`super::pi`] |
-//! | `gpi` | generalised PI with dead zones (Kuhnen 2003) | [`super::gpi`] |
-//! | `preisach` | discrete Preisach plane (Mayergoyz 1991) | [`super::preisach`] |
-//! | `jiles-atherton` | Jiles & Atherton (1986) | [`super::jiles_atherton`] |
-//! | `bouc-wen` | static Bouc–Wen operator (Wen 1976) | [`super::bouc_wen`] |
-//! | `duhem` | generalised Duhem / Coleman–Hodgdon operator | [`super::duhem`] |
-//! | `dahl` | Dahl friction (Dahl 1968) | [`super::dahl`] |
-//! | `maxwell-slip` | generalised Maxwell-slip (Lampaert, Al-Bender & Swevers 2003) | [`super::maxwell_slip`] |
-//! | `backlash` | play operator with gain (Krasnosel'skii & Pokrovskii 1989) | [`super::backlash`] |
-//! | `ch4`, `ch6` | Coleman–Hodgdon hysteresis alone (Coleman & Hodgdon 1986; Vörös 2015) | [`crate::identify::hysteresis`] |
+//! The families are the registry's ([`Family`], [`crate::model::operators::registry`]); each
+//! implements [`Identify`] in its own module of [`crate::identify::operators`]; `ch4` and `ch6`
+//! are the Coleman–Hodgdon hysteresis alone ([`crate::identify::hysteresis`]).
 //!
 //! [`fit_operator`] returns the fitted model as a [`FittedModel`] (kind `operator`, or
 //! `coleman_hodgdon` for ch4/ch6), so every family saves, simulates and compensates the same way.
 
-use super::{
-    backlash, bouc_wen, dahl, duhem, gpi, jiles_atherton, maxwell_slip, pi, preisach, OperatorFit,
-};
+use super::OperatorFit;
 use crate::data::IdData;
 use crate::identify::hysteresis::HysteresisIdentification;
+use crate::identify::operator_cascade::OperatorCascadeIdentification;
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
-use crate::model::operators::{OperatorModel, Orientation};
+pub use crate::model::operators::Family;
+use crate::model::operators::{OperatorFamily, OperatorModel, Orientation};
 use crate::model::saved::FittedModel;
+use crate::model::OperatorCascade;
 use crate::model::{ChForm, Parameter, ParameterSet};
 use crate::numerics::levenberg_marquardt::Control;
 use crate::numerics::metrics;
 use crate::numerics::Observer;
 use crate::{Error, Result};
 use std::time::Instant;
-
-/// A hysteresis family, named as on the command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[allow(missing_docs)] // each variant is its name (see the module table)
-pub enum Family {
-    Pi,
-    Gpi,
-    Preisach,
-    JilesAtherton,
-    BoucWen,
-    Duhem,
-    Dahl,
-    MaxwellSlip,
-    Backlash,
-    Ch4,
-    Ch6,
-}
-
-impl Family {
-    /// Every family, in the order of the module table.
-    pub const ALL: [Family; 11] = [
-        Family::Pi,
-        Family::Gpi,
-        Family::Preisach,
-        Family::JilesAtherton,
-        Family::BoucWen,
-        Family::Duhem,
-        Family::Dahl,
-        Family::MaxwellSlip,
-        Family::Backlash,
-        Family::Ch4,
-        Family::Ch6,
-    ];
-
-    /// The family's name (`pi`, `gpi`, `preisach`, `jiles-atherton`, `bouc-wen`, `duhem`,
-    /// `dahl`, `maxwell-slip`, `backlash`, `ch4`, `ch6`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Family::Pi => "pi",
-            Family::Gpi => "gpi",
-            Family::Preisach => "preisach",
-            Family::JilesAtherton => "jiles-atherton",
-            Family::BoucWen => "bouc-wen",
-            Family::Duhem => "duhem",
-            Family::Dahl => "dahl",
-            Family::MaxwellSlip => "maxwell-slip",
-            Family::Backlash => "backlash",
-            Family::Ch4 => "ch4",
-            Family::Ch6 => "ch6",
-        }
-    }
-
-    /// The family named `name` (case-insensitive; `_` for `-` accepted).
-    pub fn parse(name: &str) -> Result<Family> {
-        let wanted = name.trim().to_ascii_lowercase().replace('_', "-");
-        Family::ALL
-            .into_iter()
-            .find(|f| f.name() == wanted)
-            .ok_or_else(|| {
-                Error::invalid_option(
-                    "family",
-                    name,
-                    format!(
-                        "unknown hysteresis family '{name}'; use one of {}",
-                        Family::ALL.map(Family::name).join(", ")
-                    ),
-                )
-            })
-    }
-
-    /// A comma-separated list of families, or `all`.
-    pub fn parse_list(list: &str) -> Result<Vec<Family>> {
-        if list.trim().eq_ignore_ascii_case("all") {
-            return Ok(Family::ALL.to_vec());
-        }
-        let mut out: Vec<Family> = Vec::new();
-        for name in list.split(',').filter(|s| !s.trim().is_empty()) {
-            let f = Family::parse(name)?;
-            if !out.contains(&f) {
-                out.push(f);
-            }
-        }
-        if out.is_empty() {
-            return Err(Error::invalid_option(
-                "families",
-                "[]",
-                "the family list is empty; name at least one family, or all".into(),
-            ));
-        }
-        Ok(out)
-    }
-}
-
-impl std::fmt::Display for Family {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// The settings of the families' recipes that a user chooses (the rest are each recipe's
 /// defaults).
@@ -227,6 +121,37 @@ impl FittedOperator {
     }
 }
 
+/// A family's identification recipe: implemented for each operator type of the registry
+/// ([`crate::model::operators::registry`]) in the family's own module of
+/// [`crate::identify::operators`].
+pub trait Identify: OperatorFamily + Into<OperatorModel> {
+    /// Fits the family to input `u` and output `y` from the data alone (no initial guess),
+    /// with the user's `options` (the settings that do not apply to the family are ignored).
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>>;
+
+    /// The global start of an operator cascade with this family's operator (the refinement
+    /// of [`OperatorCascadeIdentification`] takes it from there), with a short description
+    /// of how it was obtained. The default: the family's own fit to the loop (u, y) in the
+    /// counter-clockwise orientation, then an ARX fit of y on v₀ = Γ₀\[u\]
+    /// ([`OperatorCascadeIdentification::family_arx_start`]).
+    fn cascade_start(
+        cascade: &OperatorCascadeIdentification,
+        u: &[f64],
+        y: &[f64],
+        options: &FamilyOptions,
+    ) -> Result<(OperatorCascade, &'static str)> {
+        let options = FamilyOptions {
+            orientation: Some(Orientation::COUNTER_CLOCKWISE),
+            ..options.clone()
+        };
+        let start = Self::identify(u, y, &options)?.model.into();
+        Ok((cascade.family_arx_start(start, u, y)?, FAMILY_ARX))
+    }
+}
+
+/// How [`Identify::cascade_start`]'s default start is obtained.
+pub const FAMILY_ARX: &str = "family fit and ARX";
+
 /// Fits `family` to input `u` and output `y` with `options`.
 pub fn fit_operator(
     family: Family,
@@ -235,130 +160,73 @@ pub fn fit_operator(
     options: &FamilyOptions,
 ) -> Result<FittedOperator> {
     options.validate()?;
-    let o = options.orientation;
     let fit = match family {
-        Family::Pi => boxed(
-            pi::fit(
-                u,
-                y,
-                &pi::PiOptions {
-                    thresholds: options.thresholds,
-                    grid: options.threshold_grid.clone(),
-                    orientation: o,
-                    select: None,
-                },
-            )?,
-            OperatorModel::Pi,
-        ),
-        Family::Gpi => boxed(
-            gpi::fit(
-                u,
-                y,
-                &gpi::GpiOptions {
-                    thresholds: options.thresholds,
-                    grid: options.threshold_grid.clone(),
-                    dead_zones: options.dead_zones,
-                    orientation: o,
-                    ..gpi::GpiOptions::default()
-                },
-            )?,
-            OperatorModel::Gpi,
-        ),
-        Family::Preisach => boxed(
-            preisach::fit(
-                u,
-                y,
-                &preisach::PreisachOptions {
-                    levels: options.grid,
-                    lambda: options.lambda,
-                    orientation: o,
-                    ..preisach::PreisachOptions::default()
-                },
-            )?,
-            OperatorModel::Preisach,
-        ),
-        Family::MaxwellSlip => boxed(
-            maxwell_slip::fit(
-                u,
-                y,
-                &maxwell_slip::MaxwellSlipOptions {
-                    elements: options.thresholds,
-                    widths: options.threshold_grid.clone(),
-                    orientation: o,
-                    ..maxwell_slip::MaxwellSlipOptions::default()
-                },
-            )?,
-            OperatorModel::MaxwellSlip,
-        ),
-        Family::Backlash => boxed(
-            backlash::fit(
-                u,
-                y,
-                &backlash::BacklashOptions {
-                    orientation: o,
-                    ..backlash::BacklashOptions::default()
-                },
-            )?,
-            OperatorModel::Backlash,
-        ),
-        Family::JilesAtherton => boxed(
-            jiles_atherton::fit(
-                u,
-                y,
-                &jiles_atherton::JilesAthertonOptions {
-                    observer: options.observer.clone(),
-                    ..Default::default()
-                },
-            )?,
-            OperatorModel::JilesAtherton,
-        ),
-        Family::BoucWen => boxed(
-            bouc_wen::fit(
-                u,
-                y,
-                &bouc_wen::BoucWenOptions {
-                    observer: options.observer.clone(),
-                    ..Default::default()
-                },
-            )?,
-            OperatorModel::BoucWen,
-        ),
-        Family::Duhem => boxed(
-            duhem::fit(
-                u,
-                y,
-                &duhem::DuhemOptions {
-                    observer: options.observer.clone(),
-                    ..Default::default()
-                },
-            )?,
-            OperatorModel::Duhem,
-        ),
-        Family::Dahl => boxed(
-            dahl::fit(
-                u,
-                y,
-                &dahl::DahlOptions {
-                    observer: options.observer.clone(),
-                    ..Default::default()
-                },
-            )?,
-            OperatorModel::Dahl,
-        ),
         Family::Ch4 => coleman_hodgdon(ChForm::Saturated4, u, y)?,
         Family::Ch6 => coleman_hodgdon(ChForm::General6, u, y)?,
+        operator => by_family::fit(operator, u, y, options)?,
     };
     Ok(FittedOperator { family, fit })
 }
 
+/// The start of an operator cascade of `family` (an operator family, not ch4/ch6).
+pub(crate) fn cascade_start(
+    family: Family,
+    cascade: &OperatorCascadeIdentification,
+    u: &[f64],
+    y: &[f64],
+    options: &FamilyOptions,
+) -> Result<(OperatorCascade, &'static str)> {
+    by_family::cascade_start(family, cascade, u, y, options)
+}
+
+/// The dispatch from a [`Family`] to its type's [`Identify`] implementation, generated
+/// from the registry's list.
+mod by_family {
+    use super::*;
+
+    macro_rules! dispatch {
+        ($($variant:ident: $ty:ty),* $(,)?) => {
+            pub(super) fn fit(
+                family: Family,
+                u: &[f64],
+                y: &[f64],
+                options: &FamilyOptions,
+            ) -> Result<OperatorFit<FittedModel>> {
+                match family {
+                    $(Family::$variant => Ok(boxed(<$ty as Identify>::identify(u, y, options)?)),)*
+                    other => Err(not_an_operator(other)),
+                }
+            }
+
+            pub(super) fn cascade_start(
+                family: Family,
+                cascade: &OperatorCascadeIdentification,
+                u: &[f64],
+                y: &[f64],
+                options: &FamilyOptions,
+            ) -> Result<(OperatorCascade, &'static str)> {
+                match family {
+                    $(Family::$variant => <$ty as Identify>::cascade_start(cascade, u, y, options),)*
+                    other => Err(not_an_operator(other)),
+                }
+            }
+        };
+    }
+    crate::model::operators::operator_families!(dispatch);
+
+    fn not_an_operator(family: Family) -> Error {
+        Error::Unsupported(format!(
+            "{family} is the Coleman–Hodgdon hysteresis, not an operator family; \
+             identify it with `identify hysteresis` or `identify cascade --hysteresis {family}`"
+        ))
+    }
+}
+
 /// An operator fit with its model wrapped as a [`FittedModel`].
-fn boxed<M>(
-    fit: OperatorFit<M>,
-    wrap: impl FnOnce(M) -> OperatorModel,
-) -> OperatorFit<FittedModel> {
+fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>) -> OperatorFit<FittedModel> {
     let std = fit.std.iter().map(|s| s.unwrap_or(f64::NAN)).collect();
     OperatorFit {
-        model: FittedModel::operator(wrap(fit.model), std),
+        model: FittedModel::operator(fit.model.into(), std),
         parameters: fit.parameters,
         std: fit.std,
         simulated: fit.simulated,

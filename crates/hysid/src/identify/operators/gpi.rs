@@ -19,6 +19,7 @@
 //! nonlinearities: a modified Prandtl–Ishlinskii approach", European Journal of Control 9
 //! (2003) 407–418.
 
+use super::family::{FamilyOptions, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, threshold_grid, GramAccumulator,
 };
@@ -172,4 +173,20 @@ pub fn fit(u: &[f64], y: &[f64], options: &GpiOptions) -> Result<OperatorFit<Gen
         sol.converged,
         start,
     ))
+}
+
+impl Identify for GeneralizedPi {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &GpiOptions {
+                thresholds: options.thresholds,
+                grid: options.threshold_grid.clone(),
+                dead_zones: options.dead_zones,
+                orientation: options.orientation,
+                ..GpiOptions::default()
+            },
+        )
+    }
 }

@@ -19,6 +19,7 @@
 //! [`crate::model::operators::jiles_atherton`].
 
 use super::differential_fit::{self as common, Search, Simulated};
+use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
 use crate::model::operators::jiles_atherton::{langevin, MU0};
 use crate::model::operators::{
@@ -170,4 +171,17 @@ fn inverse_langevin(t: f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+impl Identify for JilesAtherton {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &JilesAthertonOptions {
+                observer: options.observer.clone(),
+                ..JilesAthertonOptions::default()
+            },
+        )
+    }
 }

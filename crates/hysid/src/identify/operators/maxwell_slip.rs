@@ -12,11 +12,16 @@
 //! model appropriate for control purposes", Proc. PhysCon 2003; F. Al-Bender, V. Lampaert,
 //! J. Swevers, IEEE Trans. Automatic Control 50 (2005) 1883–1887.
 
+use super::family::{FamilyOptions, Identify};
 use super::linear_support::{
     check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator,
 };
 use super::OperatorFit;
+use crate::identify::operator_cascade::{
+    oriented, OperatorCascadeIdentification, RankOne, RANK_ONE,
+};
 use crate::model::operators::{stop, validate_thresholds, MaxwellSlip, Orientation};
+use crate::model::OperatorCascade;
 use crate::{Error, Result};
 use std::time::Instant;
 
@@ -106,4 +111,42 @@ pub fn fit(u: &[f64], y: &[f64], options: &MaxwellSlipOptions) -> Result<Operato
         sol.converged,
         start,
     ))
+}
+
+impl Identify for MaxwellSlip {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &MaxwellSlipOptions {
+                elements: options.thresholds,
+                widths: options.threshold_grid.clone(),
+                orientation: options.orientation,
+                ..MaxwellSlipOptions::default()
+            },
+        )
+    }
+
+    /// The over-parameterised equation error in the basis u, E_{δᵢ}\[u\], 1 with a rank-one
+    /// factorisation ([`crate::identify::operator_cascade`]); stiffnesses clipped at 0.
+    fn cascade_start(
+        cascade: &OperatorCascadeIdentification,
+        u: &[f64],
+        y: &[f64],
+        options: &FamilyOptions,
+    ) -> Result<(OperatorCascade, &'static str)> {
+        let widths = match &options.threshold_grid {
+            Some(grid) => grid.clone(),
+            None => threshold_grid(u, options.thresholds)?,
+        };
+        let n = widths.len();
+        let mut basis = vec![u.to_vec()];
+        basis.extend(widths.iter().map(|&d| stop(u, d)));
+        basis.push(vec![1.0; u.len()]);
+        let RankOne { a, b, theta, .. } = cascade.rank_one(y, &basis)?;
+        let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
+        let k: Vec<f64> = theta[1..=n].iter().map(|v| v.max(0.0)).collect();
+        let op = MaxwellSlip::new(theta[0].max(0.0), k, widths, theta[n + 1], o)?;
+        Ok((cascade.cascade(op.into(), a, b)?, RANK_ONE))
+    }
 }

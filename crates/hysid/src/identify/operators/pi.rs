@@ -15,11 +15,16 @@
 //! nonlinearities: a modified Prandtl–Ishlinskii approach", European Journal of Control 9
 //! (2003) 407–418.
 
+use super::family::{FamilyOptions, Identify};
 use super::linear_support::{
     check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator,
 };
 use super::OperatorFit;
+use crate::identify::operator_cascade::{
+    monotone_weights, oriented, OperatorCascadeIdentification, RankOne, RANK_ONE,
+};
 use crate::model::operators::{play, validate_thresholds, Orientation, PrandtlIshlinskii};
+use crate::model::OperatorCascade;
 use crate::numerics::metrics;
 use crate::{Error, Result};
 use std::time::Instant;
@@ -137,4 +142,43 @@ fn fit_selected(
             ..options.clone()
         },
     )
+}
+
+impl Identify for PrandtlIshlinskii {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &PiOptions {
+                thresholds: options.thresholds,
+                grid: options.threshold_grid.clone(),
+                orientation: options.orientation,
+                select: None,
+            },
+        )
+    }
+
+    /// The over-parameterised equation error in the basis u, F_{rᵢ}\[u\], 1 with a rank-one
+    /// factorisation ([`crate::identify::operator_cascade`]); weights projected onto the
+    /// monotone set.
+    fn cascade_start(
+        cascade: &OperatorCascadeIdentification,
+        u: &[f64],
+        y: &[f64],
+        options: &FamilyOptions,
+    ) -> Result<(OperatorCascade, &'static str)> {
+        let grid = match &options.threshold_grid {
+            Some(grid) => grid.clone(),
+            None => threshold_grid(u, options.thresholds)?,
+        };
+        let n = grid.len();
+        let mut basis = vec![u.to_vec()];
+        basis.extend(grid.iter().map(|&r| play(u, r)));
+        basis.push(vec![1.0; u.len()]);
+        let RankOne { a, b, theta, .. } = cascade.rank_one(y, &basis)?;
+        let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
+        let (a0, weights) = monotone_weights(theta[0], &theta[1..=n]);
+        let op = PrandtlIshlinskii::new(a0, weights, grid, theta[n + 1], o)?;
+        Ok((cascade.cascade(op.into(), a, b)?, RANK_ONE))
+    }
 }

@@ -15,6 +15,7 @@
 //!
 //! Reference: I. D. Mayergoyz, *Mathematical Models of Hysteresis*, Springer 1991.
 
+use super::family::{FamilyOptions, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, GramAccumulator,
 };
@@ -163,5 +164,20 @@ fn add_smoothness(g: &mut DMatrix<f64>, grid: &Grid, first: usize, lambda: f64) 
                 couple(Grid::index(i, j), Grid::index(i + 1, j));
             }
         }
+    }
+}
+
+impl Identify for Preisach {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &PreisachOptions {
+                levels: options.grid,
+                lambda: options.lambda,
+                orientation: options.orientation,
+                ..PreisachOptions::default()
+            },
+        )
     }
 }

@@ -112,7 +112,7 @@ impl Core for Backlash {
 
 impl HysteresisOperator for Backlash {
     fn family(&self) -> &'static str {
-        "backlash"
+        <Self as super::OperatorFamily>::NAME
     }
 
     fn parameters(&self) -> ParameterSet {
@@ -130,5 +130,34 @@ impl HysteresisOperator for Backlash {
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, self.orientation, reference)
+    }
+}
+
+impl super::OperatorFamily for Backlash {
+    const NAME: &'static str = "backlash";
+    const TITLE: &'static str = "play operator with gain (Krasnosel'skii & Pokrovskii 1989)";
+
+    fn example() -> Result<Self> {
+        Self::new(1.5, 0.2, 0.1, Orientation::default())
+    }
+
+    fn checked(self) -> Result<Self> {
+        Self::new(
+            self.gain(),
+            self.half_width(),
+            self.offset(),
+            self.orientation(),
+        )
+    }
+
+    /// Values g, r, c.
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        super::check_values(self, values)?;
+        Self::new(values[0], values[1], values[2], self.orientation())
+    }
+
+    /// g and c (not for the inverse-operator parameterisation).
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        (!self.orientation().inverse).then(|| vec![0, 2])
     }
 }

@@ -130,7 +130,7 @@ impl InputOde for BoucWen {
 
 impl HysteresisOperator for BoucWen {
     fn family(&self) -> &'static str {
-        "bouc-wen"
+        <Self as super::OperatorFamily>::NAME
     }
     fn parameters(&self) -> ParameterSet {
         let inf = f64::INFINITY;
@@ -152,5 +152,45 @@ impl HysteresisOperator for BoucWen {
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         self.validate()?;
         differential::invert(self, reference)
+    }
+}
+
+impl super::OperatorFamily for BoucWen {
+    const NAME: &'static str = "bouc-wen";
+    const TITLE: &'static str =
+        "static Bouc–Wen operator (Wen 1976; Ismail, Ikhouane & Rodellar 2009)";
+
+    fn example() -> Result<Self> {
+        Self::new(0.5, 1.0, 1.5, 0.5, 1.0)
+    }
+
+    fn checked(self) -> Result<Self> {
+        self.validate()?;
+        Ok(self)
+    }
+
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        let [kx, kw, a, beta, gamma, n, w0] = super::registry::values_array(self, values)?;
+        let next = Self {
+            kx,
+            kw,
+            a,
+            beta,
+            gamma,
+            n,
+            w0,
+        };
+        next.validate()?;
+        Ok(next)
+    }
+
+    /// The exponent n, held as the family's own fit holds it.
+    fn held(&self) -> Vec<usize> {
+        vec![5]
+    }
+
+    /// k_x and k_w.
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        Some(vec![0, 1])
     }
 }

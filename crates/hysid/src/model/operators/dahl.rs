@@ -107,7 +107,7 @@ impl InputOde for Dahl {
 
 impl HysteresisOperator for Dahl {
     fn family(&self) -> &'static str {
-        "dahl"
+        <Self as super::OperatorFamily>::NAME
     }
     fn parameters(&self) -> ParameterSet {
         let inf = f64::INFINITY;
@@ -126,5 +126,42 @@ impl HysteresisOperator for Dahl {
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         self.validate()?;
         differential::invert(self, reference)
+    }
+}
+
+impl super::OperatorFamily for Dahl {
+    const NAME: &'static str = "dahl";
+    const TITLE: &'static str = "Dahl friction (Dahl 1968)";
+
+    fn example() -> Result<Self> {
+        Self::new(3.0, 1.0, 1.0)
+    }
+
+    fn checked(self) -> Result<Self> {
+        self.validate()?;
+        Ok(self)
+    }
+
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        let [sigma, fc, i, f0] = super::registry::values_array(self, values)?;
+        let next = Self {
+            sigma,
+            fc,
+            i,
+            f0,
+            ..self.clone()
+        };
+        next.validate()?;
+        Ok(next)
+    }
+
+    /// The exponent i, held as the family's own fit holds it.
+    fn held(&self) -> Vec<usize> {
+        vec![2]
+    }
+
+    /// σ, F_c and f0.
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        Some(vec![0, 1, 3])
     }
 }

@@ -108,7 +108,7 @@ impl InputOde for Duhem {
 
 impl HysteresisOperator for Duhem {
     fn family(&self) -> &'static str {
-        "duhem"
+        <Self as super::OperatorFamily>::NAME
     }
     fn parameters(&self) -> ParameterSet {
         let p = vec![
@@ -127,5 +127,32 @@ impl HysteresisOperator for Duhem {
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         self.validate()?;
         differential::invert(self, reference)
+    }
+}
+
+impl super::OperatorFamily for Duhem {
+    const NAME: &'static str = "duhem";
+    const TITLE: &'static str =
+        "generalised Duhem / Coleman–Hodgdon operator (Coleman & Hodgdon 1986)";
+
+    fn example() -> Result<Self> {
+        Self::new(2.0, 0.5, 0.1, 1.0)
+    }
+
+    fn checked(self) -> Result<Self> {
+        self.validate()?;
+        Ok(self)
+    }
+
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        let [alpha, a, b, c, y0] = super::registry::values_array(self, values)?;
+        let next = Self { alpha, a, b, c, y0 };
+        next.validate()?;
+        Ok(next)
+    }
+
+    /// a, b, c and y0 (α sets the loop's shape).
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        Some(vec![1, 2, 3, 4])
     }
 }

@@ -179,7 +179,7 @@ impl Core for GeneralizedPi {
 
 impl HysteresisOperator for GeneralizedPi {
     fn family(&self) -> &'static str {
-        "gpi"
+        <Self as super::OperatorFamily>::NAME
     }
 
     fn parameters(&self) -> ParameterSet {
@@ -208,5 +208,72 @@ impl HysteresisOperator for GeneralizedPi {
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, self.orientation, reference)
+    }
+}
+
+impl super::OperatorFamily for GeneralizedPi {
+    const NAME: &'static str = "gpi";
+    const TITLE: &'static str = "generalised PI with dead zones (Kuhnen 2003)";
+
+    fn example() -> Result<Self> {
+        let pi = PrandtlIshlinskii::new(
+            0.5,
+            vec![0.3, 0.2],
+            vec![0.2, 0.5],
+            0.0,
+            Orientation::default(),
+        )?;
+        let zones = DeadZones::new(1.0, vec![(0.3, 0.2)], vec![(-0.4, 0.1)])?;
+        Ok(Self::new(pi, zones, Orientation::default()))
+    }
+
+    fn checked(self) -> Result<Self> {
+        let z = self.dead_zones();
+        let zones = DeadZones::new(z.d0(), z.upper().to_vec(), z.lower().to_vec())?;
+        Ok(Self::new(
+            self.pi.clone().checked()?,
+            zones,
+            self.orientation(),
+        ))
+    }
+
+    /// Values a0, a1 … an, r1 … rn, c, d0, dp1 …, zp1 …, dn1 …, zn1 … (the order of
+    /// [`GeneralizedPi::parameters`]).
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        super::check_values(self, values)?;
+        let n = self.pi().weights().len();
+        let pi = PrandtlIshlinskii::new(
+            values[0],
+            values[1..=n].to_vec(),
+            values[n + 1..=2 * n].to_vec(),
+            values[2 * n + 1],
+            self.pi().orientation(),
+        )?;
+        let zones = self.dead_zones();
+        let mut at = 2 * n + 2;
+        let d0 = values[at];
+        at += 1;
+        let mut side = |count: usize| {
+            let weights = &values[at..at + count];
+            let thresholds = &values[at + count..at + 2 * count];
+            at += 2 * count;
+            thresholds
+                .iter()
+                .copied()
+                .zip(weights.iter().copied())
+                .collect()
+        };
+        let upper = side(zones.upper().len());
+        let lower = side(zones.lower().len());
+        Ok(Self::new(
+            pi,
+            DeadZones::new(d0, upper, lower)?,
+            self.orientation(),
+        ))
+    }
+
+    /// The generalised PI's output scale touches the dead zones' thresholds too; none.
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        None
     }
 }

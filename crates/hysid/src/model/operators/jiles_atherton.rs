@@ -218,7 +218,7 @@ impl InputOde for JilesAtherton {
 
 impl HysteresisOperator for JilesAtherton {
     fn family(&self) -> &'static str {
-        "jiles-atherton"
+        <Self as super::OperatorFamily>::NAME
     }
     fn parameters(&self) -> ParameterSet {
         let p = vec![
@@ -244,5 +244,40 @@ impl HysteresisOperator for JilesAtherton {
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         self.validate()?;
         differential::invert(self, reference)
+    }
+}
+
+impl super::OperatorFamily for JilesAtherton {
+    const NAME: &'static str = "jiles-atherton";
+    const TITLE: &'static str = "Jiles & Atherton (1986)";
+
+    fn example() -> Result<Self> {
+        // The classic parameters of Jiles & Atherton (1986), with H in A/m.
+        Self::new(1.6e6, 1100.0, 400.0, 0.2, 1.6e-3)
+    }
+
+    fn checked(self) -> Result<Self> {
+        self.validate()?;
+        Ok(self)
+    }
+
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        let [ms, a, k, c, alpha, m0] = super::registry::values_array(self, values)?;
+        let next = Self {
+            ms,
+            a,
+            k,
+            c,
+            alpha,
+            m0,
+            ..self.clone()
+        };
+        next.validate()?;
+        Ok(next)
+    }
+
+    /// None: B = μ₀(H + M) has no output scale apart from the loop's shape.
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        None
     }
 }

@@ -125,7 +125,7 @@ impl Core for MaxwellSlip {
 
 impl HysteresisOperator for MaxwellSlip {
     fn family(&self) -> &'static str {
-        "maxwell-slip"
+        <Self as super::OperatorFamily>::NAME
     }
 
     fn parameters(&self) -> ParameterSet {
@@ -146,5 +146,55 @@ impl HysteresisOperator for MaxwellSlip {
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, self.orientation, reference)
+    }
+}
+
+impl super::OperatorFamily for MaxwellSlip {
+    const NAME: &'static str = "maxwell-slip";
+    const TITLE: &'static str = "generalised Maxwell-slip (Lampaert, Al-Bender & Swevers 2003)";
+
+    fn example() -> Result<Self> {
+        Self::new(
+            0.2,
+            vec![1.0, 0.5],
+            vec![0.1, 0.4],
+            0.0,
+            Orientation::default(),
+        )
+    }
+
+    fn checked(self) -> Result<Self> {
+        Self::new(
+            self.k0(),
+            self.stiffness().to_vec(),
+            self.widths().to_vec(),
+            self.offset(),
+            self.orientation(),
+        )
+    }
+
+    /// Values k0, k1 … kn, W1 … Wn (derived, recomputed), c.
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        super::check_values(self, values)?;
+        let n = self.stiffness().len();
+        Self::new(
+            values[0],
+            values[1..=n].to_vec(),
+            self.widths().to_vec(),
+            values[2 * n + 1],
+            self.orientation(),
+        )
+    }
+
+    /// The slip forces Wᵢ = kᵢδᵢ are derived from the stiffnesses.
+    fn held(&self) -> Vec<usize> {
+        let n = self.stiffness().len();
+        (n + 1..=2 * n).collect()
+    }
+
+    /// k0 … kn and c (not for the inverse-operator parameterisation).
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        let n = self.stiffness().len();
+        (!self.orientation().inverse).then(|| (0..=n).chain([2 * n + 1]).collect())
     }
 }

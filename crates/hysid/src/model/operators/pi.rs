@@ -219,7 +219,7 @@ impl Core for PrandtlIshlinskii {
 
 impl HysteresisOperator for PrandtlIshlinskii {
     fn family(&self) -> &'static str {
-        "pi"
+        <Self as super::OperatorFamily>::NAME
     }
 
     fn parameters(&self) -> ParameterSet {
@@ -260,4 +260,48 @@ pub(crate) fn pi_parameters(
     }
     p.push(Parameter::new("c", offset));
     ParameterSet::new(p).unwrap_or_default()
+}
+
+impl super::OperatorFamily for PrandtlIshlinskii {
+    const NAME: &'static str = "pi";
+    const TITLE: &'static str = "Prandtl–Ishlinskii (Krejčí & Kuhnen 2001)";
+
+    fn example() -> Result<Self> {
+        Self::new(
+            0.5,
+            vec![0.3, 0.2, 0.1],
+            vec![0.1, 0.3, 0.6],
+            0.05,
+            Orientation::default(),
+        )
+    }
+
+    fn checked(self) -> Result<Self> {
+        Self::new(
+            self.a0(),
+            self.weights().to_vec(),
+            self.thresholds().to_vec(),
+            self.offset(),
+            self.orientation(),
+        )
+    }
+
+    /// Values a0, a1 … an, r1 … rn, c.
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        super::check_values(self, values)?;
+        let n = self.weights().len();
+        Self::new(
+            values[0],
+            values[1..=n].to_vec(),
+            values[n + 1..=2 * n].to_vec(),
+            values[2 * n + 1],
+            self.orientation(),
+        )
+    }
+
+    /// a0 … an and c (not for the inverse-operator parameterisation).
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        let n = self.weights().len();
+        (!self.orientation().inverse).then(|| (0..=n).chain([2 * n + 1]).collect())
+    }
 }

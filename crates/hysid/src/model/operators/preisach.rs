@@ -412,7 +412,7 @@ impl Core for Preisach {
 
 impl HysteresisOperator for Preisach {
     fn family(&self) -> &'static str {
-        "preisach"
+        <Self as super::OperatorFamily>::NAME
     }
 
     fn parameters(&self) -> ParameterSet {
@@ -435,5 +435,47 @@ impl HysteresisOperator for Preisach {
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, self.orientation, reference)
+    }
+}
+
+impl super::OperatorFamily for Preisach {
+    const NAME: &'static str = "preisach";
+    const TITLE: &'static str = "discrete Preisach plane (Mayergoyz 1991)";
+
+    fn example() -> Result<Self> {
+        let weights = vec![0.1, 0.2, 0.05, 0.3, 0.1, 0.15];
+        Self::new(-1.0, 1.0, 3, weights, 0.2, 0.0, Orientation::default())
+    }
+
+    fn checked(self) -> Result<Self> {
+        Self::new(
+            self.lower(),
+            self.upper(),
+            self.levels(),
+            self.weights().to_vec(),
+            self.a0(),
+            self.offset(),
+            self.orientation(),
+        )
+    }
+
+    /// Values a0, μ1 … μN (the cells), c.
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        super::check_values(self, values)?;
+        let n = self.weights().len();
+        Self::new(
+            self.lower(),
+            self.upper(),
+            self.levels(),
+            values[1..=n].to_vec(),
+            values[0],
+            values[n + 1],
+            self.orientation(),
+        )
+    }
+
+    /// Every parameter (not for the inverse-operator parameterisation).
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        (!self.orientation().inverse).then(|| (0..self.weights().len() + 2).collect())
     }
 }

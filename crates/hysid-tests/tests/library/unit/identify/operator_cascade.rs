@@ -2,9 +2,11 @@
 
 use hysid::data::IdData;
 use hysid::identify::operator_cascade::*;
+use hysid::identify::operators::linear_support::threshold_grid;
+use hysid::identify::operators::{Family, FamilyOptions};
 use hysid::model::operators::BoucWen;
 use hysid::model::operators::{Backlash, Orientation, PrandtlIshlinskii};
-use hysid::model::{CascadeOperator, LinearBlock, OperatorCascade};
+use hysid::model::{LinearBlock, OperatorCascade, OperatorModel};
 use hysid::numerics::metrics;
 use hysid::numerics::Control;
 use rand::rngs::Xoshiro256PlusPlus;
@@ -30,15 +32,18 @@ fn data(u: &[f64], y: Vec<f64>) -> IdData {
     IdData::siso(1.0, "u", u.to_vec(), "y", y).unwrap()
 }
 
-fn fit(family: CascadeFamily, d: &IdData) -> OperatorCascadeFit {
-    OperatorCascadeIdentification::new(family, 2, 2, 1)
-        .estimate(d, &mut |_| Control::Continue)
-        .unwrap()
+fn fit(family: Family, thresholds: usize, d: &IdData) -> OperatorCascadeFit {
+    let mut id = OperatorCascadeIdentification::new(family, 2, 2, 1);
+    id.options = FamilyOptions {
+        thresholds,
+        ..FamilyOptions::default()
+    };
+    id.estimate(d, &mut |_| Control::Continue).unwrap()
 }
 
 fn backlash_truth() -> OperatorCascade {
     let op = Backlash::new(1.7, 0.437, -0.3, Orientation::default()).unwrap();
-    OperatorCascade::new(CascadeOperator::Backlash(op), block()).unwrap()
+    OperatorCascade::new(OperatorModel::Backlash(op), block()).unwrap()
 }
 
 fn assert_relative(est: &[f64], truth: &[f64], tol: f64) {
@@ -55,7 +60,7 @@ fn backlash_cascade_is_recovered_without_noise() {
     let u = input(3000);
     let truth = backlash_truth();
     let y = truth.simulate(&u).unwrap().y;
-    let f = fit(CascadeFamily::Backlash { profile_points: 40 }, &data(&u, y));
+    let f = fit(Family::Backlash, 10, &data(&u, y));
     assert_eq!(
         f.initialisation,
         "equation-error least squares, rank-one factorisation"
@@ -80,7 +85,7 @@ fn backlash_cascade_within_three_sigma_at_40_db() {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(40 + seed);
         let normal = Normal::new(0.0, sd).unwrap();
         let y: Vec<f64> = clean.iter().map(|v| v + normal.sample(&mut rng)).collect();
-        let f = fit(CascadeFamily::Backlash { profile_points: 40 }, &data(&u, y));
+        let f = fit(Family::Backlash, 10, &data(&u, y));
         for (i, s) in f.std.iter().enumerate() {
             if let Some(s) = s {
                 let e = f.output_error.parameters.get(i).value;
@@ -105,9 +110,9 @@ fn pi_cascade_is_recovered_without_noise() {
         Orientation::default(),
     )
     .unwrap();
-    let truth = OperatorCascade::new(CascadeOperator::Pi(op), block()).unwrap();
+    let truth = OperatorCascade::new(OperatorModel::Pi(op), block()).unwrap();
     let y = truth.simulate(&u).unwrap().y;
-    let f = fit(CascadeFamily::Pi { thresholds: 6 }, &data(&u, y));
+    let f = fit(Family::Pi, 6, &data(&u, y));
     let (est, tv) = (
         f.output_error.parameters.values(),
         truth.parameters().values(),
@@ -117,8 +122,8 @@ fn pi_cascade_is_recovered_without_noise() {
     }
     // a decreasing trend is found as the decreasing orientation
     let y: Vec<f64> = truth.simulate(&u).unwrap().y.iter().map(|v| -v).collect();
-    let f = fit(CascadeFamily::Pi { thresholds: 6 }, &data(&u, y));
-    let CascadeOperator::Pi(pi) = &f.model.operator else {
+    let f = fit(Family::Pi, 6, &data(&u, y));
+    let OperatorModel::Pi(pi) = &f.model.operator else {
         panic!()
     };
     assert!(pi.orientation().decreasing);
@@ -129,9 +134,9 @@ fn pi_cascade_is_recovered_without_noise() {
 fn bouc_wen_cascade_starts_from_its_family_fit() {
     let u = input(1500);
     let op = BoucWen::new(0.6, 0.8, 1.5, 0.5, 1.0).unwrap();
-    let truth = OperatorCascade::new(CascadeOperator::BoucWen(op), block()).unwrap();
+    let truth = OperatorCascade::new(OperatorModel::BoucWen(op), block()).unwrap();
     let y = truth.simulate(&u).unwrap().y;
-    let f = fit(CascadeFamily::BoucWen, &data(&u, y));
+    let f = fit(Family::BoucWen, 10, &data(&u, y));
     assert_eq!(f.initialisation, "family fit and ARX");
     assert!(f.fit_percent > 99.99, "{}", f.fit_percent);
 }
@@ -141,10 +146,10 @@ fn bad_settings_are_refused() {
     let u = input(200);
     let y = backlash_truth().simulate(&u).unwrap().y;
     let d = data(&u, y);
-    let id = OperatorCascadeIdentification::new(CascadeFamily::Pi { thresholds: 4 }, 2, 0, 1);
+    let id = OperatorCascadeIdentification::new(Family::Pi, 2, 0, 1);
     assert!(id.estimate(&d, &mut |_| Control::Continue).is_err());
     let short = data(&u[..20], u[..20].to_vec());
-    let id = OperatorCascadeIdentification::new(CascadeFamily::Pi { thresholds: 4 }, 2, 2, 1);
+    let id = OperatorCascadeIdentification::new(Family::Pi, 2, 2, 1);
     assert!(id.estimate(&short, &mut |_| Control::Continue).is_err());
     let flat = data(&vec![1.0; 200], (0..200).map(|k| k as f64).collect());
     assert!(id.estimate(&flat, &mut |_| Control::Continue).is_err());
@@ -164,9 +169,9 @@ fn a_misfitting_family_still_starts_from_a_stable_block() {
         Orientation::default(),
     )
     .unwrap();
-    let truth = OperatorCascade::new(CascadeOperator::Pi(op), block()).unwrap();
+    let truth = OperatorCascade::new(OperatorModel::Pi(op), block()).unwrap();
     let y = truth.simulate(&u).unwrap().y;
-    let f = fit(CascadeFamily::BoucWen, &data(&u, y));
+    let f = fit(Family::BoucWen, 10, &data(&u, y));
     assert!(f.start.linear.spectral_radius() < 0.99);
     assert!(f.fit_percent > 90.0, "{}", f.fit_percent);
 }

@@ -3,7 +3,7 @@
 use hysid::model::operator_cascade::*;
 use hysid::model::operators::Orientation;
 use hysid::model::operators::{Backlash, BoucWen, PrandtlIshlinskii};
-use hysid::model::LinearBlock;
+use hysid::model::{LinearBlock, OperatorModel};
 
 /// Nested reversals: a decaying oscillation with a faster one on top (minor loops).
 fn input(n: usize) -> Vec<f64> {
@@ -15,8 +15,8 @@ fn input(n: usize) -> Vec<f64> {
         .collect()
 }
 
-fn pi() -> CascadeOperator {
-    CascadeOperator::Pi(
+fn pi() -> OperatorModel {
+    OperatorModel::Pi(
         PrandtlIshlinskii::new(
             0.8,
             vec![0.5, 0.3, 0.2],
@@ -50,7 +50,7 @@ fn parameters_round_trip_and_prefix_collisions() {
     bad[10] = 2.0;
     assert!(c.with_values(&bad).is_err());
     let bl = Backlash::new(1.0, 0.3, 0.0, Orientation::default()).unwrap();
-    let c = OperatorCascade::new(CascadeOperator::Backlash(bl), second_order(vec![1.0])).unwrap();
+    let c = OperatorCascade::new(OperatorModel::Backlash(bl), second_order(vec![1.0])).unwrap();
     assert_eq!(c.parameters().names(), ["g", "r", "c", "a1", "a2", "b1"]);
 }
 
@@ -58,7 +58,7 @@ fn parameters_round_trip_and_prefix_collisions() {
 fn compensation_tracks_the_reference_pi_and_backlash() {
     let r: Vec<f64> = input(2000).iter().map(|x| 1.5 * x).collect();
     let bl = Backlash::new(1.7, 0.4, 0.2, Orientation::default()).unwrap();
-    for (op, tol) in [(pi(), 1e-9), (CascadeOperator::Backlash(bl), 1e-9)] {
+    for (op, tol) in [(pi(), 1e-9), (OperatorModel::Backlash(bl), 1e-9)] {
         let c = OperatorCascade::new(op, second_order(vec![1.0, 0.4])).unwrap();
         let comp = c.compensate(&r).unwrap();
         assert!(comp.clipped.is_empty());
@@ -78,7 +78,7 @@ fn compensation_tracks_the_reference_pi_and_backlash() {
 fn compensation_through_a_numerical_inverse() {
     let r: Vec<f64> = input(1500).iter().map(|x| 0.8 * x).collect();
     let bw = BoucWen::new(0.6, 0.8, 1.5, 0.5, 1.0).unwrap();
-    let c = OperatorCascade::new(CascadeOperator::BoucWen(bw), second_order(vec![1.0])).unwrap();
+    let c = OperatorCascade::new(OperatorModel::BoucWen(bw), second_order(vec![1.0])).unwrap();
     let comp = c.compensate(&r).unwrap();
     assert!(comp.clipped.is_empty(), "{:?}", comp.clipped.len());
     for (t, (p, rt)) in comp.predicted.iter().zip(&r).enumerate().skip(2) {
@@ -105,7 +105,7 @@ fn structure_survives_json_and_values_are_rechecked() {
     let c = OperatorCascade::new(pi(), second_order(vec![1.0, 0.4])).unwrap();
     let json = serde_json::to_string(&c.operator).unwrap();
     assert!(json.contains("\"family\":\"pi\""), "{json}");
-    let back: CascadeOperator = serde_json::from_str(&json).unwrap();
+    let back: OperatorModel = serde_json::from_str(&json).unwrap();
     assert_eq!(
         back.with_values(&c.operator.as_operator().parameters().values())
             .unwrap(),

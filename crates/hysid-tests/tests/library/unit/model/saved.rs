@@ -3,8 +3,8 @@
 use hysid::experiments::voros::CascadeExample;
 use hysid::model::coleman_hodgdon::InitialOutput;
 use hysid::model::saved::*;
-use hysid::model::{CascadeOperator, OperatorCascade};
 use hysid::model::{ColemanHodgdon, LinearBlock};
+use hysid::model::{OperatorCascade, OperatorModel};
 
 #[test]
 fn cascade_round_trips_through_json() {
@@ -29,7 +29,7 @@ fn operator_cascade_round_trips_through_json() {
     let w: Vec<f64> = (0..10).map(|k| 0.05 + 0.01 * k as f64).collect();
     let op = Preisach::new(-2.0, 2.0, 4, w, 0.3, 0.1, Orientation::default()).unwrap();
     let linear = LinearBlock::new(vec![-0.5], vec![1.0, 0.3], 1).unwrap();
-    let model = OperatorCascade::new(CascadeOperator::Preisach(op), linear).unwrap();
+    let model = OperatorCascade::new(OperatorModel::Preisach(op), linear).unwrap();
     let std: Vec<f64> = (0..model.parameters().len())
         .map(|i| 0.01 * i as f64)
         .collect();

@@ -1,6 +1,5 @@
 //! Tests of `hysid::model::operators`.
 
-mod any;
 mod backlash;
 mod bouc_wen;
 mod dahl;
@@ -12,3 +11,4 @@ mod jiles_atherton;
 mod maxwell_slip;
 mod pi;
 mod preisach;
+mod registry;
