@@ -12,6 +12,7 @@
 //! Every error is one line on stderr: what is wrong, where, and what to do. Usage errors
 //! from the argument parser are folded to one line and end with the `--help` to run.
 
+use hysid::error::Category;
 use hysid::Error;
 use std::process::ExitCode;
 
@@ -45,21 +46,19 @@ impl ExitClass {
     }
 }
 
-/// The class of a library error, by the meaning of its variant: an unreadable or
-/// unwritable file is I/O, a singular regression or a diverged simulation is numerical,
-/// everything about the content of files and parameters is bad input.
+/// The class of a library error, from its [`Category`]: an unreadable or unwritable file is
+/// I/O, a numerical failure is numerical, everything about the content of files, data and
+/// settings is bad input (so are a cancelled run and an internal serialisation failure,
+/// which a command reports like any other refusal).
 pub fn library_class(error: &Error) -> ExitClass {
-    match error {
-        Error::Io { .. } => ExitClass::Io,
-        Error::Singular(_)
-        | Error::Diverged { .. }
-        | Error::NonFiniteResult { .. }
-        | Error::NonFiniteOutput(_) => ExitClass::Numerical,
-        // Csv, MissingColumn, NotNumeric, NonFinite, InvalidData, TooFewSamples,
-        // NotExciting, RateLimit, InvalidParameter, InvalidOption, InvalidModel,
-        // ModelMismatch, UnknownParameter, Unsupported(Kind), InvalidOutput, ModelFile — and
-        // any variant added later until it is classified here — describe what the user gave.
-        _ => ExitClass::BadInput,
+    match error.category() {
+        Category::Io => ExitClass::Io,
+        Category::Numerical => ExitClass::Numerical,
+        Category::Data
+        | Category::Config
+        | Category::ModelFile
+        | Category::Cancelled
+        | Category::Internal => ExitClass::BadInput,
     }
 }
 

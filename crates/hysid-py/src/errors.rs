@@ -71,27 +71,14 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 
 /// The Python exception for a library error, with the library's one-line message.
 pub fn to_py(py: Python<'_>, e: hysid::Error) -> PyErr {
-    use hysid::Error as E;
+    use hysid::error::Category;
     let message = e.to_string();
-    let class = match e {
-        E::NonFinite { .. }
-        | E::InvalidData(_)
-        | E::TooFewSamples { .. }
-        | E::NotExciting { .. }
-        | E::RateLimit { .. }
-        | E::Csv { .. }
-        | E::MissingColumn { .. }
-        | E::NotNumeric { .. } => "DataError",
-        E::InvalidParameter { .. }
-        | E::InvalidOption { .. }
-        | E::InvalidModel(_)
-        | E::ModelMismatch(_)
-        | E::UnknownParameter(_)
-        | E::Unsupported(_)
-        | E::UnsupportedKind { .. }
-        | E::Equations(_) => "ConfigError",
-        E::ModelFile { .. } | E::Io { .. } | E::InvalidOutput(_) => "ModelFileError",
-        _ => "NumericalError",
+    let class = match e.category() {
+        Category::Data => "DataError",
+        Category::Config => "ConfigError",
+        Category::ModelFile | Category::Io => "ModelFileError",
+        Category::Numerical | Category::Cancelled => "NumericalError",
+        Category::Internal => "InternalError",
     };
     named(py, class, message)
 }

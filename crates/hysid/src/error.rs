@@ -248,7 +248,62 @@ pub struct EquationFileError {
     pub message: String,
 }
 
+/// What kind of failure an [`Error`] is: the one classification from which the command
+/// line's exit codes and the Python exception classes are derived.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Category {
+    /// Input data that cannot be used: unreadable CSV content, a missing column, non-finite
+    /// or too few samples, an input that does not excite the model.
+    Data,
+    /// A setting or a model that is out of range, unknown or inconsistent with what it is
+    /// applied to (an option, a parameter, a model's structure, an operation the model does
+    /// not support).
+    Config,
+    /// A saved model or an output file that cannot be read or written as asked.
+    ModelFile,
+    /// The file system: a file could not be opened, read or written.
+    Io,
+    /// A numerical failure: a singular regression, a diverged simulation, a non-finite
+    /// result.
+    Numerical,
+    /// The caller stopped the computation.
+    Cancelled,
+    /// A failure of hysid itself (serialisation or plot layout), never of the data: a bug.
+    Internal,
+}
+
 impl Error {
+    /// The error's [`Category`] (exhaustive: a new variant must be classified here).
+    pub fn category(&self) -> Category {
+        match self {
+            Error::Csv { .. }
+            | Error::MissingColumn { .. }
+            | Error::NotNumeric { .. }
+            | Error::NonFinite { .. }
+            | Error::InvalidData(_)
+            | Error::TooFewSamples { .. }
+            | Error::NotExciting { .. }
+            | Error::RateLimit { .. } => Category::Data,
+            Error::InvalidParameter { .. }
+            | Error::InvalidOption { .. }
+            | Error::InvalidModel(_)
+            | Error::ModelMismatch(_)
+            | Error::UnknownParameter(_)
+            | Error::Unsupported(_)
+            | Error::UnsupportedKind { .. }
+            | Error::Equations(_)
+            | Error::NotInvertible { .. } => Category::Config,
+            Error::ModelFile { .. } | Error::InvalidOutput(_) => Category::ModelFile,
+            Error::Io { .. } => Category::Io,
+            Error::Singular(_)
+            | Error::Diverged { .. }
+            | Error::NonFiniteOutput(_)
+            | Error::NonFiniteResult { .. } => Category::Numerical,
+            Error::Cancelled(_) => Category::Cancelled,
+            Error::Serialization(_) | Error::Plot(_) => Category::Internal,
+        }
+    }
+
     /// [`Error::InvalidOption`] of the setting `option` with value `value`.
     pub fn invalid_option(option: &str, value: impl std::fmt::Display, reason: String) -> Self {
         Error::InvalidOption {
