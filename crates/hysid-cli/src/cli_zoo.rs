@@ -1,6 +1,8 @@
 //! Command-line syntax of the hysteresis model zoo: `identify operator`, `compare`,
-//! `compensate` (clap derive; the help text comes from these doc comments).
+//! `compensate` (clap derive; the help text comes from these doc comments). The record and
+//! the outputs are the shared groups of [`crate::cli`] ([`DataArgs`], [`OutputArgs`]).
 
+use crate::cli::{DataArgs, OutputArgs};
 use clap::Args;
 use hysid::model::operators::Family;
 use std::path::PathBuf;
@@ -15,26 +17,6 @@ pub fn family_help(lead: &str) -> String {
     format!("{lead}: {}", families.join("; "))
 }
 
-/// The record: one input and one output column.
-#[derive(Debug, Args)]
-pub struct ZooDataArgs {
-    /// CSV file with a header row, or a MATLAB .mat file (-v7 or older).
-    #[arg(long)]
-    pub data: PathBuf,
-    /// Input column (the hysteresis input u, e.g. voltage or field H).
-    #[arg(long)]
-    pub input: String,
-    /// Output column (the hysteresis output y, e.g. displacement or flux density B).
-    #[arg(long)]
-    pub output: String,
-    /// Sample time; otherwise from the time column, else 1 (rate-independent families ignore it).
-    #[arg(long)]
-    pub ts: Option<f64>,
-    /// Time column (default: a column named t, time, t_s or time_s, if any).
-    #[arg(long)]
-    pub time: Option<String>,
-}
-
 /// The families' settings.
 #[derive(Debug, Args)]
 pub struct FamilyArgs {
@@ -46,8 +28,9 @@ pub struct FamilyArgs {
     /// Intervals N of the Preisach grid over the input range, 1..=100 (N(N+1)/2 cells).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=100))]
     pub grid: u32,
-    /// Smoothness penalty λ ≥ 0 of the Preisach weights (relative to the Gram matrix).
-    #[arg(long, default_value_t = 1e-6)]
+    /// Smoothness penalty λ of the Preisach weights (relative to the Gram matrix). Range
+    /// [0, 1e6].
+    #[arg(long, default_value_t = 1e-6, value_parser = crate::options::nonnegative)]
     pub lambda: f64,
     /// Dead zones on each side of the generalised PI, 0..=20.
     #[arg(long = "dead-zones", default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=20))]
@@ -60,27 +43,23 @@ pub struct OperatorArgs {
     /// The family (the list is the registry's).
     #[arg(long, help = family_help("The family"))]
     pub family: String,
+    /// The record: one --input and one --output column.
     #[command(flatten)]
-    pub data: ZooDataArgs,
+    pub data: DataArgs,
     #[command(flatten)]
     pub options: FamilyArgs,
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write the fitted model here (`hysid.model/1`, loadable by `hysid simulate --model`
-    /// and `hysid compensate --model`).
-    #[arg(long = "model-out")]
-    pub model_out: Option<PathBuf>,
-    /// Directory for plots (SVG): the measured and simulated loops.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    /// The report, the fitted model (loadable by `hysid simulate --model` and `hysid
+    /// compensate --model`) and the plots (the measured and simulated loops).
+    #[command(flatten)]
+    pub output: OutputArgs,
 }
 
 /// Options of `hysid compare`.
 #[derive(Debug, Args)]
 pub struct CompareArgs {
+    /// The record: one --input and one --output column.
     #[command(flatten)]
-    pub data: ZooDataArgs,
+    pub data: DataArgs,
     /// Validation record with the same columns; without it the first 60 % of --data trains
     /// and the rest validates.
     #[arg(long)]
@@ -90,15 +69,10 @@ pub struct CompareArgs {
     pub families: String,
     #[command(flatten)]
     pub options: FamilyArgs,
-    /// Write the JSON report here (the rows in details.families, the best model in model).
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Write the best family's model here (`hysid.model/1`).
-    #[arg(long = "model-out")]
-    pub model_out: Option<PathBuf>,
-    /// Directory for plots (SVG): every family's validation loop over the measured one.
-    #[arg(long)]
-    pub plots: Option<PathBuf>,
+    /// The report (the rows in details.families, the best model in model), the best
+    /// family's model and the plots (every family's validation loop over the measured one).
+    #[command(flatten)]
+    pub output: OutputArgs,
 }
 
 /// Options of `hysid compensate`.
@@ -114,8 +88,8 @@ pub struct CompensateArgs {
     /// Column of the reference r the output should follow.
     #[arg(long)]
     pub reference: String,
-    /// Sample time; otherwise from the time column, else 1.
-    #[arg(long)]
+    /// Sample time [s]; otherwise from the time column, else 1. Range (0, 1e12].
+    #[arg(long, value_parser = crate::options::positive)]
     pub ts: Option<f64>,
     /// Time column (default: a column named t, time, t_s or time_s, if any).
     #[arg(long)]

@@ -9,7 +9,6 @@ mod budget;
 mod cli;
 mod cli_zoo;
 mod commands;
-mod deprecated;
 mod exit;
 mod options;
 mod output;
@@ -23,8 +22,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     exit::one_line_panics();
-    let args = deprecated::rewrite(std::env::args_os().collect());
-    let cli = match cli::Cli::try_parse_from(args) {
+    let cli = match cli::Cli::try_parse_from(std::env::args_os()) {
         Ok(cli) => cli,
         Err(e) => return parser_exit(&e),
     };

@@ -28,13 +28,24 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let mut inputs = vec![args.data.data.as_path()];
     inputs.extend(args.validate.as_deref());
     let mut files = OutputSet::new(&inputs)?;
-    let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
+    let json_tmp = args
+        .output
+        .json
+        .as_deref()
+        .map(|p| files.file(p))
+        .transpose()?;
     let model_tmp = args
+        .output
         .model_out
         .as_deref()
         .map(|p| files.file(p))
         .transpose()?;
-    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
+    let plots_tmp = args
+        .output
+        .plots
+        .as_deref()
+        .map(|p| files.dir(p))
+        .transpose()?;
     let data = load(&args.data, &args.data.data)?;
     let validation = args
         .validate
@@ -88,9 +99,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     files.commit()?;
     for (what, path) in [
-        ("report", &args.json),
-        ("model", &args.model_out),
-        ("plots", &args.plots),
+        ("report", &args.output.json),
+        ("model", &args.output.model_out),
+        ("plots", &args.output.plots),
     ] {
         if let Some(p) = path {
             println!("  {what}: {}", p.display());

@@ -20,13 +20,24 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family).context("--family")?;
     let mut options = family_options(&args.options)?;
     let mut files = OutputSet::new(&[args.data.data.as_path()])?;
-    let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
+    let json_tmp = args
+        .output
+        .json
+        .as_deref()
+        .map(|p| files.file(p))
+        .transpose()?;
     let model_tmp = args
+        .output
         .model_out
         .as_deref()
         .map(|p| files.file(p))
         .transpose()?;
-    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
+    let plots_tmp = args
+        .output
+        .plots
+        .as_deref()
+        .map(|p| files.dir(p))
+        .transpose()?;
     let data = load(&args.data, &args.data.data)?;
     let exp = data.experiment(0);
     let (u, y) = (exp.input(0), exp.output(0));
@@ -93,9 +104,9 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
     }
     files.commit()?;
     for (what, path) in [
-        ("report", &args.json),
-        ("model", &args.model_out),
-        ("plots", &args.plots),
+        ("report", &args.output.json),
+        ("model", &args.output.model_out),
+        ("plots", &args.output.plots),
     ] {
         if let Some(p) = path {
             println!("  {what}: {}", p.display());

@@ -1,7 +1,9 @@
 //! What `identify operator`, `compare` and `compensate` share: the family options from the
 //! flags, reading a record, and the loop plots (through the plotting module's figure API only).
 
-use crate::cli_zoo::{FamilyArgs, ZooDataArgs};
+use crate::cli::DataArgs;
+use crate::cli_zoo::FamilyArgs;
+use crate::exit::UsageError;
 use anyhow::{Context, Result};
 use hysid::data::{CsvSpec, IdData};
 use hysid::identify::operators::FamilyOptions;
@@ -42,11 +44,26 @@ pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
     Ok(options)
 }
 
+/// The one input and output column of a zoo command (its families are single-input,
+/// single-output operators).
+pub fn columns(args: &DataArgs) -> Result<(&str, &str)> {
+    match (args.input.as_slice(), args.output.as_slice()) {
+        ([input], [output]) => Ok((input, output)),
+        _ => Err(UsageError(format!(
+            "this command fits one hysteresis loop: give one --input and one --output (got {} and {})",
+            args.input.len(),
+            args.output.len()
+        ))
+        .into()),
+    }
+}
+
 /// Reads the input and output columns of `path` (one experiment).
-pub fn load(args: &ZooDataArgs, path: &Path) -> Result<IdData> {
+pub fn load(args: &DataArgs, path: &Path) -> Result<IdData> {
+    let (input, output) = columns(args)?;
     let spec = CsvSpec {
-        inputs: vec![args.input.clone()],
-        outputs: vec![args.output.clone()],
+        inputs: vec![input.to_string()],
+        outputs: vec![output.to_string()],
         time: args.time.clone(),
         ts: args.ts,
     };

@@ -39,7 +39,7 @@ fn equation_file_fit_saves_a_self_contained_model() {
         .arg(&report)
         .arg("--model-out")
         .arg(&model)
-        .arg("--out")
+        .arg("--plots")
         .arg(&plots)
         .assert()
         .success();
