@@ -25,6 +25,7 @@ pub mod errors;
 pub mod pool;
 pub mod recipes;
 pub mod user_model;
+pub mod zoo;
 
 /// The module `hysid._hysid`.
 #[pymodule]
@@ -35,6 +36,7 @@ fn _hysid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     pool::register(m)?;
     actuator::register(m)?;
     equations::register(m)?;
+    zoo::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

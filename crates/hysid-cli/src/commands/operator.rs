@@ -7,10 +7,7 @@ use crate::report::{print_table, Row};
 use anyhow::{Context, Result};
 use hysid::identify::operators::{fit_operator, Family, FittedOperator};
 use hysid::io::atomic::OutputSet;
-use hysid::report::{
-    DataSummary, FitSummary, Report, SearchSummary, TerminationSummary, UncertaintySummary,
-};
-use serde_json::json;
+use hysid::report::{operator_report, operator_simulation, Report};
 
 /// Parameters printed before the table is cut short (a Preisach plane has hundreds).
 const PRINTED_PARAMETERS: usize = 16;
@@ -47,36 +44,8 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
     let fitted = fit_operator(family, u, y, &options)
         .with_context(|| format!("identifying a {family} operator"))?;
     drop(progress);
-    // The report's fit is the saved model's own simulation, so `hysid simulate` reproduces it.
-    let yhat = fitted
-        .fit
-        .model
-        .simulate(&[u], data.ts(), y.first().copied())?
-        .swap_remove(0);
-    let mut report = Report::new("identify operator");
-    report.data = Some(DataSummary::of(
-        &data,
-        vec![args.data.data.display().to_string()],
-    ));
-    report.fit = Some(FitSummary::of(
-        std::slice::from_ref(&exp.name),
-        &[y],
-        &[&yhat],
-    )?);
-    report.search = Some(search(&fitted));
-    report.uncertainty = Some(if fitted.fit.iterations == 0 {
-        UncertaintySummary::least_squares()
-    } else {
-        UncertaintySummary::asymptotic()
-    });
-    report.model = Some(fitted.fit.model.to_file());
-    report.details = json!({
-        "family": family.name(),
-        "estimated_parameters": fitted.estimated_parameters(),
-        "converged": fitted.fit.termination.converged(),
-        "aic": finite(fitted.fit.aic),
-        "fpe": finite(fitted.fit.fpe),
-    });
+    let yhat = operator_simulation(&fitted, &data)?;
+    let report = operator_report(&fitted, &data, vec![args.data.data.display().to_string()])?;
     print_summary(&fitted, &report);
     if let Some(dir) = &plots_tmp {
         let title = format!("{family}: measured and simulated loop");
@@ -113,20 +82,6 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-fn search(fitted: &FittedOperator) -> SearchSummary {
-    let fit = &fitted.fit;
-    SearchSummary {
-        iterations: fit.iterations,
-        evaluations: fit.evaluations,
-        termination: TerminationSummary::of(&fit.termination),
-        elapsed_s: fit.elapsed_s,
-    }
-}
-
-fn finite(v: f64) -> Option<f64> {
-    v.is_finite().then_some(v)
 }
 
 fn exp_name(data: &hysid::data::IdData, input: bool) -> String {

@@ -45,6 +45,7 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tupl
 import numpy as np
 
 from . import _hysid
+from ._families import FAMILIES, FamilyName
 from ._hysid import (
     CallbackError,
     ConfigError,
@@ -58,6 +59,9 @@ from ._hysid import (
 __version__ = _hysid.__version__
 
 __all__ = [
+    "FAMILIES",
+    "FamilyName",
+    "identify_operator",
     "identify_cascade",
     "identify_hysteresis",
     "greybox_fit",
@@ -655,6 +659,55 @@ def identify_cascade(
         _choice(uncertainty, "uncertainty"),
         _count(replicates, "replicates"),
         _count(seed, "seed"),
+        _threads(threads),
+    )
+    return Result(json.loads(text))
+
+
+def identify_operator(
+    u: Any,
+    y: Any = None,
+    *,
+    family: FamilyName,
+    ts: float = 1.0,
+    thresholds: "int | Sequence[float]" = 10,
+    grid: int = 20,
+    lambda_: float = 1e-6,
+    dead_zones: int = 4,
+    threads: Optional[int] = None,
+) -> Result:
+    """Fits one hysteresis family y = Γ[u] to a measured input ``u`` and output ``y`` from
+    the data alone (no initial guess): the CLI's ``hysid identify operator``, the same
+    estimates and report.
+
+    ``family``: one of :data:`FAMILIES` (``"pi"``, ``"preisach"``, ``"bouc-wen"``, …; see
+    ``docs/zoo.md``). ``thresholds``: PI/GPI thresholds and Maxwell-slip elements, a count
+    (a uniform grid over the input range) or the thresholds themselves (strictly increasing,
+    > 0). ``grid``: Preisach intervals; ``lambda_``: Preisach smoothness; ``dead_zones``: GPI
+    dead zones per side. ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
+    """
+    u, y, ts = _pair(u, y, ("u", "y"), ts)
+    name = _choice(family, "family")
+    if name not in FAMILIES:
+        raise ConfigError(f"family={family!r}: unknown hysteresis family; use one of {', '.join(FAMILIES)}")
+    if isinstance(thresholds, (int, np.integer)) and not isinstance(thresholds, bool):
+        count, grid_values = _count(thresholds, "thresholds"), []
+    else:
+        grid_values = [float(r) for r in _array(thresholds, "thresholds")]
+        count = len(grid_values)
+    lam = float(lambda_)
+    if not (math.isfinite(lam) and lam >= 0.0):
+        raise ConfigError(f"lambda_={lambda_!r}: the Preisach smoothness must be finite and >= 0")
+    text = _hysid.identify_operator(
+        u,
+        y,
+        name,
+        _ts(ts, 1.0),
+        count,
+        grid_values,
+        _count(grid, "grid"),
+        lam,
+        _count(dead_zones, "dead_zones"),
         _threads(threads),
     )
     return Result(json.loads(text))

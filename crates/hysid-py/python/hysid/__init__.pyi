@@ -5,6 +5,8 @@ import numpy as np
 import numpy.typing as npt
 
 from . import fleet as fleet
+from ._families import FAMILIES as FAMILIES
+from ._families import FamilyName as FamilyName
 from ._hysid import CallbackError as CallbackError
 from ._hysid import ConfigError as ConfigError
 from ._hysid import DataError as DataError
@@ -100,6 +102,18 @@ def identify_cascade(
     uncertainty: str = ...,
     seed: int = ...,
     replicates: int = ...,
+    threads: Optional[int] = ...,
+) -> Result: ...
+def identify_operator(
+    u: Any,
+    y: Any = ...,
+    *,
+    family: FamilyName,
+    ts: float = ...,
+    thresholds: "int | Sequence[float]" = ...,
+    grid: int = ...,
+    lambda_: float = ...,
+    dead_zones: int = ...,
     threads: Optional[int] = ...,
 ) -> Result: ...
 def identify_hysteresis(

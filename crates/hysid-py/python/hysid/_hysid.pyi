@@ -33,6 +33,19 @@ def identify_cascade(
     seed: int,
     threads: int = 0,
 ) -> str: ...
+def families() -> List[Tuple[str, str]]: ...
+def identify_operator(
+    u: _Array,
+    y: _Array,
+    family: str,
+    ts: float,
+    thresholds: int,
+    threshold_grid: Sequence[float],
+    grid: int,
+    lambda_: float,
+    dead_zones: int,
+    threads: int = 0,
+) -> str: ...
 def identify_hysteresis(
     x: _Array, y: _Array, hysteresis: str, ts: float, initial_output: str, threads: int = 0
 ) -> str: ...

@@ -25,6 +25,7 @@
 pub mod actuator;
 pub mod cascade;
 pub mod greybox;
+pub mod operator;
 pub mod plot;
 pub mod rigid_body;
 pub mod simulate;
@@ -33,6 +34,7 @@ pub use cascade::{
     cascade_report, hysteresis_report, operator_cascade_model, operator_cascade_report,
 };
 pub use greybox::{bouc_wen_benchmark_report, greybox_report, greybox_residuals};
+pub use operator::{operator_report, operator_simulation};
 pub use rigid_body::{rigid_body_model, rigid_body_report, RigidBodyRecord};
 pub use simulate::simulate_report;
 

@@ -43,7 +43,7 @@ fn published_schemas_are_up_to_date() {
         assert_eq!(
             committed,
             text,
-            "{} is out of date: run HYSID_WRITE_SCHEMA=1 cargo test -p hysid --lib published_schemas",
+            "{} is out of date: run HYSID_WRITE_SCHEMA=1 cargo test --release -p hysid-tests --test library published_schemas",
             path.display()
         );
     }

@@ -109,3 +109,37 @@ fn docs_table_is_the_registry() {
         Family::markdown_table()
     );
 }
+
+/// The Python package's family names (`hysid.FamilyName`, `hysid.FAMILIES`) are generated
+/// from the registry into `python/hysid/_families.py`; `HYSID_WRITE_SCHEMA=1` rewrites it.
+#[test]
+fn registry_python_names() {
+    let items: String = Family::ALL
+        .iter()
+        .map(|f| format!("    \"{}\",\n", f.name()))
+        .collect();
+    let expected = format!(
+        "\"\"\"The hysteresis families of the library's registry, as Python names.\n\n\
+         Generated from ``hysid::model::operators::Family`` — do not edit: the test\n\
+         ``registry_python_names`` in ``crates/hysid-tests`` checks this file and rewrites it under\n\
+         ``HYSID_WRITE_SCHEMA=1 cargo test --release -p hysid-tests --test library registry``.\n\
+         \"\"\"\n\n\
+         from typing import Literal, Tuple\n\n\
+         #: A hysteresis family's name, as ``hysid identify operator --family`` takes it.\n\
+         FamilyName = Literal[\n{items}]\n\n\
+         #: Every family name, in the registry's order.\n\
+         FAMILIES: Tuple[str, ...] = (\n{items})\n"
+    );
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../hysid-py/python/hysid/_families.py"
+    );
+    if std::env::var_os("HYSID_WRITE_SCHEMA").is_some() {
+        std::fs::write(path, &expected).unwrap();
+    }
+    let found = std::fs::read_to_string(path).unwrap();
+    assert_eq!(
+        found, expected,
+        "_families.py is out of date: run HYSID_WRITE_SCHEMA=1 cargo test --release -p hysid-tests --test library registry"
+    );
+}

@@ -1,0 +1,99 @@
+"""The hysteresis zoo from Python: the family names are the library's registry, and
+``identify_operator`` gives the command line's estimates."""
+
+import ast
+import json
+import os
+import pathlib
+import subprocess
+import typing
+
+import hysid
+import numpy as np
+import pytest
+
+CLI = os.environ.get("HYSID_CLI")
+PACKAGE = pathlib.Path(hysid.__file__).parent
+
+
+def _loop(n=1200):
+    """A loop with nested reversals (minor loops) through a PI operator with three plays:
+    every family has something to fit."""
+    t = np.arange(n) / n
+    u = 2.0 * (1.0 - 0.6 * t) * np.sin(2 * np.pi * 5 * t) + 0.3 * np.sin(2 * np.pi * 23 * t)
+    y = np.empty(n)
+    plays = np.zeros(3)
+    for k, uk in enumerate(u):
+        for i, r in enumerate((0.2, 0.5, 0.9)):
+            plays[i] = max(uk - r, min(uk + r, plays[i]))
+        y[k] = 0.4 * uk + plays @ np.array([0.5, 0.3, 0.2]) + 0.1
+    return u, y
+
+
+def _stub_literal():
+    """The FamilyName Literal's names as written in ``_families.py`` (what type checkers read)."""
+    tree = ast.parse((PACKAGE / "_families.py").read_text())
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "FamilyName" for t in node.targets):
+            return tuple(ast.literal_eval(e) for e in node.value.slice.elts)
+    raise AssertionError("FamilyName is not in __init__.pyi")
+
+
+def test_family_names_are_the_registry():
+    registry = tuple(name for name, _ in hysid._hysid.families())
+    assert hysid.FAMILIES == registry
+    assert typing.get_args(hysid.FamilyName) == registry
+    assert _stub_literal() == registry
+    hints = typing.get_type_hints(hysid.identify_operator)
+    assert typing.get_args(hints["family"]) == registry
+
+
+def test_unknown_family_is_a_value_error():
+    u, y = _loop(200)
+    with pytest.raises(ValueError, match="unknown hysteresis family"):
+        hysid.identify_operator(u, y, family="prandtl")
+
+
+@pytest.mark.parametrize("family", ["pi", "preisach", "maxwell-slip", "backlash", "gpi"])
+def test_fits_and_simulates(family):
+    u, y = _loop()
+    r = hysid.identify_operator(u, y, family=family)
+    assert r.fit_percent > 90.0, (family, r.fit_percent)
+    yhat = np.ravel(r.model.simulate(u, ts=1.0))
+    fit = 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean()))
+    assert abs(fit - r.fit_percent) <= 1e-9, (family, fit, r.fit_percent)
+
+
+@pytest.mark.skipif(not CLI, reason="set HYSID_CLI to a hysid binary to compare live")
+@pytest.mark.parametrize("family", list(hysid.FAMILIES))
+def test_estimates_equal_the_command_line(tmp_path, family):
+    u, y = _loop()
+    csv = tmp_path / "loop.csv"
+    np.savetxt(csv, np.column_stack([u, y]), delimiter=",", header="u,y", comments="", fmt="%.17g")
+    report = tmp_path / "report.json"
+    subprocess.run(
+        [
+            CLI,
+            "-q",
+            "identify",
+            "operator",
+            "--family",
+            family,
+            "--data",
+            str(csv),
+            "--input",
+            "u",
+            "--output",
+            "y",
+            "--json",
+            str(report),
+        ],
+        check=True,
+    )
+    cli = json.loads(report.read_text())
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    r = hysid.identify_operator(data[:, 0], data[:, 1], family=family)
+    cli_values = {p["name"]: p["value"] for p in cli["model"]["parameters"]}
+    assert set(cli_values) == set(r.parameters)
+    for name, value in cli_values.items():
+        assert abs(r.parameters[name].value - value) <= 1e-12 * max(1.0, abs(value)), (family, name)

@@ -1,0 +1,64 @@
+//! The report of one hysteresis family fitted to a record (`hysid identify operator`, Python's
+//! `hysid.identify_operator`): the same report from both front ends.
+
+use super::UncertaintySummary;
+use super::{DataSummary, FitSummary, Report, SearchSummary, TerminationSummary};
+use crate::data::IdData;
+use crate::identify::operators::FittedOperator;
+use crate::Result;
+use serde_json::json;
+
+/// The output the report's fit is computed from: the saved model's own simulation of the
+/// first experiment, so that `hysid simulate` on the model file reproduces the report.
+pub fn operator_simulation(fitted: &FittedOperator, data: &IdData) -> Result<Vec<f64>> {
+    let exp = data.experiment(0);
+    let (u, y) = (exp.input(0), exp.output(0));
+    Ok(fitted
+        .fit
+        .model
+        .simulate(&[u], data.ts(), y.first().copied())?
+        .swap_remove(0))
+}
+
+/// The report of `fitted` on the first experiment of `data` (read from `sources`): data,
+/// fit (of [`operator_simulation`]), search, uncertainty, the model, and `details` with the
+/// family, the number of estimated parameters, whether the search converged, AIC and FPE
+/// (null when not finite, e.g. the AIC of an exact fit).
+pub fn operator_report(
+    fitted: &FittedOperator,
+    data: &IdData,
+    sources: Vec<String>,
+) -> Result<Report> {
+    let exp = data.experiment(0);
+    let y = exp.output(0);
+    let yhat = operator_simulation(fitted, data)?;
+    let fit = &fitted.fit;
+    let mut report = Report::new("identify operator");
+    report.data = Some(DataSummary::of(data, sources));
+    report.fit = Some(FitSummary::of(
+        std::slice::from_ref(&exp.name),
+        &[y],
+        &[&yhat],
+    )?);
+    report.search = Some(SearchSummary {
+        iterations: fit.iterations,
+        evaluations: fit.evaluations,
+        termination: TerminationSummary::of(&fit.termination),
+        elapsed_s: fit.elapsed_s,
+    });
+    report.uncertainty = Some(if fit.iterations == 0 {
+        UncertaintySummary::least_squares()
+    } else {
+        UncertaintySummary::asymptotic()
+    });
+    report.model = Some(fit.model.to_file());
+    let finite = |v: f64| v.is_finite().then_some(v);
+    report.details = json!({
+        "family": fitted.family.name(),
+        "estimated_parameters": fitted.estimated_parameters(),
+        "converged": fit.termination.converged(),
+        "aic": finite(fit.aic),
+        "fpe": finite(fit.fpe),
+    });
+    Ok(report)
+}
