@@ -50,8 +50,8 @@ pub struct KpOptions {
     /// thresholds, 210 kernels, the size of the default Preisach plane).
     pub levels: usize,
     /// Candidate ridge widths a relative to the grid's range (upper − lower), each finite and
-    /// > 0; the one with the smallest penalised equation error is kept, a single entry fixes a
-    /// (default [`KpOptions::DEFAULT_WIDTHS`]).
+    /// positive; the one with the smallest penalised equation error is kept, a single entry
+    /// fixes a (default [`KpOptions::DEFAULT_WIDTHS`]).
     pub widths: Vec<f64>,
     /// Smoothness penalty λ (relative to the mean diagonal of the weights' Gram matrix), finite
     /// and ≥ 0 (default 1e-6); 0 switches it off.
