@@ -148,45 +148,57 @@ impl KernelStates {
         for (i, &up) in self.ramps.iter().enumerate() {
             let row = &mut self.xi[k..k + i + 1];
             for (xi, &down) in row.iter_mut().zip(&self.ramps[..=i]) {
-                *xi = up.max(down.min(*xi));
+                // max(up, min(down, ξ)) by comparisons: the states are finite, and these
+                // compile to the packed min/max instructions
+                let held = if down < *xi { down } else { *xi };
+                *xi = if up > held { up } else { held };
             }
             k += i + 1;
         }
     }
 
-    /// Moves the input to `x` and returns Σ wₖξₖ.
+    /// Moves the input to `x` and returns Σ wₖξₖ (summed in four interleaved partial sums,
+    /// so that the sum is not one chain of dependent additions).
     fn advance_weighted(&mut self, thresholds: &[f64], width: f64, weights: &[f64], x: f64) -> f64 {
+        self.advance(thresholds, width, x);
+        let mut acc = [0.0; 4];
+        let mut chunks = self.xi.chunks_exact(4).zip(weights.chunks_exact(4));
+        for (xi, w) in &mut chunks {
+            for l in 0..4 {
+                acc[l] += w[l] * xi[l];
+            }
+        }
+        let tail = self.xi.len() - self.xi.len() % 4;
+        let rest: f64 = self.xi[tail..]
+            .iter()
+            .zip(&weights[tail..])
+            .map(|(xi, w)| w * xi)
+            .sum();
+        (acc[0] + acc[1]) + (acc[2] + acc[3]) + rest
+    }
+
+    /// Σ wₖξₖ if the input moved to `x`, without moving it; `ramps` is scratch space of one
+    /// value per threshold.
+    fn trial_weighted(
+        &self,
+        thresholds: &[f64],
+        width: f64,
+        weights: &[f64],
+        x: f64,
+        ramps: &mut [f64],
+    ) -> f64 {
         let two_over_a = 2.0 / width;
-        for (r, &t) in self.ramps.iter_mut().zip(thresholds) {
+        for (r, &t) in ramps.iter_mut().zip(thresholds) {
             *r = ridge(x - t, two_over_a);
         }
         let mut k = 0;
         let mut acc = 0.0;
-        for (i, &up) in self.ramps.iter().enumerate() {
-            let row = &mut self.xi[k..k + i + 1];
-            let w = &weights[k..k + i + 1];
-            for ((xi, &down), &wk) in row.iter_mut().zip(&self.ramps[..=i]).zip(w) {
-                *xi = up.max(down.min(*xi));
-                acc += wk * *xi;
-            }
-            k += i + 1;
-        }
-        acc
-    }
-
-    /// Σ wₖξₖ if the input moved to `x`, without moving it.
-    fn trial_weighted(&self, thresholds: &[f64], width: f64, weights: &[f64], x: f64) -> f64 {
-        let two_over_a = 2.0 / width;
-        let mut k = 0;
-        let mut acc = 0.0;
-        for (i, &ti) in thresholds.iter().enumerate() {
-            let up = ridge(x - ti, two_over_a);
+        for (i, &up) in ramps.iter().enumerate() {
             let row = &self.xi[k..k + i + 1];
             let w = &weights[k..k + i + 1];
-            for ((&xi, &tj), &wk) in row.iter().zip(&thresholds[..=i]).zip(w) {
-                if wk != 0.0 {
-                    acc += wk * up.max(ridge(x - tj, two_over_a).min(xi));
-                }
+            for ((&xi, &down), &wk) in row.iter().zip(&ramps[..=i]).zip(w) {
+                let held = if down < xi { down } else { xi };
+                acc += wk * if up > held { up } else { held };
             }
             k += i + 1;
         }
@@ -421,12 +433,19 @@ impl Core for Kp {
             unbounded_above: self.a0 > 0.0,
         };
         let mut states = KernelStates::new(&self.thresholds, self.width);
+        let scratch = std::cell::RefCell::new(vec![0.0; self.levels()]);
         let (mut u, mut clipped) = (Vec::with_capacity(v.len()), Vec::new());
         for (k, &vk) in v.iter().enumerate() {
             let trial = |x: f64| {
-                self.offset
-                    + self.a0 * x
-                    + states.trial_weighted(&self.thresholds, self.width, &self.weights, x)
+                let mut ramps = scratch.borrow_mut();
+                let s = states.trial_weighted(
+                    &self.thresholds,
+                    self.width,
+                    &self.weights,
+                    x,
+                    &mut ramps,
+                );
+                self.offset + self.a0 * x + s
             };
             let (x, c) = solve_monotone(trial, vk, branch);
             if c {

@@ -83,6 +83,32 @@ fn initial_state_is_every_play_at_zero() {
 }
 
 #[test]
+fn simulation_equals_the_weighted_sum_of_the_kernel_states() {
+    // the kernel states are the recipe's regressors: c + a0·u + Σ μ ξ must be the output
+    let kp = example(0.2, Orientation::default());
+    let u = input(1500);
+    let y = kp.simulate(&u).unwrap();
+    let mut states = KernelStates::new(kp.thresholds(), kp.width());
+    for (k, &x) in u.iter().enumerate() {
+        states.advance(kp.thresholds(), kp.width(), x);
+        let direct = kp.offset()
+            + kp.a0() * x
+            + states
+                .values()
+                .iter()
+                .zip(kp.weights())
+                .map(|(xi, w)| xi * w)
+                .sum::<f64>();
+        assert!(
+            (direct - y[k]).abs() < 1e-12,
+            "sample {k}: {direct} vs {}",
+            y[k]
+        );
+        assert!(states.values().iter().all(|v| (-1.0..=1.0).contains(v)));
+    }
+}
+
+#[test]
 fn saturates_at_plus_minus_the_weight_sum() {
     let kp = example(0.2, Orientation::default());
     let total: f64 = kp.weights().iter().sum();
