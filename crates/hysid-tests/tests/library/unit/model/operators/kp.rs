@@ -109,6 +109,33 @@ fn simulation_equals_the_weighted_sum_of_the_kernel_states() {
 }
 
 #[test]
+fn rate_independent_and_periodic_after_one_cycle() {
+    let kp = example(0.2, Orientation::default());
+    // rate independence: inserting intermediate points between the samples (the same input
+    // path, sampled more finely) changes nothing at the original samples
+    let u = input(700);
+    let mut fine = Vec::with_capacity(3 * u.len());
+    for k in 0..u.len() {
+        if k > 0 {
+            fine.push(u[k - 1] + (u[k] - u[k - 1]) / 3.0);
+            fine.push(u[k - 1] + 2.0 * (u[k] - u[k - 1]) / 3.0);
+        }
+        fine.push(u[k]);
+    }
+    let (y, yf) = (kp.simulate(&u).unwrap(), kp.simulate(&fine).unwrap());
+    for k in 0..u.len() {
+        assert!((y[k] - yf[3 * k]).abs() < 1e-12, "sample {k}");
+    }
+    // a periodic input between fixed extremes: the loop closes after the first period
+    let period = 400;
+    let u: Vec<f64> = (0..3 * period)
+        .map(|k| 1.5 * (2.0 * std::f64::consts::PI * k as f64 / period as f64).sin() + 0.2)
+        .collect();
+    let y = kp.simulate(&u).unwrap();
+    assert!(max_abs_diff(&y[period..2 * period], &y[2 * period..]) < 1e-12);
+}
+
+#[test]
 fn saturates_at_plus_minus_the_weight_sum() {
     let kp = example(0.2, Orientation::default());
     let total: f64 = kp.weights().iter().sum();
