@@ -208,7 +208,7 @@ fn normal_equations(
     let mut row = vec![0.0; p];
     row[p - 1] = 1.0;
     for (&xk, &vk) in x.iter().zip(v) {
-        states.advance(thresholds, width, xk);
+        states.advance(xk);
         if reversible {
             row[0] = xk;
         }

@@ -104,20 +104,23 @@ fn ridge(x: f64, two_over_a: f64) -> f64 {
     (x * two_over_a).clamp(-1.0, 1.0)
 }
 
-/// The states ξ_{ij} of the kernels of a threshold grid, in the weights' order (0,0), (1,0),
-/// (1,1), (2,0), …; each advanced by ξ ← max(ρ_a(x − tᵢ), min(ρ_a(x − tⱼ), ξ)).
+/// The states ξ_{ij} of the kernels of a threshold grid with a ridge width, in the weights'
+/// order (0,0), (1,0), (1,1), (2,0), …; each advanced by ξ ← max(ρ_a(x − tᵢ), min(ρ_a(x − tⱼ), ξ)).
 ///
 /// This is the operator's memory and, per sample, its regressor row: the identification recipe
 /// builds its least-squares problem from [`KernelStates::values`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct KernelStates {
+    thresholds: Vec<f64>,
+    two_over_a: f64,
     xi: Vec<f64>,
     ramps: Vec<f64>,
 }
 
 impl KernelStates {
-    /// The initial state of the kernels of the grid `thresholds` with ridge width `width`:
-    /// every kernel's play at 0, ξ_{ij} = ρ_a(−(tᵢ + tⱼ)/2) (see the module documentation).
+    /// The initial state of the kernels of the grid `thresholds` with ridge width `width`
+    /// (as validated by [`Kp::new`]): every kernel's play at 0, ξ_{ij} = ρ_a(−(tᵢ + tⱼ)/2)
+    /// (see the module documentation).
     pub fn new(thresholds: &[f64], width: f64) -> Self {
         let two_over_a = 2.0 / width;
         let n = thresholds.len();
@@ -128,6 +131,8 @@ impl KernelStates {
             }
         }
         Self {
+            thresholds: thresholds.to_vec(),
+            two_over_a,
             xi,
             ramps: vec![0.0; n],
         }
@@ -138,12 +143,17 @@ impl KernelStates {
         &self.xi
     }
 
-    /// Moves the input to `x` on the grid `thresholds` with ridge width `width`.
-    pub fn advance(&mut self, thresholds: &[f64], width: f64, x: f64) {
-        let two_over_a = 2.0 / width;
-        for (r, &t) in self.ramps.iter_mut().zip(thresholds) {
+    /// ρ_a(x − tᵢ) for every threshold into `ramps`.
+    #[inline(always)]
+    fn ramps_at(thresholds: &[f64], two_over_a: f64, x: f64, ramps: &mut [f64]) {
+        for (r, &t) in ramps.iter_mut().zip(thresholds) {
             *r = ridge(x - t, two_over_a);
         }
+    }
+
+    /// Moves the input to `x`.
+    pub fn advance(&mut self, x: f64) {
+        Self::ramps_at(&self.thresholds, self.two_over_a, x, &mut self.ramps);
         let mut k = 0;
         for (i, &up) in self.ramps.iter().enumerate() {
             let row = &mut self.xi[k..k + i + 1];
@@ -159,8 +169,8 @@ impl KernelStates {
 
     /// Moves the input to `x` and returns Σ wₖξₖ (summed in four interleaved partial sums,
     /// so that the sum is not one chain of dependent additions).
-    fn advance_weighted(&mut self, thresholds: &[f64], width: f64, weights: &[f64], x: f64) -> f64 {
-        self.advance(thresholds, width, x);
+    fn advance_weighted(&mut self, weights: &[f64], x: f64) -> f64 {
+        self.advance(x);
         let mut acc = [0.0; 4];
         let mut chunks = self.xi.chunks_exact(4).zip(weights.chunks_exact(4));
         for (xi, w) in &mut chunks {
@@ -179,18 +189,8 @@ impl KernelStates {
 
     /// Σ wₖξₖ if the input moved to `x`, without moving it; `ramps` is scratch space of one
     /// value per threshold.
-    fn trial_weighted(
-        &self,
-        thresholds: &[f64],
-        width: f64,
-        weights: &[f64],
-        x: f64,
-        ramps: &mut [f64],
-    ) -> f64 {
-        let two_over_a = 2.0 / width;
-        for (r, &t) in ramps.iter_mut().zip(thresholds) {
-            *r = ridge(x - t, two_over_a);
-        }
+    fn trial_weighted(&self, weights: &[f64], x: f64, ramps: &mut [f64]) -> f64 {
+        Self::ramps_at(&self.thresholds, self.two_over_a, x, ramps);
         let mut k = 0;
         let mut acc = 0.0;
         for (i, &up) in ramps.iter().enumerate() {
@@ -418,7 +418,7 @@ impl Core for Kp {
         let mut states = KernelStates::new(&self.thresholds, self.width);
         u.iter()
             .map(|&x| {
-                let s = states.advance_weighted(&self.thresholds, self.width, &self.weights, x);
+                let s = states.advance_weighted(&self.weights, x);
                 self.offset + self.a0 * x + s
             })
             .collect()
@@ -438,20 +438,14 @@ impl Core for Kp {
         for (k, &vk) in v.iter().enumerate() {
             let trial = |x: f64| {
                 let mut ramps = scratch.borrow_mut();
-                let s = states.trial_weighted(
-                    &self.thresholds,
-                    self.width,
-                    &self.weights,
-                    x,
-                    &mut ramps,
-                );
+                let s = states.trial_weighted(&self.weights, x, &mut ramps);
                 self.offset + self.a0 * x + s
             };
             let (x, c) = solve_monotone(trial, vk, branch);
             if c {
                 clipped.push(k);
             }
-            states.advance(&self.thresholds, self.width, x);
+            states.advance(x);
             u.push(x);
         }
         (u, clipped)

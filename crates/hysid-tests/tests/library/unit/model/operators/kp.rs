@@ -90,7 +90,7 @@ fn simulation_equals_the_weighted_sum_of_the_kernel_states() {
     let y = kp.simulate(&u).unwrap();
     let mut states = KernelStates::new(kp.thresholds(), kp.width());
     for (k, &x) in u.iter().enumerate() {
-        states.advance(kp.thresholds(), kp.width(), x);
+        states.advance(x);
         let direct = kp.offset()
             + kp.a0() * x
             + states
