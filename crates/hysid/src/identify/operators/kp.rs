@@ -46,8 +46,9 @@ use std::time::Instant;
 /// Options of the KP identification.
 #[derive(Clone, Debug, PartialEq)]
 pub struct KpOptions {
-    /// Number of intervals N of the threshold grid over the input range (default 20: 20
-    /// thresholds, 210 kernels, the size of the default Preisach plane).
+    /// Number of intervals N of the threshold grid over the input range, 1..=100 (default
+    /// 20: 20 thresholds, 210 kernels, the size of the default Preisach plane). The Gram
+    /// matrix has (N(N + 1)/2 + 2)² entries: 200 MB at N = 100.
     pub levels: usize,
     /// Candidate ridge widths a relative to the grid's range (upper − lower), each finite and
     /// positive; the one with the smallest penalised equation error is kept, a single entry
@@ -147,14 +148,17 @@ pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>>
     ))
 }
 
+/// The largest grid: 5050 kernels, a Gram matrix of 200 MB.
+const MAX_LEVELS: usize = 100;
+
 /// Refuses options out of range, naming the option.
 fn check_options(options: &KpOptions) -> Result<()> {
-    if options.levels == 0 || options.levels > 1000 {
+    if options.levels == 0 || options.levels > MAX_LEVELS {
         return Err(Error::invalid_option(
             "levels",
             options.levels,
             format!(
-                "KP: levels = {}; give 1..=1000 grid intervals",
+                "KP: levels = {}; give 1..={MAX_LEVELS} grid intervals",
                 options.levels
             ),
         ));

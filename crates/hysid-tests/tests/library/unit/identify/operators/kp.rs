@@ -151,6 +151,13 @@ fn bad_options_are_refused() {
                 ..KpOptions::default()
             },
         ),
+        (
+            "levels",
+            KpOptions {
+                levels: 101,
+                ..KpOptions::default()
+            },
+        ),
     ];
     for (option, opts) in cases {
         match fit(&u, &y, &opts) {
