@@ -108,7 +108,6 @@ pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>>
 
     let mut best: Option<(f64, f64, WeightSolution)> = None;
     let mut iterations = 0;
-    let mut converged = true;
     for &relative in &options.widths {
         let width = relative * (upper - lower);
         let (g, b, yy, n) = normal_equations(&thresholds, width, &x, &v, options.reversible);
@@ -116,7 +115,6 @@ pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>>
         add_smoothness(&mut g_pen, thresholds.len(), first, options.lambda);
         let sol = solve_weights(&g_pen, &b, yy, n, &unconstrained, Some(&g))?;
         iterations += sol.iterations;
-        converged &= sol.converged;
         let criterion = penalised_error(&g_pen, &b, yy, &sol.x);
         if best.as_ref().is_none_or(|(c, _, _)| criterion < *c) {
             best = Some((criterion, width, sol));
@@ -125,6 +123,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>>
     let (_, width, sol) = best.ok_or_else(|| {
         Error::invalid_option("widths", "[]", "KP: give at least one ridge width".into())
     })?;
+    let converged = sol.converged;
     let a0 = if options.reversible { sol.x[0] } else { 0.0 };
     let weights = sol.x[first..first + kernels].to_vec();
     let model = Kp::new(thresholds, width, weights, a0, sol.x[p - 1], o).map_err(|e| {
