@@ -51,9 +51,12 @@ fn recovers_weights_both_orientations() {
         let f = fit(&u, &y, &options(o, range, 6, 0.25)).unwrap();
         assert_eq!(f.model.thresholds(), t.thresholds());
         assert_eq!(f.model.width(), t.width());
+        let mut worst = 0.0f64;
         for (k, (a, b)) in f.model.weights().iter().zip(t.weights()).enumerate() {
             assert!((a - b).abs() < 1e-6 * b, "{o:?} weight {k}: {a} vs {b}");
+            worst = worst.max((a - b).abs() / b);
         }
+        println!("{o:?}: largest relative weight error {worst:.1e}");
         assert!((f.model.a0() - 0.3).abs() < 1e-6 * 0.3, "{o:?}");
         assert!((f.model.offset() - 0.1).abs() < 1e-6, "{o:?}");
         assert_eq!(f.termination, Termination::ZeroResidual, "{o:?}");
@@ -98,6 +101,7 @@ fn noisy_fit_predicts_a_second_record_as_well_as_the_truth() {
     let yv = add_noise(&t.simulate(&uv).unwrap(), 2);
     let fit_true = metrics::fit_percent(&yv, &t.simulate(&uv).unwrap());
     let fit_est = metrics::fit_percent(&yv, &f.model.simulate(&uv).unwrap());
+    println!("40 dB: validation fit {fit_est:.4} % (true operator {fit_true:.4} %)");
     assert!(
         (fit_true - fit_est).abs() < 0.1,
         "validation fit {fit_est:.4} % vs the true operator's {fit_true:.4} %"
