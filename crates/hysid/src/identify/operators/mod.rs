@@ -9,6 +9,8 @@
 //!   S⁻¹\[y\] = H\[u\] (Kuhnen 2003).
 //! * [`preisach`]: regularised non-negative least squares on the cell regressors of a
 //!   triangular Preisach grid.
+//! * [`kp`]: the same on the kernel states of a Krasnosel'skii–Pokrovskii grid, the ridge
+//!   width profiled over a few candidates.
 //! * [`jiles_atherton`], [`bouc_wen`], [`duhem`], [`dahl`]: bounded Levenberg–Marquardt
 //!   output-error fits of the differential operators ([`differential_fit`] holds their common
 //!   part).
@@ -32,6 +34,7 @@ pub mod duhem;
 pub mod family;
 pub mod gpi;
 pub mod jiles_atherton;
+pub mod kp;
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod linear_support;
 pub mod maxwell_slip;

@@ -10,6 +10,8 @@
 //!   one-sided dead zones, for asymmetric loops; analytic inverse.
 //! * [`Preisach`] — the discrete Preisach plane (Mayergoyz 1991) with a piecewise-constant
 //!   density on a triangular grid, simulated through the Everett function.
+//! * [`Kp`] — the Krasnosel'skii–Pokrovskii operator (Krasnosel'skii & Pokrovskii 1989; Banks,
+//!   Kurdila & Webb 1997): continuous play-and-ridge kernels on a triangular threshold grid.
 //! * [`MaxwellSlip`] — generalised Maxwell-slip friction elements (Lampaert, Al-Bender &
 //!   Swevers 2003), a stop-operator superposition, inverted through the PI inverse.
 //!
@@ -20,8 +22,9 @@
 //!   operator (`duhem`, [`Duhem`]) and Dahl friction (`dahl`, [`Dahl`]).
 //!
 //! **Initial states.** Every play/stop operator starts from the state 0 as if the input had
-//! been 0 before the first sample: F_r\[u\]₀ = max(u₀ − r, min(u₀ + r, 0)). The Preisach plane
-//! starts in negative saturation (all relays down, as if the input came from below the grid).
+//! been 0 before the first sample: F_r\[u\]₀ = max(u₀ − r, min(u₀ + r, 0)); so does the play
+//! inside every KP kernel. The Preisach plane starts in negative saturation (all relays down,
+//! as if the input came from below the grid).
 //!
 //! **Orientation.** A counter-clockwise loop (the output lags the input, as most B(H) loops and
 //! the play operator itself) is modelled directly: Γ = G. A clockwise loop (the output leads)
@@ -51,6 +54,7 @@ pub mod duhem;
 pub(crate) mod elementary;
 pub(crate) mod gpi;
 pub mod jiles_atherton;
+pub mod kp;
 pub(crate) mod maxwell_slip;
 pub(crate) mod pi;
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
@@ -67,6 +71,7 @@ pub use elementary::{
 };
 pub use gpi::{DeadZones, GeneralizedPi};
 pub use jiles_atherton::{Anhysteretic, JaOutput, JilesAtherton};
+pub use kp::Kp;
 pub use maxwell_slip::MaxwellSlip;
 pub use pi::PrandtlIshlinskii;
 pub use preisach::Preisach;

@@ -8,6 +8,7 @@ mod duhem;
 mod family;
 mod gpi;
 mod jiles_atherton;
+mod kp;
 mod maxwell_slip;
 mod pi;
 mod preisach;
