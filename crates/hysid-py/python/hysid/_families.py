@@ -18,6 +18,7 @@ FamilyName = Literal[
     "dahl",
     "maxwell-slip",
     "backlash",
+    "kp",
     "ch4",
     "ch6",
 ]
@@ -33,6 +34,7 @@ FAMILIES: Tuple[str, ...] = (
     "dahl",
     "maxwell-slip",
     "backlash",
+    "kp",
     "ch4",
     "ch6",
 )

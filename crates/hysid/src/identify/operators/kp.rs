@@ -36,6 +36,7 @@
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, GramAccumulator, WeightSolution,
 };
+use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
 use crate::model::operators::kp::KernelStates;
 use crate::model::operators::{Kp, Orientation};
@@ -253,5 +254,20 @@ fn add_smoothness(g: &mut DMatrix<f64>, levels: usize, first: usize, lambda: f64
                 couple(index(i, j), index(i + 1, j));
             }
         }
+    }
+}
+
+impl Identify for Kp {
+    fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        fit(
+            u,
+            y,
+            &KpOptions {
+                levels: options.grid,
+                lambda: options.lambda,
+                orientation: options.orientation,
+                ..KpOptions::default()
+            },
+        )
     }
 }

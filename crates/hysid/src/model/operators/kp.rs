@@ -306,52 +306,6 @@ impl Kp {
         })
     }
 
-    /// The same operator rebuilt through [`Kp::new`]: the check for a structure read from a
-    /// model file (serde does not validate).
-    pub fn checked(self) -> Result<Self> {
-        Self::new(
-            self.thresholds,
-            self.width,
-            self.weights,
-            self.a0,
-            self.offset,
-            self.orientation,
-        )
-    }
-
-    /// The same structure (thresholds, ridge width, orientation) with the parameter values
-    /// `values` in [`HysteresisOperator::parameters`] order (a0, μ…, c), validated.
-    pub fn with_values(&self, values: &[f64]) -> Result<Self> {
-        let n = self.weights.len();
-        if values.len() != n + 2 {
-            return Err(Error::InvalidModel(format!(
-                "a kp operator has {} parameters, got {}",
-                n + 2,
-                values.len()
-            )));
-        }
-        Self::new(
-            self.thresholds.clone(),
-            self.width,
-            values[1..=n].to_vec(),
-            values[0],
-            values[n + 1],
-            self.orientation,
-        )
-    }
-
-    /// Indices (in [`HysteresisOperator::parameters`] order) of the parameters that scale the
-    /// output linearly — a₀, every μ and c: Γ\[u\] scaled by s > 0 is these multiplied by s —
-    /// or None for an inverse-parameterised orientation (Γ = ±G⁻¹), whose output is not
-    /// linear in them.
-    pub fn output_scale(&self) -> Option<Vec<usize>> {
-        if self.orientation.inverse {
-            None
-        } else {
-            Some((0..self.weights.len() + 2).collect())
-        }
-    }
-
     /// The midpoints of `levels` equal intervals over [lower, upper]: the identification
     /// recipe's grid.
     pub fn uniform_thresholds(lower: f64, upper: f64, levels: usize) -> Result<Vec<f64>> {
@@ -454,7 +408,7 @@ impl Core for Kp {
 
 impl HysteresisOperator for Kp {
     fn family(&self) -> &'static str {
-        "kp"
+        <Self as super::OperatorFamily>::NAME
     }
 
     fn parameters(&self) -> ParameterSet {
@@ -474,5 +428,51 @@ impl HysteresisOperator for Kp {
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, self.orientation, reference)
+    }
+}
+
+impl super::OperatorFamily for Kp {
+    const NAME: &'static str = "kp";
+    const TITLE: &'static str =
+        "Krasnosel'skii–Pokrovskii kernels on the Preisach triangle (Krasnosel'skii & Pokrovskii 1989; Banks, Kurdila & Webb 1997)";
+
+    fn example() -> Result<Self> {
+        let thresholds = Self::uniform_thresholds(-1.0, 1.0, 3)?;
+        let weights = vec![0.1, 0.2, 0.05, 0.3, 0.1, 0.15];
+        Self::new(thresholds, 0.3, weights, 0.2, 0.0, Orientation::default())
+    }
+
+    /// The same operator rebuilt through [`Kp::new`]: the check for a structure read from a
+    /// model file (serde does not validate).
+    fn checked(self) -> Result<Self> {
+        Self::new(
+            self.thresholds,
+            self.width,
+            self.weights,
+            self.a0,
+            self.offset,
+            self.orientation,
+        )
+    }
+
+    /// Values a0, μ…, c ([`HysteresisOperator::parameters`] order) on the same thresholds,
+    /// ridge width and orientation.
+    fn with_values(&self, values: &[f64]) -> Result<Self> {
+        super::check_values(self, values)?;
+        let n = self.weights.len();
+        Self::new(
+            self.thresholds.clone(),
+            self.width,
+            values[1..=n].to_vec(),
+            values[0],
+            values[n + 1],
+            self.orientation,
+        )
+    }
+
+    /// a₀, every μ and c: Γ\[u\] scaled by s > 0 is these multiplied by s; None for an
+    /// inverse-parameterised orientation (Γ = ±G⁻¹), whose output is not linear in them.
+    fn output_scale(&self) -> Option<Vec<usize>> {
+        (!self.orientation.inverse).then(|| (0..self.weights.len() + 2).collect())
     }
 }

@@ -94,6 +94,7 @@ macro_rules! operator_families {
             Dahl: $crate::model::operators::Dahl,
             MaxwellSlip: $crate::model::operators::MaxwellSlip,
             Backlash: $crate::model::operators::Backlash,
+            Kp: $crate::model::operators::Kp,
         }
     };
 }
