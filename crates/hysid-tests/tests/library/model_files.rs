@@ -384,3 +384,71 @@ fn a_key_given_twice_is_refused() {
     let e = FittedModel::load(&path).unwrap_err().to_string();
     assert!(e.contains("duplicate field `delay`"), "{e}");
 }
+
+#[test]
+fn a_grey_box_model_of_the_user_is_written_under_its_own_kind_and_not_read_back() {
+    use hysid::model::greybox::models::GreyBoxKind;
+    use hysid::model::greybox::Simulation;
+    // The built-in kinds: their names are their models' own kinds and parse back, with the
+    // command line's dashes too.
+    for kind in GreyBoxKind::ALL {
+        assert_eq!(kind.model().kind(), kind.name());
+        assert_eq!(GreyBoxKind::parse(kind.name()), Some(kind));
+        assert_eq!(
+            GreyBoxKind::parse(&kind.name().replace('_', "-")),
+            Some(kind)
+        );
+    }
+    assert_eq!(GreyBoxKind::parse("duffing"), None);
+    // A model of the user's own (e.g. Python callbacks) under the kind it gives itself.
+    let model = GreyBoxKind::RigidBody.model();
+    let parameters = model.parameters();
+    let fitted = FittedModel::GreyBox {
+        kind: "python".into(),
+        std: vec![f64::NAN; parameters.len()],
+        parameters,
+        simulation: Simulation::default(),
+        initial_state: vec![0.0; model.states().len()],
+    };
+    let file = fitted.to_file();
+    assert_eq!(file.kind(), "python");
+    let value = serde_json::to_value(&file).unwrap();
+    let keys: BTreeSet<&str> = value
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(
+        keys,
+        BTreeSet::from([
+            "schema",
+            "kind",
+            "parameters",
+            "simulation",
+            "initial_state"
+        ])
+    );
+    assert_eq!(value["kind"], "python");
+    let e = refusal(&value);
+    assert!(e.contains("unknown model kind 'python'"), "{e}");
+    // The same model under its built-in kind is a rigid_body file.
+    let FittedModel::GreyBox {
+        parameters,
+        std,
+        simulation,
+        initial_state,
+        ..
+    } = fitted
+    else {
+        unreachable!()
+    };
+    let builtin = FittedModel::GreyBox {
+        kind: "rigid_body".into(),
+        parameters,
+        std,
+        simulation,
+        initial_state,
+    };
+    assert!(matches!(builtin.to_file().model, SavedModel::RigidBody(_)));
+}
