@@ -124,6 +124,9 @@ impl ParameterRecord {
 /// keys, then `prefilter` and `inverse_dynamics` when set. Read strictly: a key that is not
 /// the kind's is refused, naming it (a `null` stands for an absent key, as files written by
 /// hand spell out keys that do not apply), and so is a key given twice.
+// Serialize and the JSON Schema are derived (`deny_unknown_fields` gives the schema its
+// `unevaluatedProperties: false`); Deserialize is written out (`ModelFile::from_object`), as
+// serde's `flatten` would let any key through.
 #[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelFile {
@@ -145,6 +148,8 @@ pub struct ModelFile {
 /// A saved model by its kind (the `kind` key of `hysid.model/1`): the parameters in the
 /// model's order and the structure keys the kind needs (see the module docs). Each kind's
 /// required keys are required here; the optional ones have the documented defaults.
+// `parameters` sits in every variant, right after the tag, so that a file's keys come in the
+// order every version has written them: `schema`, `kind`, `parameters`, the structure.
 #[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SavedModel {
@@ -1092,15 +1097,12 @@ impl FittedModel {
                 simulation.as_ref(),
                 initial_state.as_deref(),
             ),
-            SavedModel::BoucWen(file)
-            | SavedModel::RigidBody(file)
-            | SavedModel::ActuatorFixed(file)
-            | SavedModel::ActuatorFree(file) => {
-                let kind = GreyBoxKind::parse(records.kind).ok_or_else(|| {
-                    Error::InvalidModel(format!("unknown model kind '{}'", records.kind))
-                })?;
-                Self::grey_box_from_file(kind, file)
+            SavedModel::BoucWen(g) => Self::grey_box_from_file(GreyBoxKind::BoucWen, g),
+            SavedModel::RigidBody(g) => Self::grey_box_from_file(GreyBoxKind::RigidBody, g),
+            SavedModel::ActuatorFixed(g) => {
+                Self::grey_box_from_file(GreyBoxKind::ActuatorFixed, g)
             }
+            SavedModel::ActuatorFree(g) => Self::grey_box_from_file(GreyBoxKind::ActuatorFree, g),
             SavedModel::UserGreyBox { kind, .. } => Err(Error::InvalidModel(format!(
                 "unknown model kind '{kind}'; this version knows {} (a grey-box model of your own is rebuilt from its code, not from a file)",
                 MODEL_KINDS.join(", ")
