@@ -123,7 +123,7 @@ pub fn write_report(out: &Staged, report: &Report) -> Result<()> {
 /// Writes the saved-model file of `model`, refused when a parameter is not finite.
 pub fn write_model(out: &Staged, model: &FittedModel) -> Result<()> {
     let file = model.to_file();
-    if let Some(p) = file.parameters.iter().find(|p| !p.value.is_finite()) {
+    if let Some(p) = file.parameters().iter().find(|p| !p.value.is_finite()) {
         anyhow::bail!(
             "the estimate of {} is not finite; no model file written",
             p.name

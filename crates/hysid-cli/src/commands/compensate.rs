@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::io::atomic::OutputSet;
 use hysid::model::compensate::compensate;
-use hysid::model::saved::FittedModel;
+use hysid::model::saved::{FittedModel, SavedModel};
 use hysid::report::{DataSummary, Report};
 use serde_json::json;
 
@@ -34,7 +34,10 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
     let (rms, max) = c.tracking_error();
     let ranges = c.clipped_ranges();
     let file = model.to_file();
-    let family = file.family.clone().unwrap_or_else(|| file.kind.clone());
+    let family = match &file.model {
+        SavedModel::Operator { family, .. } => family.as_str(),
+        other => other.kind(),
+    };
     println!(
         "Compensated {} samples of '{}' with the {family} model",
         reference.len(),

@@ -62,7 +62,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         }
         write_csv(&csv.tmp, &headers, &cols)?;
     }
-    let kind = report.model.as_ref().map_or("", |m| m.kind.as_str());
+    let kind = report.model.as_ref().map_or("", |m| m.kind());
     for ((source, d), p) in records.iter().zip(&predictions) {
         println!(
             "Simulated {kind} on {source} ({} samples{})",

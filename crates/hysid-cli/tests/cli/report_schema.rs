@@ -355,7 +355,7 @@ fn actuator_and_rigid_body_reports_and_model_files() {
     );
     let loaded = hysid::model::saved::FittedModel::load(&rb).unwrap();
     let file = loaded.to_file();
-    let m = file.parameters.iter().find(|p| p.name == "M").unwrap();
+    let m = file.parameters().iter().find(|p| p.name == "M").unwrap();
     assert!((m.value - 95.1167).abs() < 0.01, "M = {}", m.value);
     // The model predicts the drive signal from the position as the fit did.
     reproduces(dir, &rb, &emps, ("qm_m", "vir_V"), fit_of(&report));

@@ -10,7 +10,7 @@ use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::models::{ActuatorFixed, BoucWen};
 use hysid::model::greybox::simulate::{simulate, InputTrack};
 use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
-use hysid::model::saved::FittedModel;
+use hysid::model::saved::{FittedModel, SavedModel};
 use hysid::model::ParameterSet;
 use hysid::numerics::signal::{gaussian_noise, multisine};
 use hysid::numerics::Control;
@@ -516,7 +516,10 @@ fn saved_equation_models_round_trip() {
     assert!(a[0].iter().zip(truth).all(|(x, y)| (x - y).abs() < 1e-12));
     // A corrupted text is reported with its line and column.
     let mut file = fitted.to_file();
-    file.equations = Some(model.source().replace("c*v", "cc*v"));
+    let SavedModel::Equations { equations, .. } = &mut file.model else {
+        panic!("not an equations model: {}", file.kind())
+    };
+    *equations = model.source().replace("c*v", "cc*v");
     let e = FittedModel::from_file(&file).unwrap_err().to_string();
     assert!(
         e.contains("line ") && e.contains("unknown name 'cc'"),

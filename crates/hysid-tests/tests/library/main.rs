@@ -11,6 +11,7 @@ mod equations;
 mod fuzz_readers;
 mod greybox;
 mod hysteresis_alone;
+mod model_files;
 mod preprocessing;
 mod properties;
 mod unit;

@@ -103,7 +103,7 @@ pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation
             (inv.u, inv.predicted, inv.clipped)
         }
         other => {
-            let kind = other.to_file().kind;
+            let kind = other.to_file().kind().to_string();
             return Err(Error::NotInvertible {
                 kind,
                 reason: "compensation inverts hysteresis operators, the Coleman–Hodgdon \

@@ -6,17 +6,21 @@
 //! file:
 //!
 //! ```json
-//! {"schema": "hysid.model/1", "kind": "ch_cascade", "hysteresis": "ch4", "delay": 1,
+//! {"schema": "hysid.model/1", "kind": "ch_cascade",
 //!  "parameters": [
 //!    {"name": "alpha", "value": 0.3, "std": 0.001, "unit": "", "fixed": false,
 //!     "lower": 0.0, "upper": null},
 //!    {"name": "b1", "value": 1.0, "std": null, "unit": "", "fixed": true,
-//!     "lower": null, "upper": null}, …]}
+//!     "lower": null, "upper": null}, …],
+//!  "hysteresis": "ch4", "delay": 1}
 //! ```
 //!
 //! `parameters` is a flat list in the model's order: `std` is null where the parameter was not
-//! estimated (fixed, or unknown), `lower`/`upper` null where unbounded. Kinds and their
-//! structure keys:
+//! estimated (fixed, or unknown), `lower`/`upper` null where unbounded. The kinds are the
+//! variants of [`SavedModel`], a serde enum tagged by `kind` whose variants hold each kind's
+//! parameters and structure keys, so a key the kind needs is required by the type and any
+//! other key is refused, naming it ([`ModelFile::from_object`]). Kinds and their structure
+//! keys:
 //!
 //! | kind | structure | parameters |
 //! |---|---|---|
@@ -42,6 +46,7 @@
 
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
+use crate::model::greybox::models::GreyBoxKind;
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::operators::OperatorModel;
 use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
@@ -111,45 +116,25 @@ impl ParameterRecord {
     }
 }
 
-/// The saved-model file `hysid.model/1` (see the module docs).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+/// The saved-model file `hysid.model/1` (see the module docs): the schema tag, the model
+/// (its kind, parameters and structure, [`SavedModel`]) and the processing its fit applied
+/// to the records.
+///
+/// Written as one flat JSON object, `schema`, `kind`, `parameters`, the kind's structure
+/// keys, then `prefilter` and `inverse_dynamics` when set. Read strictly: a key that is not
+/// the kind's is refused, naming it (a `null` stands for an absent key, as files written by
+/// hand spell out keys that do not apply), and so is a key given twice.
+// Serialize and the JSON Schema are derived (`deny_unknown_fields` gives the schema its
+// `unevaluatedProperties: false`); Deserialize is written out (`ModelFile::from_object`), as
+// serde's `flatten` would let any key through.
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ModelFile {
     /// Always `hysid.model/1`.
     pub schema: String,
-    /// The model kind (see the module docs).
-    pub kind: String,
-    /// The parameters in the model's order.
-    pub parameters: Vec<ParameterRecord>,
-    /// `ch4` or `ch6` (Coleman–Hodgdon kinds).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub hysteresis: Option<ChForm>,
-    /// Delay k of the linear block (cascade).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub delay: Option<usize>,
-    /// Where the output of the hysteresis alone starts.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub initial_output: Option<InitialOutput>,
-    /// How a grey-box model is simulated.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub simulation: Option<SimulationSpec>,
-    /// Initial state of a grey-box model.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub initial_state: Option<Vec<f64>>,
-    /// The equation file's text (kind `equations`), so that the saved model is
-    /// self-contained.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub equations: Option<String>,
-    /// The operator family (kind `operator`): `pi`, `gpi`, `preisach`, `jiles-atherton`,
-    /// `bouc-wen`, `duhem`, `dahl`, `maxwell-slip` or `backlash`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub family: Option<String>,
-    /// The operator's full structure: for kind `operator` its thresholds, weights, grids,
-    /// orientation and initial state, as the family defines them; for kind
-    /// `operator_cascade` `{"family": …, "operator": {…}}` with the structure, whose values
-    /// are read from `parameters`. Checked on reading.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub operator: Option<serde_json::Value>,
+    /// The model: its kind, parameters and structure.
+    #[serde(flatten)]
+    pub model: SavedModel,
     /// The pre-filter the model was fitted with (the actuator's step 3): `hysid simulate`
     /// filters input and measured output alike before simulating.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -158,6 +143,375 @@ pub struct ModelFile {
     /// the model predicts the drive signal from the measured position, as the fit did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inverse_dynamics: Option<InverseDynamics>,
+}
+
+/// A saved model by its kind (the `kind` key of `hysid.model/1`): the parameters in the
+/// model's order and the structure keys the kind needs (see the module docs). Each kind's
+/// required keys are required here; the optional ones have the documented defaults.
+// `parameters` sits in every variant, right after the tag, so that a file's keys come in the
+// order every version has written them: `schema`, `kind`, `parameters`, the structure.
+#[derive(Clone, Debug, PartialEq, Serialize, JsonSchema)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SavedModel {
+    /// The Coleman–Hodgdon hysteresis alone.
+    ColemanHodgdon {
+        /// alpha, m1, c1, d (ch6: alpha, m1, m2, c1, c2, d).
+        parameters: Vec<ParameterRecord>,
+        /// `ch4` or `ch6`.
+        hysteresis: ChForm,
+        /// Where the output of the hysteresis starts (`measured` when absent).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        initial_output: Option<InitialOutput>,
+    },
+    /// The Coleman–Hodgdon hysteresis followed by a linear block (Vörös 2015).
+    ChCascade {
+        /// The hysteresis parameters, then b1 (fixed at 1) … bm, a1 … an.
+        parameters: Vec<ParameterRecord>,
+        /// `ch4` or `ch6`.
+        hysteresis: ChForm,
+        /// Delay k of the linear block.
+        delay: usize,
+    },
+    /// A hysteresis operator followed by a linear block.
+    OperatorCascade {
+        /// The operator's parameters (prefixed `op_` where they collide with a1…, b1…),
+        /// then a1 … an, b1 (fixed at 1) … bm.
+        parameters: Vec<ParameterRecord>,
+        /// Delay k of the linear block.
+        delay: usize,
+        /// `{"family": …, "operator": {…}}`: the operator family and its structure, whose
+        /// values are read from `parameters`. Checked on reading.
+        operator: serde_json::Value,
+    },
+    /// The built-in Bouc–Wen oscillator (`GreyBoxKind::BoucWen`).
+    BoucWen(GreyBoxFile),
+    /// The built-in rigid body (`GreyBoxKind::RigidBody`).
+    RigidBody(GreyBoxFile),
+    /// The built-in actuator, saddle fixed (`GreyBoxKind::ActuatorFixed`).
+    ActuatorFixed(GreyBoxFile),
+    /// The built-in actuator, saddle free (`GreyBoxKind::ActuatorFree`).
+    ActuatorFree(GreyBoxFile),
+    /// A grey-box model written as equations (`hysid-equations`).
+    Equations {
+        /// The equation file's `[parameters]`, in its order.
+        parameters: Vec<ParameterRecord>,
+        /// How the model is simulated (the default RK4 when absent).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        simulation: Option<SimulationSpec>,
+        /// Its initial state (the text's `[initial]` when absent).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        initial_state: Option<Vec<f64>>,
+        /// The equation file's text, so that the saved model is self-contained.
+        equations: String,
+    },
+    /// A hysteresis operator of one family.
+    Operator {
+        /// The family's parameters, named as in the literature.
+        parameters: Vec<ParameterRecord>,
+        /// `pi`, `gpi`, `preisach`, `jiles-atherton`, `bouc-wen`, `duhem`, `dahl`,
+        /// `maxwell-slip` or `backlash`.
+        family: String,
+        /// The operator's full structure: thresholds, weights, grids, orientation and
+        /// initial state, as the family defines them. Checked on reading.
+        operator: serde_json::Value,
+    },
+    /// A grey-box model of the library's user (its own [`StateSpaceModel`], e.g. Python
+    /// callbacks), under the kind the model gives itself: written into reports, never read
+    /// back (no file can rebuild it).
+    ///
+    /// [`StateSpaceModel`]: crate::model::greybox::StateSpaceModel
+    #[serde(untagged, skip_deserializing)]
+    #[schemars(skip)]
+    UserGreyBox {
+        /// The model's own kind.
+        kind: String,
+        /// Its parameters.
+        parameters: Vec<ParameterRecord>,
+        /// How it is simulated.
+        simulation: SimulationSpec,
+        /// Its initial state.
+        initial_state: Vec<f64>,
+    },
+}
+
+/// How [`SavedModel`] is read: the same enum without [`SavedModel::UserGreyBox`], which is
+/// never read back and, as an untagged variant in the derived reader, would turn every error
+/// of the tagged ones (a missing key, an unknown one) into "did not match any variant". The
+/// compiler checks that each variant builds its [`SavedModel`] twin field by field.
+#[derive(Deserialize)]
+#[serde(
+    remote = "SavedModel",
+    tag = "kind",
+    rename_all = "snake_case",
+    deny_unknown_fields
+)]
+enum SavedModelReader {
+    ColemanHodgdon {
+        parameters: Vec<ParameterRecord>,
+        hysteresis: ChForm,
+        #[serde(default)]
+        initial_output: Option<InitialOutput>,
+    },
+    ChCascade {
+        parameters: Vec<ParameterRecord>,
+        hysteresis: ChForm,
+        delay: usize,
+    },
+    OperatorCascade {
+        parameters: Vec<ParameterRecord>,
+        delay: usize,
+        operator: serde_json::Value,
+    },
+    BoucWen(GreyBoxFile),
+    RigidBody(GreyBoxFile),
+    ActuatorFixed(GreyBoxFile),
+    ActuatorFree(GreyBoxFile),
+    Equations {
+        parameters: Vec<ParameterRecord>,
+        #[serde(default)]
+        simulation: Option<SimulationSpec>,
+        #[serde(default)]
+        initial_state: Option<Vec<f64>>,
+        equations: String,
+    },
+    Operator {
+        parameters: Vec<ParameterRecord>,
+        family: String,
+        operator: serde_json::Value,
+    },
+}
+
+impl<'de> Deserialize<'de> for SavedModel {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        SavedModelReader::deserialize(deserializer)
+    }
+}
+
+/// The structure of a built-in grey-box model in a model file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GreyBoxFile {
+    /// The built-in model's parameters (matched by name).
+    pub parameters: Vec<ParameterRecord>,
+    /// How the model is simulated (the default RK4 when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<SimulationSpec>,
+    /// Its initial state (zeros when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_state: Option<Vec<f64>>,
+}
+
+/// The kinds this version reads, in the order of [`SavedModel`].
+pub const MODEL_KINDS: [&str; 9] = [
+    "coleman_hodgdon",
+    "ch_cascade",
+    OPERATOR_CASCADE_KIND,
+    "bouc_wen",
+    "rigid_body",
+    "actuator_fixed",
+    "actuator_free",
+    EQUATIONS_KIND,
+    OPERATOR_KIND,
+];
+
+/// The keys of `hysid.model/1` besides `schema` and `kind`: a `null` for any of them reads as
+/// the key left out.
+const MODEL_KEYS: [&str; 11] = [
+    "parameters",
+    "hysteresis",
+    "delay",
+    "initial_output",
+    "simulation",
+    "initial_state",
+    "equations",
+    "family",
+    "operator",
+    "prefilter",
+    "inverse_dynamics",
+];
+
+impl SavedModel {
+    /// The kind (the `kind` key).
+    pub fn kind(&self) -> &str {
+        match self {
+            SavedModel::ColemanHodgdon { .. } => "coleman_hodgdon",
+            SavedModel::ChCascade { .. } => "ch_cascade",
+            SavedModel::OperatorCascade { .. } => OPERATOR_CASCADE_KIND,
+            SavedModel::BoucWen(_) => GreyBoxKind::BoucWen.name(),
+            SavedModel::RigidBody(_) => GreyBoxKind::RigidBody.name(),
+            SavedModel::ActuatorFixed(_) => GreyBoxKind::ActuatorFixed.name(),
+            SavedModel::ActuatorFree(_) => GreyBoxKind::ActuatorFree.name(),
+            SavedModel::Equations { .. } => EQUATIONS_KIND,
+            SavedModel::Operator { .. } => OPERATOR_KIND,
+            SavedModel::UserGreyBox { kind, .. } => kind,
+        }
+    }
+
+    /// The parameters in the model's order.
+    pub fn parameters(&self) -> &[ParameterRecord] {
+        match self {
+            SavedModel::ColemanHodgdon { parameters, .. }
+            | SavedModel::ChCascade { parameters, .. }
+            | SavedModel::OperatorCascade { parameters, .. }
+            | SavedModel::Equations { parameters, .. }
+            | SavedModel::Operator { parameters, .. }
+            | SavedModel::UserGreyBox { parameters, .. } => parameters,
+            SavedModel::BoucWen(g)
+            | SavedModel::RigidBody(g)
+            | SavedModel::ActuatorFixed(g)
+            | SavedModel::ActuatorFree(g) => &g.parameters,
+        }
+    }
+
+    /// The saved built-in grey-box model `kind`.
+    pub fn grey_box(kind: GreyBoxKind, file: GreyBoxFile) -> Self {
+        match kind {
+            GreyBoxKind::BoucWen => SavedModel::BoucWen(file),
+            GreyBoxKind::RigidBody => SavedModel::RigidBody(file),
+            GreyBoxKind::ActuatorFixed => SavedModel::ActuatorFixed(file),
+            GreyBoxKind::ActuatorFree => SavedModel::ActuatorFree(file),
+        }
+    }
+
+    /// The built-in grey-box model and its structure, for the grey-box kinds.
+    pub fn as_grey_box(&self) -> Option<(GreyBoxKind, &GreyBoxFile)> {
+        match self {
+            SavedModel::BoucWen(g) => Some((GreyBoxKind::BoucWen, g)),
+            SavedModel::RigidBody(g) => Some((GreyBoxKind::RigidBody, g)),
+            SavedModel::ActuatorFixed(g) => Some((GreyBoxKind::ActuatorFixed, g)),
+            SavedModel::ActuatorFree(g) => Some((GreyBoxKind::ActuatorFree, g)),
+            _ => None,
+        }
+    }
+}
+
+impl ModelFile {
+    /// The model file of `model` (schema `hysid.model/1`, no record processing).
+    pub fn new(model: SavedModel) -> Self {
+        Self {
+            schema: MODEL_SCHEMA.into(),
+            model,
+            prefilter: None,
+            inverse_dynamics: None,
+        }
+    }
+
+    /// The model kind (the `kind` key).
+    pub fn kind(&self) -> &str {
+        self.model.kind()
+    }
+
+    /// The parameters in the model's order.
+    pub fn parameters(&self) -> &[ParameterRecord] {
+        self.model.parameters()
+    }
+
+    /// The model file of a JSON object, checked key by key (see [`ModelFile`]); the error is
+    /// one line naming the kind and the key.
+    pub fn from_object(mut object: serde_json::Map<String, serde_json::Value>) -> Result<Self> {
+        let bad = |message: String| Error::InvalidModel(message);
+        object.retain(|key, value| !(value.is_null() && MODEL_KEYS.contains(&key.as_str())));
+        let schema = match object.remove("schema") {
+            Some(serde_json::Value::String(s)) => s,
+            Some(other) => return Err(bad(format!("\"schema\" is {other}, not a string"))),
+            None => return Err(bad("missing field `schema`".into())),
+        };
+        let kind = match object.get("kind") {
+            Some(serde_json::Value::String(kind)) => kind.clone(),
+            Some(other) => return Err(bad(format!("\"kind\" is {other}, not a string"))),
+            None => return Err(bad("missing field `kind`".into())),
+        };
+        if !MODEL_KINDS.contains(&kind.as_str()) {
+            return Err(bad(format!(
+                "unknown model kind '{kind}'; this version knows {}",
+                MODEL_KINDS.join(", ")
+            )));
+        }
+        let prefilter = object
+            .remove("prefilter")
+            .map(serde_json::from_value)
+            .transpose()
+            .map_err(|e| bad(format!("\"prefilter\": {e}")))?;
+        let inverse_dynamics = object
+            .remove("inverse_dynamics")
+            .map(serde_json::from_value)
+            .transpose()
+            .map_err(|e| bad(format!("\"inverse_dynamics\": {e}")))?;
+        let read = |object: serde_json::Map<String, serde_json::Value>| {
+            serde_json::from_value::<SavedModel>(serde_json::Value::Object(object))
+        };
+        let model = read(object.clone()).map_err(|e| {
+            // serde names a missing or unknown key, not one whose value is wrong: that key
+            // is the one without which the model reads, or is only missing.
+            let message = e.to_string();
+            let names_a_key = object
+                .keys()
+                .map(String::as_str)
+                .chain(MODEL_KEYS)
+                .any(|key| message.contains(&format!("field `{key}`")));
+            let culprit = (!names_a_key).then(|| {
+                object.keys().filter(|k| *k != "kind").find(|key| {
+                    let mut without = object.clone();
+                    without.remove(*key);
+                    match read(without) {
+                        Ok(_) => true,
+                        Err(e) => e.to_string() == format!("missing field `{key}`"),
+                    }
+                })
+            });
+            match culprit.flatten() {
+                Some(key) => bad(format!("the {kind} model: \"{key}\": {message}")),
+                None => bad(format!("the {kind} model: {message}")),
+            }
+        })?;
+        Ok(Self {
+            schema,
+            model,
+            prefilter,
+            inverse_dynamics,
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for ModelFile {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        let object = deserializer.deserialize_map(ObjectVisitor)?;
+        ModelFile::from_object(object).map_err(|e| match e {
+            Error::InvalidModel(message) => D::Error::custom(message),
+            other => D::Error::custom(other),
+        })
+    }
+}
+
+/// A JSON object whose keys are all different.
+struct ObjectVisitor;
+
+impl<'de> serde::de::Visitor<'de> for ObjectVisitor {
+    type Value = serde_json::Map<String, serde_json::Value>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a hysid.model/1 object")
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(
+        self,
+        mut access: A,
+    ) -> std::result::Result<Self::Value, A::Error> {
+        use serde::de::Error as _;
+        let mut object = serde_json::Map::new();
+        while let Some((key, value)) = access.next_entry::<String, serde_json::Value>()? {
+            if object.contains_key(&key) {
+                return Err(A::Error::custom(format!("duplicate field `{key}`")));
+            }
+            object.insert(key, value);
+        }
+        Ok(object)
+    }
 }
 
 /// The simulation settings in a model file.
@@ -513,7 +867,7 @@ impl FittedModel {
             } if kind == "rigid_body" => parameters,
             other => {
                 return Err(Error::UnsupportedKind {
-                    kind: other.to_file().kind,
+                    kind: other.to_file().kind().to_string(),
                     operation: "inverse dynamics (a rigid_body model)".into(),
                 })
             }
@@ -562,48 +916,34 @@ impl FittedModel {
 
     /// The model file of this model.
     pub fn to_file(&self) -> ModelFile {
-        let empty = |kind: &str, parameters: Vec<ParameterRecord>| ModelFile {
-            schema: MODEL_SCHEMA.into(),
-            kind: kind.into(),
-            parameters,
-            hysteresis: None,
-            delay: None,
-            initial_output: None,
-            simulation: None,
-            initial_state: None,
-            equations: None,
-            family: None,
-            operator: None,
-            prefilter: None,
-            inverse_dynamics: None,
+        let records = |parameters: &ParameterSet, std: &[f64]| -> Vec<ParameterRecord> {
+            parameters
+                .iter()
+                .zip(std)
+                .map(|(p, s)| ParameterRecord::of(p, *s))
+                .collect()
         };
-        match self {
+        let model = match self {
             FittedModel::Hysteresis {
                 model,
                 initial,
                 std,
-            } => ModelFile {
-                hysteresis: Some(model.form()),
+            } => SavedModel::ColemanHodgdon {
+                parameters: hysteresis_records(model, std),
+                hysteresis: model.form(),
                 initial_output: Some(*initial),
-                ..empty("coleman_hodgdon", hysteresis_records(model, std))
             },
-            FittedModel::Cascade { model, std } => ModelFile {
-                hysteresis: Some(model.hysteresis.form()),
-                delay: Some(model.linear.delay()),
-                ..empty("ch_cascade", cascade_records(model, std))
+            FittedModel::Cascade { model, std } => SavedModel::ChCascade {
+                parameters: cascade_records(model, std),
+                hysteresis: model.hysteresis.form(),
+                delay: model.linear.delay(),
             },
-            FittedModel::OperatorCascade { model, std } => ModelFile {
-                delay: Some(model.linear.delay()),
-                operator: serde_json::to_value(&model.operator).ok(),
-                ..empty(
-                    OPERATOR_CASCADE_KIND,
-                    model
-                        .parameters()
-                        .iter()
-                        .zip(std)
-                        .map(|(p, s)| ParameterRecord::of(p, *s))
-                        .collect(),
-                )
+            FittedModel::OperatorCascade { model, std } => SavedModel::OperatorCascade {
+                parameters: records(&model.parameters(), std),
+                delay: model.linear.delay(),
+                // The structure of a constructed operator is always representable; a failure
+                // would only leave it null, and reading the file back then says so.
+                operator: serde_json::to_value(&model.operator).unwrap_or_default(),
             },
             FittedModel::GreyBox {
                 kind,
@@ -611,65 +951,61 @@ impl FittedModel {
                 std,
                 simulation,
                 initial_state,
-            } => ModelFile {
-                simulation: Some(SimulationSpec::of(simulation)),
-                initial_state: Some(initial_state.clone()),
-                ..empty(
-                    kind,
-                    parameters
-                        .iter()
-                        .zip(std)
-                        .map(|(p, s)| ParameterRecord::of(p, *s))
-                        .collect(),
-                )
-            },
+            } => {
+                let parameters = records(parameters, std);
+                let simulation = SimulationSpec::of(simulation);
+                match GreyBoxKind::parse(kind).filter(|k| k.name() == kind) {
+                    Some(kind) => SavedModel::grey_box(
+                        kind,
+                        GreyBoxFile {
+                            parameters,
+                            simulation: Some(simulation),
+                            initial_state: Some(initial_state.clone()),
+                        },
+                    ),
+                    None => SavedModel::UserGreyBox {
+                        kind: kind.clone(),
+                        parameters,
+                        simulation,
+                        initial_state: initial_state.clone(),
+                    },
+                }
+            }
             FittedModel::Equations {
                 equations,
                 parameters,
                 std,
                 simulation,
                 initial_state,
-            } => ModelFile {
+            } => SavedModel::Equations {
+                parameters: records(parameters, std),
                 simulation: Some(SimulationSpec::of(simulation)),
                 initial_state: Some(initial_state.clone()),
-                equations: Some(equations.clone()),
-                ..empty(
-                    EQUATIONS_KIND,
-                    parameters
-                        .iter()
-                        .zip(std)
-                        .map(|(p, s)| ParameterRecord::of(p, *s))
-                        .collect(),
-                )
+                equations: equations.clone(),
             },
-            FittedModel::Prefiltered { model, prefilter } => ModelFile {
-                prefilter: Some(*prefilter),
-                ..model.to_file()
-            },
+            FittedModel::Prefiltered { model, prefilter } => {
+                return ModelFile {
+                    prefilter: Some(*prefilter),
+                    ..model.to_file()
+                }
+            }
             FittedModel::InverseDynamics {
                 model,
                 preprocessing,
-            } => ModelFile {
-                inverse_dynamics: Some(*preprocessing),
-                ..model.to_file()
+            } => {
+                return ModelFile {
+                    inverse_dynamics: Some(*preprocessing),
+                    ..model.to_file()
+                }
+            }
+            FittedModel::Operator { family, model, std } => SavedModel::Operator {
+                parameters: records(&model.as_operator().parameters(), std),
+                family: family.to_string(),
+                // As for the operator cascade: a failure would only leave the structure null.
+                operator: model.structure().unwrap_or_default(),
             },
-            FittedModel::Operator { family, model, std } => ModelFile {
-                family: Some(family.to_string()),
-                // The structure of a constructed operator is always representable; a failure
-                // would only drop it, and reading the file back then says so.
-                operator: model.structure().ok(),
-                ..empty(
-                    OPERATOR_KIND,
-                    model
-                        .as_operator()
-                        .parameters()
-                        .iter()
-                        .zip(std)
-                        .map(|(p, s)| ParameterRecord::of(p, *s))
-                        .collect(),
-                )
-            },
-        }
+        };
+        ModelFile::new(model)
     }
 
     /// The fitted model of an operator with standard deviations `std` (NaN: none).
@@ -689,7 +1025,7 @@ impl FittedModel {
                 file.schema
             )));
         }
-        if let Some(p) = file.parameters.iter().find(|p| !p.value.is_finite()) {
+        if let Some(p) = file.parameters().iter().find(|p| !p.value.is_finite()) {
             return Err(Error::InvalidModel(format!(
                 "parameter '{}' has no finite value",
                 p.name
@@ -716,85 +1052,75 @@ impl FittedModel {
             model.rigid_body()?;
             return Ok(model);
         }
-        match file.kind.as_str() {
-            "coleman_hodgdon" | "ch_cascade" => Self::coleman_hodgdon_from_file(file),
-            EQUATIONS_KIND => equations_from_file(file),
-            OPERATOR_CASCADE_KIND => operator_cascade_from_file(file),
-            OPERATOR_KIND => Self::operator_from_file(file),
-            kind => Self::grey_box_from_file(kind, file),
-        }
-    }
-
-    fn coleman_hodgdon_from_file(file: &ModelFile) -> Result<Self> {
-        let form = file.hysteresis.ok_or_else(|| {
-            Error::InvalidModel(format!(
-                "a {} model needs \"hysteresis\": \"ch4\" or \"ch6\"",
-                file.kind
-            ))
-        })?;
-        let mut values = Vec::new();
-        let mut std = Vec::new();
-        for name in form.parameter_names() {
-            let e = record(file, name)?;
-            values.push(e.value);
-            std.push(e.std_or_nan());
-        }
-        let hysteresis = ColemanHodgdon::from_params(form, &values)?;
-        if file.kind == "coleman_hodgdon" {
-            return Ok(FittedModel::Hysteresis {
-                model: hysteresis,
-                initial: file.initial_output.unwrap_or(InitialOutput::Measured),
-                std,
-            });
-        }
-        let b = coefficients(file, 'b')?;
-        let a = coefficients(file, 'a')?;
-        if b.is_empty() || b[0].value != 1.0 {
-            return Err(Error::InvalidModel(
-                "a ch_cascade model needs b1 = 1 (the gain sits in the hysteresis)".into(),
-            ));
-        }
-        let delay = file
-            .delay
-            .ok_or_else(|| Error::InvalidModel("a ch_cascade model needs \"delay\"".into()))?;
-        let linear = LinearBlock::new(
-            a.iter().map(|e| e.value).collect(),
-            b.iter().map(|e| e.value).collect(),
-            delay,
-        )?;
-        std.extend(b.iter().skip(1).map(ParameterRecord::std_or_nan));
-        std.extend(a.iter().map(ParameterRecord::std_or_nan));
-        Ok(FittedModel::Cascade {
-            model: HysteresisCascade::new(hysteresis, linear)?,
-            std,
-        })
-    }
-
-    fn operator_from_file(file: &ModelFile) -> Result<Self> {
-        let (Some(family), Some(structure)) = (&file.family, &file.operator) else {
-            return Err(Error::InvalidModel(
-                "an operator model needs \"family\" and \"operator\"; save the model again".into(),
-            ));
+        let records = Records {
+            kind: file.kind(),
+            list: file.parameters(),
         };
-        let model = OperatorModel::from_structure(family, structure)?;
-        let names = model.as_operator().parameters();
-        let mut std = Vec::with_capacity(names.len());
-        for p in names.iter() {
-            std.push(record(file, &p.name)?.std_or_nan());
+        match &file.model {
+            SavedModel::ColemanHodgdon {
+                hysteresis,
+                initial_output,
+                ..
+            } => {
+                let (model, std) = hysteresis_from_records(*hysteresis, &records)?;
+                Ok(FittedModel::Hysteresis {
+                    model,
+                    initial: initial_output.unwrap_or(InitialOutput::Measured),
+                    std,
+                })
+            }
+            SavedModel::ChCascade {
+                hysteresis, delay, ..
+            } => ch_cascade_from_records(*hysteresis, *delay, &records),
+            SavedModel::OperatorCascade {
+                delay, operator, ..
+            } => operator_cascade_from_file(*delay, operator, &records),
+            SavedModel::Operator {
+                family, operator, ..
+            } => {
+                let model = OperatorModel::from_structure(family, operator)?;
+                let names = model.as_operator().parameters();
+                let mut std = Vec::with_capacity(names.len());
+                for p in names.iter() {
+                    std.push(records.get(&p.name)?.std_or_nan());
+                }
+                Ok(Self::operator(model, std))
+            }
+            SavedModel::Equations {
+                parameters,
+                simulation,
+                initial_state,
+                equations,
+            } => equations_from_file(
+                equations,
+                parameters,
+                simulation.as_ref(),
+                initial_state.as_deref(),
+            ),
+            SavedModel::BoucWen(g) => Self::grey_box_from_file(GreyBoxKind::BoucWen, g),
+            SavedModel::RigidBody(g) => Self::grey_box_from_file(GreyBoxKind::RigidBody, g),
+            SavedModel::ActuatorFixed(g) => {
+                Self::grey_box_from_file(GreyBoxKind::ActuatorFixed, g)
+            }
+            SavedModel::ActuatorFree(g) => Self::grey_box_from_file(GreyBoxKind::ActuatorFree, g),
+            SavedModel::UserGreyBox { kind, .. } => Err(Error::InvalidModel(format!(
+                "unknown model kind '{kind}'; this version knows {} (a grey-box model of your own is rebuilt from its code, not from a file)",
+                MODEL_KINDS.join(", ")
+            ))),
         }
-        Ok(Self::operator(model, std))
     }
 
-    fn grey_box_from_file(kind: &str, file: &ModelFile) -> Result<Self> {
-        let model = models::by_kind(kind).map_err(|_| {
-            Error::InvalidModel(format!(
-                "unknown model kind '{kind}'; this version knows coleman_hodgdon, ch_cascade, bouc_wen, rigid_body, actuator_fixed, actuator_free, equations, operator and operator_cascade"
-            ))
-        })?;
+    fn grey_box_from_file(kind: GreyBoxKind, file: &GreyBoxFile) -> Result<Self> {
+        let model = kind.model();
+        let name = kind.name();
+        let records = Records {
+            kind: name,
+            list: &file.parameters,
+        };
         let mut parameters = model.parameters();
         let mut std = Vec::new();
         for i in 0..parameters.len() {
-            let e = record(file, &parameters.get(i).name.clone())?;
+            let e = records.get(&parameters.get(i).name.clone())?;
             // The model's own bounds are its physics (a positive mass, non-negative
             // friction): a file's wider bounds do not admit a value outside them.
             let own = parameters.get(i);
@@ -803,7 +1129,7 @@ impl FittedModel {
                     name: own.name.clone(),
                     value: e.value,
                     reason: format!(
-                        "the {kind} model needs {} in [{}, {}]",
+                        "the {name} model needs {} in [{}, {}]",
                         own.name, own.min, own.max
                     ),
                 });
@@ -816,7 +1142,7 @@ impl FittedModel {
         let initial_state = file.initial_state.clone().unwrap_or_else(|| vec![0.0; n]);
         if initial_state.len() != n || initial_state.iter().any(|v| !v.is_finite()) {
             return Err(Error::InvalidModel(format!(
-                "\"initial_state\" needs {n} finite values for the {kind} model"
+                "\"initial_state\" needs {n} finite values for the {name} model"
             )));
         }
         let simulation = file
@@ -824,7 +1150,7 @@ impl FittedModel {
             .as_ref()
             .map_or(Ok(Simulation::default()), SimulationSpec::simulation)?;
         Ok(FittedModel::GreyBox {
-            kind: kind.to_string(),
+            kind: name.to_string(),
             parameters,
             std,
             simulation,
@@ -844,20 +1170,26 @@ impl FittedModel {
         };
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| bad(format!("not JSON: {e}")))?;
-        let object = match value.get("schema").and_then(|s| s.as_str()) {
-            Some(s) if s.starts_with("hysid.report/") => value
-                .get("model")
-                .cloned()
-                .ok_or_else(|| bad("this report holds no model (its \"model\" is null)".into()))?,
-            _ => value,
+        let no_model = || bad("this report holds no model (its \"model\" is null)".into());
+        let not_a_model =
+            |e: serde_json::Error| bad(format!("not a {MODEL_SCHEMA} model file: {e}"));
+        // Read from the text, not from `value`, so that a key given twice is refused.
+        let file: ModelFile = match value.get("schema").and_then(|s| s.as_str()) {
+            Some(s) if s.starts_with("hysid.report/") => {
+                /// The model of a report (its other keys are the report's business).
+                #[derive(Deserialize)]
+                struct ReportModel {
+                    model: Option<ModelFile>,
+                }
+                if value.get("model").is_none_or(serde_json::Value::is_null) {
+                    return Err(no_model());
+                }
+                let report: ReportModel = serde_json::from_str(&text).map_err(not_a_model)?;
+                report.model.ok_or_else(no_model)?
+            }
+            _ if value.is_null() => return Err(no_model()),
+            _ => serde_json::from_str(&text).map_err(not_a_model)?,
         };
-        if object.is_null() {
-            return Err(bad(
-                "this report holds no model (its \"model\" is null)".into()
-            ));
-        }
-        let file: ModelFile = serde_json::from_value(object)
-            .map_err(|e| bad(format!("not a {MODEL_SCHEMA} model file: {e}")))?;
         Self::from_file(&file).map_err(|e| bad(e.to_string()))
     }
 }
@@ -902,20 +1234,16 @@ pub const OPERATOR_CASCADE_KIND: &str = "operator_cascade";
 
 /// An operator cascade from its file: the structure from `operator`, every value from
 /// `parameters` (validated by the family's constructor).
-fn operator_cascade_from_file(file: &ModelFile) -> Result<FittedModel> {
-    let structure = file.operator.clone().ok_or_else(|| {
-        Error::InvalidModel(
-            "an operator_cascade model needs \"operator\" (family and structure)".into(),
-        )
-    })?;
-    let operator: OperatorModel = serde_json::from_value(structure).map_err(|e| {
+fn operator_cascade_from_file(
+    delay: usize,
+    structure: &serde_json::Value,
+    records: &Records,
+) -> Result<FittedModel> {
+    let operator: OperatorModel = serde_json::from_value(structure.clone()).map_err(|e| {
         Error::InvalidModel(format!("the operator of the operator_cascade model: {e}"))
     })?;
-    let delay = file
-        .delay
-        .ok_or_else(|| Error::InvalidModel("an operator_cascade model needs \"delay\"".into()))?;
-    let b = coefficients(file, 'b')?;
-    let a = coefficients(file, 'a')?;
+    let b = records.coefficients('b')?;
+    let a = records.coefficients('a')?;
     if b.is_empty() || b[0].value != 1.0 {
         return Err(Error::InvalidModel(
             "an operator_cascade model needs b1 = 1 (the gain sits in the operator)".into(),
@@ -930,12 +1258,48 @@ fn operator_cascade_from_file(file: &ModelFile) -> Result<FittedModel> {
     let mut values = Vec::new();
     let mut std = Vec::new();
     for name in template.parameters().names() {
-        let e = record(file, &name)?;
+        let e = records.get(&name)?;
         values.push(e.value);
         std.push(e.std_or_nan());
     }
     Ok(FittedModel::OperatorCascade {
         model: template.with_values(&values)?,
+        std,
+    })
+}
+
+/// The Coleman–Hodgdon hysteresis of form `form` from its records, and their standard
+/// deviations in [`ChForm::parameter_names`] order.
+fn hysteresis_from_records(form: ChForm, records: &Records) -> Result<(ColemanHodgdon, Vec<f64>)> {
+    let mut values = Vec::new();
+    let mut std = Vec::new();
+    for name in form.parameter_names() {
+        let e = records.get(name)?;
+        values.push(e.value);
+        std.push(e.std_or_nan());
+    }
+    Ok((ColemanHodgdon::from_params(form, &values)?, std))
+}
+
+/// A Coleman–Hodgdon cascade from its records: the hysteresis, then b1 = 1, b2 … and a1 ….
+fn ch_cascade_from_records(form: ChForm, delay: usize, records: &Records) -> Result<FittedModel> {
+    let (hysteresis, mut std) = hysteresis_from_records(form, records)?;
+    let b = records.coefficients('b')?;
+    let a = records.coefficients('a')?;
+    if b.is_empty() || b[0].value != 1.0 {
+        return Err(Error::InvalidModel(
+            "a ch_cascade model needs b1 = 1 (the gain sits in the hysteresis)".into(),
+        ));
+    }
+    let linear = LinearBlock::new(
+        a.iter().map(|e| e.value).collect(),
+        b.iter().map(|e| e.value).collect(),
+        delay,
+    )?;
+    std.extend(b.iter().skip(1).map(ParameterRecord::std_or_nan));
+    std.extend(a.iter().map(ParameterRecord::std_or_nan));
+    Ok(FittedModel::Cascade {
+        model: HysteresisCascade::new(hysteresis, linear)?,
         std,
     })
 }
@@ -971,37 +1335,43 @@ fn cascade_records(model: &HysteresisCascade, std: &[f64]) -> Vec<ParameterRecor
     records
 }
 
-fn record<'a>(file: &'a ModelFile, name: &str) -> Result<&'a ParameterRecord> {
-    file.parameters
-        .iter()
-        .find(|p| p.name == name)
-        .ok_or_else(|| {
-            Error::InvalidModel(format!(
-                "parameter '{name}' is missing from the {} model",
-                file.kind
-            ))
-        })
+/// The parameter records of a model file of kind `kind`, looked up by name.
+struct Records<'a> {
+    kind: &'a str,
+    list: &'a [ParameterRecord],
 }
 
-/// The coefficients `<letter>1`, `<letter>2`, … in order (none missing in between).
-fn coefficients(file: &ModelFile, letter: char) -> Result<Vec<ParameterRecord>> {
-    let mut found: Vec<(usize, &ParameterRecord)> = file
-        .parameters
-        .iter()
-        .filter_map(|p| {
-            let rest = p.name.strip_prefix(letter)?;
-            rest.parse::<usize>().ok().map(|k| (k, p))
+impl<'a> Records<'a> {
+    /// The record called `name`.
+    fn get(&self, name: &str) -> Result<&'a ParameterRecord> {
+        self.list.iter().find(|p| p.name == name).ok_or_else(|| {
+            Error::InvalidModel(format!(
+                "parameter '{name}' is missing from the {} model",
+                self.kind
+            ))
         })
-        .collect();
-    found.sort_by_key(|(k, _)| *k);
-    for (i, (k, _)) in found.iter().enumerate() {
-        if *k != i + 1 {
-            return Err(Error::InvalidModel(format!(
-                "coefficient {letter}{} is missing from the {} model",
-                i + 1,
-                file.kind
-            )));
-        }
     }
-    Ok(found.into_iter().map(|(_, p)| p.clone()).collect())
+
+    /// The coefficients `<letter>1`, `<letter>2`, … in order (none missing in between).
+    fn coefficients(&self, letter: char) -> Result<Vec<ParameterRecord>> {
+        let mut found: Vec<(usize, &ParameterRecord)> = self
+            .list
+            .iter()
+            .filter_map(|p| {
+                let rest = p.name.strip_prefix(letter)?;
+                rest.parse::<usize>().ok().map(|k| (k, p))
+            })
+            .collect();
+        found.sort_by_key(|(k, _)| *k);
+        for (i, (k, _)) in found.iter().enumerate() {
+            if *k != i + 1 {
+                return Err(Error::InvalidModel(format!(
+                    "coefficient {letter}{} is missing from the {} model",
+                    i + 1,
+                    self.kind
+                )));
+            }
+        }
+        Ok(found.into_iter().map(|(_, p)| p.clone()).collect())
+    }
 }

@@ -4,54 +4,43 @@
 use crate::model::greybox::equation_model::EquationStateSpace;
 use crate::model::greybox::simulate::{simulate, InputTrack};
 use crate::model::greybox::{Simulation, StateSpaceModel};
-use crate::model::saved::{FittedModel, ModelFile, SimulationSpec};
+use crate::model::saved::{FittedModel, ParameterRecord, SimulationSpec};
 use crate::{Error, Result};
 
-/// The fitted equation model of a model file: the embedded text compiled, its parameters
-/// taken from the file's records by name (every one must be there), the initial state from
-/// `initial_state` or else the text's `[initial]`.
-pub(crate) fn equations_from_file(file: &ModelFile) -> Result<FittedModel> {
-    let text = file.equations.as_ref().ok_or_else(|| {
-        Error::InvalidModel(
-            "an equations model needs \"equations\": the equation file's text; save the model again"
-                .into(),
-        )
-    })?;
+/// The fitted equation model of a model file: the embedded text `text` compiled, its
+/// parameters taken from the file's records by name (every one must be there), the initial
+/// state from `initial_state` or else the text's `[initial]`.
+pub(crate) fn equations_from_file(
+    text: &str,
+    records: &[ParameterRecord],
+    simulation: Option<&SimulationSpec>,
+    initial_state: Option<&[f64]>,
+) -> Result<FittedModel> {
     let model = EquationStateSpace::parse(text, "the model's \"equations\"")?;
     let mut parameters = model.parameters();
     let mut std = Vec::with_capacity(parameters.len());
     for i in 0..parameters.len() {
         let name = parameters.get(i).name.clone();
-        let record = file
-            .parameters
-            .iter()
-            .find(|p| p.name == name)
-            .ok_or_else(|| {
-                Error::InvalidModel(format!(
-                    "parameter '{name}' of the equations is missing from \"parameters\""
-                ))
-            })?;
+        let record = records.iter().find(|p| p.name == name).ok_or_else(|| {
+            Error::InvalidModel(format!(
+                "parameter '{name}' of the equations is missing from \"parameters\""
+            ))
+        })?;
         *parameters.get_mut(i) = record.parameter();
         std.push(record.std_or_nan());
     }
     parameters.validate()?;
     let n = model.states().len();
-    let initial_state = file
-        .initial_state
-        .clone()
-        .unwrap_or_else(|| model.initial_values());
+    let initial_state = initial_state.map_or_else(|| model.initial_values(), <[f64]>::to_vec);
     if initial_state.len() != n || initial_state.iter().any(|v| !v.is_finite()) {
         return Err(Error::InvalidModel(format!(
             "\"initial_state\" needs {n} finite values for the equations model '{}'",
             model.name()
         )));
     }
-    let simulation = file
-        .simulation
-        .as_ref()
-        .map_or(Ok(Simulation::default()), SimulationSpec::simulation)?;
+    let simulation = simulation.map_or(Ok(Simulation::default()), SimulationSpec::simulation)?;
     Ok(FittedModel::Equations {
-        equations: text.clone(),
+        equations: text.to_string(),
         parameters,
         std,
         simulation,

@@ -459,7 +459,7 @@ impl Report {
         let mut bad = Vec::new();
         if let Some(m) = &self.model {
             bad.extend(
-                m.parameters
+                m.parameters()
                     .iter()
                     .filter(|p| !p.value.is_finite() || p.std.is_some_and(|s| !s.is_finite()))
                     .map(|p| format!("model parameter {}", p.name)),

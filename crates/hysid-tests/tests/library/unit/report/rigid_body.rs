@@ -26,8 +26,8 @@ fn model_holds_the_estimates_and_fixes_the_rest() {
         ..RigidBodyLs::emps()
     };
     let file = rigid_body_model(&estimate(), &ls).to_file();
-    let p = |name: &str| file.parameters.iter().find(|p| p.name == name).unwrap();
-    assert_eq!(file.kind, "rigid_body");
+    let p = |name: &str| file.parameters().iter().find(|p| p.name == name).unwrap();
+    assert_eq!(file.kind(), "rigid_body");
     assert_eq!(
         (p("M").value, p("M").std, p("M").fixed),
         (1.5, Some(0.01), false)

@@ -19,17 +19,68 @@ pub use rigid_body::RigidBody;
 use super::StateSpaceModel;
 use crate::{Error, Result};
 
+/// The built-in grey-box models, by the kind a model file names them with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GreyBoxKind {
+    /// [`BoucWen`], `bouc_wen`.
+    BoucWen,
+    /// [`RigidBody`], `rigid_body`.
+    RigidBody,
+    /// [`ActuatorFixed`], `actuator_fixed`.
+    ActuatorFixed,
+    /// [`ActuatorFree`], `actuator_free`.
+    ActuatorFree,
+}
+
+impl GreyBoxKind {
+    /// Every built-in model.
+    pub const ALL: [GreyBoxKind; 4] = [
+        GreyBoxKind::BoucWen,
+        GreyBoxKind::RigidBody,
+        GreyBoxKind::ActuatorFixed,
+        GreyBoxKind::ActuatorFree,
+    ];
+
+    /// The kind's name in a model file (`bouc_wen`, `rigid_body`, `actuator_fixed`,
+    /// `actuator_free`), equal to the model's [`StateSpaceModel::kind`].
+    pub fn name(self) -> &'static str {
+        match self {
+            GreyBoxKind::BoucWen => "bouc_wen",
+            GreyBoxKind::RigidBody => "rigid_body",
+            GreyBoxKind::ActuatorFixed => "actuator_fixed",
+            GreyBoxKind::ActuatorFree => "actuator_free",
+        }
+    }
+
+    /// The built-in model called `name` (any case, dashes allowed for underscores:
+    /// `bouc-wen` as on the command line), or None.
+    pub fn parse(name: &str) -> Option<Self> {
+        let name = name.trim().to_ascii_lowercase().replace('-', "_");
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// The model.
+    pub fn model(self) -> Box<dyn StateSpaceModel> {
+        match self {
+            GreyBoxKind::BoucWen => Box::new(BoucWen),
+            GreyBoxKind::RigidBody => Box::new(RigidBody),
+            GreyBoxKind::ActuatorFixed => Box::new(ActuatorFixed),
+            GreyBoxKind::ActuatorFree => Box::new(ActuatorFree),
+        }
+    }
+}
+
 /// The built-in model called `kind` (`bouc_wen`, `rigid_body`, `actuator_fixed`,
-/// `actuator_free`; dashes allowed for underscores).
+/// `actuator_free`; dashes allowed for underscores; see [`GreyBoxKind::parse`]).
 pub fn by_kind(kind: &str) -> Result<Box<dyn StateSpaceModel>> {
-    match kind.trim().to_ascii_lowercase().replace('-', "_").as_str() {
-        "bouc_wen" => Ok(Box::new(BoucWen)),
-        "rigid_body" => Ok(Box::new(RigidBody)),
-        "actuator_fixed" => Ok(Box::new(ActuatorFixed)),
-        "actuator_free" => Ok(Box::new(ActuatorFree)),
-        other => Err(Error::invalid_option("model", other, format!(
-            "unknown grey-box model '{other}'; the built-in ones are bouc-wen, rigid-body, actuator-fixed and actuator-free"
-        ))),
+    match GreyBoxKind::parse(kind) {
+        Some(kind) => Ok(kind.model()),
+        None => {
+            let other = kind.trim().to_ascii_lowercase().replace('-', "_");
+            Err(Error::invalid_option("model", &other, format!(
+                "unknown grey-box model '{other}'; the built-in ones are bouc-wen, rigid-body, actuator-fixed and actuator-free"
+            )))
+        }
     }
 }
 
