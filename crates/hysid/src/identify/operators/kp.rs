@@ -33,10 +33,10 @@
 //! Problems in Engineering 3 (1997) 287–328; C. L. Lawson, R. J. Hanson, *Solving Least
 //! Squares Problems*, Prentice-Hall 1974.
 
+use super::family::{FamilyOptions, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, GramAccumulator, WeightSolution,
 };
-use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
 use crate::model::operators::kp::KernelStates;
 use crate::model::operators::{Kp, Orientation};

@@ -1,7 +1,7 @@
 //! Tests of `hysid::model::operators::kp`.
 
-use hysid::model::operators::OperatorFamily;
 use hysid::model::operators::kp::KernelStates;
+use hysid::model::operators::OperatorFamily;
 use hysid::model::operators::{play, HysteresisOperator, Kp, Orientation};
 use hysid::Error;
 
