@@ -90,7 +90,9 @@ pub fn to_py(py: Python<'_>, e: hysid::Error) -> PyErr {
         | E::Unsupported(_)
         | E::UnsupportedKind { .. }
         | E::Equations(_) => "ConfigError",
-        E::ModelFile { .. } | E::Io { .. } | E::InvalidOutput(_) => "ModelFileError",
+        E::ModelFile { .. } | E::Io { .. } | E::InvalidOutput(_) | E::OutputClash(_) => {
+            "ModelFileError"
+        }
         _ => "NumericalError",
     };
     named(py, class, message)
