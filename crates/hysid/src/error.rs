@@ -110,7 +110,7 @@ pub enum Error {
     },
 
     /// A model parameter value is not acceptable.
-    #[error("parameter {name} = {value}: {reason}")]
+    #[error("parameter {name} = {}: {reason}", number(.value))]
     InvalidParameter {
         /// Parameter name (literature symbol).
         name: String,
@@ -252,6 +252,17 @@ pub struct EquationFileError {
     pub column: usize,
     /// What is wrong and what to do (one line).
     pub message: String,
+}
+
+/// A number for a message: as Rust writes it, but in exponent form when that would be a
+/// long row of digits (1e308, 1e-300).
+fn number(value: &f64) -> String {
+    let v = value.abs();
+    if v != 0.0 && v.is_finite() && !(1e-6..1e16).contains(&v) {
+        format!("{value:e}")
+    } else {
+        value.to_string()
+    }
 }
 
 /// What an output path clashes with (see [`Error::OutputClash`]).
