@@ -8,6 +8,7 @@ mod commands;
 mod equations_cli;
 mod exit_codes;
 mod hardening;
+mod inputs_sacred;
 mod operator_cascade_cli;
 mod outputs;
 mod report_schema;
