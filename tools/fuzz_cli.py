@@ -17,7 +17,9 @@ directory holding copies of the inputs it needs, with a timeout, and is classifi
     code       a run that must be refused (an output that is an input or another output:
                exit 2; degenerate data: a non-zero exit) exited otherwise
     stray      a failing run left a file behind (temporaries included)
-    multiline  a failing run printed other than exactly one line on stderr
+    multiline  a failing run printed other than exactly one error line on stderr, last
+               (plain progress lines of a long run may come before it)
+    dump       the error line holds a debug dump of a dependency's error ({:?})
     unbounded  still running at the timeout
     ok         anything else
 
@@ -70,6 +72,7 @@ COMMANDS = [
     {
         "name": "demo voros",
         "base": ["demo", "voros", "--uncertainty", "asymptotic", FLAG["plots"], "plots"],
+        "plots_sub": ["voros-example1"],
         "numeric": ["--example", "--seed", "--replicates"],
         "inputs": {},
         "outputs": {"--json": "file", FLAG["plots"]: "dir"},
@@ -167,6 +170,7 @@ COMMANDS = [
         "name": "demo actuator",
         "slow": True,
         "base": ["demo", "actuator", "--max-iterations", "2", FLAG["plots"], "plots"],
+        "plots_sub": ["actuator"],
         "numeric": ["--backlash", "--noise", "--gear-ratio", "--saddle-mass", "--cutoff",
                     "--reversal-margin", "--max-iterations", "--tolerance"],
         "inputs": {},
@@ -445,7 +449,9 @@ def build_cases(full):
                                   copies=placeholders(args), expect=2))
             dirs = [f for f in outs if c["outputs"][f] == "dir"]
             if files and dirs:
-                args = with_option(with_option(base, dirs[0], "od"), files[0], "od/x.json")
+                # The demos write their plots into a subdirectory of --plots.
+                inside = "/".join(["od"] + c.get("plots_sub", []) + ["x.json"])
+                args = with_option(with_option(base, dirs[0], "od"), files[0], inside)
                 cases.append(Case(c["name"], "a file output inside the directory output",
                                   args, copies=placeholders(args), expect=2))
         # Degenerate records on every CSV input: refused (a non-zero exit).
@@ -601,9 +607,20 @@ def classify(proc, before, after, work, expect=None):
     if created or changed or removed:
         return "stray", rc, f"left {created} changed {changed} removed {removed}; stderr: {err.strip()[:200]!r}"
     lines = [l for l in err.splitlines() if l.strip()]
-    if len(lines) != 1:
+    # A run longer than a few seconds shows plain progress lines on a pipe (documented):
+    # those may precede the one error line, which must be the last.
+    progress = lines[:-1]
+    if (not lines or not lines[-1].startswith("error: ") or
+            any(l.startswith(("error", "warning")) or "panicked" in l for l in progress)):
         return "multiline", rc, f"{len(lines)} lines: {err.strip()[:300]!r}"
+    if DEBUG_DUMP.search(lines[-1]):
+        return "dump", rc, f"a debug dump in the error: {lines[-1][:300]!r}"
     return "ok", rc, ""
+
+
+# A dependency's error printed with {:?}: `Os { code: 2, kind: NotFound, … }`, `Custom {
+# kind: …`, `Error { … }`, `Some(…)` wrappers.
+DEBUG_DUMP = re.compile(r"\w+ \{ \w+: |\bkind: [A-Z]|\bSome\(")
 
 
 def check_flags(binary):
@@ -677,7 +694,7 @@ def main():
 
 def report(results, show, elapsed):
     classes = ["panic", "signal", "nonfinite", "clobber", "code", "stray", "multiline",
-               "unbounded", "ok"]
+               "dump", "unbounded", "ok"]
     tally = {k: 0 for k in classes}
     codes = {}
     for case, cls, rc, detail, _ in results:

@@ -176,7 +176,11 @@ fn spellings(input: &str, output_is_dir: bool) -> Vec<Spelling> {
     if input == "rig" {
         for inside in ["dataset1.csv", "rig.json"] {
             all.push((inside.into(), format!("rig/{inside}"), vec![]));
-            all.push((format!("{inside} as ../"), format!("rig/../rig/{inside}"), vec![]));
+            all.push((
+                format!("{inside} as ../"),
+                format!("rig/../rig/{inside}"),
+                vec![],
+            ));
         }
         all.push((
             "a hard link of a file inside".into(),
@@ -304,8 +308,18 @@ fn two_outputs_of_one_file_or_one_inside_the_other_are_refused() {
         if let (Some(a), Some(d)) = (files.first(), dirs.first()) {
             fs::create_dir(dir.join("out")).unwrap();
             let mut args = base();
-            args.extend([d.to_string(), "out".into(), a.to_string(), "out/x.json".into()]);
-            refused(dir, &args, &[d, a], "a file output inside the directory output");
+            args.extend([
+                d.to_string(),
+                "out".into(),
+                a.to_string(),
+                "out/x.json".into(),
+            ]);
+            refused(
+                dir,
+                &args,
+                &[d, a],
+                "a file output inside the directory output",
+            );
         }
     }
 }
