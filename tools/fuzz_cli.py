@@ -184,11 +184,35 @@ COMMANDS = [
         "inputs": {"--data": "csv", "--validate": "csv"},
         "outputs": {"--json": "file"},
     },
+    {
+        "name": "identify operator",
+        "base": ["identify", "operator", "--family", "pi", "--data", "{cascade}", "--input", "x",
+                 "--output", "y"],
+        "numeric": ["--ts", "--grid", "--lambda", "--dead-zones"],
+        "inputs": {"--data": "csv"},
+        "outputs": {"--json": "file", FLAG["model_out"]: "file", FLAG["plots"]: "dir"},
+    },
+    {
+        "name": "compare",
+        "base": ["compare", "--data", "{cascade}", "--input", "x", "--output", "y",
+                 "--families", "pi,backlash"],
+        "numeric": ["--ts", "--grid", "--lambda"],
+        "inputs": {"--data": "csv", "--validate": "csv"},
+        "outputs": {"--json": "file", FLAG["model_out"]: "file", FLAG["plots"]: "dir"},
+    },
+    {
+        "name": "compensate",
+        "base": ["compensate", "--model", "{op}", "--data", "{cascade}", "--reference", "y",
+                 "--csv", "comp.csv"],
+        "numeric": ["--ts"],
+        "inputs": {"--data": "csv", "--model": "model"},
+        "outputs": {"--csv": "file", "--json": "file", FLAG["plots"]: "dir"},
+    },
 ]
 
 # Input files: what a placeholder is copied from, by kind.
 PLACEHOLDER_KIND = {"cascade": "csv", "bw": "csv", "rb": "csv", "model": "model",
-                    "rig": "rigdir", "mat": "mat"}
+                    "rig": "rigdir", "mat": "mat", "op": "model"}
 
 # Address space of one case: 4 GiB.
 MEMORY_KIB = 4 * 1024 * 1024
@@ -237,6 +261,10 @@ def make_fixtures(binary, root):
     fx["model"] = os.path.join(root, "model.json")
     with open(fx["model"], "w") as f:
         f.write(model_json())
+    # A PI operator of the cascade record's hysteresis, for compensate.
+    run(["identify", "operator", "--family", "pi", "--data", "cascade.csv", "--input", "x",
+         "--output", "y", FLAG["model_out"], "op.json"])
+    fx["op"] = os.path.join(root, "op.json")
     return fx
 
 

@@ -256,7 +256,7 @@ pub struct EquationFileError {
 
 /// A number for a message: as Rust writes it, but in exponent form when that would be a
 /// long row of digits (1e308, 1e-300).
-fn number(value: &f64) -> String {
+pub(crate) fn number(value: &f64) -> String {
     let v = value.abs();
     if v != 0.0 && v.is_finite() && !(1e-6..1e16).contains(&v) {
         format!("{value:e}")

@@ -288,7 +288,9 @@ impl Rig {
                     value,
                     reason: format!(
                         "the actuator's true {} must lie in [{}, {}]",
-                        p.name, p.min, p.max
+                        p.name,
+                        crate::error::number(&p.min),
+                        crate::error::number(&p.max)
                     ),
                 });
             }
