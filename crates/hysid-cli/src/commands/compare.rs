@@ -28,13 +28,14 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let mut inputs = vec![args.data.data.as_path()];
     inputs.extend(args.validate.as_deref());
     let mut files = OutputSet::new(&inputs)?;
+    // The directory first: a file inside it is then refused as a clash.
+    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
     let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
     let model_tmp = args
         .model_out
         .as_deref()
         .map(|p| files.file(p))
         .transpose()?;
-    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
     let data = load(&args.data, &args.data.data)?;
     let validation = args
         .validate
