@@ -3,7 +3,7 @@
 //! | code | meaning |
 //! | --- | --- |
 //! | 0 | success (also `--help` and `--version`) |
-//! | 1 | bad input or data: a malformed or inconsistent file, a parameter out of its range, data that cannot identify the model |
+//! | 1 | bad input or data: a malformed or inconsistent file, a parameter out of its range, data that cannot identify the model — degenerate data among them: a channel whose squares overflow or underflow (beyond 1e150, all below 1e-150), an output without variation at double precision, a rig truth that makes the simulation or its tables non-finite |
 //! | 2 | usage: the command line itself is wrong (unknown option, missing or unparsable value, an output path that is an input or another output of the run) |
 //! | 3 | numerical failure: a singular regression, a diverged simulation, a non-finite result |
 //! | 4 | I/O: a file could not be opened, read or written |

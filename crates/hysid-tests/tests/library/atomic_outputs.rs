@@ -267,6 +267,7 @@ fn clash(e: Error) -> hysid::error::Clash {
     }
 }
 
+#[cfg(unix)]
 #[test]
 fn an_input_is_refused_through_links_dotdot_and_inside_an_input_directory() {
     use hysid::error::ClashKind;
