@@ -12,8 +12,14 @@ directory holding copies of the inputs it needs, with a timeout, and is classifi
     signal     killed by a signal (SIGABRT from a failed allocation, SIGSEGV, ...)
     nonfinite  exit 0 with NaN/inf in stdout or in a file it wrote (printed bounds such as
                "[0, inf]" are settings, not results, and are left out)
-    stray      a failing run left a file behind (temporaries included) or changed an input
-    multiline  a failing run printed other than exactly one line on stderr
+    clobber    a run (failing or not) changed or removed a file that was there before it
+               (an input, or a file an input links to)
+    code       a run that must be refused (an output that is an input or another output:
+               exit 2; degenerate data: a non-zero exit) exited otherwise
+    stray      a failing run left a file behind (temporaries included)
+    multiline  a failing run printed other than exactly one error line on stderr, last
+               (plain progress lines of a long run may come before it)
+    dump       the error line holds a debug dump of a dependency's error ({:?})
     unbounded  still running at the timeout
     ok         anything else
 
@@ -66,6 +72,7 @@ COMMANDS = [
     {
         "name": "demo voros",
         "base": ["demo", "voros", "--uncertainty", "asymptotic", FLAG["plots"], "plots"],
+        "plots_sub": ["voros-example1"],
         "numeric": ["--example", "--seed", "--replicates"],
         "inputs": {},
         "outputs": {"--json": "file", FLAG["plots"]: "dir"},
@@ -163,6 +170,7 @@ COMMANDS = [
         "name": "demo actuator",
         "slow": True,
         "base": ["demo", "actuator", "--max-iterations", "2", FLAG["plots"], "plots"],
+        "plots_sub": ["actuator"],
         "numeric": ["--backlash", "--noise", "--gear-ratio", "--saddle-mass", "--cutoff",
                     "--reversal-margin", "--max-iterations", "--tolerance"],
         "inputs": {},
@@ -176,11 +184,35 @@ COMMANDS = [
         "inputs": {"--data": "csv", "--validate": "csv"},
         "outputs": {"--json": "file"},
     },
+    {
+        "name": "identify operator",
+        "base": ["identify", "operator", "--family", "pi", "--data", "{cascade}", "--input", "x",
+                 "--output", "y"],
+        "numeric": ["--ts", "--grid", "--lambda", "--dead-zones"],
+        "inputs": {"--data": "csv"},
+        "outputs": {"--json": "file", FLAG["model_out"]: "file", FLAG["plots"]: "dir"},
+    },
+    {
+        "name": "compare",
+        "base": ["compare", "--data", "{cascade}", "--input", "x", "--output", "y",
+                 "--families", "pi,backlash"],
+        "numeric": ["--ts", "--grid", "--lambda"],
+        "inputs": {"--data": "csv", "--validate": "csv"},
+        "outputs": {"--json": "file", FLAG["model_out"]: "file", FLAG["plots"]: "dir"},
+    },
+    {
+        "name": "compensate",
+        "base": ["compensate", "--model", "{op}", "--data", "{cascade}", "--reference", "y",
+                 "--csv", "comp.csv"],
+        "numeric": ["--ts"],
+        "inputs": {"--data": "csv", "--model": "model"},
+        "outputs": {"--csv": "file", "--json": "file", FLAG["plots"]: "dir"},
+    },
 ]
 
 # Input files: what a placeholder is copied from, by kind.
 PLACEHOLDER_KIND = {"cascade": "csv", "bw": "csv", "rb": "csv", "model": "model",
-                    "rig": "rigdir", "mat": "mat"}
+                    "rig": "rigdir", "mat": "mat", "op": "model"}
 
 # Address space of one case: 4 GiB.
 MEMORY_KIB = 4 * 1024 * 1024
@@ -229,6 +261,10 @@ def make_fixtures(binary, root):
     fx["model"] = os.path.join(root, "model.json")
     with open(fx["model"], "w") as f:
         f.write(model_json())
+    # A PI operator of the cascade record's hysteresis, for compensate.
+    run(["identify", "operator", "--family", "pi", "--data", "cascade.csv", "--input", "x",
+         "--output", "y", FLAG["model_out"], "op.json"])
+    fx["op"] = os.path.join(root, "op.json")
     return fx
 
 
@@ -265,8 +301,16 @@ def bad_files(kind):
             b"%d,%d,1,%d,1,%d,1\n" % (k * k, k, k, k) for k in range(50))),
         ("two samples", b"t,x,y,u,q,u_N,y_m\n0,1,1,1,1,1,1\n1,2,2,2,2,2,2\n"),
     ]
+    # Degenerate records, refused whatever the command (expected to fail): every channel
+    # scaled to 1e-300 (squares underflow: a zero loss whatever the fit) or 1e300 (squares
+    # overflow), and a constant output beside a varying input.
+    degenerate = [
+        ("scaled 1e-300", varied_csv(1e-300)),
+        ("scaled 1e300", varied_csv(1e300)),
+        ("constant output", varied_csv(1.0, constant_outputs=True)),
+    ]
     if kind == "csv":
-        return [(label, {"in.csv": data}) for label, data in csv] + [
+        return [(label, {"in.csv": data}) for label, data in csv + degenerate] + [
             ("mat garbage", {"in.mat": b"MATLAB 5.0 MAT-file" + b"\0" * 105 + b"\0" * 8 +
                              b"\x00\x01IM" + b"\x0f\0\0\0\x40\0\0\0" + b"\x78\x9c" + b"\xff" * 62}),
             ("mat truncated header", {"in.mat": b"MATLAB 5.0"}),
@@ -304,16 +348,43 @@ def bad_files(kind):
     return []
 
 
+def varied_csv(scale, constant_outputs=False):
+    """A record whose every column varies (two sines and a ramp), times `scale`; with
+    `constant_outputs` the output columns (y, q, y_m) are constant."""
+    rows = [b"t,t_s,x,y,u,q,u_N,y_m"]
+    for k in range(600):
+        a = math.sin(0.05 * k) * (1 + 0.002 * k)
+        b = math.sin(0.05 * k - 0.4) + 0.1 * math.sin(0.31 * k)
+        out = 0.5 if constant_outputs else b
+        cells = [k * 1e-3, k * 1e-3] + [v * scale for v in (a, out, a, out, a, out)]
+        rows.append(",".join(repr(c) for c in cells).encode())
+    return b"\n".join(rows) + b"\n"
+
+
+# Rig truth files (DIR/rig.json) that make the tables non-finite: refused.
+RIG_TRUTH = {"J": 5.0e-4, "Fv": 1.413e-3, "Fc": 0.2065, "k1": 11.31, "k2": 144.3,
+             "alpha": 112.5, "A": 42.49}
+
+
+def rig_truth(**override):
+    truth = dict(RIG_TRUTH, **override)
+    return ('{"truth": {' + ", ".join(f'"{k}": {v}' for k, v in truth.items()) + "}}").encode()
+
+
 # --- Cases ----------------------------------------------------------------------------
 
 
 class Case:
-    def __init__(self, command, label, args, files=None, copies=None):
+    def __init__(self, command, label, args, files=None, copies=None, links=None,
+                 expect=None):
         self.command = command
         self.label = label
         self.args = args  # with placeholders
         self.files = files or {}  # name -> bytes, written in the case directory
         self.copies = copies or []  # placeholders to copy in
+        self.links = links or []  # (kind "sym" or "hard", link name, target with placeholders)
+        # The exit code the run must have: an int, "fail" (any non-zero), or None (any).
+        self.expect = expect
 
     def describe(self):
         return f"[{self.command}] {self.label}: hysid " + " ".join(
@@ -377,23 +448,96 @@ def build_cases(full):
                 args = with_option(base, flag, target)
                 cases.append(Case(c["name"], f"{flag} {label}", args, files={"afile": b"x"},
                                   copies=placeholders(args)))
-            # Output equal to each input.
+            # Output equal to each input, spelled directly, as dir/../input, through a
+            # symbolic link and a hard link; for an input directory also each file read
+            # from inside it. Refused as a usage error (exit 2), the input unchanged.
             for name in placeholders(base):
-                args = with_option(base, flag, "{" + name + "}")
-                cases.append(Case(c["name"], f"{flag} = input {name}", args,
-                                  copies=placeholders(args)))
+                for label, target, links, files in clash_targets(name, kind):
+                    args = with_option(base, flag, target)
+                    cases.append(Case(c["name"], f"{flag} = input {name} {label}", args,
+                                      files=files, copies=placeholders(base), links=links,
+                                      expect=2))
             # A run that fails (bad first numeric option) must leave no output behind.
             if c["numeric"]:
                 args = with_option(with_option(base, flag, "out1"), c["numeric"][0], "nan")
                 cases.append(Case(c["name"], f"{flag} with a failing run", args,
                                   copies=placeholders(args)))
-        # Two outputs on the same path.
+        # Two outputs on the same path, or on two hard links of one file, or a file output
+        # inside the directory output: exit 2.
         outs = list(c["outputs"])
         if len(outs) >= 2:
             args = with_option(with_option(base, outs[0], "same"), outs[1], "same")
             cases.append(Case(c["name"], "two outputs, one path", args,
-                              copies=placeholders(args)))
+                              copies=placeholders(args), expect=2))
+            files = [f for f in outs if c["outputs"][f] == "file"]
+            if len(files) >= 2:
+                args = with_option(with_option(base, files[0], "o1"), files[1], "o2")
+                cases.append(Case(c["name"], "two outputs, hard links of one file", args,
+                                  files={"o1": b"old"}, links=[("hard", "o2", "o1")],
+                                  copies=placeholders(args), expect=2))
+            dirs = [f for f in outs if c["outputs"][f] == "dir"]
+            if files and dirs:
+                # The demos write their plots into a subdirectory of --plots.
+                inside = "/".join(["od"] + c.get("plots_sub", []) + ["x.json"])
+                args = with_option(with_option(base, dirs[0], "od"), files[0], inside)
+                cases.append(Case(c["name"], "a file output inside the directory output",
+                                  args, copies=placeholders(args), expect=2))
+        # Degenerate records on every CSV input: refused (a non-zero exit). compensate
+        # reads no output: a constant reference (a set point) is a fair request.
+        degenerate = DEGENERATE if c["name"] != "compensate" else DEGENERATE[:2]
+        for case in cases:
+            if (case.command == c["name"] and case.expect is None and
+                    any(case.label.endswith(d) for d in degenerate)):
+                case.expect = "fail"
+        # A rig truth file whose values make the tables non-finite.
+        if "rigdir" in c["inputs"].values():
+            flag = next(f for f, k in c["inputs"].items() if k == "rigdir")
+            for p, v in [("J", "1e308"), ("alpha", "1e300"), ("A", "-1e308"), ("k1", "1e13")]:
+                args = with_option(base, flag, "{rig}")
+                cases.append(Case(c["name"], f"{flag} rig.json truth {p}={v}", args,
+                                  files={"rig/rig.json": rig_truth(**{p: v})},
+                                  copies=placeholders(args), expect="fail"))
+        # A true parameter of the rig that makes its simulation or tables non-finite.
+        for flag in c.get("name_values", []):
+            if flag == "--truth":
+                for p in ["J", "Fv", "Fc", "k1", "k2", "alpha", "A"]:
+                    for v in ["1e308", "1e300", "-1e308", "1e13"]:
+                        args = base + [flag, f"{p}={v}"]
+                        cases.append(Case(c["name"], f"{flag} {p}={v} (refused)", args,
+                                          copies=placeholders(args), expect="fail"))
     return cases
+
+
+DEGENERATE = ["scaled 1e-300", "scaled 1e300", "constant output"]
+
+
+def clash_targets(name, kind):
+    """Spellings of the input placeholder `name` as an output path of `kind` ("file" or
+    "dir"): [(label, target, links, files)]. Links are made after the inputs are copied
+    in."""
+    ref = "{" + name + "}"
+    targets = [
+        ("directly", ref, [], {}),
+        ("as sub/../input", "sub/../" + ref, [], {"sub/": b""}),
+        ("through a symbolic link", "link_to_input", [("sym", "link_to_input", ref)], {}),
+    ]
+    if PLACEHOLDER_KIND[name] != "rigdir" and kind == "dir":
+        targets.append(("the directory holding it", ".", [], {}))
+    if PLACEHOLDER_KIND[name] == "rigdir":
+        for inside in ["dataset1.csv", "rig.json"]:
+            targets.append((f"file {inside} inside it", f"{ref}/{inside}", [], {}))
+            targets.append((f"file {inside} inside it as ../", f"{ref}/../{ref}/{inside}", [],
+                            {}))
+        targets.append(("a hard link of dataset2.csv inside it", "hard_to_input",
+                        [("hard", "hard_to_input", ref + "/dataset2.csv")], {}))
+        targets.append(("a symbolic link to rig.json inside it", "link_to_file",
+                        [("sym", "link_to_file", ref + "/rig.json")], {}))
+        if kind == "dir":
+            targets.append(("the directory holding it", ".", [], {}))
+    else:
+        targets.append(("through a hard link", "hard_to_input",
+                        [("hard", "hard_to_input", ref)], {}))
+    return targets
 
 
 # --- Running and classifying ----------------------------------------------------------
@@ -433,6 +577,12 @@ def run_case(binary, fixtures, case, timeout):
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with open(path, "wb") as f:
                 f.write(data)
+        for kind, link, target in case.links:
+            target = target.format(**mapping)
+            if kind == "sym":
+                os.symlink(target, os.path.join(work, link))
+            else:
+                os.link(os.path.join(work, target), os.path.join(work, link))
         args = [a.format(**mapping) if "{" in a else a for a in case.args]
         before = snapshot(work)
         start = time.monotonic()
@@ -446,16 +596,23 @@ def run_case(binary, fixtures, case, timeout):
             return "unbounded", None, f"still running after {timeout} s", time.monotonic() - start
         elapsed = time.monotonic() - start
         after = snapshot(work)
-        return classify(proc, before, after, work) + (elapsed,)
+        return classify(proc, before, after, work, case.expect) + (elapsed,)
 
 
-def classify(proc, before, after, work):
+def classify(proc, before, after, work, expect=None):
     rc = proc.returncode
     err = proc.stderr.decode("utf-8", "replace")
     if rc < 0:
         return "signal", rc, f"killed by signal {-rc}; stderr: {err[-300:]!r}"
     if rc == 101 or "panicked" in err:
         return "panic", rc, err.strip()[-400:]
+    # Inputs are sacred: nothing that was there before may change, whatever the exit.
+    clobbered = sorted(n for n in before if not n.endswith("/") and after.get(n) != before[n])
+    if clobbered:
+        return "clobber", rc, f"changed or removed {clobbered}; stderr: {err.strip()[:200]!r}"
+    if expect is not None and (rc == 0 if expect == "fail" else rc != expect):
+        want = "a failure" if expect == "fail" else f"exit {expect}"
+        return "code", rc, f"expected {want}; stderr: {err.strip()[:300]!r}"
     if rc == 0:
         bad = nonfinite_result(proc.stdout)
         where = "stdout" if bad else None
@@ -480,9 +637,20 @@ def classify(proc, before, after, work):
     if created or changed or removed:
         return "stray", rc, f"left {created} changed {changed} removed {removed}; stderr: {err.strip()[:200]!r}"
     lines = [l for l in err.splitlines() if l.strip()]
-    if len(lines) != 1:
+    # A run longer than a few seconds shows plain progress lines on a pipe (documented):
+    # those may precede the one error line, which must be the last.
+    progress = lines[:-1]
+    if (not lines or not lines[-1].startswith("error: ") or
+            any(l.startswith(("error", "warning")) or "panicked" in l for l in progress)):
         return "multiline", rc, f"{len(lines)} lines: {err.strip()[:300]!r}"
+    if DEBUG_DUMP.search(lines[-1]):
+        return "dump", rc, f"a debug dump in the error: {lines[-1][:300]!r}"
     return "ok", rc, ""
+
+
+# A dependency's error printed with {:?}: `Os { code: 2, kind: NotFound, … }`, `Custom {
+# kind: …`, `Error { … }`, `Some(…)` wrappers.
+DEBUG_DUMP = re.compile(r"\w+ \{ \w+: |\bkind: [A-Z]|\bSome\(")
 
 
 def check_flags(binary):
@@ -555,7 +723,8 @@ def main():
 
 
 def report(results, show, elapsed):
-    classes = ["panic", "signal", "nonfinite", "stray", "multiline", "unbounded", "ok"]
+    classes = ["panic", "signal", "nonfinite", "clobber", "code", "stray", "multiline",
+               "dump", "unbounded", "ok"]
     tally = {k: 0 for k in classes}
     codes = {}
     for case, cls, rc, detail, _ in results:

@@ -3,8 +3,8 @@
 //! | code | meaning |
 //! | --- | --- |
 //! | 0 | success (also `--help` and `--version`) |
-//! | 1 | bad input or data: a malformed or inconsistent file, a parameter out of its range, data that cannot identify the model |
-//! | 2 | usage: the command line itself is wrong (unknown option, missing or unparsable value) |
+//! | 1 | bad input or data: a malformed or inconsistent file, a parameter out of its range, data that cannot identify the model — degenerate data among them: a channel whose squares overflow or underflow (beyond 1e150, all below 1e-150), an output without variation at double precision, a rig truth that makes the simulation or its tables non-finite |
+//! | 2 | usage: the command line itself is wrong (unknown option, missing or unparsable value, an output path that is an input or another output of the run) |
 //! | 3 | numerical failure: a singular regression, a diverged simulation, a non-finite result |
 //! | 4 | I/O: a file could not be opened, read or written |
 //! | 101 | an internal fault (a panic) — a bug to report |
@@ -54,6 +54,8 @@ pub fn library_class(error: &Error) -> ExitClass {
     match error.category() {
         Category::Io => ExitClass::Io,
         Category::Numerical => ExitClass::Numerical,
+        // Flags that name the same file twice: the command line itself is wrong.
+        Category::Usage => ExitClass::Usage,
         Category::Data
         | Category::Config
         | Category::ModelFile
@@ -122,13 +124,87 @@ fn flag_of(e: &anyhow::Error) -> Option<&'static str> {
         })
 }
 
+/// The command line as parsed (after [`crate::deprecated::rewrite`]), for naming the flag
+/// of a path in an error.
+static ARGS: std::sync::OnceLock<Vec<std::ffi::OsString>> = std::sync::OnceLock::new();
+
+/// Keeps the command line for [`one_line`]: an output clash names its paths by their flags.
+pub fn remember_args(args: &[std::ffi::OsString]) {
+    let _ = ARGS.set(args.to_vec());
+}
+
+/// The output options of every command, by role (the rest of a command's path options are
+/// inputs).
+const OUTPUT_FLAGS: [&str; 5] = ["--json", "--model-out", "--csv", "--plots", "--data-out"];
+
+/// The flags whose value is `path` on the command line (`--flag PATH` or `--flag=PATH`),
+/// among the output flags or among the others; else the output flags whose value is a
+/// directory `path` lies in (`demo`'s `--plots DIR` holds `DIR/actuator`).
+fn flags_for(path: &std::path::Path, output: bool) -> Vec<String> {
+    let Some(args) = ARGS.get() else {
+        return Vec::new();
+    };
+    let mut pairs: Vec<(String, std::path::PathBuf)> = Vec::new();
+    for (k, arg) in args.iter().enumerate() {
+        let Some(text) = arg.to_str() else { continue };
+        if !text.starts_with("--") {
+            continue;
+        }
+        match text.split_once('=') {
+            Some((flag, value)) => pairs.push((flag.to_string(), value.into())),
+            None => {
+                if let Some(value) = args.get(k + 1) {
+                    pairs.push((text.to_string(), value.into()));
+                }
+            }
+        }
+    }
+    let wanted = |flag: &str| OUTPUT_FLAGS.contains(&flag) == output;
+    let exact: Vec<String> = pairs
+        .iter()
+        .filter(|(flag, value)| wanted(flag) && value == path)
+        .map(|(flag, _)| flag.clone())
+        .collect();
+    if !exact.is_empty() || !output {
+        return exact;
+    }
+    pairs
+        .iter()
+        .filter(|(flag, value)| {
+            wanted(flag) && !value.as_os_str().is_empty() && path.starts_with(value)
+        })
+        .map(|(flag, _)| flag.clone())
+        .collect()
+}
+
+/// The message of a library error, an output clash naming its paths by their flags.
+fn library_text(cause: &(dyn std::error::Error + 'static)) -> String {
+    match cause.downcast_ref::<Error>() {
+        Some(Error::OutputClash(clash)) => {
+            let other_is_output = clash.kind == hysid::error::ClashKind::Output;
+            let output = flags_for(&clash.output, true);
+            let other = flags_for(&clash.other, other_is_output);
+            // Two outputs given the same path: name two different flags.
+            let other_flag = other
+                .iter()
+                .find(|f| output.first() != Some(*f))
+                .or(other.first());
+            clash.describe(
+                output.first().map(String::as_str),
+                other_flag.map(String::as_str),
+            )
+        }
+        _ => cause.to_string(),
+    }
+}
+
 /// The error chain on one line, "context: cause", leaving out causes the message already
 /// quotes (the library's errors include their source in their own text); a setting out of
-/// range is prefixed by its flag.
+/// range is prefixed by its flag, an output clash names the flags of both paths.
 pub fn one_line(e: &anyhow::Error) -> String {
     let mut message = String::new();
     for cause in e.chain() {
-        let text = cause.to_string();
+        let text = library_text(cause);
         if !message.contains(&text) {
             if !message.is_empty() {
                 message.push_str(": ");

@@ -22,7 +22,9 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     exit::one_line_panics();
-    let cli = match cli::Cli::try_parse_from(std::env::args_os()) {
+    let args: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    exit::remember_args(&args);
+    let cli = match cli::Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e) => return parser_exit(&e),
     };

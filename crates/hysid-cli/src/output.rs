@@ -45,9 +45,11 @@ impl Outputs {
             model_out: None,
             plots: None,
         };
+        // The directory first: a file inside it is then refused as a clash, even before
+        // the directory exists.
+        out.plots = out.dir(plots)?;
         out.json = out.file(json)?;
         out.model_out = out.file(model_out)?;
-        out.plots = out.dir(plots)?;
         Ok(out)
     }
 

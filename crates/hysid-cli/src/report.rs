@@ -12,6 +12,18 @@ pub fn figures(report: &Report) -> (f64, f64, f64) {
         })
 }
 
+/// A criterion (FPE, AIC) for printing: its value (`scientific`: `1.2345e-4`, else
+/// `-1234.5`), or "undefined" where it is not finite — a zero loss (an exact fit to exact
+/// data) makes AIC −∞, and FPE is undefined with as many parameters as samples; the report
+/// then holds null (docs/report.md §1.2).
+pub fn criterion(value: f64, scientific: bool) -> String {
+    match (value.is_finite(), scientific) {
+        (false, _) => "undefined".into(),
+        (true, true) => format!("{value:.4e}"),
+        (true, false) => format!("{value:.1}"),
+    }
+}
+
 /// One row of the printed parameter table.
 pub struct Row {
     /// Parameter name.

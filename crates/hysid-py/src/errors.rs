@@ -76,7 +76,7 @@ pub fn to_py(py: Python<'_>, e: hysid::Error) -> PyErr {
     let class = match e.category() {
         Category::Data => "DataError",
         Category::Config => "ConfigError",
-        Category::ModelFile | Category::Io => "ModelFileError",
+        Category::ModelFile | Category::Io | Category::Usage => "ModelFileError",
         Category::Numerical | Category::Cancelled => "NumericalError",
         Category::Internal => "InternalError",
     };

@@ -110,7 +110,7 @@ pub enum Error {
     },
 
     /// A model parameter value is not acceptable.
-    #[error("parameter {name} = {value}: {reason}")]
+    #[error("parameter {name} = {}: {reason}", number(.value))]
     InvalidParameter {
         /// Parameter name (literature symbol).
         name: String,
@@ -170,6 +170,12 @@ pub enum Error {
     /// directory is missing).
     #[error("{0}")]
     InvalidOutput(String),
+
+    /// An output of a run is one of its inputs or another of its outputs — the same file
+    /// after symbolic links, `..` and hard links — or a directory output holds one. Refused
+    /// when the output is registered, before any work.
+    #[error("{0}")]
+    OutputClash(Clash),
 
     /// An operation is not defined for a model of this kind.
     #[error("model kind '{kind}' does not support {operation}")]
@@ -248,6 +254,95 @@ pub struct EquationFileError {
     pub message: String,
 }
 
+/// A number for a message: as Rust writes it, but in exponent form when that would be a
+/// long row of digits (1e308, 1e-300).
+pub(crate) fn number(value: &f64) -> String {
+    let v = value.abs();
+    if v != 0.0 && v.is_finite() && !(1e-6..1e16).contains(&v) {
+        format!("{value:e}")
+    } else {
+        value.to_string()
+    }
+}
+
+/// What an output path clashes with (see [`Error::OutputClash`]).
+#[non_exhaustive]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClashKind {
+    /// The output is a file the run reads.
+    Input,
+    /// The output is a directory that holds a file (or directory) the run reads.
+    HoldsInput,
+    /// The output is another output of the run, or one is inside the other.
+    Output,
+}
+
+/// An output path that would replace an input or another output of the same run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Clash {
+    /// The output, as given.
+    pub output: PathBuf,
+    /// The input or output it clashes with, as given: for a file read from inside a
+    /// directory, the directory.
+    pub other: PathBuf,
+    /// The file concerned, as found: the input file read, or the other output.
+    pub file: PathBuf,
+    /// What the clash is.
+    pub kind: ClashKind,
+}
+
+impl Clash {
+    /// The one-line message, naming the output and the other path by their command-line
+    /// flags where a front end gives them (`--json report.json`), else as "output …".
+    pub fn describe(&self, output_flag: Option<&str>, other_flag: Option<&str>) -> String {
+        let named = |flag: Option<&str>, path: &std::path::Path, what: &str| match flag {
+            Some(f) => format!("{f} {}", path.display()),
+            None => format!("{what}{}", path.display()),
+        };
+        let out = named(output_flag, &self.output, "output ");
+        let file = self.file.display();
+        match self.kind {
+            ClashKind::Input => {
+                let other = named(other_flag, &self.other, "");
+                let same = if self.file == self.other {
+                    format!("the same file as {other}")
+                } else {
+                    format!("the same file as {file}, read from {other}")
+                };
+                format!(
+                    "{out} is also an input of this run ({same}); writing it would destroy the \
+                     input: choose another output path"
+                )
+            }
+            ClashKind::HoldsInput => {
+                let other = named(other_flag, &self.other, "");
+                let held = if self.file == self.other {
+                    other
+                } else {
+                    format!("{file}, read from {other}")
+                };
+                format!(
+                    "{out} holds the input {held}, which replacing the directory would delete; \
+                     choose another directory"
+                )
+            }
+            ClashKind::Output => {
+                let other = named(other_flag, &self.other, "");
+                format!(
+                    "{out} clashes with the output {other} of the same run (the same file, or one \
+                     inside the other); give each output its own path"
+                )
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for Clash {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.describe(None, None))
+    }
+}
+
 /// What kind of failure an [`Error`] is: the one classification from which the command
 /// line's exit codes and the Python exception classes are derived.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -266,6 +361,9 @@ pub enum Category {
     /// A numerical failure: a singular regression, a diverged simulation, a non-finite
     /// result.
     Numerical,
+    /// The request contradicts itself: an output that would replace an input or another
+    /// output of the same run.
+    Usage,
     /// The caller stopped the computation.
     Cancelled,
     /// A failure of hysid itself (serialisation or plot layout), never of the data: a bug.
@@ -294,6 +392,7 @@ impl Error {
             | Error::Equations(_)
             | Error::NotInvertible { .. } => Category::Config,
             Error::ModelFile { .. } | Error::InvalidOutput(_) => Category::ModelFile,
+            Error::OutputClash(_) => Category::Usage,
             Error::Io { .. } => Category::Io,
             Error::Singular(_)
             | Error::Diverged { .. }

@@ -258,5 +258,10 @@ fn rig_truth(dir: &Path) -> Result<Option<Vec<f64>>> {
             })
         })
         .collect::<Result<Vec<f64>>>()
-        .map(Some)
+        .and_then(|truth| {
+            Rig::check_truth(&truth).with_context(|| {
+                format!("{}: truth (remove the file or rewrite it with `hysid actuator rig`)", path.display())
+            })?;
+            Ok(Some(truth))
+        })
 }

@@ -67,7 +67,8 @@ pub fn print_summary(fit: &CascadeFit, report: &Report) {
         .as_ref()
         .map_or("none", |u| u.method.as_str());
     println!(
-        "  fit {fit_percent:.2} %   RMSE {rmse:.4e}   FPE {fpe:.4e}   time {:.2} s   std: {method} (threshold d: truncated normal)",
+        "  fit {fit_percent:.2} %   RMSE {rmse:.4e}   FPE {}   time {:.2} s   std: {method} (threshold d: truncated normal)",
+        crate::report::criterion(fpe, true),
         fit.elapsed_s
     );
     let adm = fit.model.hysteresis.admissibility();

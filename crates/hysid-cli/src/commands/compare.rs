@@ -28,6 +28,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let mut inputs = vec![args.data.data.as_path()];
     inputs.extend(args.validate.as_deref());
     let mut files = OutputSet::new(&inputs)?;
+    // The directory first: a file inside it is then refused as a clash.
+    let plots_tmp = args
+        .output
+        .plots
+        .as_deref()
+        .map(|p| files.dir(p))
+        .transpose()?;
     let json_tmp = args
         .output
         .json
@@ -39,12 +46,6 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         .model_out
         .as_deref()
         .map(|p| files.file(p))
-        .transpose()?;
-    let plots_tmp = args
-        .output
-        .plots
-        .as_deref()
-        .map(|p| files.dir(p))
         .transpose()?;
     let data = load(&args.data, &args.data.data)?;
     let validation = args

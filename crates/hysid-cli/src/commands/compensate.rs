@@ -16,9 +16,10 @@ const PRINTED_RANGES: usize = 5;
 /// Inverts the model along the reference, writes OUT.csv, the report and the plots.
 pub fn run(args: &CompensateArgs) -> Result<()> {
     let mut files = OutputSet::new(&[args.model.as_path(), args.data.as_path()])?;
+    // The directory first: a file inside it is then refused as a clash.
+    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
     let csv_tmp = files.file(&args.csv)?;
     let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
-    let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
     let model = FittedModel::load(&args.model)?;
     let spec = CsvSpec {
         inputs: vec![args.reference.clone()],

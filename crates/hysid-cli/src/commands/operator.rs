@@ -17,6 +17,13 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family).context("--family")?;
     let mut options = family_options(&args.options)?;
     let mut files = OutputSet::new(&[args.data.data.as_path()])?;
+    // The directory first: a file inside it is then refused as a clash.
+    let plots_tmp = args
+        .output
+        .plots
+        .as_deref()
+        .map(|p| files.dir(p))
+        .transpose()?;
     let json_tmp = args
         .output
         .json
@@ -28,12 +35,6 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
         .model_out
         .as_deref()
         .map(|p| files.file(p))
-        .transpose()?;
-    let plots_tmp = args
-        .output
-        .plots
-        .as_deref()
-        .map(|p| files.dir(p))
         .transpose()?;
     let data = load(&args.data, &args.data.data)?;
     let exp = data.experiment(0);

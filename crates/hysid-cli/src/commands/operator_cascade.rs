@@ -78,7 +78,8 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
         fit.initialisation, fit.iterations, fit.termination
     );
     println!(
-        "  fit {fit_percent:.4} %   RMSE {rmse:.4e}   FPE {fpe:.4e}   time {:.2} s   std: asymptotic",
+        "  fit {fit_percent:.4} %   RMSE {rmse:.4e}   FPE {}   time {:.2} s   std: asymptotic",
+        crate::report::criterion(fpe, true),
         fit.elapsed_s
     );
     if !fit.model.linear.is_stable() {

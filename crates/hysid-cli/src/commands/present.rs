@@ -2,6 +2,7 @@
 //! bounds and fixed flags; strong correlations; fit per experiment; loss, FPE, AIC; why the
 //! search stopped; residual analysis; optional sensitivity table.
 
+use crate::report::criterion;
 use hysid::data::IdData;
 use hysid::identify::greybox::GreyBoxFit;
 use hysid::identify::validate::{ResidualAnalysis, SensitivityRow};
@@ -47,8 +48,8 @@ pub fn print_fit(title: &str, fit: &GreyBoxFit) {
         .collect();
     println!("  fit per experiment: {}", fits.join(", "));
     println!(
-        "  loss {:.4e}   FPE {:.4e}   AIC {:.1}   {} iterations, {} function evaluations, {} rejected trials",
-        oe.loss, oe.fpe, oe.aic, oe.report.iterations, oe.report.function_evaluations, oe.report.rejected_trials
+        "  loss {:.4e}   FPE {}   AIC {}   {} iterations, {} function evaluations, {} rejected trials",
+        oe.loss, criterion(oe.fpe, true), criterion(oe.aic, false), oe.report.iterations, oe.report.function_evaluations, oe.report.rejected_trials
     );
     println!(
         "  stopped: {}   time {:.2} s",

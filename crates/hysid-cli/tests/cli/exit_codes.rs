@@ -168,7 +168,7 @@ fn simulate_refuses_to_write_over_its_input_and_commits_both_outputs() {
             .arg(&data)
             .arg("--json")
             .arg(dir.path().join(".").join("data.csv")),
-        1,
+        2,
     );
     assert!(line.contains("is also an input"), "{line}");
     assert_eq!(fs::read(&data).unwrap(), before);

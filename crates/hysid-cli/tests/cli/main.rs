@@ -8,6 +8,8 @@ mod commands;
 mod equations_cli;
 mod exit_codes;
 mod hardening;
+#[cfg(unix)] // symbolic links
+mod inputs_sacred;
 mod operator_cascade_cli;
 mod outputs;
 mod report_schema;

@@ -258,3 +258,73 @@ fn sigterm_removes_the_temporaries_and_keeps_the_previous_outputs() {
     );
     assert!(listing(&dir.path().join("plots")).is_empty());
 }
+
+/// The clash of a refused registration.
+fn clash(e: Error) -> hysid::error::Clash {
+    match e {
+        Error::OutputClash(c) => c,
+        other => panic!("expected an output clash, got {other}"),
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn an_input_is_refused_through_links_dotdot_and_inside_an_input_directory() {
+    use hysid::error::ClashKind;
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    let data = root.join("data");
+    fs::create_dir(&data).unwrap();
+    fs::write(data.join("set1.csv"), "t,u\n0,1\n").unwrap();
+    fs::write(root.join("model.json"), "{}").unwrap();
+    fs::create_dir(root.join("sub")).unwrap();
+    fs::hard_link(data.join("set1.csv"), root.join("hard.csv")).unwrap();
+    std::os::unix::fs::symlink(root.join("model.json"), root.join("link.json")).unwrap();
+    let mut outputs = OutputSet::new(&[&data, &root.join("model.json")]).unwrap();
+    // A file read from inside the input directory, spelled through `..`.
+    let c = clash(
+        outputs
+            .file(&root.join("sub/../data/set1.csv"))
+            .unwrap_err(),
+    );
+    assert_eq!(
+        (c.kind, c.other.as_path()),
+        (ClashKind::Input, data.as_path())
+    );
+    assert!(c.to_string().contains("is also an input"), "{c}");
+    // A hard link of it, and a symbolic link to the other input.
+    let c = clash(outputs.file(&root.join("hard.csv")).unwrap_err());
+    assert_eq!(c.file, data.join("set1.csv"));
+    let c = clash(outputs.dir(&root.join("link.json")).unwrap_err());
+    assert_eq!(c.other, root.join("model.json"));
+    // The input directory itself, and a directory holding it.
+    let c = clash(outputs.dir(&data).unwrap_err());
+    assert_eq!(c.kind, ClashKind::HoldsInput);
+    let c = clash(outputs.dir(root).unwrap_err());
+    assert_eq!(c.kind, ClashKind::HoldsInput);
+    // A new file beside the inputs, or inside the input directory, is no clash.
+    outputs.file(&data.join("report.json")).unwrap();
+    outputs.file(&root.join("model-out.json")).unwrap();
+    assert_eq!(
+        fs::read_to_string(data.join("set1.csv")).unwrap(),
+        "t,u\n0,1\n"
+    );
+}
+
+#[test]
+fn outputs_that_are_one_file_are_refused_by_identity() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    fs::write(root.join("a.json"), "old").unwrap();
+    fs::hard_link(root.join("a.json"), root.join("b.json")).unwrap();
+    let mut outputs = OutputSet::new(&[]).unwrap();
+    outputs.file(&root.join("a.json")).unwrap();
+    let c = clash(outputs.file(&root.join("b.json")).unwrap_err());
+    assert_eq!(c.other, root.join("a.json"));
+    // A directory registered first holds a file registered after it, even before the
+    // directory exists.
+    let mut outputs = OutputSet::new(&[]).unwrap();
+    outputs.dir(&root.join("new/plots")).unwrap();
+    let c = clash(outputs.file(&root.join("new/plots/x.json")).unwrap_err());
+    assert!(c.to_string().contains("clashes with the output"), "{c}");
+}

@@ -478,10 +478,25 @@ fn csv_error(path: &Path, error: csv::Error) -> Error {
                  every row needs one field per column"
             ),
         },
+        // The reader's own text carries its position record ("(line: 3, byte: 20)"): the
+        // line is in the error already, the rest is said in words.
+        ErrorKind::Utf8 { err, .. } => Error::Csv {
+            path: path.to_path_buf(),
+            line,
+            message: format!(
+                "field {} is not valid UTF-8 text; save the file as UTF-8 (or plain ASCII)",
+                err.field() + 1
+            ),
+        },
         _ => Error::Csv {
             path: path.to_path_buf(),
             line,
-            message,
+            message: format!(
+                "cannot be read as CSV ({}); save it as comma-separated text with a header row",
+                message
+                    .split_once("): ")
+                    .map_or(message.as_str(), |(_, what)| what)
+            ),
         },
     }
 }

@@ -227,9 +227,15 @@ impl Reader {
 
     /// The zlib stream of a compressed element, refused past the decompression budget.
     fn inflate(&mut self, element: &Element) -> Result<Vec<u8>, String> {
+        // The decoder's own message describes its internals (bit regions, block types):
+        // only whether the stream ends early or is malformed is said.
         let corrupt = |e: std::io::Error| {
+            let what = match e.kind() {
+                std::io::ErrorKind::UnexpectedEof => "ends before its data are complete",
+                _ => "is not a valid zlib stream",
+            };
             format!(
-                "the compressed element at byte {} is corrupt ({e})",
+                "the compressed element at byte {} is corrupt: it {what}",
                 element.offset
             )
         };

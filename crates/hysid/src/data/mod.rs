@@ -162,7 +162,9 @@ impl IdData {
     /// channels as described. Fails with [`Error::NonFinite`] on the first NaN or infinite
     /// sample; its `channel` is the channel name, followed by ` (experiment i)` (zero-based)
     /// when there are several experiments, and its `index` is the zero-based sample index
-    /// within that experiment.
+    /// within that experiment. Fails with [`Error::InvalidData`] on a channel whose values
+    /// cannot be squared and summed at double precision (see [`MAX_MAGNITUDE`] and
+    /// [`MIN_MAGNITUDE`]): every estimator's loss, fit % and criteria are sums of squares.
     pub fn new(
         ts: f64,
         inputs: Vec<Channel>,
@@ -182,6 +184,8 @@ impl IdData {
             };
             check_finite(&experiment.inputs, &inputs, label)?;
             check_finite(&experiment.outputs, &outputs, label)?;
+            check_scale(&experiment.inputs, &inputs, label)?;
+            check_scale(&experiment.outputs, &outputs, label)?;
         }
         Ok(Self {
             ts,
@@ -491,6 +495,65 @@ fn check_channel_counts(
         }
     }
     Ok(())
+}
+
+/// The largest magnitude a sample may have: the sum of the squares of 10⁸ such samples is
+/// still finite (1e150² · 1e8 = 1e308). A channel beyond it is refused by [`IdData::new`]
+/// (rescale it, e.g. change its unit).
+pub const MAX_MAGNITUDE: f64 = 1e150;
+
+/// The smallest magnitude of a channel (its largest |sample|) that is not zero: below it the
+/// squares of its values and of their differences underflow (1e-150² · ε ≈ 2e-316, near the
+/// smallest double), so a loss would be zero whatever the fit. A channel whose samples are
+/// all this small (and not all zero) is refused by [`IdData::new`].
+pub const MIN_MAGNITUDE: f64 = 1e-150;
+
+/// Refuses a channel that cannot be squared at double precision: a sample beyond
+/// [`MAX_MAGNITUDE`], or every sample below [`MIN_MAGNITUDE`] without all being zero.
+fn check_scale(
+    samples: &[Vec<f64>],
+    channels: &[Channel],
+    label: impl Fn(&str) -> String,
+) -> Result<()> {
+    for (values, channel) in samples.iter().zip(channels) {
+        let (index, largest) =
+            values
+                .iter()
+                .map(|v| v.abs())
+                .enumerate()
+                .fold(
+                    (0, 0.0_f64),
+                    |best, (k, v)| if v > best.1 { (k, v) } else { best },
+                );
+        if largest > MAX_MAGNITUDE {
+            return Err(invalid(format!(
+                "channel '{}', sample {index}: |value| {largest:e} exceeds {MAX_MAGNITUDE:e}, where squares and sums of squares overflow double precision; rescale the channel (e.g. change its unit)",
+                one_line(&label(&channel.name))
+            )));
+        }
+        if largest > 0.0 && largest < MIN_MAGNITUDE {
+            return Err(invalid(format!(
+                "channel '{}': every value is below {MIN_MAGNITUDE:e} in magnitude (the largest is {largest:e}), where squares underflow double precision and every loss would be zero; rescale the channel (e.g. change its unit)",
+                one_line(&label(&channel.name))
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Whether `values` vary at double precision: their spread (max − min) is at least
+/// [`MIN_MAGNITUDE`] and more than a few rounding errors (8 ε) of their magnitude. A
+/// measured output that does not vary leaves nothing to fit and fit % undefined; the
+/// estimators refuse it through this one test.
+pub fn varies(values: &[f64]) -> bool {
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let spread = hi - lo;
+    let magnitude = lo.abs().max(hi.abs());
+    spread.is_finite() && spread >= MIN_MAGNITUDE && spread > 8.0 * f64::EPSILON * magnitude
 }
 
 /// Reports the first non-finite sample; `label` turns a channel name into the reported one.

@@ -51,6 +51,11 @@ pub const TORQUE_QUANTUM: f64 = 10.0 / 65_536.0;
 /// √12: a uniform rounding error of one count q has standard deviation q/√12.
 const SQRT_12: f64 = 3.464_101_615_137_754_6;
 
+/// The largest magnitude of a true parameter of the rig (SI units): the actuator's
+/// parameters are of order 1e-4 to 1e2, and beyond 1e12 the simulation or the tables
+/// (which scale them by up to 1e4) leave the finite range.
+pub const MAX_TRUTH: f64 = 1e12;
+
 /// Settings of the virtual rig.
 #[derive(Clone, Debug)]
 pub struct Rig {
@@ -249,27 +254,52 @@ impl Rig {
         })
     }
 
-    fn validate(&self) -> Result<()> {
-        if self.truth.len() != 7 || self.truth.iter().any(|v| !v.is_finite()) {
+    /// Refuses true parameters (J, Fv, Fc, k1, k2, α, A) the rig cannot simulate, or whose
+    /// tables would not be finite: not 7 values, a value outside the model's bounds (positive
+    /// inertia, non-negative friction and hysteresis rate), or a magnitude beyond
+    /// [`MAX_TRUTH`]. Used for the rig's settings and for the truth file (`rig.json`) read
+    /// back beside its data sets.
+    pub fn check_truth(truth: &[f64]) -> Result<()> {
+        if truth.len() != 7 {
             return Err(Error::invalid_option(
                 "truth",
-                format!("{:?}", self.truth),
-                "the rig needs 7 finite true parameters (J, Fv, Fc, k1, k2, alpha, A)".into(),
+                truth.len(),
+                format!(
+                    "the rig needs 7 true parameters (J, Fv, Fc, k1, k2, alpha, A), got {}",
+                    truth.len()
+                ),
             ));
         }
-        // The physics: positive inertia, non-negative friction and hysteresis rate.
-        for (p, &value) in ActuatorFixed.parameters().iter().zip(&self.truth) {
+        for (p, &value) in ActuatorFixed.parameters().iter().zip(truth) {
+            if !value.is_finite() || value.abs() > MAX_TRUTH {
+                return Err(Error::InvalidParameter {
+                    name: p.name.clone(),
+                    value,
+                    reason: format!(
+                        "the actuator's true {} must be finite and at most {MAX_TRUTH:e} in magnitude (SI units); a larger one makes the simulation or its tables non-finite",
+                        p.name
+                    ),
+                });
+            }
+            // The physics: positive inertia, non-negative friction and hysteresis rate.
             if !(p.min..=p.max).contains(&value) {
                 return Err(Error::InvalidParameter {
                     name: p.name.clone(),
                     value,
                     reason: format!(
                         "the actuator's true {} must lie in [{}, {}]",
-                        p.name, p.min, p.max
+                        p.name,
+                        crate::error::number(&p.min),
+                        crate::error::number(&p.max)
                     ),
                 });
             }
         }
+        Ok(())
+    }
+
+    fn validate(&self) -> Result<()> {
+        Self::check_truth(&self.truth)?;
         if self.fs.is_nan()
             || self.fs <= 0.0
             || self.substeps == 0

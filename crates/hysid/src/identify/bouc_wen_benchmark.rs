@@ -154,6 +154,14 @@ impl BoucWenBenchmark {
         tests: &[(String, IdData)],
         callback: &mut dyn FnMut(&IterationRecord) -> Control,
     ) -> Result<BoucWenResult> {
+        // A test output that does not vary leaves its fit % undefined: refused before the fit.
+        for (source, data) in tests {
+            if !crate::data::varies(data.experiment(0).output(0)) {
+                return Err(Error::InvalidData(format!(
+                    "test record {source}: the output does not vary at double precision, so it cannot score a model (fit % undefined); check the output column"
+                )));
+            }
+        }
         let simulation = self.simulation();
         let fit = self.estimation().estimate(
             Arc::new(BoucWen),

@@ -1232,9 +1232,9 @@ fn check_outputs_vary(data: &IdData) -> Result<()> {
         for (o, channel) in data.output_channels().iter().enumerate() {
             let y = experiment.output(o);
             if let Some(&first) = y.first() {
-                if y.iter().all(|v| *v == first) {
+                if !crate::data::varies(y) {
                     return Err(Error::InvalidData(format!(
-                        "output '{}' is constant ({first}) in experiment '{}': there is nothing to fit and fit % is undefined; check the output column",
+                        "output '{}' is constant ({first}) at double precision in experiment '{}': there is nothing to fit and fit % is undefined; check the output column",
                         channel.name,
                         experiment.name()
                     )));

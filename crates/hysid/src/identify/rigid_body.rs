@@ -179,6 +179,14 @@ impl RigidBodyLs {
                     .into(),
             });
         }
+        // Positions that do not vary at double precision have derivatives of rounding
+        // noise: the regression would "fit" that noise.
+        if !crate::data::varies(q) {
+            return Err(Error::NotExciting {
+                channel: "position".into(),
+                reason: "it does not vary at double precision, so there is no motion to explain; check the position column".into(),
+            });
+        }
         let preprocessing = self.preprocessing();
         preprocessing.check(q.len(), ts, self.names().len())?;
         let [_, qd, qdd] = preprocessing.motion(q, ts)?;

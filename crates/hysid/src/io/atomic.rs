@@ -6,9 +6,13 @@
 //! destination atomically, POSIX.1-2008):
 //!
 //! 1. every output path is registered before any work ([`OutputSet::file`],
-//!    [`OutputSet::dir`]); registration refuses a path equal to an input (compared
-//!    canonicalised), a path given twice, a directory output that contains an input, and a
-//!    destination directory where a probe file cannot be created and removed;
+//!    [`OutputSet::dir`]); registration refuses, as [`Error::OutputClash`], an output that
+//!    is a file the run reads, a directory output that holds one, and an output that is
+//!    another output or lies inside it — compared by identity: the same file after symbolic
+//!    links and `..` (canonical paths) and, on unix, after hard links (device and inode).
+//!    An input directory counts with every file directly inside it (the files a command
+//!    reads from it). Registration then refuses a destination directory where a probe file
+//!    cannot be created and removed;
 //! 2. each output is written to a temporary in its destination directory — a file to
 //!    `.NAME.hysid-tmp-PID-N`, a directory output to a sibling directory of that form — whose
 //!    path registration returns;
@@ -28,7 +32,7 @@ use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, Once};
 
-use crate::error::{Error, Result};
+use crate::error::{Clash, ClashKind, Error, Result};
 
 /// The prefix-free middle part of every temporary name.
 const TMP_TAG: &str = "hysid-tmp";
@@ -49,12 +53,70 @@ enum Kind {
     Dir,
 }
 
+/// Entries read from one input directory, or walked in one existing output directory, at
+/// most: a bound on the work of registration, far above what a command reads.
+const MAX_ENTRIES: usize = 100_000;
+
+/// Which file a path is: its canonical path and, on unix, its device and inode (the same
+/// for every hard link of the file).
+#[derive(Clone, Debug)]
+struct Identity {
+    canonical: PathBuf,
+    inode: Option<(u64, u64)>,
+}
+
+impl Identity {
+    /// The identity of `path`, existing or to be created (then without an inode, and
+    /// with the part below its deepest existing ancestor taken as written, `..` removing
+    /// the component before it); `None` when no ancestor can be resolved.
+    fn of(path: &Path) -> Option<Self> {
+        let canonical = match canonical_target(path) {
+            Ok(c) => c,
+            Err(_) => lexical_target(path)?,
+        };
+        Some(Self {
+            canonical,
+            inode: inode(path),
+        })
+    }
+
+    /// The same file: the same canonical path, or the same inode.
+    fn same(&self, other: &Identity) -> bool {
+        self.canonical == other.canonical || (self.inode.is_some() && self.inode == other.inode)
+    }
+}
+
+/// Device and inode of the file `path` resolves to.
+#[cfg(unix)]
+fn inode(path: &Path) -> Option<(u64, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    fs::metadata(path).ok().map(|m| (m.dev(), m.ino()))
+}
+
+/// Device and inode of the file `path` resolves to (not known off unix).
+#[cfg(not(unix))]
+fn inode(_path: &Path) -> Option<(u64, u64)> {
+    None
+}
+
+/// One file or directory the run reads.
+#[derive(Debug)]
+struct Input {
+    /// The path as given (for a file inside an input directory: the directory).
+    given: PathBuf,
+    /// The file itself.
+    file: PathBuf,
+    id: Identity,
+}
+
 /// One registered output: where it goes and where it is being written.
 #[derive(Debug)]
 struct Output {
     kind: Kind,
     target: PathBuf,
-    canonical: PathBuf,
+    id: Identity,
+    /// The inodes of the files inside an existing directory output (hard links count).
+    held: Vec<(u64, u64)>,
     staged: PathBuf,
 }
 
@@ -78,7 +140,7 @@ struct Output {
 #[derive(Debug)]
 pub struct OutputSet {
     id: usize,
-    inputs: Vec<PathBuf>,
+    inputs: Vec<Input>,
     outputs: Vec<Output>,
     /// Parent directories created for directory outputs, removed again on failure.
     created: Vec<PathBuf>,
@@ -86,17 +148,42 @@ pub struct OutputSet {
 }
 
 impl OutputSet {
-    /// A new transaction whose outputs must differ from every path of `inputs` (those that
-    /// exist; compared canonicalised, so `./a.csv` and `a.csv` are the same).
+    /// A new transaction whose outputs must not be, nor hold, any of `inputs`: the files
+    /// the run reads, and the directories it reads files from (with every file directly
+    /// inside them). Compared by identity (see the [module documentation](self)), so
+    /// `./a.csv`, `d/../a.csv`, a symbolic link to `a.csv` and a hard link of it are all
+    /// `a.csv`. An input that does not exist yet counts by its path.
     pub fn new(inputs: &[&Path]) -> Result<Self> {
         install_signal_cleanup();
-        let inputs = inputs
-            .iter()
-            .filter_map(|p| fs::canonicalize(p).ok())
-            .collect();
+        let mut found = Vec::new();
+        for given in inputs {
+            let Some(id) = Identity::of(given) else {
+                continue;
+            };
+            if given.is_dir() {
+                let entries = fs::read_dir(given).into_iter().flatten().flatten();
+                for entry in entries.take(MAX_ENTRIES) {
+                    let file = entry.path();
+                    if file.is_file() {
+                        if let Some(id) = Identity::of(&file) {
+                            found.push(Input {
+                                given: given.to_path_buf(),
+                                file,
+                                id,
+                            });
+                        }
+                    }
+                }
+            }
+            found.push(Input {
+                given: given.to_path_buf(),
+                file: given.to_path_buf(),
+                id,
+            });
+        }
         Ok(Self {
             id: COUNTER.fetch_add(1, Ordering::Relaxed),
-            inputs,
+            inputs: found,
             outputs: Vec::new(),
             created: Vec::new(),
             committed: false,
@@ -107,6 +194,7 @@ impl OutputSet {
     /// same directory, not yet created). Refused: an input, a path already registered, an
     /// existing directory, a missing or unwritable directory.
     pub fn file(&mut self, path: &Path) -> Result<PathBuf> {
+        self.check_clash(path, Kind::File)?;
         if path.is_dir() {
             return Err(invalid_output(path, "is a directory; give a file name"));
         }
@@ -120,10 +208,10 @@ impl OutputSet {
                 ),
             ));
         }
-        let canonical = self.check_new(path)?;
+        let id = self.check_new(path, Kind::File)?;
         probe(path, parent)?;
         let staged = temporary_beside(path);
-        self.push(Kind::File, path, canonical, staged.clone());
+        self.push(Kind::File, path, id, staged.clone());
         Ok(staged)
     }
 
@@ -132,6 +220,7 @@ impl OutputSet {
     /// the run fails). Refused: an input or a directory holding one, a path already
     /// registered, an existing file, an unwritable parent.
     pub fn dir(&mut self, path: &Path) -> Result<PathBuf> {
+        self.check_clash(path, Kind::Dir)?;
         if path.exists() && !path.is_dir() {
             return Err(invalid_output(
                 path,
@@ -140,20 +229,11 @@ impl OutputSet {
         }
         let parent = parent_of(path).to_path_buf();
         self.create_parents(&parent)?;
-        let canonical = self.check_new(path)?;
-        if let Some(input) = self.inputs.iter().find(|i| i.starts_with(&canonical)) {
-            return Err(invalid_output(
-                path,
-                &format!(
-                    "holds the input {}, which replacing the directory would delete; choose another directory",
-                    input.display()
-                ),
-            ));
-        }
+        let id = self.check_new(path, Kind::Dir)?;
         probe(path, &parent)?;
         let staged = temporary_beside(path);
         fs::create_dir(&staged).map_err(|source| io(&staged, source))?;
-        self.push(Kind::Dir, path, canonical, staged.clone());
+        self.push(Kind::Dir, path, id, staged.clone());
         Ok(staged)
     }
 
@@ -200,30 +280,66 @@ impl OutputSet {
         Ok(())
     }
 
-    /// The canonical form of a new output path, refused if it is an input or registered.
-    fn check_new(&self, path: &Path) -> Result<PathBuf> {
-        let canonical = canonical_target(path)?;
-        if self.inputs.contains(&canonical) {
-            return Err(invalid_output(
-                path,
-                "is also an input of this run; writing it would destroy the input: choose another output path",
-            ));
+    /// The identity of a new output path, refused (as any other error of
+    /// [`canonical_target`]) when it does not name a file or directory in an existing one.
+    fn check_new(&self, path: &Path, kind: Kind) -> Result<Identity> {
+        self.check_clash(path, kind)?;
+        Ok(Identity {
+            canonical: canonical_target(path)?,
+            inode: inode(path),
+        })
+    }
+
+    /// Refuses an output of `kind` at `path` that is an input, holds one, or clashes with
+    /// an output registered before (see the [module documentation](self)). A path whose
+    /// directory does not exist clashes with nothing (its registration fails otherwise).
+    fn check_clash(&self, path: &Path, kind: Kind) -> Result<()> {
+        let Some(id) = Identity::of(path) else {
+            return Ok(());
+        };
+        let clash = |other: &Path, file: &Path, kind: ClashKind| {
+            Err(Error::OutputClash(Clash {
+                output: path.to_path_buf(),
+                other: other.to_path_buf(),
+                file: file.to_path_buf(),
+                kind,
+            }))
+        };
+        if let Some(input) = self.inputs.iter().find(|i| i.id.same(&id)) {
+            let what = if kind == Kind::Dir && input.file.is_dir() {
+                ClashKind::HoldsInput
+            } else {
+                ClashKind::Input
+            };
+            return clash(&input.given, &input.file, what);
+        }
+        // A directory output is replaced whole: it must hold no input, by path or as a
+        // hard link inside it.
+        let held = match kind {
+            Kind::Dir => held_inodes(path),
+            Kind::File => Vec::new(),
+        };
+        if kind == Kind::Dir {
+            let inside = |i: &&Input| {
+                i.id.canonical.starts_with(&id.canonical)
+                    || i.id.inode.is_some_and(|n| held.contains(&n))
+            };
+            if let Some(input) = self.inputs.iter().find(inside) {
+                return clash(&input.given, &input.file, ClashKind::HoldsInput);
+            }
         }
         // The same path, or one inside the other (a file in a directory output).
-        let clash = self
-            .outputs
-            .iter()
-            .find(|o| o.canonical.starts_with(&canonical) || canonical.starts_with(&o.canonical));
-        if let Some(other) = clash {
-            return Err(invalid_output(
-                path,
-                &format!(
-                    "clashes with the output {} of the same run; give each output its own path",
-                    other.target.display()
-                ),
-            ));
+        let clashes = |o: &&Output| {
+            o.id.same(&id)
+                || o.id.canonical.starts_with(&id.canonical)
+                || id.canonical.starts_with(&o.id.canonical)
+                || id.inode.is_some_and(|n| o.held.contains(&n))
+                || o.id.inode.is_some_and(|n| held.contains(&n))
+        };
+        if let Some(other) = self.outputs.iter().find(clashes) {
+            return clash(&other.target, &other.target, ClashKind::Output);
         }
-        Ok(canonical)
+        Ok(())
     }
 
     /// Creates the missing ancestors of `dir`, remembering them for a rollback.
@@ -240,14 +356,19 @@ impl OutputSet {
         Ok(())
     }
 
-    fn push(&mut self, kind: Kind, target: &Path, canonical: PathBuf, staged: PathBuf) {
+    fn push(&mut self, kind: Kind, target: &Path, id: Identity, staged: PathBuf) {
         if let Ok(mut live) = LIVE.lock() {
             live.push((self.id, staged.clone()));
         }
+        let held = match kind {
+            Kind::Dir => held_inodes(target),
+            Kind::File => Vec::new(),
+        };
         self.outputs.push(Output {
             kind,
             target: target.to_path_buf(),
-            canonical,
+            id,
+            held,
             staged,
         });
     }
@@ -279,6 +400,33 @@ fn restore(outputs: &[Output], aside: &[(usize, PathBuf)], moved: usize) {
     for (k, old) in aside {
         let _ = fs::rename(old, &outputs[*k].target);
     }
+}
+
+/// The inodes of the files under the existing directory `dir` (symbolic links not
+/// followed: replacing the directory removes a link, not what it points to), at most
+/// [`MAX_ENTRIES`] entries; empty when `dir` is not a directory or off unix.
+fn held_inodes(dir: &Path) -> Vec<(u64, u64)> {
+    let mut held = Vec::new();
+    if !dir.is_dir() {
+        return held;
+    }
+    let mut pending = vec![dir.to_path_buf()];
+    let mut seen = 0usize;
+    while let Some(d) = pending.pop() {
+        for entry in fs::read_dir(&d).into_iter().flatten().flatten() {
+            seen += 1;
+            if seen > MAX_ENTRIES {
+                return held;
+            }
+            let path = entry.path();
+            match fs::symlink_metadata(&path) {
+                Ok(m) if m.is_dir() => pending.push(path),
+                Ok(m) if m.is_file() => held.extend(inode(&path)),
+                _ => {}
+            }
+        }
+    }
+    held
 }
 
 /// Removes a file or a directory tree, ignoring what is already gone.
@@ -347,6 +495,34 @@ fn canonical_target(path: &Path) -> Result<PathBuf> {
     };
     let parent = fs::canonicalize(parent_of(path)).map_err(|source| io(path, source))?;
     Ok(parent.join(name))
+}
+
+/// The path `path` will have once its missing directories are created: its deepest
+/// existing ancestor canonicalised, joined with the rest, `.` dropped and `..` removing the
+/// component before it.
+fn lexical_target(path: &Path) -> Option<PathBuf> {
+    let absolute = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir().ok()?.join(path)
+    };
+    let parts: Vec<Component> = absolute.components().collect();
+    let (exists, mut out) = (0..=parts.len()).rev().find_map(|n| {
+        Some((
+            n,
+            fs::canonicalize(parts[..n].iter().collect::<PathBuf>()).ok()?,
+        ))
+    })?;
+    for part in &parts[exists..] {
+        match part {
+            Component::Normal(name) => out.push(name),
+            Component::ParentDir => {
+                out.pop();
+            }
+            _ => {}
+        }
+    }
+    Some(out)
 }
 
 /// Creates and removes a probe file in `dir`: the only sure test that it is writable.

@@ -182,7 +182,8 @@ impl ParameterSet {
                     value: p.value,
                     reason: format!(
                         "initial value outside its bounds [{}, {}]; move it inside or widen the bounds",
-                        p.min, p.max
+                        crate::error::number(&p.min),
+                        crate::error::number(&p.max)
                     ),
                 });
             }

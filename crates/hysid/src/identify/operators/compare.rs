@@ -158,6 +158,15 @@ pub fn compare(
             y.len()
         )));
     }
+    let outputs = std::iter::once(("the output", y))
+        .chain(validation.map(|v| ("the validation output", v.1)));
+    for (what, out) in outputs {
+        if !crate::data::varies(out) {
+            return Err(Error::InvalidData(format!(
+                "{what} does not vary at double precision: there is nothing to fit and fit % is undefined; check the output column"
+            )));
+        }
+    }
     if options.families.is_empty() {
         return Err(Error::invalid_option(
             "families",

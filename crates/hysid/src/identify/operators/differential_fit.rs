@@ -65,7 +65,7 @@ pub fn check_record(family: &str, u: &[f64], y: &[f64], p: usize) -> Result<()> 
             ),
         });
     }
-    if metrics::std_dev(y) == 0.0 {
+    if !crate::data::varies(y) {
         return Err(Error::InvalidData(format!(
             "{family}: the output is constant; there is no loop to fit"
         )));

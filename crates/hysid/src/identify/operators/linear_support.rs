@@ -40,8 +40,7 @@ pub(crate) fn check_data(u: &[f64], y: &[f64], parameters: usize) -> Result<()> 
             ),
         });
     }
-    let (lo, hi) = range(y);
-    if lo == hi {
+    if !crate::data::varies(y) {
         return Err(Error::NotExciting {
             channel: "y".into(),
             reason: "the output is constant: nothing to fit".into(),

@@ -413,3 +413,36 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn channels_whose_squares_overflow_or_underflow_are_refused() {
+    let wave: Vec<f64> = (0..50).map(|k| (0.3 * k as f64).sin()).collect();
+    let scaled = |s: f64| wave.iter().map(|v| v * s).collect::<Vec<f64>>();
+    for (scale, words) in [(1e-300, "below 1e-150"), (1e300, "exceeds 1e150")] {
+        let message = invalid_message(IdData::siso(1.0, "u", wave.clone(), "y", scaled(scale)));
+        assert!(
+            message.contains("'y'") && message.contains(words),
+            "{message}"
+        );
+        let message = invalid_message(IdData::siso(1.0, "u", scaled(scale), "y", wave.clone()));
+        assert!(
+            message.contains("'u'") && message.contains("rescale"),
+            "{message}"
+        );
+    }
+    // Zero channels, and the limits themselves, are data.
+    assert!(IdData::siso(1.0, "u", vec![0.0; 50], "y", wave.clone()).is_ok());
+    assert!(IdData::siso(1.0, "u", scaled(1e-149), "y", scaled(1e149)).is_ok());
+}
+
+#[test]
+fn variation_is_judged_at_double_precision() {
+    assert!(varies(&[0.0, 1.0]));
+    assert!(varies(&[1e-100, -1e-100]));
+    assert!(!varies(&[0.5; 10]));
+    assert!(!varies(&[]));
+    // A spread of a rounding error, or one whose square underflows, is no variation.
+    assert!(!varies(&[1.0, 1.0 + f64::EPSILON]));
+    assert!(!varies(&[1e-300, 2e-300]));
+    assert!(varies(&[1.0, 1.0 + 1e-12]));
+}
