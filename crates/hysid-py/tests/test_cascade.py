@@ -55,7 +55,7 @@ def test_cascade_equals_live_cli(example1, tmp_path):
             "2",
             "--delay",
             "1",
-            "--model",
+            "--model-out",
             str(model),
         ],
         check=True,
