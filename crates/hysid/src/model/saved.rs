@@ -29,7 +29,7 @@
 //! | `operator_cascade` | `operator` (the family and its structure: thresholds, grid, orientation, …), `delay` | the operator's (prefixed `op_` where they collide with a₁…, b₁…), then a₁ … a_n, b₁ (fixed at 1) … b_m |
 //! | `bouc_wen`, `rigid_body`, `actuator_fixed`, `actuator_free` | `simulation`, `initial_state` | the grey-box model's |
 //! | `equations` | `equations` (the equation file's text), `simulation`, `initial_state` | the file's `[parameters]` |
-//! | `operator` | `family` (`pi`, `gpi`, `preisach`, `jiles-atherton`, `bouc-wen`, `duhem`, `dahl`, `maxwell-slip`, `backlash`), `operator` (the operator's full structure: thresholds, weights, grid, orientation, initial state) | the family's, named as in the literature |
+//! | `operator` | `family` (an operator family of the registry, `model::operators::Family`), `operator` (the operator's full structure: thresholds, weights, grid, orientation, initial state) | the family's, named as in the literature |
 //!
 //! Any kind may carry the processing its fit applied to the records ([`record_filters`]):
 //! `prefilter` (`{remove_mean, cutoff_hz, order}`, the actuator's step 3: records filtered
@@ -208,8 +208,8 @@ pub enum SavedModel {
     Operator {
         /// The family's parameters, named as in the literature.
         parameters: Vec<ParameterRecord>,
-        /// `pi`, `gpi`, `preisach`, `jiles-atherton`, `bouc-wen`, `duhem`, `dahl`,
-        /// `maxwell-slip` or `backlash`.
+        /// The family's name, one of the registry's operator families (`pi`, `preisach`,
+        /// `kp`, …: `hysid::model::operators::Family`).
         family: String,
         /// The operator's full structure: thresholds, weights, grids, orientation and
         /// initial state, as the family defines them. Checked on reading.
