@@ -50,3 +50,17 @@ pub fn band_limited_upsample(x: &[f64], factor: usize) -> Vec<f64> {
     planner.plan_fft_inverse(m).process(&mut padded);
     padded.iter().map(|c| c.re / n as f64).collect()
 }
+
+/// The one-sided energy spectrum |X_k|², k = 0 … ⌊n/2⌋, of a real record `x` (length n),
+/// X = DFT(x): bin k is the frequency k/n of the sampling rate, the last one (for even n)
+/// the Nyquist frequency. An empty record gives an empty spectrum.
+pub fn energy_spectrum(x: &[f64]) -> Vec<f64> {
+    let n = x.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let mut planner = FftPlanner::<f64>::new();
+    let mut spectrum: Vec<Complex<f64>> = x.iter().map(|&v| Complex::new(v, 0.0)).collect();
+    planner.plan_fft_forward(n).process(&mut spectrum);
+    spectrum[..=n / 2].iter().map(|c| c.norm_sqr()).collect()
+}

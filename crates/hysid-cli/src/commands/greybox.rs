@@ -90,6 +90,9 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         &fit,
     );
     let residuals = print_residuals(&fit, &data);
+    for warning in fit.warnings() {
+        eprintln!("warning: {warning}");
+    }
     let sensitivity = if args.sensitivity {
         let structure = hysid::identify::greybox::GreyBox::new(
             model.clone(),

@@ -8,6 +8,7 @@ mod commands;
 mod equations_cli;
 mod exit_codes;
 mod hardening;
+mod hold_check_cli;
 #[cfg(unix)] // symbolic links
 mod inputs_sacred;
 mod operator_cascade_cli;

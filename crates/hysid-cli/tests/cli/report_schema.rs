@@ -14,7 +14,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
 
-const TOP_LEVEL: [&str; 10] = [
+const TOP_LEVEL: [&str; 11] = [
     "schema",
     "command",
     "version",
@@ -25,6 +25,7 @@ const TOP_LEVEL: [&str; 10] = [
     "uncertainty",
     "validation",
     "details",
+    "warnings",
 ];
 const PARAMETER_KEYS: [&str; 7] = ["fixed", "lower", "name", "std", "unit", "upper", "value"];
 

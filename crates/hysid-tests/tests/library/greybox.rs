@@ -407,3 +407,95 @@ fn bad_starts_and_numerical_trouble_are_reported() {
         fit.fit.report
     );
 }
+
+/// The hold check on synthetic signals: a band-limited input whose residual is a shifted copy
+/// of it fires; the same residual with a staircase input, or a white residual with the
+/// band-limited input, does not.
+#[test]
+fn hold_check_fires_on_a_band_limited_input_with_correlated_residuals() {
+    use hysid::identify::greybox::hold_check;
+    let n = 4096;
+    let u = multisine(n, 1, 750.0, 5.0, 150.0, 50.0, 5).unwrap();
+    let stairs: Vec<f64> = {
+        let levels = gaussian_noise(n / 8 + 1, 50.0, 6).unwrap();
+        (0..n).map(|t| levels[t / 8]).collect()
+    };
+    let noise = gaussian_noise(n, 1.0, 7).unwrap();
+    // y = 0, ŷ = −(input one sample later)·1e-3 + noise: a residual correlated with the input.
+    let correlated = |u: &[f64]| -> Vec<f64> {
+        (0..n)
+            .map(|t| -1e-3 * u[(t + 1) % n] + 1e-3 * noise[t])
+            .collect()
+    };
+    let record = |u: &[f64]| IdData::siso(1.0 / 750.0, "u", u.to_vec(), "y", vec![0.0; n]).unwrap();
+    let fired = hold_check(&record(&u), &[vec![correlated(&u)]]);
+    eprintln!("band-limited, correlated: {fired:?}");
+    assert!(fired.fires && fired.high_band_fraction < 1e-10);
+    assert!(fired
+        .warning()
+        .unwrap()
+        .contains("--interpolation band-limited"));
+    let held = hold_check(&record(&stairs), &[vec![correlated(&stairs)]]);
+    eprintln!("staircase, correlated: {held:?}");
+    assert!(!held.fires && held.high_band_fraction > 1e-2 && held.cross_correlation_ratio > 2.0);
+    assert!(held.warning().is_none());
+    let white = hold_check(&record(&u), &[vec![noise.clone()]]);
+    eprintln!("band-limited, white residual: {white:?}");
+    assert!(!white.fires && white.cross_correlation_ratio < 2.0);
+}
+
+/// After a fit with zero-order hold (the default), the fit says whether the hold misled it:
+/// on a band-limited multisine record (simulated band-limited) it does, with the warning
+/// naming `--interpolation band-limited`; on a random staircase record simulated with the
+/// hold itself it does not. A fit with band-limited interpolation runs no check.
+#[test]
+fn zero_order_hold_fit_warns_on_a_band_limited_record_only() {
+    let zoh = Simulation {
+        integrator: Integrator::Rk4 { substeps: 4 },
+        interpolation: InputInterpolation::ZeroOrderHold,
+    };
+    let fit_with = |data: &IdData, simulation: Simulation| {
+        GreyBoxEstimation {
+            simulation,
+            lm: hysid::numerics::LmConfig {
+                max_iterations: 10,
+                ..Default::default()
+            },
+            ..Default::default()
+        }
+        .estimate(
+            Arc::new(BoucWen),
+            data,
+            &BoucWen.parameters(),
+            InitialStates::at_rest(3, 1),
+            &mut |_| Control::Continue,
+        )
+        .unwrap()
+    };
+    let band_limited = synthetic_record(1, 11);
+    let fit = fit_with(&band_limited, zoh);
+    let check = fit.hold_check.clone().unwrap();
+    eprintln!("multisine record, zero-order hold: {check:?}");
+    assert!(check.fires, "{check:?}");
+    assert_eq!(fit.warnings().len(), 1);
+    assert!(fit.warnings()[0].contains("--interpolation band-limited"));
+    let fit = fit_with(&band_limited, benchmark_simulation());
+    assert!(fit.hold_check.is_none() && fit.warnings().is_empty());
+
+    // A random staircase (levels of RMS 50 N held 8 samples), simulated with the hold.
+    let n = 4096;
+    let levels = gaussian_noise(n / 8 + 1, 50.0, 12).unwrap();
+    let u: Vec<f64> = (0..n).map(|t| levels[t / 8]).collect();
+    let input = IdData::siso(1.0 / 750.0, "u", u.clone(), "y", vec![0.0; n]).unwrap();
+    let gb = GreyBox::new(Arc::new(BoucWen), &input, zoh, InitialStates::at_rest(3, 1)).unwrap();
+    let mut theta = BoucWen.parameters().values();
+    theta.extend([0.0; 3]);
+    let mut y = vec![vec![0.0; n]];
+    gb.simulate(&theta, &input, 0, &mut y).unwrap();
+    let held = with_output(&input, y.remove(0));
+    let fit = fit_with(&held, zoh);
+    let check = fit.hold_check.clone().unwrap();
+    eprintln!("staircase record, zero-order hold: {check:?}");
+    assert!(!check.fires && check.high_band_fraction > 1e-2, "{check:?}");
+    assert!(fit.warnings().is_empty());
+}

@@ -23,7 +23,8 @@ use serde_json::{json, Value};
 pub const RESIDUAL_LAGS: usize = 25;
 
 /// The report of a grey-box fit under `command` on `data` (read from `source`), with the
-/// model file `model`; the keys of `extra` are added to `details`.
+/// model file `model`; the keys of `extra` are added to `details`, the fit's warnings (a
+/// band-limited input held between samples) are the report's `warnings`.
 pub fn greybox_report(
     command: &str,
     fit: &GreyBoxFit,
@@ -45,8 +46,9 @@ pub fn greybox_report(
         "correlation": correlation,
         "history": oe.report.history,
         "starts": fit.starts,
+        "hold_check": fit.hold_check,
     });
-    Ok(Report::of_output_error(
+    let mut report = Report::of_output_error(
         command,
         data,
         source,
@@ -55,7 +57,9 @@ pub fn greybox_report(
         fit.elapsed_s,
         UncertaintySummary::asymptotic(),
     )?
-    .with_details(merged(details, extra)))
+    .with_details(merged(details, extra));
+    report.warnings = fit.warnings();
+    Ok(report)
 }
 
 /// Residual analysis (auto-correlation of the residual, cross-correlation with each input,

@@ -15,8 +15,10 @@
 //! | `uncertainty` | [`UncertaintySummary`]: how the standard deviations were obtained |
 //! | `validation` | [`ValidationEntry`] per validation/test record |
 //! | `details` | command-specific (documented per command in `docs/report.md`) |
+//! | `warnings` | one line per warning the command printed on stderr about its result |
 //!
-//! A key that does not apply is `null` (an empty list for `validation`), never missing.
+//! A key that does not apply is `null` (an empty list for `validation` and `warnings`), never
+//! missing.
 //! Multi-step commands put each step's report in `details.steps`, each a `Report` itself.
 //!
 //! fit % is the normalised RMSE fit 100 (1 − ‖y − ŷ‖ / ‖y − ȳ‖) of MATLAB's `compare`;
@@ -73,6 +75,11 @@ pub struct Report {
     pub validation: Vec<ValidationEntry>,
     /// Command-specific details (null when there are none).
     pub details: serde_json::Value,
+    /// Warnings about the result, one line each, the same as the command printed on stderr
+    /// (e.g. a band-limited input held between samples in a grey-box fit); empty when there
+    /// are none (and when read from a report written before the key existed).
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 /// The data a command read or made.
@@ -403,6 +410,7 @@ impl Report {
             uncertainty: None,
             validation: Vec::new(),
             details: serde_json::Value::Null,
+            warnings: Vec::new(),
         }
     }
 

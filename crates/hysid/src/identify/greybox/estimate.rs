@@ -4,11 +4,12 @@
 //! records (screening); the best screened start is then fitted on all the data. Screening
 //! keeps a multi-start affordable: most poor starts are recognisable after a few iterations.
 
+use super::hold_check::{hold_check, HoldCheck};
 use super::structure::{GreyBox, InitialStates};
 use crate::data::IdData;
 use crate::identify::multistart::{best_of, draw_starts, StartOutcome};
 use crate::identify::{OutputError, OutputErrorFit};
-use crate::model::greybox::{Simulation, StateSpaceModel};
+use crate::model::greybox::{InputInterpolation, Simulation, StateSpaceModel};
 use crate::model::saved::FittedModel;
 use crate::model::ParameterSet;
 use crate::numerics::{Control, IterationRecord, LmConfig, Observer};
@@ -63,9 +64,21 @@ pub struct GreyBoxFit {
     pub starts: Vec<StartOutcome>,
     /// Wall-clock time of the whole estimation.
     pub elapsed_s: f64,
+    /// With zero-order hold of the input (the default): whether a band-limited input should
+    /// have been interpolated band-limited ([`super::hold_check`]); None with another
+    /// interpolation and for a discrete-time model.
+    pub hold_check: Option<HoldCheck>,
 }
 
 impl GreyBoxFit {
+    /// The warnings of the fit, one line each (the report's `warnings`).
+    pub fn warnings(&self) -> Vec<String> {
+        self.hold_check
+            .iter()
+            .filter_map(HoldCheck::warning)
+            .collect()
+    }
+
     /// The fitted model: the model's own parameters (the leading ones of the estimate) with
     /// their standard deviations, the first experiment's initial state, and `simulation`.
     pub fn fitted_model(&self, model: &dyn StateSpaceModel, simulation: Simulation) -> FittedModel {
@@ -129,7 +142,7 @@ impl GreyBoxEstimation {
         let params = structure.parameter_set(model_params);
         params.validate()?;
         let (start, starts) = if self.starts > 1 {
-            self.screen(model, data, &params, initial)?
+            self.screen(model.clone(), data, &params, initial)?
         } else {
             (params, Vec::new())
         };
@@ -139,10 +152,15 @@ impl GreyBoxEstimation {
             skip: 0,
         };
         let fit = estimator.estimate(&structure, data, &start, callback)?;
+        // A discrete-time model has no input between samples to interpolate.
+        let held = self.simulation.interpolation == InputInterpolation::ZeroOrderHold
+            && !model.discrete_time();
+        let hold_check = held.then(|| hold_check(data, &fit.simulated));
         Ok(GreyBoxFit {
             fit,
             starts,
             elapsed_s: clock.elapsed().as_secs_f64(),
+            hold_check,
         })
     }
 

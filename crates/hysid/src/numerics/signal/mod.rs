@@ -3,7 +3,10 @@
 //! version. The MATLAB-compatible preprocessing (`butter`, `filter`, `filtfilt`, `gradient`)
 //! functions are re-exported here from the `filter` submodule.
 
+mod band;
 mod filter;
+
+pub use band::high_band_fraction;
 
 pub use filter::{
     butter, cheby1, decimate, filter, filtfilt, gradient, remove_mean,

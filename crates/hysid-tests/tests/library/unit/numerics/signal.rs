@@ -51,3 +51,29 @@ fn noise_is_seeded_and_has_the_asked_snr() {
     let u = uniform_noise(1000, 0.2, 3).unwrap();
     assert!(u.iter().all(|v| v.abs() <= 0.2));
 }
+
+/// A random staircase of `n` samples holding each Gaussian level for `hold` samples.
+fn staircase(n: usize, hold: usize, seed: u64) -> Vec<f64> {
+    let levels = gaussian_noise(n / hold + 1, 1.0, seed).unwrap();
+    (0..n).map(|t| levels[t / hold]).collect()
+}
+
+/// A band-limited multisine (5–150 Hz at 750 Hz: up to 0.4 of Nyquist) has no energy above
+/// half the Nyquist frequency but leakage, a whole number of periods or not; a staircase held
+/// for 1 to 100 samples has more than the 10⁻³ of the grey-box hold check, a constant none.
+#[test]
+fn high_band_fraction_separates_multisines_from_staircases() {
+    let u = multisine(4096, 2, 750.0, 5.0, 150.0, 50.0, 3).unwrap();
+    let whole = high_band_fraction(&u, 0.5);
+    let part = high_band_fraction(&u[..3000], 0.5);
+    eprintln!("multisine: {whole:.2e} (whole periods), {part:.2e} (3000 samples)");
+    assert!(whole < 1e-12 && part < 1e-6, "{whole} {part}");
+    for (hold, low) in [(1, 0.3), (10, 5e-3), (100, 1.1e-3)] {
+        let x = staircase(20_000, hold, 7);
+        let f = high_band_fraction(&x, 0.5);
+        eprintln!("staircase held {hold}: {f:.2e}");
+        assert!(f > low, "held {hold}: {f}");
+    }
+    assert_eq!(high_band_fraction(&[2.0; 100], 0.5), 0.0);
+    assert_eq!(high_band_fraction(&[1.0, 2.0], 0.5), 0.0);
+}

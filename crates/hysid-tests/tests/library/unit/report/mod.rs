@@ -20,10 +20,12 @@ fn an_empty_report_has_every_key_and_nulls() {
         "uncertainty",
         "validation",
         "details",
+        "warnings",
     ] {
         assert!(keys.contains(&k), "{k} missing");
     }
     assert!(v["fit"].is_null() && v["model"].is_null());
+    assert_eq!(v["warnings"], serde_json::json!([]));
 }
 
 #[test]
