@@ -82,6 +82,9 @@ impl InputOde for AsymmetricBoucWen {
     }
 }
 
+/// A plant: input to noise-free output.
+type Plant = Box<dyn Fn(&[f64]) -> Vec<f64>>;
+
 fn write(dir: &str, name: &str, u: &[f64], y: &[f64]) {
     let mut text = String::from("u,y\n");
     for (u, y) in u.iter().zip(y) {
@@ -109,11 +112,26 @@ fn main() {
         gamma: 0.4,
         delta: 0.5,
     };
-    let cases: Vec<(&str, Box<dyn Fn(&[f64]) -> Vec<f64>>, f64, u64)> = vec![
-        ("bouc-wen", Box::new(move |u| bw.simulate(u).unwrap()), 1.5, 1),
-        ("duhem", Box::new(move |u| duhem.simulate(u).unwrap()), 1.5, 2),
+    let cases: Vec<(&str, Plant, f64, u64)> = vec![
+        (
+            "bouc-wen",
+            Box::new(move |u| bw.simulate(u).unwrap()),
+            1.5,
+            1,
+        ),
+        (
+            "duhem",
+            Box::new(move |u| duhem.simulate(u).unwrap()),
+            1.5,
+            2,
+        ),
         ("dahl", Box::new(move |u| dahl.simulate(u).unwrap()), 1.0, 3),
-        ("jiles-atherton", Box::new(move |u| ja.simulate(u).unwrap()), 60.0, 4),
+        (
+            "jiles-atherton",
+            Box::new(move |u| ja.simulate(u).unwrap()),
+            60.0,
+            4,
+        ),
         (
             "bouc-wen-asym",
             Box::new(move |u| differential::simulate(&asym, u).unwrap()),
@@ -125,6 +143,11 @@ fn main() {
         let u = training(amplitude);
         write(&dir, name, &u, &with_noise(&plant(&u), seed));
         let v = validation(amplitude);
-        write(&dir, &format!("{name}_val"), &v, &with_noise(&plant(&v), seed + 100));
+        write(
+            &dir,
+            &format!("{name}_val"),
+            &v,
+            &with_noise(&plant(&v), seed + 100),
+        );
     }
 }

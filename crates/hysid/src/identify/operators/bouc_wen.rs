@@ -12,9 +12,9 @@
 //!   classes β > 0, −β < γ ≤ β are the box s > 0, d ≥ 0, where the engine's projection keeps
 //!   every trial point simulable (in (β, γ) the constraint γ ≤ β is not a box, and trials past it
 //!   fail).
-//! * *Start grid* over the shape: saturation levels w_s = (β + γ)^{−1/n} from 1 % to 4 times the
-//!   input's half range (log-spaced) times the ratios γ/β ∈ {−0.9 … 1} (and n ∈ {1, 1.5, 2, 3}
-//!   when n is estimated).
+//! * *Start grid* over the shape: 12 saturation levels w_s = (β + γ)^{−1/n} from 1 % to 4 times
+//!   the input's half range (log-spaced) times the ratios γ/β ∈ {−0.9, −0.5, 0, 0.5, 0.9, 1}
+//!   (and n ∈ {1, 1.5, 2, 3} when n is estimated).
 //!
 //! References: Ismail, Ikhouane & Rodellar (2009); Ikhouane & Rodellar (2007), see
 //! [`crate::model::operators::bouc_wen`].
@@ -91,7 +91,11 @@ impl DifferentialFamily for Family {
     }
     fn bounds(&self, _shape: &LoopShape) -> (Vec<f64>, Vec<f64>) {
         let inf = f64::INFINITY;
-        let (kw_lo, kw_hi) = if self.sign > 0.0 { (0.0, inf) } else { (-inf, 0.0) };
+        let (kw_lo, kw_hi) = if self.sign > 0.0 {
+            (0.0, inf)
+        } else {
+            (-inf, 0.0)
+        };
         (
             vec![-inf, kw_lo, 0.0, 1e-300, 0.0, 1.0, -inf],
             vec![inf, kw_hi, inf, inf, inf, 20.0, inf],
@@ -126,10 +130,10 @@ impl DifferentialFamily for Family {
         };
         let mut points = Vec::new();
         for &n in exponents {
-            for k in 0..14 {
+            for k in 0..12 {
                 // 1 % … 400 % of the half range, log-spaced.
-                let ws = half * 0.01 * 400f64.powf(k as f64 / 13.0);
-                for q in [-0.9, -0.6, -0.3, 0.0, 0.3, 0.6, 0.9, 1.0] {
+                let ws = half * 0.01 * 400f64.powf(k as f64 / 11.0);
+                for q in [-0.9, -0.5, 0.0, 0.5, 0.9, 1.0] {
                     let beta = 1.0 / (ws.powf(n) * (1.0 + q));
                     points.push(vec![beta, q * beta, n]);
                 }

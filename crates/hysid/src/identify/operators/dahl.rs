@@ -10,8 +10,8 @@
 //! **What the family supplies.** With z = F/F_c and ρ = σ/F_c the equation reads
 //! dz/dx = ρ·(1 − z·sign dx)^i: the force is F_c times the response z of a unit operator
 //! that depends on the shape (ρ, i, z0) alone, so F_c is the linear parameter. The start grid
-//! places ρ log-spaced from 0.5 to 500 per input range, i ∈ {1, 1.5, 2, 3, 5} when it is
-//! estimated, and z0 = F\[0\]/max|F| (|F| approaches F_c on a long branch).
+//! places ρ log-spaced from 0.5 to 500 per input range, i ∈ {1, 1.5, 2.5, 4} when it is
+//! estimated (12 × 4 points), and z0 = F\[0\]/max|F| (|F| approaches F_c on a long branch).
 //!
 //! References: Dahl (1968, 1976), see [`crate::model::operators::dahl`].
 
@@ -96,14 +96,14 @@ impl DifferentialFamily for Family {
         let peak = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let z0 = (shape.first.1 / peak).clamp(-0.95, 0.95);
         let exponents: &[f64] = if self.estimate_i {
-            &[1.0, 1.5, 2.0, 3.0, 5.0]
+            &[1.0, 1.5, 2.5, 4.0]
         } else {
             std::slice::from_ref(&self.i)
         };
         let mut points = Vec::new();
         for &i in exponents {
-            for k in 0..16 {
-                points.push(vec![0.5 * 1000f64.powf(k as f64 / 15.0) / span, i, z0]);
+            for k in 0..12 {
+                points.push(vec![0.5 * 1000f64.powf(k as f64 / 11.0) / span, i, z0]);
             }
         }
         points

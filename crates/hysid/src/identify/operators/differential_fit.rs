@@ -28,8 +28,9 @@
 //!    bounded Levenberg–Marquardt ([`crate::numerics::levenberg_marquardt`]) with exact
 //!    sensitivities.
 //! 4. **Refinement on the full record** of the best local minimum (and of the runner-up when
-//!    its criterion is within [`RIVAL_MARGIN`] of the best and its parameters differ: two
-//!    minima too close to tell apart on the subsample). The sensitivities ∂ŷ/∂θ are integrated
+//!    its criterion is within [`RIVAL_MARGIN`] of the best but does not agree with it to
+//!    [`AGREEMENT`], and its parameters differ: two minima too close to tell apart on the
+//!    subsample). Local searches that agree are one minimum found from several starts. The sensitivities ∂ŷ/∂θ are integrated
 //!    in u beside the state ([`simulate_with_sensitivities`]): exact derivatives of the
 //!    computed output at the cost of about one simulation, where forward differences need p
 //!    further simulations and lose half the digits. The normal equations JᵀJ, Jᵀr are summed
@@ -51,7 +52,7 @@
 //! [`DifferentialFamily::theta_of`] and [`DifferentialFamily::chain`].
 //!
 //! The observer of the options sees "grid", "start" and "iteration" progress; its
-//! [`Control::Stop`](crate::numerics::Control::Stop) ends the fit with the best point so far and
+//! [`Control::Stop`] ends the fit with the best point so far and
 //! [`Termination::Stopped`] (how a time limit is honoured).
 //!
 //! References: G. H. Golub, V. Pereyra, "The differentiation of pseudo-inverses and nonlinear
@@ -79,14 +80,17 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 /// Samples the global stages keep (at least: every reversal of the input is kept too).
-pub const DECIMATED_SAMPLES: usize = 1500;
+pub const DECIMATED_SAMPLES: usize = 800;
 /// The integration tolerance of the global stages (the operator's own is
 /// [`TOLERANCE`]): a fifth-order step grows as the tolerance's fifth root, so the
 /// exploration takes several times fewer steps, and a start needs no more digits.
 pub const COARSE_TOLERANCE: f64 = 1e-6;
-/// A local minimum whose decimated criterion is within this fraction of the best one's is
-/// refined on the full record too.
+/// A local minimum whose decimated criterion is within this fraction of the best one's (and
+/// not within [`AGREEMENT`]) is refined on the full record too.
 pub const RIVAL_MARGIN: f64 = 0.02;
+/// Local searches whose decimated criteria agree to this fraction reached the same minimum
+/// (their parameters may still differ along a direction the subsample hardly determines).
+pub const AGREEMENT: f64 = 1e-6;
 /// The relative decrease the Gauss–Newton model may still promise at the end of a run
 /// without a restart.
 pub const RESTART_THRESHOLD: f64 = 1e-9;
@@ -209,11 +213,12 @@ pub struct Settings {
     pub observer: Observer,
 }
 
-/// The default engine settings of these fits: 200 iterations, tight tolerances.
+/// The default engine settings of these fits: 200 iterations, a relative improvement
+/// tolerance of 1e-10 (the criterion's last digits move the fit % by less than 1e-8 points).
 pub fn default_config() -> LmConfig {
     LmConfig {
         max_iterations: 200,
-        improvement_tolerance: 1e-12,
+        improvement_tolerance: 1e-10,
         ..LmConfig::default()
     }
 }
@@ -346,9 +351,14 @@ struct OutputError<'a, F: DifferentialFamily> {
     n_phi: usize,
     floor: f64,
     tolerance: f64,
-    last_system: Mutex<Option<(Vec<f64>, Vec<usize>, System)>>,
-    best_output: Option<Mutex<(Vec<f64>, f64, Vec<f64>)>>,
+    last_system: Mutex<Option<LastSystem>>,
+    best_output: Option<Mutex<BestOutput>>,
 }
+
+/// The last normal equations computed: (φ, free, system).
+type LastSystem = (Vec<f64>, Vec<usize>, System);
+/// The output of the lowest criterion evaluated: (φ, S, ŷ).
+type BestOutput = (Vec<f64>, f64, Vec<f64>);
 
 /// The normal equations in φ (for the engine) and JᵀJ in the model's θ (for the covariance).
 #[derive(Clone)]
@@ -395,7 +405,12 @@ impl<'a, F: DifferentialFamily> OutputError<'a, F> {
             }
         }
         let yhat = simulate_with_tolerance(&self.model(phi)?, self.u, self.tolerance)?;
-        let cost: f64 = self.y.iter().zip(&yhat).map(|(y, h)| (y - h) * (y - h)).sum();
+        let cost: f64 = self
+            .y
+            .iter()
+            .zip(&yhat)
+            .map(|(y, h)| (y - h) * (y - h))
+            .sum();
         if !cost.is_finite() {
             return Err(Error::Diverged {
                 index: 0,
@@ -587,7 +602,9 @@ impl<F: DifferentialFamily> Driver<'_, F> {
                 sse.is_finite().then(|| (sse, self.family.phi_of(&theta)))
             })
             .collect();
-        self.settings.observer.report("grid", points.len(), points.len());
+        self.settings
+            .observer
+            .report("grid", points.len(), points.len());
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
         scored
     }
@@ -621,7 +638,6 @@ pub fn fit<F: DifferentialFamily>(
     let ud: Vec<f64> = kept.iter().map(|&k| u[k]).collect();
     let yd: Vec<f64> = kept.iter().map(|&k| y[k]).collect();
     let grid = driver.grid(&ud, &yd, &shape);
-    trace(&format!("grid {} points, {} kept, {:?}", grid.len(), kept.len(), started.elapsed()));
     evaluations += grid.len();
     if grid.is_empty() {
         return Err(Error::NotExciting {
@@ -661,13 +677,14 @@ pub fn fit<F: DifferentialFamily>(
         minima.push(grid[0].clone());
     }
     minima.sort_by(|a, b| a.0.total_cmp(&b.0));
-    trace(&format!("local {:?} it {iterations} {:?}", minima.iter().map(|m| m.0).collect::<Vec<_>>(), started.elapsed()));
 
     // 4–5: the full record from the best minimum (and a close rival), checked.
     let full = OutputError::new(family, (u, y), n_phi, TOLERANCE, true);
     let mut candidates = vec![minima[0].1.clone()];
     if let Some(rival) = minima[1..].iter().find(|m| {
-        m.0 <= minima[0].0 * (1.0 + RIVAL_MARGIN) && differs(&m.1, &minima[0].1, &driver.free)
+        m.0 > minima[0].0 * (1.0 + AGREEMENT)
+            && m.0 <= minima[0].0 * (1.0 + RIVAL_MARGIN)
+            && differs(&m.1, &minima[0].1, &driver.free)
     }) {
         candidates.push(rival.1.clone());
     }
@@ -684,8 +701,6 @@ pub fn fit<F: DifferentialFamily>(
         };
         iterations += work.0;
         evaluations += work.1;
-        trace(&format!("full it {} ev {} cost {} {:?} {:?}", work.0, work.1, report.cost, termination, started.elapsed()));
-        trace(&format!("hist {:?}", report.history.iter().map(|h| (h.cost, h.lambda)).collect::<Vec<_>>()));
         stopped |= halted;
         if best.as_ref().is_none_or(|b| report.cost < b.0.cost) {
             best = Some((report, termination));
@@ -723,12 +738,6 @@ pub fn fit<F: DifferentialFamily>(
     )
 }
 
-fn trace(s: &str) {
-    if std::env::var_os("HYSID_DRIVER_TRACE").is_some() {
-        eprintln!("[driver] {s}");
-    }
-}
-
 /// True when two points differ by more than 0.1 % (relative) in a free coordinate.
 fn differs(a: &[f64], b: &[f64], free: &[usize]) -> bool {
     free.iter()
@@ -764,8 +773,13 @@ fn refine<F: DifferentialFamily>(
             return Ok((run.report, t, (iterations, evaluations), false));
         }
         let system = problem.system(&r.theta, &driver.free)?.phi;
-        let promise =
-            expected_improvement(&system, &r.theta, &driver.free, &driver.lower, &driver.upper);
+        let promise = expected_improvement(
+            &system,
+            &r.theta,
+            &driver.free,
+            &driver.lower,
+            &driver.upper,
+        );
         let out_of_iterations = r.termination == Termination::MaxIterations;
         if promise <= RESTART_THRESHOLD || restarts == MAX_RESTARTS || out_of_iterations {
             let termination = if promise > FLAT_THRESHOLD && !out_of_iterations {

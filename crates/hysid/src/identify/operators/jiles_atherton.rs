@@ -156,7 +156,10 @@ impl DifferentialFamily for Family {
         points
     }
     fn basis(&self, p: &[f64], u: &[f64], tolerance: f64) -> Result<Basis> {
-        let unit = self.operator(&[1.0, p[0], p[1], p[2], p[3], p[4]], JaOutput::Magnetisation);
+        let unit = self.operator(
+            &[1.0, p[0], p[1], p[2], p[3], p[4]],
+            JaOutput::Magnetisation,
+        );
         let mut m = simulate_with_tolerance(&unit, u, tolerance)?;
         let fixed = match self.output {
             JaOutput::Magnetisation => None,

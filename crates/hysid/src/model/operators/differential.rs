@@ -353,13 +353,14 @@ pub fn simulate_with_sensitivities<O: InputOdeSensitivity + ?Sized>(
     ode.initial_state_partials(&mut rule.s[..p]);
     let mut x = ode.initial_state();
     let mut dy = [0.0; MAX_SENSITIVITIES];
-    let mut emit = |k: usize, x: f64, s: &[f64; MAX_SENSITIVITIES], dy: &mut [f64; MAX_SENSITIVITIES]| {
-        let hx = ode.output_partials(u[k], x, &mut dy[..p]);
-        for j in 0..p {
-            dy[j] += hx * s[j];
-        }
-        each(k, ode.output(u[k], x), &dy[..p]);
-    };
+    let mut emit =
+        |k: usize, x: f64, s: &[f64; MAX_SENSITIVITIES], dy: &mut [f64; MAX_SENSITIVITIES]| {
+            let hx = ode.output_partials(u[k], x, &mut dy[..p]);
+            for j in 0..p {
+                dy[j] += hx * s[j];
+            }
+            each(k, ode.output(u[k], x), &dy[..p]);
+        };
     emit(0, x, &rule.s, &mut dy);
     let mut budget = MAX_SUBSTEPS + 100 * u.len();
     for (k, w) in u.windows(2).enumerate() {
@@ -401,7 +402,13 @@ impl<O: InputOdeSensitivity + ?Sized> StepRule<O> for Tangents {
         stage(0, 0.0, x, &[], &mut k);
         stage(1, h / 5.0, x + h * k[0] / 5.0, &[0.2], &mut k);
         let a2 = [3.0 / 40.0, 9.0 / 40.0];
-        stage(2, 0.3 * h, x + h * (a2[0] * k[0] + a2[1] * k[1]), &a2, &mut k);
+        stage(
+            2,
+            0.3 * h,
+            x + h * (a2[0] * k[0] + a2[1] * k[1]),
+            &a2,
+            &mut k,
+        );
         let a3 = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
         let x3 = x + h * (44.0 / 45.0 * k[0] - 56.0 / 15.0 * k[1] + 32.0 / 9.0 * k[2]);
         stage(3, 0.8 * h, x3, &a3, &mut k);
@@ -432,9 +439,10 @@ impl<O: InputOdeSensitivity + ?Sized> StepRule<O> for Tangents {
             * (35.0 / 384.0 * k[0] + 500.0 / 1113.0 * k[2] + 125.0 / 192.0 * k[3]
                 - 2187.0 / 6784.0 * k[4]
                 + 11.0 / 84.0 * k[5]);
-        for l in 0..self.p {
-            self.pending[l] = self.s[l]
-                + h * (35.0 / 384.0 * dk[0][l] + 500.0 / 1113.0 * dk[2][l]
+        for (l, pending) in self.pending.iter_mut().enumerate().take(self.p) {
+            *pending = self.s[l]
+                + h * (35.0 / 384.0 * dk[0][l]
+                    + 500.0 / 1113.0 * dk[2][l]
                     + 125.0 / 192.0 * dk[3][l]
                     - 2187.0 / 6784.0 * dk[4][l]
                     + 11.0 / 84.0 * dk[5][l]);

@@ -115,13 +115,7 @@ impl InputOdeSensitivity for Duhem {
     fn slope_partials(&self, u: f64, y: f64, direction: f64, dtheta: &mut [f64]) -> (f64, f64) {
         let f = self.slope(u, y, direction);
         let ad = self.alpha * direction;
-        dtheta.copy_from_slice(&[
-            direction * (self.a * u + self.b - y),
-            ad * u,
-            ad,
-            1.0,
-            0.0,
-        ]);
+        dtheta.copy_from_slice(&[direction * (self.a * u + self.b - y), ad * u, ad, 1.0, 0.0]);
         (f, -ad)
     }
     fn output_partials(&self, _u: f64, _y: f64, dtheta: &mut [f64]) -> f64 {

@@ -265,6 +265,7 @@ impl std::ops::Sub for Dual {
 
 impl std::ops::Mul for Dual {
     type Output = Self;
+    #[allow(clippy::suspicious_arithmetic_impl)] // the product rule
     fn mul(self, o: Self) -> Self {
         let (x, y) = (self.v, o.v);
         self.zip(o, x * y, |a, b| a * y + x * b)
@@ -273,13 +274,16 @@ impl std::ops::Mul for Dual {
 
 impl std::ops::Div for Dual {
     type Output = Self;
+    #[allow(clippy::suspicious_arithmetic_impl)] // the quotient rule
     fn div(self, o: Self) -> Self {
         let (x, y) = (self.v, o.v);
         self.zip(o, x / y, |a, b| (a * y - x * b) / (y * y))
     }
 }
 
-/// L(x), L'(x) and L''(x) of the anhysteretic shape (Langevin or tanh).
+/// L(x), L'(x) and L''(x) of the anhysteretic shape (Langevin or tanh). For the Langevin
+/// function L'' = −2/x³ + 2·coth x·csch² x is formed from coth x = L + 1/x and
+/// csch² x = 1/x² − L' (no further transcendental function), by its series near 0.
 fn shape_with_curvature(kind: Anhysteretic, x: f64) -> (f64, f64, f64) {
     match kind {
         Anhysteretic::Langevin => {
@@ -288,12 +292,8 @@ fn shape_with_curvature(kind: Anhysteretic, x: f64) -> (f64, f64, f64) {
                 let x2 = x * x;
                 x * (-2.0 / 15.0 + x2 * (8.0 / 189.0 - x2 * 6.0 / 675.0))
             } else {
-                let s = x.sinh();
-                if s.is_finite() && s.abs() < 1e100 {
-                    -2.0 / (x * x * x) + 2.0 * x.cosh() / (s * s * s)
-                } else {
-                    -2.0 / (x * x * x)
-                }
+                let r = 1.0 / x;
+                -2.0 * r * r * r + 2.0 * (l + r) * (r * r - dl)
             };
             (l, dl, ddl)
         }
@@ -349,10 +349,11 @@ impl InputOdeSensitivity for JilesAtherton {
         6
     }
     fn slope_partials(&self, u: f64, m: f64, direction: f64, dtheta: &mut [f64]) -> (f64, f64) {
-        let f = self.slope(u, m, direction);
         let s = self.orientation.sign();
         match self.dm_dh_dual(s * u, m, s * direction) {
             Some(g) => {
+                // The value is `dm_dh`'s, operation for operation: the slope's very bits.
+                let f = s * g.v;
                 for (j, d) in dtheta.iter_mut().take(5).enumerate() {
                     *d = s * g.d[j + 1];
                 }
@@ -361,7 +362,7 @@ impl InputOdeSensitivity for JilesAtherton {
             }
             None => {
                 dtheta.fill(f64::NAN);
-                (f, f64::NAN)
+                (f64::NAN, f64::NAN)
             }
         }
     }

@@ -37,7 +37,10 @@ fn reaches_the_truth(
 ) {
     let best = fit_percent(yv, &truth.simulate(v).unwrap());
     let got = fit_percent(yv, &fitted.simulate(v).unwrap());
-    eprintln!("{}: validation fit {got:.4} % (true parameters {best:.4} %)", truth.family());
+    eprintln!(
+        "{}: validation fit {got:.4} % (true parameters {best:.4} %)",
+        truth.family()
+    );
     assert!(
         got >= best - 0.1,
         "{}: validation fit {got:.4} % vs {best:.4} % of the true parameters",
@@ -82,7 +85,12 @@ fn decimation_keeps_every_reversal_and_the_states_there() {
     let (full, thin) = (m.simulate(&u).unwrap(), m.simulate(&ud).unwrap());
     for (j, &k) in kept.iter().enumerate() {
         // Equal to the integration's tolerance, accumulated over the record.
-        assert!((full[k] - thin[j]).abs() < 1e-6, "{k}: {} vs {}", full[k], thin[j]);
+        assert!(
+            (full[k] - thin[j]).abs() < 1e-6,
+            "{k}: {} vs {}",
+            full[k],
+            thin[j]
+        );
     }
     // A short record is kept whole.
     assert_eq!(decimate(&u[..100], 1500), (0..100).collect::<Vec<_>>());
@@ -230,7 +238,10 @@ fn reaches_the_family_best(plant: &AsymmetricBoucWen, best: f64) {
     assert!(fit.termination.converged(), "{:?}", fit.termination);
     let got = fit_percent(&yv, &fit.model.simulate(&v).unwrap());
     eprintln!("bouc-wen: validation fit {got:.4} % (dense-search best {best:.4} %)");
-    assert!(got >= best - 0.1, "validation fit {got:.4} % vs best {best:.4} %");
+    assert!(
+        got >= best - 0.1,
+        "validation fit {got:.4} % vs best {best:.4} %"
+    );
 }
 
 #[test]
@@ -307,9 +318,15 @@ fn dense_search_of_the_symmetric_fit() {
             .iter()
             .take(12)
             .filter_map(|(_, t)| {
-                minimize(&problem, t, &[0, 1, 2, 3, 4], &lower, &upper, &config, &mut |_| {
-                    hysid::numerics::Control::Continue
-                })
+                minimize(
+                    &problem,
+                    t,
+                    &[0, 1, 2, 3, 4],
+                    &lower,
+                    &upper,
+                    &config,
+                    &mut |_| hysid::numerics::Control::Continue,
+                )
                 .ok()
             })
             .min_by(|a, b| a.cost.total_cmp(&b.cost))

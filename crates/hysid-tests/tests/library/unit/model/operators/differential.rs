@@ -156,7 +156,10 @@ fn integrated_sensitivities_match_central_differences() {
         y0: t[4],
     };
     check(&duhem, &[3.0, 1.5, 0.2, 0.4, -0.1], &u);
-    for orientation in [LoopOrientation::Clockwise, LoopOrientation::CounterClockwise] {
+    for orientation in [
+        LoopOrientation::Clockwise,
+        LoopOrientation::CounterClockwise,
+    ] {
         let dahl = move |t: &[f64]| Dahl {
             sigma: t[0],
             fc: t[1],
