@@ -344,3 +344,42 @@ fn dense_search_of_the_symmetric_fit() {
         );
     }
 }
+
+#[test]
+fn an_observer_that_stops_ends_the_fit_and_says_so() {
+    use hysid::numerics::{Control, Observer, Termination};
+    let m = bouc_wen_truth();
+    let u = training_input(4000, 1.5);
+    let y = m.simulate(&u).unwrap();
+    let options = bouc_wen::BoucWenOptions {
+        observer: Observer::new(|p| match p.phase {
+            "iteration" => Control::Stop,
+            _ => Control::Continue,
+        }),
+        ..Default::default()
+    };
+    let fit = bouc_wen::fit(&u, &y, &options).unwrap();
+    assert_eq!(fit.termination, Termination::Stopped);
+    assert!(!fit.termination.converged());
+    // Stopped before the grid: the grid's best point, still a model.
+    let options = bouc_wen::BoucWenOptions {
+        observer: Observer::new(|p| match p.phase {
+            "grid" | "start" => Control::Stop,
+            _ => Control::Continue,
+        }),
+        ..Default::default()
+    };
+    let fit = bouc_wen::fit(&u, &y, &options).unwrap();
+    assert_eq!(fit.termination, Termination::Stopped);
+    assert!(fit.fit_percent.is_finite());
+}
+
+#[test]
+fn a_flat_region_is_not_convergence() {
+    use hysid::numerics::Termination;
+    let t = Termination::FlatRegion { expected: 1e-3 };
+    assert!(!t.converged());
+    assert!(t.to_string().contains("flat region"), "{t}");
+    let code = serde_json::to_value(&t).unwrap();
+    assert_eq!(code["code"], "flat_region");
+}
