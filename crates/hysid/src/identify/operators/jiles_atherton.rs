@@ -7,11 +7,11 @@
 //! magnetisation is Mₛ times the response m of a unit operator (Mₛ = 1) that depends on the
 //! shape (a, k, c, ᾱ, m0/Mₛ) alone, and B = μ₀·H + μ₀·Mₛ·m. Mₛ is the linear parameter.
 //! The start grid is placed from the loop (after converting B to M = B/μ₀ − H):
-//! * the saturation ratio ρ = Mₛ/max|M| ∈ {1.1, 1.5, 2.5} gives a from the anhysteretic's
+//! * the saturation ratio ρ = Mₛ/max|M| ∈ {1.05, 1.5, 3} gives a from the anhysteretic's
 //!   reach at the loop tip, L(H_max/a) = 1/ρ;
 //! * k ∈ {½, 1, 2}·H_c, H_c the coercivity (the mean |H| where M changes sign; k ≈ H_c,
 //!   Jiles, Thoelke & Devine 1992);
-//! * c ∈ {0.1, 0.4, 0.7}, ᾱ ∈ {0, 0.1, 0.3}·a, m0/Mₛ = M\[0\]/(ρ·max|M|).
+//! * c ∈ {0.2, 0.45, 0.7}, ᾱ ∈ {0, 0.05, 0.3}·a, m0/Mₛ = M\[0\]/(ρ·max|M|).
 //!
 //! The search box is the physical one: Mₛ, a, k > 0, 0 ≤ c < 1, α ≥ 0.
 //!
@@ -142,12 +142,12 @@ impl DifferentialFamily for Family {
         }
         .max(1e-3 * h_max);
         let mut points = Vec::new();
-        for rho in [1.1, 1.5, 2.5] {
+        for rho in [1.05, 1.5, 3.0] {
             let a = h_max / inverse_langevin(1.0 / rho);
             let z0 = m[0] / (rho * m_max);
             for k in [0.5, 1.0, 2.0].map(|f| f * hc) {
-                for c in [0.1, 0.4, 0.7] {
-                    for alpha in [0.0, 0.1, 0.3].map(|f| f * a) {
+                for c in [0.2, 0.45, 0.7] {
+                    for alpha in [0.0, 0.05, 0.3].map(|f| f * a) {
                         points.push(vec![a, k, c, alpha, z0]);
                     }
                 }
