@@ -32,6 +32,14 @@ pub enum Termination {
         /// The last relative change of the parameters.
         change: f64,
     },
+    /// The search stopped on a flat region, not at a minimum: its steps gained less than the
+    /// tolerance while the undamped Gauss–Newton model at the point still promises the
+    /// relative decrease `expected` of the criterion (e.g. after many trial points where the
+    /// model is not defined, the damped steps became too short to matter).
+    FlatRegion {
+        /// The relative decrease gᵀ(JᵀJ)⁻¹g/S that a Gauss–Newton step still promises.
+        expected: f64,
+    },
     /// A fixed-point iteration left the region where the model is defined.
     Diverged {
         /// What went wrong.
@@ -74,6 +82,11 @@ impl fmt::Display for Termination {
             Termination::Converged { change } => {
                 write!(f, "parameter change {change:.2e} below tolerance")
             }
+            Termination::FlatRegion { expected } => write!(
+                f,
+                "stopped on a flat region (a Gauss-Newton step still promises a relative \
+                 decrease of {expected:.2e})"
+            ),
             Termination::Diverged { reason } => write!(f, "diverged: {reason}"),
         }
     }

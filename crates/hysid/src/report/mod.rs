@@ -254,7 +254,8 @@ pub struct SearchSummary {
 pub struct TerminationSummary {
     /// `max_iterations`, `improvement_below_tolerance`, `step_below_tolerance`,
     /// `gradient_below_tolerance`, `zero_residual`, `no_descent`, `stopped`,
-    /// `nothing_to_estimate`, `converged`, `diverged`, `direct` for a direct solve, or
+    /// `nothing_to_estimate`, `converged`, `flat_region`, `diverged`, `direct` for a direct
+    /// solve, or
     /// `time_limit` when a front end's time limit stopped the search (the best result so far).
     pub code: String,
     /// The reason in words.

@@ -41,3 +41,22 @@ pub fn within_three_sigma(
     }
     counts
 }
+
+/// The driver's training input: [`nested_loops`] (a decaying sine with nested reversals).
+pub fn training_input(n: usize, amplitude: f64) -> Vec<f64> {
+    nested_loops(n, amplitude)
+}
+
+/// The driver's validation input: a growing sine with another ripple,
+/// u(t) = A·((0.4 + 0.6t)·sin(5πt + 0.4) + 0.2·sin(26πt + 1)), t ∈ [0, 1).
+pub fn validation_input(n: usize, amplitude: f64) -> Vec<f64> {
+    let tau = std::f64::consts::TAU;
+    (0..n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            amplitude
+                * ((0.4 + 0.6 * t) * (tau * 2.5 * t + 0.4).sin()
+                    + 0.2 * (tau * 13.0 * t + 1.0).sin())
+        })
+        .collect()
+}

@@ -1,25 +1,32 @@
 //! Fit of the static Bouc–Wen operator ([`BoucWen`]) y = k_x·u + k_w·w,
-//! dw = (A − (β·sign(du·w) + γ)|w|ⁿ) du, A = 1, to a measured loop.
+//! dw = (A − (β·sign(du·w) + γ)|w|ⁿ) du, A = 1, to a measured loop, by the differential
+//! driver ([`differential_fit`](super::differential_fit)).
 //!
-//! **Start from the data.** The loop orientation (the sign of the enclosed area,
-//! [`LoopOrientation::of_loop`]) fixes the sign of k_w: k_w ≥ 0 for a clockwise loop (the
-//! orientation of w itself), ≤ 0 for a counter-clockwise one, and the search keeps it. For a grid of saturation levels
-//! w_s = (β + γ)^{-1/n} (2 %…100 % of the input's half range) and ratios γ/β ∈ {−½, 0, ½, 1},
-//! the state w is simulated and (k_x, k_w) solved by linear least squares (y is linear in
-//! them); the best grid points start a bounded Levenberg–Marquardt search of
-//! (k_x, k_w, β, γ, \[n\], w0), forward finite-difference sensitivities.
+//! **What the family supplies.**
+//! * *Linear parameters* k_x, k_w: for fixed (β, γ, n, w0) the output is the combination
+//!   k_x·u + k_w·w of the input and the state.
+//! * *Orientation*: the loop's (the sign of the enclosed area, [`LoopOrientation::of_loop`])
+//!   fixes the sign of k_w — k_w ≥ 0 for a clockwise loop (the orientation of w itself), ≤ 0
+//!   for a counter-clockwise one — and the search keeps it.
+//! * *Search coordinates* (k_x, k_w, A, s, d, n, w0) with s = β + γ and d = β − γ: the bounded
+//!   classes β > 0, −β < γ ≤ β are the box s > 0, d ≥ 0, where the engine's projection keeps
+//!   every trial point simulable (in (β, γ) the constraint γ ≤ β is not a box, and trials past it
+//!   fail).
+//! * *Start grid* over the shape: 12 saturation levels w_s = (β + γ)^{−1/n} from 1 % to 4 times
+//!   the input's half range (log-spaced) times the ratios γ/β ∈ {−0.9, −0.5, 0, 0.5, 0.9, 1}
+//!   (and n ∈ {1, 1.5, 2, 3} when n is estimated).
 //!
 //! References: Ismail, Ikhouane & Rodellar (2009); Ikhouane & Rodellar (2007), see
 //! [`crate::model::operators::bouc_wen`].
 
-use super::differential_fit::{self as common, Search, Simulated};
+use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopShape, Settings};
 use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
-use crate::model::operators::{BoucWen, HysteresisOperator, InputOde, LoopOrientation};
+use crate::model::operators::differential::states_with_tolerance;
+use crate::model::operators::{BoucWen, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
 use crate::Result;
-use std::time::Instant;
 
 /// Options of the Bouc–Wen fit.
 #[derive(Clone, Debug)]
@@ -28,11 +35,12 @@ pub struct BoucWenOptions {
     pub n: f64,
     /// Estimate n too (default false: n fixed).
     pub estimate_n: bool,
-    /// Number of grid points that start a search (default 3).
+    /// Local searches on the decimated record, from the best grid points (default 4).
     pub starts: usize,
-    /// Levenberg–Marquardt settings.
+    /// Levenberg–Marquardt settings of the full-record refinement.
     pub config: LmConfig,
-    /// Sees the search's starts and iterations and may stop it (see [`Search::observer`]).
+    /// Sees the fit's grid, starts and iterations and may stop it (see
+    /// [`Settings::observer`]).
     pub observer: Observer,
 }
 
@@ -41,100 +49,130 @@ impl Default for BoucWenOptions {
         Self {
             n: 1.0,
             estimate_n: false,
-            starts: 3,
-            config: common::default_config(),
+            starts: 4,
+            config: driver::default_config(),
             observer: Observer::none(),
         }
     }
 }
 
-/// θ = (k_x, k_w, A, β, γ, n, w0), the order of [`BoucWen::parameters`].
-fn model_of(theta: &[f64]) -> Result<BoucWen> {
-    let m = BoucWen {
-        kx: theta[0],
-        kw: theta[1],
-        a: theta[2],
-        beta: theta[3],
-        gamma: theta[4],
-        n: theta[5],
-        w0: theta[6],
-    };
-    m.validate()?;
-    Ok(m)
+/// The Bouc–Wen family for the driver: θ = (k_x, k_w, A, β, γ, n, w0), the order of
+/// [`BoucWen::parameters`]; φ = (k_x, k_w, A, β + γ, β − γ, n, w0).
+struct Family {
+    n: f64,
+    estimate_n: bool,
+    /// +1: k_w ≥ 0 (clockwise loop), −1: k_w ≤ 0.
+    sign: f64,
+}
+
+impl DifferentialFamily for Family {
+    type Model = BoucWen;
+    fn name(&self) -> &'static str {
+        "bouc-wen"
+    }
+    fn model(&self, t: &[f64]) -> Result<BoucWen> {
+        let m = BoucWen {
+            kx: t[0],
+            kw: t[1],
+            a: t[2],
+            beta: t[3],
+            gamma: t[4],
+            n: t[5],
+            w0: t[6],
+        };
+        m.validate()?;
+        Ok(m)
+    }
+    fn free(&self) -> Vec<usize> {
+        if self.estimate_n {
+            vec![0, 1, 3, 4, 5, 6]
+        } else {
+            vec![0, 1, 3, 4, 6]
+        }
+    }
+    fn bounds(&self, _shape: &LoopShape) -> (Vec<f64>, Vec<f64>) {
+        let inf = f64::INFINITY;
+        let (kw_lo, kw_hi) = if self.sign > 0.0 {
+            (0.0, inf)
+        } else {
+            (-inf, 0.0)
+        };
+        (
+            vec![-inf, kw_lo, 0.0, 1e-300, 0.0, 1.0, -inf],
+            vec![inf, kw_hi, inf, inf, inf, 20.0, inf],
+        )
+    }
+    fn theta_of(&self, p: &[f64]) -> Vec<f64> {
+        vec![
+            p[0],
+            p[1],
+            p[2],
+            0.5 * (p[3] + p[4]),
+            0.5 * (p[3] - p[4]),
+            p[5],
+            p[6],
+        ]
+    }
+    fn phi_of(&self, t: &[f64]) -> Vec<f64> {
+        vec![t[0], t[1], t[2], t[3] + t[4], t[3] - t[4], t[5], t[6]]
+    }
+    fn chain(&self, dt: &[f64], dp: &mut [f64]) {
+        dp.copy_from_slice(dt);
+        dp[3] = 0.5 * (dt[3] + dt[4]);
+        dp[4] = 0.5 * (dt[3] - dt[4]);
+    }
+    /// Points (β, γ, n).
+    fn shape_grid(&self, _u: &[f64], _y: &[f64], shape: &LoopShape) -> Vec<Vec<f64>> {
+        let half = shape.half_span();
+        let exponents: &[f64] = if self.estimate_n {
+            &[1.0, 1.5, 2.0, 3.0]
+        } else {
+            std::slice::from_ref(&self.n)
+        };
+        let mut points = Vec::new();
+        for &n in exponents {
+            for k in 0..12 {
+                // 1 % … 400 % of the half range, log-spaced.
+                let ws = half * 0.01 * 400f64.powf(k as f64 / 11.0);
+                for q in [-0.9, -0.5, 0.0, 0.5, 0.9, 1.0] {
+                    let beta = 1.0 / (ws.powf(n) * (1.0 + q));
+                    points.push(vec![beta, q * beta, n]);
+                }
+            }
+        }
+        points
+    }
+    fn basis(&self, p: &[f64], u: &[f64], tolerance: f64) -> Result<Basis> {
+        let m = BoucWen::new(0.0, 1.0, p[0], p[1], p[2])?;
+        Ok(Basis {
+            fixed: None,
+            columns: vec![u.to_vec(), states_with_tolerance(&m, u, tolerance)?],
+        })
+    }
+    fn assemble(&self, p: &[f64], c: &[f64]) -> Option<Vec<f64>> {
+        (c[1] * self.sign >= 0.0).then(|| vec![c[0], c[1], 1.0, p[0], p[1], p[2], 0.0])
+    }
 }
 
 /// Fits a Bouc–Wen operator to input `u` and output `y` (module doc).
 pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit<BoucWen>> {
-    let started = Instant::now();
-    let free: Vec<usize> = if options.estimate_n {
-        vec![0, 1, 3, 4, 5, 6]
-    } else {
-        vec![0, 1, 3, 4, 6]
-    };
-    common::check_record("bouc-wen", u, y, free.len())?;
     BoucWen::new(1.0, 1.0, 1.0, 0.0, options.n)?;
     // The w loop is clockwise: k_w > 0 for a clockwise loop, < 0 for a counter-clockwise one.
-    let sign = -LoopOrientation::of_loop(u, y).sign();
-    let starts = grid_starts(u, y, options.n, sign, options.starts.max(1))?;
-    let inf = f64::INFINITY;
-    let (kw_lo, kw_hi) = if sign > 0.0 { (0.0, inf) } else { (-inf, 0.0) };
-    let search = Search {
-        free,
-        lower: vec![-inf, kw_lo, 0.0, 0.0, -inf, 1.0, -inf],
-        upper: vec![inf, kw_hi, inf, inf, inf, 20.0, inf],
+    let family = Family {
+        n: options.n,
+        estimate_n: options.estimate_n,
+        sign: if u.len() == y.len() {
+            -LoopOrientation::of_loop(u, y).sign()
+        } else {
+            1.0
+        },
+    };
+    let settings = Settings {
+        starts: options.starts,
         config: options.config.clone(),
         observer: options.observer.clone(),
     };
-    let simulate = |theta: &[f64]| model_of(theta)?.simulate(u);
-    let problem = Simulated {
-        y,
-        simulate: &simulate,
-        n_params: 7,
-    };
-    let searched = common::best_of(&problem, &starts, &search)?;
-    common::report(model_of(&searched.best.theta)?, u, y, &searched, started)
-}
-
-/// The best grid points (module doc) as full parameter vectors.
-fn grid_starts(u: &[f64], y: &[f64], n: f64, sign: f64, keep: usize) -> Result<Vec<Vec<f64>>> {
-    let (lo, hi) = common::range(u);
-    let half = 0.5 * (hi - lo);
-    let mut scored = Vec::new();
-    for ws in [0.02, 0.05, 0.1, 0.2, 0.5, 1.0].map(|f| f * half) {
-        for q in [-0.5, 0.0, 0.5, 1.0] {
-            let beta = 1.0 / (ws.powf(n) * (1.0 + q));
-            let m = BoucWen::new(0.0, 1.0, beta, q * beta, n)?;
-            let Ok(w) = crate::model::operators::differential::states(&m, u) else {
-                continue;
-            };
-            let Some((k, sse)) = common::linear_fit(&[u, &w], y) else {
-                continue;
-            };
-            if k[1] * sign < 0.0 {
-                continue;
-            }
-            scored.push((
-                sse,
-                vec![k[0], k[1], 1.0, beta, q * beta, n, m.initial_state()],
-            ));
-        }
-    }
-    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut starts: Vec<Vec<f64>> = scored.into_iter().take(keep).map(|s| s.1).collect();
-    if starts.is_empty() {
-        // No grid point has the loop's orientation: start from a thin loop of that sign.
-        let beta = 1.0 / (0.1 * half).powf(n);
-        starts.push(vec![
-            0.0,
-            sign * 1e-3 * common::range(y).1.abs(),
-            1.0,
-            beta,
-            0.0,
-            n,
-            0.0,
-        ]);
-    }
-    Ok(starts)
+    driver::fit(&family, u, y, &settings)
 }
 
 impl Identify for BoucWen {

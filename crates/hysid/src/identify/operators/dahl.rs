@@ -1,27 +1,28 @@
 //! Fit of the Dahl friction operator ([`Dahl`]) dF/dx = σ(1 − (F/F_c)·sign dx)^i to a
-//! measured force–displacement loop.
+//! measured force–displacement loop, by the differential driver
+//! ([`differential_fit`](super::differential_fit)).
 //!
 //! **Orientation.** A clockwise loop (Dahl's own) is fitted as it is; a counter-clockwise one
 //! (detected from the sign of the enclosed area, [`LoopOrientation::of_loop`]) with the
 //! operator driven by −u ([`LoopOrientation::CounterClockwise`]); the inverse of the fitted
 //! operator includes the flip, so it returns an input on the measured scale.
 //!
-//! **Start from the data.** With i = 1 the equation reads dF/dx = σ − ρ·sign(dx)·F,
-//! ρ = σ/F_c, so for fixed ρ the force is linear in (σ, f0): f0·e^{−ρ·TV(x)} (TV the total
-//! variation travelled) plus σ times the unit-σ response. A grid of ρ (1 to 200 per input
-//! range) with (σ, f0) by linear least squares gives the starts of a bounded
-//! Levenberg–Marquardt search of (σ, F_c, \[i\], f0), forward finite-difference sensitivities.
+//! **What the family supplies.** With z = F/F_c and ρ = σ/F_c the equation reads
+//! dz/dx = ρ·(1 − z·sign dx)^i: the force is F_c times the response z of a unit operator
+//! that depends on the shape (ρ, i, z0) alone, so F_c is the linear parameter. The start grid
+//! places ρ log-spaced from 0.5 to 500 per input range, i ∈ {1, 1.5, 2.5, 4} when it is
+//! estimated (12 × 4 points), and z0 = F\[0\]/max|F| (|F| approaches F_c on a long branch).
 //!
 //! References: Dahl (1968, 1976), see [`crate::model::operators::dahl`].
 
-use super::differential_fit::{self as common, Search, Simulated};
+use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopShape, Settings};
 use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
-use crate::model::operators::{Dahl, HysteresisOperator, LoopOrientation};
+use crate::model::operators::differential::simulate_with_tolerance;
+use crate::model::operators::{Dahl, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
 use crate::Result;
-use std::time::Instant;
 
 /// Options of the Dahl fit.
 #[derive(Clone, Debug)]
@@ -30,11 +31,12 @@ pub struct DahlOptions {
     pub i: f64,
     /// Estimate i too (default true).
     pub estimate_i: bool,
-    /// Number of grid points that start a search (default 3).
+    /// Local searches on the decimated record, from the best grid points (default 3).
     pub starts: usize,
-    /// Levenberg–Marquardt settings.
+    /// Levenberg–Marquardt settings of the full-record refinement.
     pub config: LmConfig,
-    /// Sees the search's starts and iterations and may stop it (see [`Search::observer`]).
+    /// Sees the fit's grid, starts and iterations and may stop it (see
+    /// [`Settings::observer`]).
     pub observer: Observer,
 }
 
@@ -44,103 +46,106 @@ impl Default for DahlOptions {
             i: 1.0,
             estimate_i: true,
             starts: 3,
-            config: common::default_config(),
+            config: driver::default_config(),
             observer: Observer::none(),
         }
     }
 }
 
-/// θ = (σ, F_c, i, f0), the order of [`Dahl::parameters`].
-fn model_of(theta: &[f64], orientation: LoopOrientation) -> Result<Dahl> {
-    let m = Dahl {
-        sigma: theta[0],
-        fc: theta[1],
-        i: theta[2],
-        f0: theta[3],
-        orientation,
-    };
-    m.validate()?;
-    Ok(m)
+/// The Dahl family for the driver: θ = (σ, F_c, i, f0), the order of [`Dahl::parameters`].
+struct Family {
+    i: f64,
+    estimate_i: bool,
+    orientation: LoopOrientation,
+}
+
+impl DifferentialFamily for Family {
+    type Model = Dahl;
+    fn name(&self) -> &'static str {
+        "dahl"
+    }
+    fn model(&self, t: &[f64]) -> Result<Dahl> {
+        let m = Dahl {
+            sigma: t[0],
+            fc: t[1],
+            i: t[2],
+            f0: t[3],
+            orientation: self.orientation,
+        };
+        m.validate()?;
+        Ok(m)
+    }
+    fn free(&self) -> Vec<usize> {
+        if self.estimate_i {
+            vec![0, 1, 2, 3]
+        } else {
+            vec![0, 1, 3]
+        }
+    }
+    fn bounds(&self, shape: &LoopShape) -> (Vec<f64>, Vec<f64>) {
+        let inf = f64::INFINITY;
+        let y_scale = (shape.y_range.1 - shape.y_range.0).max(f64::MIN_POSITIVE);
+        let tiny = 1e-12 * y_scale;
+        (
+            vec![tiny / shape.half_span(), tiny, 1.0, -inf],
+            vec![inf, inf, 50.0, inf],
+        )
+    }
+    /// Points (ρ, i, z0).
+    fn shape_grid(&self, _u: &[f64], y: &[f64], shape: &LoopShape) -> Vec<Vec<f64>> {
+        let span = 2.0 * shape.half_span();
+        let peak = y.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let z0 = (shape.first.1 / peak).clamp(-0.95, 0.95);
+        let exponents: &[f64] = if self.estimate_i {
+            &[1.0, 1.5, 2.5, 4.0]
+        } else {
+            std::slice::from_ref(&self.i)
+        };
+        let mut points = Vec::new();
+        for &i in exponents {
+            for k in 0..12 {
+                points.push(vec![0.5 * 1000f64.powf(k as f64 / 11.0) / span, i, z0]);
+            }
+        }
+        points
+    }
+    fn basis(&self, p: &[f64], u: &[f64], tolerance: f64) -> Result<Basis> {
+        let unit = Dahl {
+            sigma: p[0],
+            fc: 1.0,
+            i: p[1],
+            f0: p[2],
+            orientation: self.orientation,
+        };
+        Ok(Basis {
+            fixed: None,
+            columns: vec![simulate_with_tolerance(&unit, u, tolerance)?],
+        })
+    }
+    fn assemble(&self, p: &[f64], c: &[f64]) -> Option<Vec<f64>> {
+        let fc = c[0];
+        (fc > 0.0).then(|| vec![p[0] * fc, fc, p[1], p[2] * fc])
+    }
 }
 
 /// Fits a Dahl operator to displacement `u` and force `y` (module doc).
 pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Dahl>> {
-    let started = Instant::now();
-    let free: Vec<usize> = if options.estimate_i {
-        vec![0, 1, 2, 3]
-    } else {
-        vec![0, 1, 3]
-    };
-    common::check_record("dahl", u, y, free.len())?;
     Dahl::new(1.0, 1.0, options.i)?;
-    let orientation = LoopOrientation::of_loop(u, y);
-    let starts = grid_starts(u, y, options.i, orientation, options.starts.max(1))?;
-    let inf = f64::INFINITY;
-    let search = Search {
-        free,
-        lower: vec![0.0, 0.0, 1.0, -inf],
-        upper: vec![inf, inf, 50.0, inf],
+    let family = Family {
+        i: options.i,
+        estimate_i: options.estimate_i,
+        orientation: if u.len() == y.len() {
+            LoopOrientation::of_loop(u, y)
+        } else {
+            LoopOrientation::Clockwise
+        },
+    };
+    let settings = Settings {
+        starts: options.starts,
         config: options.config.clone(),
         observer: options.observer.clone(),
     };
-    let simulate = |theta: &[f64]| model_of(theta, orientation)?.simulate(u);
-    let problem = Simulated {
-        y,
-        simulate: &simulate,
-        n_params: 4,
-    };
-    let searched = common::best_of(&problem, &starts, &search)?;
-    common::report(
-        model_of(&searched.best.theta, orientation)?,
-        u,
-        y,
-        &searched,
-        started,
-    )
-}
-
-/// The best grid points of ρ = σ/F_c with (σ, f0) by linear least squares (i = 1).
-fn grid_starts(
-    u: &[f64],
-    y: &[f64],
-    i: f64,
-    orientation: LoopOrientation,
-    keep: usize,
-) -> Result<Vec<Vec<f64>>> {
-    let (lo, hi) = common::range(u);
-    let span = hi - lo;
-    let mut travelled = vec![0.0; u.len()];
-    for k in 1..u.len() {
-        travelled[k] = travelled[k - 1] + (u[k] - u[k - 1]).abs();
-    }
-    let mut scored = Vec::new();
-    for rho in [1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0].map(|f| f / span) {
-        let unit = Dahl {
-            sigma: 1.0,
-            fc: 1.0 / rho,
-            i: 1.0,
-            f0: 0.0,
-            orientation,
-        };
-        let Ok(p_sigma) = unit.simulate(u) else {
-            continue;
-        };
-        let p_f0: Vec<f64> = travelled.iter().map(|t| (-rho * t).exp()).collect();
-        if let Some((k, sse)) = common::linear_fit(&[&p_sigma, &p_f0], y) {
-            if k[0] > 0.0 {
-                scored.push((sse, vec![k[0], k[0] / rho, i, k[1]]));
-            }
-        }
-    }
-    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let starts: Vec<Vec<f64>> = scored.into_iter().take(keep).map(|s| s.1).collect();
-    if starts.is_empty() {
-        return Err(crate::Error::NotExciting {
-            channel: "input".into(),
-            reason: "no Dahl start with σ > 0 fits the loop; is it a friction loop?".into(),
-        });
-    }
-    Ok(starts)
+    driver::fit(&family, u, y, &settings)
 }
 
 impl Identify for Dahl {

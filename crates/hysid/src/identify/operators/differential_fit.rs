@@ -1,22 +1,254 @@
-//! The part common to the fits of the differential operators: checks of the data, the
-//! output-error least-squares problem, the multi-start Levenberg–Marquardt search and the
-//! [`OperatorFit`] report.
+//! The one driver of the differential-operator fits (Bouc–Wen, Duhem, Dahl, Jiles–Atherton):
+//! the output-error criterion
 //!
-//! The criterion is V(θ) = Σ_t (y_t − Γ_θ\[u\]_t)², the simulated (output-error) residual,
-//! minimised by the bounded Levenberg–Marquardt engine
-//! ([`crate::numerics::levenberg_marquardt`]) with forward finite-difference sensitivities of
-//! the H/u-integration, from each start of a small multi-start; the start with the lowest V
-//! wins. Standard deviations are σ²(JᵀJ)⁻¹ at the optimum (Ljung 1999, §9.3).
+//! ```text
+//! V(θ) = Σ_t (y_t − Γ_θ[u]_t)²,      Γ_θ: dx/du = F(u, x, δ; θ), ŷ = h(u, x; θ)
+//! ```
+//!
+//! minimised from the data alone. A family says what it is ([`DifferentialFamily`]: its
+//! equations, through the model's [`InputOdeSensitivity`]; its search box; the parameters that
+//! enter the output linearly for fixed shape; a start grid of shape parameters placed from a
+//! cheap characterisation of the loop, [`LoopShape`]); the driver ([`fit`]) does the rest, the
+//! same for all:
+//!
+//! 1. **Decimation.** The operators are rate independent: the state after a monotone stretch
+//!    of input depends on its end points only. The record is thinned to every m-th sample *and
+//!    every reversal of the input* ([`decimate`]), so the states at the kept samples are those of
+//!    the full record (to the integration tolerance); the criterion on them is a subsample of
+//!    V. About [`DECIMATED_SAMPLES`] samples remain: the global stages cost a fraction of one
+//!    full simulation per trial.
+//! 2. **Global start by variable projection** (Golub & Pereyra 1973, 2003). For fixed shape
+//!    parameters the output is linear in the family's output parameters (Bouc–Wen's k_x, k_w;
+//!    Duhem's a, b, c, y0 — its equation is linear in y and in the forcing; the scales F_c of
+//!    Dahl and Mₛ of Jiles–Atherton, whose states scale with them). At every grid point the
+//!    basis responses are simulated on the decimated record and the linear parameters solved
+//!    by least squares: the grid explores only the few shape parameters, and every point is
+//!    scored at its best linear completion.
+//! 3. **Local searches on the decimated record** from the best grid points (in parallel;
+//!    three times as many when the record is short enough to be kept whole): bounded
+//!    Levenberg–Marquardt ([`crate::numerics::levenberg_marquardt`]) with exact
+//!    sensitivities, at most 200 iterations each.
+//! 4. **Refinement on the full record** of the best local minimum (and of the runner-up when
+//!    its criterion is within [`RIVAL_MARGIN`] of the best but does not agree with it to
+//!    [`AGREEMENT`], and its parameters differ: two minima too close to tell apart on the
+//!    subsample). Local searches that agree are one minimum found from several starts. The sensitivities ∂ŷ/∂θ are integrated
+//!    in u beside the state ([`simulate_with_sensitivities`]): exact derivatives of the
+//!    computed output at the cost of about one simulation, where forward differences need p
+//!    further simulations and lose half the digits. The normal equations JᵀJ, Jᵀr are summed
+//!    sample by sample, nothing of the record's length is stored.
+//! 5. **Checked convergence.** A Levenberg–Marquardt run may stop when its *damped* steps gain
+//!    less than the tolerance, which after many rejected trials (steps into a region where the
+//!    model is not defined) says little about the point. At the end the driver asks the
+//!    undamped Gauss–Newton model what a step from there still promises (with the active
+//!    bounds held, [`expected_improvement`]). A relative decrease above
+//!    [`RESTART_THRESHOLD`] restarts the engine from that point, with fresh damping, at most
+//!    [`MAX_RESTARTS`] times; a point that still promises more than [`FLAT_THRESHOLD`] is
+//!    reported as [`Termination::FlatRegion`], never as converged.
+//! 6. **Report** ([`OperatorFit`]): standard deviations σ²(JᵀJ)⁻¹ of the model's own
+//!    parameters at the optimum (Ljung 1999, §9.3), the simulated output, fit %, the
+//!    iterations and evaluations of every stage together.
+//!
+//! A family's search may run in coordinates φ other than the model's θ when that turns its
+//! domain into a box (Bouc–Wen: β + γ > 0, β − γ ≥ 0); the map is linear,
+//! [`DifferentialFamily::theta_of`] and [`DifferentialFamily::chain`].
+//!
+//! The observer of the options sees "grid", "start" and "iteration" progress; its
+//! [`Control::Stop`] ends the fit with the best point so far and
+//! [`Termination::Stopped`] (how a time limit is honoured).
+//!
+//! References: G. H. Golub, V. Pereyra, "The differentiation of pseudo-inverses and nonlinear
+//! least squares problems whose variables separate", SIAM J. Numer. Anal. 10 (1973) 413–432;
+//! "Separable nonlinear least squares: the variable projection method and its applications",
+//! Inverse Problems 19 (2003) R1–R26. H. G. Bock, "Numerical treatment of inverse problems in
+//! chemical reaction kinetics", Springer 1981 (internal numerical differentiation). L. Ljung,
+//! *System Identification*, 2nd ed., Prentice Hall 1999.
 
 use super::OperatorFit;
-use crate::model::operators::differential::check_signal;
+use crate::model::operators::differential::{
+    check_signal, simulate_with_sensitivities, simulate_with_tolerance, InputOdeSensitivity,
+    LoopOrientation, MAX_SENSITIVITIES, TOLERANCE,
+};
 use crate::model::operators::HysteresisOperator;
-use crate::model::ParameterSet;
-use crate::numerics::levenberg_marquardt::{minimize, LeastSquaresProblem, LmConfig, LmReport};
+use crate::numerics::levenberg_marquardt::{
+    minimize, Control, LeastSquaresProblem, LmConfig, LmReport, NormalEquations,
+};
 use crate::numerics::metrics;
-use crate::numerics::Observer;
+use crate::numerics::{Observer, Termination};
 use crate::{Error, Result};
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use std::sync::Mutex;
 use std::time::Instant;
+
+/// Samples the global stages keep (at least: every reversal of the input is kept too).
+pub const DECIMATED_SAMPLES: usize = 800;
+/// The integration tolerance of the global stages (the operator's own is
+/// [`TOLERANCE`]): a fifth-order step grows as the tolerance's fifth root, so the
+/// exploration takes several times fewer steps, and a start needs no more digits.
+pub const COARSE_TOLERANCE: f64 = 1e-6;
+/// A local minimum whose decimated criterion is within this fraction of the best one's (and
+/// not within [`AGREEMENT`]) is refined on the full record too.
+pub const RIVAL_MARGIN: f64 = 0.02;
+/// Local searches whose decimated criteria agree to this fraction reached the same minimum
+/// (their parameters may still differ along a direction the subsample hardly determines).
+pub const AGREEMENT: f64 = 1e-6;
+/// The relative decrease the Gauss–Newton model may still promise at the end of a run
+/// without a restart.
+pub const RESTART_THRESHOLD: f64 = 1e-9;
+/// Above this relative promise, a point the engine stopped at is a flat region, not a minimum.
+pub const FLAT_THRESHOLD: f64 = 1e-6;
+/// Restarts of the engine at a point that still promises a decrease.
+pub const MAX_RESTARTS: usize = 3;
+
+/// A cheap characterisation of a measured loop, for placing a family's start grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopShape {
+    /// (min, max) of the input.
+    pub u_range: (f64, f64),
+    /// (min, max) of the output.
+    pub y_range: (f64, f64),
+    /// The least-squares line y ≈ slope·u + intercept through the loop.
+    pub slope: f64,
+    /// See `slope`.
+    pub intercept: f64,
+    /// The loop's width: the root-mean-square distance of y from that line.
+    pub width: f64,
+    /// The orientation (sign of the enclosed area).
+    pub orientation: LoopOrientation,
+    /// The first sample (u\[0\], y\[0\]).
+    pub first: (f64, f64),
+}
+
+impl LoopShape {
+    /// The characterisation of the loop (u, y).
+    pub fn of(u: &[f64], y: &[f64]) -> Self {
+        let (mu, my) = (metrics::mean(u), metrics::mean(y));
+        let (mut suu, mut suy) = (0.0, 0.0);
+        for (a, b) in u.iter().zip(y) {
+            suu += (a - mu) * (a - mu);
+            suy += (a - mu) * (b - my);
+        }
+        let slope = if suu > 0.0 { suy / suu } else { 0.0 };
+        let intercept = my - slope * mu;
+        let width = (u
+            .iter()
+            .zip(y)
+            .map(|(a, b)| (b - slope * a - intercept).powi(2))
+            .sum::<f64>()
+            / u.len().max(1) as f64)
+            .sqrt();
+        Self {
+            u_range: range(u),
+            y_range: range(y),
+            slope,
+            intercept,
+            width,
+            orientation: LoopOrientation::of_loop(u, y),
+            first: (u[0], y[0]),
+        }
+    }
+
+    /// Half the input's range (at least the smallest positive number).
+    pub fn half_span(&self) -> f64 {
+        (0.5 * (self.u_range.1 - self.u_range.0)).max(f64::MIN_POSITIVE)
+    }
+}
+
+/// The responses whose linear combination is the output at one shape point:
+/// ŷ = fixed + Σ_j c_j·columns_j.
+#[derive(Clone, Debug, Default)]
+pub struct Basis {
+    /// The part that no linear parameter multiplies (e.g. μ₀·H of a B(H) loop).
+    pub fixed: Option<Vec<f64>>,
+    /// The responses multiplied by the linear parameters.
+    pub columns: Vec<Vec<f64>>,
+}
+
+/// What a differential family supplies to the driver (module doc).
+///
+/// θ is the model's parameter vector in the order of its `parameters()`; φ the search
+/// coordinates (θ itself unless the family maps them, linearly, to make its domain a box).
+pub trait DifferentialFamily: Sync {
+    /// The operator.
+    type Model: HysteresisOperator + InputOdeSensitivity + Clone;
+    /// The family's name in messages (`bouc-wen`).
+    fn name(&self) -> &'static str;
+    /// The operator of θ, or an error where θ leaves the family's domain.
+    fn model(&self, theta: &[f64]) -> Result<Self::Model>;
+    /// The indices of the estimated parameters (the same in θ and φ).
+    fn free(&self) -> Vec<usize>;
+    /// The search box (lower, upper) of φ, placed from the loop's characterisation.
+    fn bounds(&self, shape: &LoopShape) -> (Vec<f64>, Vec<f64>);
+    /// θ of the search coordinates φ (default: φ itself).
+    fn theta_of(&self, phi: &[f64]) -> Vec<f64> {
+        phi.to_vec()
+    }
+    /// φ of θ, the inverse of [`theta_of`](Self::theta_of) (default: θ itself).
+    fn phi_of(&self, theta: &[f64]) -> Vec<f64> {
+        theta.to_vec()
+    }
+    /// The chain rule of the map: ∂ŷ/∂φ_j = Σ_i ∂ŷ/∂θ_i·∂θ_i/∂φ_j, from `dtheta` into `dphi`
+    /// (default: a copy).
+    fn chain(&self, dtheta: &[f64], dphi: &mut [f64]) {
+        dphi.copy_from_slice(dtheta);
+    }
+    /// The start grid: shape points (the nonlinear parameters, in the family's own terms),
+    /// placed from the loop's characterisation and the (decimated) record.
+    fn shape_grid(&self, u: &[f64], y: &[f64], shape: &LoopShape) -> Vec<Vec<f64>>;
+    /// The basis responses of one shape point on the input `u`, integrated to the relative
+    /// tolerance `tolerance`.
+    fn basis(&self, point: &[f64], u: &[f64], tolerance: f64) -> Result<Basis>;
+    /// θ of a shape point and the least-squares coefficients of its basis; None when the
+    /// coefficients leave the family's domain (a loop of the wrong orientation).
+    fn assemble(&self, point: &[f64], coefficients: &[f64]) -> Option<Vec<f64>>;
+}
+
+/// The driver's settings (each family's options carry them).
+#[derive(Clone, Debug)]
+pub struct Settings {
+    /// Local searches on the decimated record, from the best grid points.
+    pub starts: usize,
+    /// Levenberg–Marquardt settings of the full-record refinement.
+    pub config: LmConfig,
+    /// Sees the "grid", "start" and "iteration" progress; may stop the fit.
+    pub observer: Observer,
+}
+
+/// The default engine settings of these fits: 200 iterations, a relative improvement
+/// tolerance of 1e-10 (the criterion's last digits move the fit % by less than 1e-8 points).
+pub fn default_config() -> LmConfig {
+    LmConfig {
+        max_iterations: 200,
+        improvement_tolerance: 1e-10,
+        ..LmConfig::default()
+    }
+}
+
+/// The engine settings of the local searches on the decimated record: they only need to find
+/// the basin, the full record settles the digits.
+fn local_config(config: &LmConfig) -> LmConfig {
+    LmConfig {
+        max_iterations: config.max_iterations.min(200),
+        improvement_tolerance: config.improvement_tolerance.max(1e-8),
+        initial_damping: config.initial_damping * SMALL_DAMPING,
+        ..config.clone()
+    }
+}
+
+/// The factor on the initial damping of the driver's runs. Every run starts at a point that
+/// the grid's linear completion or a local search has placed in its basin, where the
+/// Gauss–Newton step is the right one; strongly correlated parameters (Jiles–Atherton's Mₛ,
+/// a, α) would otherwise take two iterations per decade of damping before the steps become
+/// long enough. A step that fails raises the damping again (doubling).
+const SMALL_DAMPING: f64 = 1e-5;
+
+/// The engine settings of the full-record refinement: the caller's, with the small damping.
+fn refine_config(config: &LmConfig) -> LmConfig {
+    LmConfig {
+        initial_damping: config.initial_damping * SMALL_DAMPING,
+        ..config.clone()
+    }
+}
 
 /// Number of direction reversals of `u` (sign changes of the non-zero increments).
 pub fn reversals(u: &[f64]) -> usize {
@@ -73,150 +305,552 @@ pub fn check_record(family: &str, u: &[f64], y: &[f64], p: usize) -> Result<()> 
     Ok(())
 }
 
-/// The output-error problem r(θ) = y − ŷ(θ) for a simulator θ ↦ ŷ.
-pub struct Simulated<'a> {
-    /// The measured output.
-    pub y: &'a [f64],
-    /// The simulator: full parameter vector to simulated output.
-    pub simulate: &'a (dyn Fn(&[f64]) -> Result<Vec<f64>> + Sync),
-    /// Number of parameters.
-    pub n_params: usize,
+/// The samples the global stages keep: the first and last, every m-th with
+/// m = ⌈N/`target`⌉, and every reversal of the input (the last sample before the direction
+/// changes), so that the input between two kept samples is monotone and a rate-independent
+/// operator reaches the same state at each kept sample as on the full record. When the
+/// reversals alone are more than four times `target` (a noisy input), only every m-th sample
+/// is kept and the subsample is approximate.
+pub fn decimate(u: &[f64], target: usize) -> Vec<usize> {
+    let n = u.len();
+    if n <= target.max(2) {
+        return (0..n).collect();
+    }
+    let m = n.div_ceil(target.max(1));
+    let mut turning = Vec::new();
+    let mut last = 0.0;
+    for k in 1..n {
+        let d = u[k] - u[k - 1];
+        if d == 0.0 {
+            continue;
+        }
+        if last != 0.0 && d.signum() != last {
+            turning.push(k - 1);
+        }
+        last = d.signum();
+    }
+    let mut keep: Vec<usize> = (0..n).step_by(m).collect();
+    keep.push(n - 1);
+    if turning.len() <= 4 * target {
+        keep.extend(turning);
+    }
+    keep.sort_unstable();
+    keep.dedup();
+    keep
 }
 
-impl LeastSquaresProblem for Simulated<'_> {
+/// The output-error problem of a family on one record, in the search coordinates φ, with the
+/// normal equations from the integrated sensitivities.
+///
+/// It remembers the last normal equations it computed (the engine's final point is the last
+/// one it accepted) and the output of the lowest criterion it evaluated (the final point of a
+/// monotone engine), so the driver's check and report cost no further pass over the record.
+struct OutputError<'a, F: DifferentialFamily> {
+    family: &'a F,
+    u: &'a [f64],
+    y: &'a [f64],
+    n_phi: usize,
+    floor: f64,
+    tolerance: f64,
+    last_system: Mutex<Option<LastSystem>>,
+    best_output: Option<Mutex<BestOutput>>,
+}
+
+/// The last normal equations computed: (φ, free, system).
+type LastSystem = (Vec<f64>, Vec<usize>, System);
+/// The output of the lowest criterion evaluated: (φ, S, ŷ).
+type BestOutput = (Vec<f64>, f64, Vec<f64>);
+
+/// The normal equations in φ (for the engine) and JᵀJ in the model's θ (for the covariance).
+#[derive(Clone)]
+struct System {
+    phi: NormalEquations,
+    theta_jtj: DMatrix<f64>,
+}
+
+impl<'a, F: DifferentialFamily> OutputError<'a, F> {
+    /// The problem on (u, y) at the integration tolerance `tolerance`; `keep_output`
+    /// remembers the best output (for the report).
+    fn new(
+        family: &'a F,
+        (u, y): (&'a [f64], &'a [f64]),
+        n_phi: usize,
+        tolerance: f64,
+        keep_output: bool,
+    ) -> Self {
+        // The integration is accurate to ~1e-10 of the signal's scale: residuals below 1e-9
+        // of the output's spread are an exact fit.
+        let s = 1e-9 * metrics::std_dev(y);
+        Self {
+            family,
+            u,
+            y,
+            n_phi,
+            floor: y.len() as f64 * s * s,
+            tolerance,
+            last_system: Mutex::new(None),
+            best_output: keep_output.then(|| Mutex::new((Vec::new(), f64::INFINITY, Vec::new()))),
+        }
+    }
+
+    fn model(&self, phi: &[f64]) -> Result<F::Model> {
+        self.family.model(&self.family.theta_of(phi))
+    }
+
+    /// The simulated output at φ and its sum of squared residuals.
+    fn output(&self, phi: &[f64]) -> Result<(Vec<f64>, f64)> {
+        if let Some(best) = &self.best_output {
+            let best = best.lock().expect("not poisoned");
+            if best.0 == phi {
+                return Ok((best.2.clone(), best.1));
+            }
+        }
+        let yhat = simulate_with_tolerance(&self.model(phi)?, self.u, self.tolerance)?;
+        let cost: f64 = self
+            .y
+            .iter()
+            .zip(&yhat)
+            .map(|(y, h)| (y - h) * (y - h))
+            .sum();
+        if !cost.is_finite() {
+            return Err(Error::Diverged {
+                index: 0,
+                reason: "a residual is not finite".into(),
+            });
+        }
+        if let Some(best) = &self.best_output {
+            let mut best = best.lock().expect("not poisoned");
+            if cost < best.1 {
+                *best = (phi.to_vec(), cost, yhat.clone());
+            }
+        }
+        Ok((yhat, cost))
+    }
+
+    /// JᵀJ, Jᵀr and S at φ for the free coordinates `free`, with JᵀJ in θ too.
+    fn system(&self, phi: &[f64], free: &[usize]) -> Result<System> {
+        if let Some((p, f, system)) = &*self.last_system.lock().expect("not poisoned") {
+            if p == phi && f == free {
+                return Ok(system.clone());
+            }
+        }
+        let model = self.model(phi)?;
+        let p = free.len();
+        let n_theta = model.n_parameters();
+        let mut jtj = DMatrix::<f64>::zeros(p, p);
+        let mut theta_jtj = DMatrix::<f64>::zeros(p, p);
+        let mut jtr = DVector::<f64>::zeros(p);
+        let mut cost = 0.0;
+        let mut dphi = [0.0; MAX_SENSITIVITIES];
+        let (mut row, mut row_theta) = ([0.0; MAX_SENSITIVITIES], [0.0; MAX_SENSITIVITIES]);
+        let mut finite = true;
+        simulate_with_sensitivities(&model, self.u, self.tolerance, |k, yhat, dtheta| {
+            let r = self.y[k] - yhat;
+            self.family.chain(dtheta, &mut dphi[..n_theta]);
+            for (a, &i) in free.iter().enumerate() {
+                row[a] = -dphi[i];
+                row_theta[a] = -dtheta[i];
+            }
+            for a in 0..p {
+                jtr[a] += row[a] * r;
+                for b in 0..=a {
+                    jtj[(a, b)] += row[a] * row[b];
+                    theta_jtj[(a, b)] += row_theta[a] * row_theta[b];
+                }
+            }
+            cost += r * r;
+            finite &= r.is_finite() && row[..p].iter().all(|v| v.is_finite());
+        })?;
+        if !finite || !cost.is_finite() {
+            return Err(Error::Diverged {
+                index: 0,
+                reason: "non-finite output or sensitivity".into(),
+            });
+        }
+        for a in 0..p {
+            for b in 0..a {
+                jtj[(b, a)] = jtj[(a, b)];
+                theta_jtj[(b, a)] = theta_jtj[(a, b)];
+            }
+        }
+        let system = System {
+            phi: NormalEquations { jtj, jtr, cost },
+            theta_jtj,
+        };
+        *self.last_system.lock().expect("not poisoned") =
+            Some((phi.to_vec(), free.to_vec(), system.clone()));
+        Ok(system)
+    }
+}
+
+impl<F: DifferentialFamily> LeastSquaresProblem for OutputError<'_, F> {
     fn n_params(&self) -> usize {
-        self.n_params
+        self.n_phi
     }
     fn n_residuals(&self) -> usize {
         self.y.len()
     }
-    fn residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
-        let yhat = (self.simulate)(theta)?;
+    fn residuals(&self, phi: &[f64], r: &mut [f64]) -> Result<()> {
+        let (yhat, _) = self.output(phi)?;
         for ((r, y), yh) in r.iter_mut().zip(self.y).zip(&yhat) {
             *r = y - yh;
         }
         Ok(())
     }
+    fn trial_cost(&self, phi: &[f64], _r: &mut Vec<f64>) -> Result<f64> {
+        Ok(self.output(phi)?.1)
+    }
+    fn normal_equations(&self, phi: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
+        Some(self.system(phi, free).map(|s| s.phi))
+    }
     fn cost_floor(&self) -> f64 {
-        // The integration is accurate to ~1e-10 of the signal's scale: residuals below
-        // 1e-9 of the output's spread are an exact fit.
-        let s = 1e-9 * metrics::std_dev(self.y);
-        self.y.len() as f64 * s * s
+        self.floor
     }
 }
 
-/// The search box and the free parameters.
-pub struct Search {
-    /// Indices of the estimated parameters.
-    pub free: Vec<usize>,
-    /// Lower bounds (full vector).
-    pub lower: Vec<f64>,
-    /// Upper bounds (full vector).
-    pub upper: Vec<f64>,
-    /// Levenberg–Marquardt settings.
-    pub config: LmConfig,
-    /// Sees "start k/N" after every start and "iteration k/max" after every accepted
-    /// iteration; its [`Control::Stop`](crate::numerics::Control::Stop) ends the search with
-    /// the best start so far (how a time limit is honoured).
-    pub observer: Observer,
-}
-
-/// The default engine settings of these fits: 200 iterations, tight tolerances.
-pub fn default_config() -> LmConfig {
-    LmConfig {
-        max_iterations: 200,
-        improvement_tolerance: 1e-12,
-        ..LmConfig::default()
-    }
-}
-
-/// The outcome of a multi-start search.
-pub struct Searched {
-    /// The report of the start with the lowest cost.
-    pub best: LmReport,
-    /// Iterations of all starts together.
-    pub iterations: usize,
-    /// Criterion evaluations of all starts together.
-    pub evaluations: usize,
-}
-
-/// Runs the search from every start and keeps the lowest cost; errors only when no start can
-/// be simulated.
-pub fn best_of(problem: &Simulated<'_>, starts: &[Vec<f64>], search: &Search) -> Result<Searched> {
-    let mut best: Option<LmReport> = None;
-    let (mut iterations, mut evaluations) = (0, 0);
-    let mut first_error = None;
-    for (k, start) in starts.iter().enumerate() {
-        if k > 0 && search.observer.should_stop("start") {
-            break;
-        }
-        let theta: Vec<f64> = start
-            .iter()
-            .zip(search.lower.iter().zip(&search.upper))
-            .map(|(v, (lo, hi))| v.clamp(*lo, *hi))
-            .collect();
-        match minimize(
-            problem,
-            &theta,
-            &search.free,
-            &search.lower,
-            &search.upper,
-            &search.config,
-            &mut |r| {
-                search
-                    .observer
-                    .report("iteration", r.iteration, search.config.max_iterations)
-            },
-        ) {
-            Ok(report) => {
-                iterations += report.iterations;
-                evaluations += report.function_evaluations;
-                let exact = report.termination == crate::numerics::Termination::ZeroResidual;
-                if best.as_ref().is_none_or(|b| report.cost < b.cost) {
-                    best = Some(report);
-                }
-                if exact {
-                    // An exact fit cannot be improved on by the other starts.
-                    break;
-                }
-            }
-            Err(e) => {
-                first_error.get_or_insert(e);
-            }
-        }
-        search.observer.report("start", k + 1, starts.len());
-    }
-    let best = best.ok_or_else(|| {
-        first_error
-            .unwrap_or_else(|| Error::invalid_option("starts", 0, "no start for the search".into()))
-    })?;
-    Ok(Searched {
-        best,
-        iterations,
-        evaluations,
-    })
-}
-
-/// The [`OperatorFit`] of `model` (already holding the estimate) on (u, y).
-pub fn report<M: HysteresisOperator>(
-    model: M,
-    u: &[f64],
-    y: &[f64],
-    searched: &Searched,
-    started: Instant,
-) -> Result<OperatorFit<M>> {
-    let best = &searched.best;
-    let simulated = model.simulate(u)?;
-    let parameters: ParameterSet = model.parameters();
-    let cov = best.covariance();
-    let std = (0..parameters.len())
-        .map(|i| {
-            let s = cov.std[i];
-            (best.free.contains(&i) && s.is_finite()).then_some(s)
+/// The relative decrease of S that the undamped Gauss–Newton step from the point of `system`
+/// promises, with the parameters held that sit on a bound the gradient pushes them through:
+/// gᵀH⁻¹g/S over the others (0 when nothing can move).
+pub fn expected_improvement(
+    system: &NormalEquations,
+    phi: &[f64],
+    free: &[usize],
+    lower: &[f64],
+    upper: &[f64],
+) -> f64 {
+    let g = &system.jtr;
+    let idx: Vec<usize> = (0..free.len())
+        .filter(|&k| {
+            let i = free[k];
+            !((phi[i] <= lower[i] && g[k] > 0.0) || (phi[i] >= upper[i] && g[k] < 0.0))
         })
         .collect();
-    let n = y.len();
-    let p = best.free.len();
+    if idx.is_empty() || system.cost <= 0.0 {
+        return 0.0;
+    }
+    let m = idx.len();
+    let scale: Vec<f64> = idx
+        .iter()
+        .map(|&k| system.jtj[(k, k)].max(f64::MIN_POSITIVE).sqrt())
+        .collect();
+    let h = DMatrix::from_fn(m, m, |r, c| {
+        system.jtj[(idx[r], idx[c])] / (scale[r] * scale[c]) + if r == c { 1e-12 } else { 0.0 }
+    });
+    let gs = DVector::from_fn(m, |r, _| g[idx[r]] / scale[r]);
+    match h.cholesky() {
+        Some(ch) => gs.dot(&ch.solve(&gs)) / system.cost,
+        None => f64::INFINITY,
+    }
+}
+
+/// One Levenberg–Marquardt run of the driver: its report and whether the observer stopped it.
+struct Run {
+    report: LmReport,
+    stopped: bool,
+}
+
+/// The driver's bookkeeping: the search box and the work counted over every stage.
+struct Driver<'a, F: DifferentialFamily> {
+    family: &'a F,
+    settings: &'a Settings,
+    free: Vec<usize>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+}
+
+impl<F: DifferentialFamily> Driver<'_, F> {
+    fn clamp(&self, phi: &[f64]) -> Vec<f64> {
+        phi.iter()
+            .zip(self.lower.iter().zip(&self.upper))
+            .map(|(v, (lo, hi))| v.clamp(*lo, *hi))
+            .collect()
+    }
+
+    fn run(&self, problem: &OutputError<'_, F>, phi: &[f64], config: &LmConfig) -> Result<Run> {
+        let mut stopped = false;
+        let observer = &self.settings.observer;
+        let report = minimize(
+            problem,
+            &self.clamp(phi),
+            &self.free,
+            &self.lower,
+            &self.upper,
+            config,
+            &mut |r| {
+                let c = observer.report("iteration", r.iteration, config.max_iterations);
+                stopped |= c == Control::Stop;
+                c
+            },
+        )?;
+        Ok(Run { report, stopped })
+    }
+
+    /// The best linear completion of every grid point on the decimated record, best first.
+    fn grid(&self, u: &[f64], y: &[f64], shape: &LoopShape) -> Vec<(f64, Vec<f64>)> {
+        let points = self.family.shape_grid(u, y, shape);
+        let mut scored: Vec<(f64, Vec<f64>)> = points
+            .par_iter()
+            .filter_map(|point| {
+                let basis = self.family.basis(point, u, COARSE_TOLERANCE).ok()?;
+                let target: Vec<f64> = match &basis.fixed {
+                    Some(f) => y.iter().zip(f).map(|(y, f)| y - f).collect(),
+                    None => y.to_vec(),
+                };
+                let cols: Vec<&[f64]> = basis.columns.iter().map(Vec::as_slice).collect();
+                let (c, sse) = linear_fit(&cols, &target)?;
+                let theta = self.family.assemble(point, &c)?;
+                self.family.model(&theta).ok()?;
+                sse.is_finite().then(|| (sse, self.family.phi_of(&theta)))
+            })
+            .collect();
+        self.settings
+            .observer
+            .report("grid", points.len(), points.len());
+        scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+        scored
+    }
+}
+
+/// Fits `family` to input `u` and output `y` (module doc).
+pub fn fit<F: DifferentialFamily>(
+    family: &F,
+    u: &[f64],
+    y: &[f64],
+    settings: &Settings,
+) -> Result<OperatorFit<F::Model>> {
+    let started = Instant::now();
+    let free = family.free();
+    check_record(family.name(), u, y, free.len())?;
+    let shape = LoopShape::of(u, y);
+    let (lower, upper) = family.bounds(&shape);
+    let driver = Driver {
+        family,
+        settings,
+        free,
+        lower,
+        upper,
+    };
+    let n_phi = driver.lower.len();
+    let observer = &settings.observer;
+    let (mut iterations, mut evaluations) = (0, 0);
+
+    // 1–2: decimated record, grid with variable projection.
+    let kept = decimate(u, DECIMATED_SAMPLES);
+    let ud: Vec<f64> = kept.iter().map(|&k| u[k]).collect();
+    let yd: Vec<f64> = kept.iter().map(|&k| y[k]).collect();
+    let grid = driver.grid(&ud, &yd, &shape);
+    evaluations += grid.len();
+    if grid.is_empty() {
+        return Err(Error::NotExciting {
+            channel: "input".into(),
+            reason: format!(
+                "no {} start fits the loop (every grid point diverged or has the wrong \
+                 orientation)",
+                family.name()
+            ),
+        });
+    }
+
+    // 3: local searches on the decimated record, in parallel.
+    let decimated = OutputError::new(family, (&ud, &yd), n_phi, COARSE_TOLERANCE, false);
+    let local = local_config(&settings.config);
+    // A record short enough to be kept whole makes every local search cheap: three times
+    // as many then (measured loops of a hundred samples have many shallow minima).
+    let n_starts = settings.starts.max(1) * if kept.len() == u.len() { 3 } else { 1 };
+    let starts: Vec<&Vec<f64>> = grid.iter().take(n_starts).map(|g| &g.1).collect();
+    let mut minima: Vec<(f64, Vec<f64>)> = Vec::new();
+    let mut stopped = observer.should_stop("start");
+    if !stopped {
+        let runs: Vec<Result<Run>> = starts
+            .par_iter()
+            .map(|phi| driver.run(&decimated, phi, &local))
+            .collect();
+        for run in runs.into_iter().flatten() {
+            iterations += run.report.iterations;
+            evaluations += run.report.function_evaluations;
+            stopped |= run.stopped;
+            minima.push((run.report.cost, run.report.theta));
+        }
+        observer.report("start", starts.len(), starts.len());
+    }
+    if minima.is_empty() {
+        minima.push(grid[0].clone());
+    }
+    minima.sort_by(|a, b| a.0.total_cmp(&b.0));
+
+    // 4–5: the full record from the best minimum (and a close rival), checked.
+    let full = OutputError::new(family, (u, y), n_phi, TOLERANCE, true);
+    let mut candidates = vec![minima[0].1.clone()];
+    if let Some(rival) = minima[1..].iter().find(|m| {
+        m.0 > minima[0].0 * (1.0 + AGREEMENT)
+            && m.0 <= minima[0].0 * (1.0 + RIVAL_MARGIN)
+            && differs(&m.1, &minima[0].1, &driver.free)
+    }) {
+        candidates.push(rival.1.clone());
+    }
+    let mut best: Option<(LmReport, Termination)> = None;
+    for phi in candidates {
+        if stopped || observer.should_stop("start") {
+            stopped = true;
+            break;
+        }
+        let Ok((report, termination, work, halted)) =
+            refine(&driver, &full, &phi, &refine_config(&settings.config))
+        else {
+            continue;
+        };
+        iterations += work.0;
+        evaluations += work.1;
+        stopped |= halted;
+        if best.as_ref().is_none_or(|b| report.cost < b.0.cost) {
+            best = Some((report, termination));
+        }
+    }
+    let (report, termination) = match best {
+        Some((report, termination)) => (
+            report,
+            if stopped {
+                Termination::Stopped
+            } else {
+                termination
+            },
+        ),
+        None => {
+            // Stopped before the full record was reached, or no refinement could be
+            // simulated: the best decimated point, said so.
+            let phi = driver.clamp(&minima[0].1);
+            let system = full.system(&phi, &driver.free)?.phi;
+            let termination = if stopped {
+                Termination::Stopped
+            } else {
+                Termination::NoDescent
+            };
+            (lm_report(&phi, &driver.free, system, u.len()), termination)
+        }
+    };
+    report_fit(
+        &driver,
+        &full,
+        &report.theta,
+        termination,
+        (iterations, evaluations),
+        started,
+    )
+}
+
+/// True when two points differ by more than 0.1 % (relative) in a free coordinate.
+fn differs(a: &[f64], b: &[f64], free: &[usize]) -> bool {
+    free.iter()
+        .any(|&i| (a[i] - b[i]).abs() > 1e-3 * a[i].abs().max(b[i].abs()).max(1e-300))
+}
+
+/// Levenberg–Marquardt on the full record from `phi`, restarted where the Gauss–Newton model
+/// still promises a decrease (module doc, stage 5): the report, the termination to publish,
+/// (iterations, evaluations), and whether the observer stopped it.
+#[allow(clippy::type_complexity)]
+fn refine<F: DifferentialFamily>(
+    driver: &Driver<'_, F>,
+    problem: &OutputError<'_, F>,
+    phi: &[f64],
+    config: &LmConfig,
+) -> Result<(LmReport, Termination, (usize, usize), bool)> {
+    let (mut iterations, mut evaluations) = (0, 0);
+    let mut run = driver.run(problem, phi, config)?;
+    let mut restarts = 0;
+    loop {
+        iterations += run.report.iterations;
+        evaluations += run.report.function_evaluations;
+        let r = &run.report;
+        if run.stopped {
+            let t = r.termination.clone();
+            return Ok((run.report, t, (iterations, evaluations), true));
+        }
+        if matches!(
+            r.termination,
+            Termination::ZeroResidual | Termination::NothingToEstimate
+        ) {
+            let t = r.termination.clone();
+            return Ok((run.report, t, (iterations, evaluations), false));
+        }
+        let system = problem.system(&r.theta, &driver.free)?.phi;
+        let promise = expected_improvement(
+            &system,
+            &r.theta,
+            &driver.free,
+            &driver.lower,
+            &driver.upper,
+        );
+        let out_of_iterations = r.termination == Termination::MaxIterations;
+        if promise <= RESTART_THRESHOLD || restarts == MAX_RESTARTS || out_of_iterations {
+            let termination = if promise > FLAT_THRESHOLD && !out_of_iterations {
+                Termination::FlatRegion { expected: promise }
+            } else {
+                r.termination.clone()
+            };
+            return Ok((run.report, termination, (iterations, evaluations), false));
+        }
+        restarts += 1;
+        let next = driver.run(problem, &r.theta.clone(), config)?;
+        if next.report.cost > run.report.cost {
+            // Cannot happen with a monotone engine; keep the better point regardless.
+            iterations += next.report.iterations;
+            evaluations += next.report.function_evaluations;
+            let t = Termination::FlatRegion { expected: promise };
+            return Ok((run.report, t, (iterations, evaluations), next.stopped));
+        }
+        run = next;
+    }
+}
+
+/// An [`LmReport`] holding only a point, its normal equations and the record's length (for
+/// the covariance).
+fn lm_report(theta: &[f64], free: &[usize], system: NormalEquations, n: usize) -> LmReport {
+    LmReport {
+        theta: theta.to_vec(),
+        free: free.to_vec(),
+        cost: system.cost,
+        initial_cost: system.cost,
+        n_residuals: n,
+        iterations: 0,
+        function_evaluations: 0,
+        residual_evaluations: 0,
+        sensitivity_evaluations: 0,
+        rejected_trials: 0,
+        termination: Termination::NothingToEstimate,
+        history: Vec::new(),
+        jtj: system.jtj,
+        elapsed_s: 0.0,
+    }
+}
+
+/// The [`OperatorFit`] at the search point `phi`: the covariance from the normal equations in
+/// the model's own parameters.
+fn report_fit<F: DifferentialFamily>(
+    driver: &Driver<'_, F>,
+    problem: &OutputError<'_, F>,
+    phi: &[f64],
+    termination: Termination,
+    (iterations, evaluations): (usize, usize),
+    started: Instant,
+) -> Result<OperatorFit<F::Model>> {
+    let theta = driver.family.theta_of(phi);
+    let model = driver.family.model(&theta)?;
+    let y = problem.y;
+    let system = problem.system(phi, &driver.free)?;
+    let normal = NormalEquations {
+        jtj: system.theta_jtj,
+        ..system.phi
+    };
+    let covariance = lm_report(&theta, &driver.free, normal, y.len()).covariance();
+    let (simulated, _) = problem.output(phi)?;
+    let parameters = model.parameters();
+    let std = (0..parameters.len())
+        .map(|i| {
+            let s = covariance.std[i];
+            (driver.free.contains(&i) && s.is_finite()).then_some(s)
+        })
+        .collect();
+    let (n, p) = (y.len(), driver.free.len());
     let loss = metrics::mse(y, &simulated);
     Ok(OperatorFit {
         model,
@@ -228,9 +862,9 @@ pub fn report<M: HysteresisOperator>(
         fpe: metrics::fpe(loss, n, p),
         aic: metrics::aic(loss, n, p),
         simulated,
-        iterations: searched.iterations,
-        evaluations: searched.evaluations,
-        termination: best.termination.clone(),
+        iterations,
+        evaluations,
+        termination,
         elapsed_s: started.elapsed().as_secs_f64(),
     })
 }

@@ -1,16 +1,19 @@
-//! Fit of the Jiles–Atherton operator ([`JilesAtherton`]) to a measured B(H) or M(H) loop.
+//! Fit of the Jiles–Atherton operator ([`JilesAtherton`]) to a measured B(H) or M(H) loop, by
+//! the differential driver ([`differential_fit`](super::differential_fit)).
 //!
-//! **Start from the data** (after converting B to M = B/μ₀ − H):
-//! * Mₛ from the saturation: a multiple ρ ∈ {1.05, 1.5, 3} of the largest |M| measured;
-//! * a from the anhysteretic's reach at the loop tip: L(H_max/a) = M_max/Mₛ;
-//! * k from the coercivity H_c, the mean |H| where M changes sign (k ≈ H_c; Jiles, Thoelke &
-//!   Devine 1992);
-//! * c ∈ {0.2, 0.7}, α = 0.05·a/Mₛ (a weak coupling), m0 = the first measured M.
+//! **What the family supplies.** With m = M/Mₛ and ᾱ = α·Mₛ the equations of the module
+//! [`crate::model::operators::jiles_atherton`] read, in m,
+//! m_an = L((H + ᾱ·m)/a), dm_irr/dH = (m_an − m_irr)/(δk − ᾱ·(m_an − m_irr)): the
+//! magnetisation is Mₛ times the response m of a unit operator (Mₛ = 1) that depends on the
+//! shape (a, k, c, ᾱ, m0/Mₛ) alone, and B = μ₀·H + μ₀·Mₛ·m. Mₛ is the linear parameter.
+//! The start grid is placed from the loop (after converting B to M = B/μ₀ − H):
+//! * the saturation ratio ρ = Mₛ/max|M| ∈ {1.05, 1.5, 3} gives a from the anhysteretic's
+//!   reach at the loop tip, L(H_max/a) = 1/ρ;
+//! * k ∈ {½, 1, 2}·H_c, H_c the coercivity (the mean |H| where M changes sign; k ≈ H_c,
+//!   Jiles, Thoelke & Devine 1992);
+//! * c ∈ {0.2, 0.45, 0.7}, ᾱ ∈ {0, 0.05, 0.3}·a, m0/Mₛ = M\[0\]/(ρ·max|M|).
 //!
-//! The six starts each begin a bounded Levenberg–Marquardt search of (Mₛ, a, k, c, α, m0) with
-//! the physical bounds Mₛ, a, k > 0, 0 ≤ c < 1, α ≥ 0, forward finite-difference
-//! sensitivities of the H-integration; the lowest criterion wins and its termination is
-//! reported as it is (a search that stopped at the iteration limit says so).
+//! The search box is the physical one: Mₛ, a, k > 0, 0 ≤ c < 1, α ≥ 0.
 //!
 //! **Orientation.** B(H) loops are counter-clockwise; a clockwise loop (negative enclosed area)
 //! is fitted with the operator driven by −u (the mirrored loop).
@@ -18,17 +21,15 @@
 //! References: Jiles & Atherton (1986); Jiles, Thoelke & Devine (1992), see
 //! [`crate::model::operators::jiles_atherton`].
 
-use super::differential_fit::{self as common, Search, Simulated};
+use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopShape, Settings};
 use super::family::{FamilyOptions, Identify};
 use super::OperatorFit;
+use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::jiles_atherton::{langevin, MU0};
-use crate::model::operators::{
-    Anhysteretic, HysteresisOperator, JaOutput, JilesAtherton, LoopOrientation,
-};
+use crate::model::operators::{Anhysteretic, JaOutput, JilesAtherton, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
 use crate::Result;
-use std::time::Instant;
 
 /// Options of the Jiles–Atherton fit.
 #[derive(Clone, Debug)]
@@ -37,9 +38,10 @@ pub struct JilesAthertonOptions {
     pub anhysteretic: Anhysteretic,
     /// What the measured output is (default B in T, with H in A/m).
     pub output: JaOutput,
-    /// Levenberg–Marquardt settings.
+    /// Levenberg–Marquardt settings of the full-record refinement.
     pub config: LmConfig,
-    /// Sees the search's starts and iterations and may stop it (see [`Search::observer`]).
+    /// Sees the fit's grid, starts and iterations and may stop it (see
+    /// [`Settings::observer`]).
     pub observer: Observer,
 }
 
@@ -48,35 +50,135 @@ impl Default for JilesAthertonOptions {
         Self {
             anhysteretic: Anhysteretic::Langevin,
             output: JaOutput::FluxDensity,
-            config: common::default_config(),
+            config: driver::default_config(),
             observer: Observer::none(),
         }
     }
 }
 
-/// The structure that is not estimated.
-#[derive(Clone, Copy)]
-struct Structure {
+/// Local searches on the decimated record.
+const STARTS: usize = 4;
+
+/// The Jiles–Atherton family for the driver: θ = (Mₛ, a, k, c, α, m0), the order of
+/// [`JilesAtherton::parameters`].
+struct Family {
     anhysteretic: Anhysteretic,
     output: JaOutput,
     orientation: LoopOrientation,
 }
 
-/// θ = (Mₛ, a, k, c, α, m0), the order of [`JilesAtherton::parameters`].
-fn model_of(theta: &[f64], s: Structure) -> Result<JilesAtherton> {
-    let m = JilesAtherton {
-        ms: theta[0],
-        a: theta[1],
-        k: theta[2],
-        c: theta[3],
-        alpha: theta[4],
-        m0: theta[5],
-        anhysteretic: s.anhysteretic,
-        output: s.output,
-        orientation: s.orientation,
-    };
-    m.validate()?;
-    Ok(m)
+impl Family {
+    fn operator(&self, t: &[f64], output: JaOutput) -> JilesAtherton {
+        JilesAtherton {
+            ms: t[0],
+            a: t[1],
+            k: t[2],
+            c: t[3],
+            alpha: t[4],
+            m0: t[5],
+            anhysteretic: self.anhysteretic,
+            output,
+            orientation: self.orientation,
+        }
+    }
+
+    /// The field H = ±u and the magnetisation M of the measured loop.
+    fn field_and_magnetisation(&self, u: &[f64], y: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let s = self.orientation.sign();
+        let h: Vec<f64> = u.iter().map(|v| s * v).collect();
+        let m = match self.output {
+            JaOutput::Magnetisation => y.to_vec(),
+            JaOutput::FluxDensity => y.iter().zip(&h).map(|(b, h)| b / MU0 - h).collect(),
+        };
+        (h, m)
+    }
+}
+
+impl DifferentialFamily for Family {
+    type Model = JilesAtherton;
+    fn name(&self) -> &'static str {
+        "jiles-atherton"
+    }
+    fn model(&self, t: &[f64]) -> Result<JilesAtherton> {
+        let m = self.operator(t, self.output);
+        m.validate()?;
+        Ok(m)
+    }
+    fn free(&self) -> Vec<usize> {
+        vec![0, 1, 2, 3, 4, 5]
+    }
+    fn bounds(&self, shape: &LoopShape) -> (Vec<f64>, Vec<f64>) {
+        let inf = f64::INFINITY;
+        let h = shape.half_span();
+        let m_scale = match self.output {
+            JaOutput::Magnetisation => shape.y_range.1 - shape.y_range.0,
+            JaOutput::FluxDensity => (shape.y_range.1 - shape.y_range.0) / MU0,
+        }
+        .max(f64::MIN_POSITIVE);
+        (
+            vec![1e-9 * m_scale, 1e-9 * h, 1e-9 * h, 0.0, 0.0, -inf],
+            vec![inf, inf, inf, 1.0 - 1e-9, inf, inf],
+        )
+    }
+    /// Points (a, k, c, ᾱ, m0/Mₛ).
+    fn shape_grid(&self, u: &[f64], y: &[f64], _shape: &LoopShape) -> Vec<Vec<f64>> {
+        let (h, m) = self.field_and_magnetisation(u, y);
+        let peak = |v: &[f64]| {
+            v.iter()
+                .fold(0.0f64, |a, x| a.max(x.abs()))
+                .max(f64::MIN_POSITIVE)
+        };
+        let (m_max, h_max) = (peak(&m), peak(&h));
+        let mut crossings = Vec::new();
+        for k in 1..m.len() {
+            if m[k - 1] * m[k] < 0.0 {
+                let t = m[k - 1] / (m[k - 1] - m[k]);
+                crossings.push((h[k - 1] + t * (h[k] - h[k - 1])).abs());
+            }
+        }
+        let hc = if crossings.is_empty() {
+            0.1 * h_max
+        } else {
+            crossings.iter().sum::<f64>() / crossings.len() as f64
+        }
+        .max(1e-3 * h_max);
+        let mut points = Vec::new();
+        for rho in [1.05, 1.5, 3.0] {
+            let a = h_max / inverse_langevin(1.0 / rho);
+            let z0 = m[0] / (rho * m_max);
+            for k in [0.5, 1.0, 2.0].map(|f| f * hc) {
+                for c in [0.2, 0.45, 0.7] {
+                    for alpha in [0.0, 0.05, 0.3].map(|f| f * a) {
+                        points.push(vec![a, k, c, alpha, z0]);
+                    }
+                }
+            }
+        }
+        points
+    }
+    fn basis(&self, p: &[f64], u: &[f64], tolerance: f64) -> Result<Basis> {
+        let unit = self.operator(
+            &[1.0, p[0], p[1], p[2], p[3], p[4]],
+            JaOutput::Magnetisation,
+        );
+        let mut m = simulate_with_tolerance(&unit, u, tolerance)?;
+        let fixed = match self.output {
+            JaOutput::Magnetisation => None,
+            JaOutput::FluxDensity => {
+                m.iter_mut().for_each(|v| *v *= MU0);
+                let s = self.orientation.sign();
+                Some(u.iter().map(|v| MU0 * s * v).collect())
+            }
+        };
+        Ok(Basis {
+            fixed,
+            columns: vec![m],
+        })
+    }
+    fn assemble(&self, p: &[f64], c: &[f64]) -> Option<Vec<f64>> {
+        let ms = c[0];
+        (ms > 0.0).then(|| vec![ms, p[0], p[1], p[2], p[3] / ms, p[4] * ms])
+    }
 }
 
 /// Fits a Jiles–Atherton operator to the field `u` (A/m) and B (T) or M (A/m) `y`.
@@ -85,78 +187,21 @@ pub fn fit(
     y: &[f64],
     options: &JilesAthertonOptions,
 ) -> Result<OperatorFit<JilesAtherton>> {
-    let started = Instant::now();
-    common::check_record("jiles-atherton", u, y, 6)?;
-    let structure = Structure {
+    let family = Family {
         anhysteretic: options.anhysteretic,
         output: options.output,
-        orientation: LoopOrientation::of_loop(u, y),
+        orientation: if u.len() == y.len() {
+            LoopOrientation::of_loop(u, y)
+        } else {
+            LoopOrientation::CounterClockwise
+        },
     };
-    let starts = data_starts(u, y, structure);
-    let inf = f64::INFINITY;
-    let tiny = |v: f64| 1e-9 * v;
-    let s0 = &starts[0];
-    let search = Search {
-        free: vec![0, 1, 2, 3, 4, 5],
-        lower: vec![tiny(s0[0]), tiny(s0[1]), tiny(s0[2]), 0.0, 0.0, -inf],
-        upper: vec![inf, inf, inf, 1.0 - 1e-9, inf, inf],
+    let settings = Settings {
+        starts: STARTS,
         config: options.config.clone(),
         observer: options.observer.clone(),
     };
-    let simulate = |theta: &[f64]| model_of(theta, structure)?.simulate(u);
-    let problem = Simulated {
-        y,
-        simulate: &simulate,
-        n_params: 6,
-    };
-    let searched = common::best_of(&problem, &starts, &search)?;
-    common::report(
-        model_of(&searched.best.theta, structure)?,
-        u,
-        y,
-        &searched,
-        started,
-    )
-}
-
-/// The data-driven starts of the module doc.
-fn data_starts(u: &[f64], y: &[f64], s: Structure) -> Vec<Vec<f64>> {
-    let sign = s.orientation.sign();
-    let h: Vec<f64> = u.iter().map(|v| sign * v).collect();
-    let m: Vec<f64> = match s.output {
-        JaOutput::Magnetisation => y.to_vec(),
-        JaOutput::FluxDensity => y.iter().zip(&h).map(|(b, h)| b / MU0 - h).collect(),
-    };
-    let m_max = m
-        .iter()
-        .fold(0.0f64, |a, v| a.max(v.abs()))
-        .max(f64::MIN_POSITIVE);
-    let h_max = h
-        .iter()
-        .fold(0.0f64, |a, v| a.max(v.abs()))
-        .max(f64::MIN_POSITIVE);
-    let mut crossings = Vec::new();
-    for k in 1..m.len() {
-        if m[k - 1] * m[k] < 0.0 {
-            let t = m[k - 1] / (m[k - 1] - m[k]);
-            crossings.push((h[k - 1] + t * (h[k] - h[k - 1])).abs());
-        }
-    }
-    let hc = if crossings.is_empty() {
-        0.1 * h_max
-    } else {
-        crossings.iter().sum::<f64>() / crossings.len() as f64
-    };
-    let k0 = hc.max(1e-3 * h_max);
-    let mut starts = Vec::new();
-    for rho in [1.05, 1.5, 3.0] {
-        let ms = rho * m_max;
-        let a = h_max / inverse_langevin(1.0 / rho);
-        for c in [0.2, 0.7] {
-            starts.push(vec![ms, a, k0, c, 0.05 * a / ms, m[0]]);
-        }
-    }
-    starts
+    driver::fit(&family, u, y, &settings)
 }
 
 /// x with L(x) = t for 0 < t < 1 (bisection; L is increasing).

@@ -11,9 +11,11 @@
 //!   triangular Preisach grid.
 //! * [`kp`]: the same on the kernel states of a Krasnosel'skii–Pokrovskii grid, the ridge
 //!   width profiled over a few candidates.
-//! * [`jiles_atherton`], [`bouc_wen`], [`duhem`], [`dahl`]: bounded Levenberg–Marquardt
-//!   output-error fits of the differential operators ([`differential_fit`] holds their common
-//!   part).
+//! * [`jiles_atherton`], [`bouc_wen`], [`duhem`], [`dahl`]: output-error fits of the
+//!   differential operators, each a small [`differential_fit::DifferentialFamily`] run by one
+//!   driver ([`differential_fit::fit`]: a variable-projection start grid on a decimated
+//!   record, local searches, then bounded Levenberg–Marquardt on the full record with
+//!   sensitivities integrated in u, and a checked stop).
 //!
 //! The loop orientation is detected from the data ([`crate::model::operators::Orientation::detect`]) unless given; a
 //! clockwise loop is fitted in the inverse-operator parameterisation (the core operator from

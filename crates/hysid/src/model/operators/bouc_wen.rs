@@ -25,7 +25,7 @@
 //! * Y.-K. Wen, "Method for random vibration of hysteretic systems", J. Eng. Mech. Div. 102
 //!   (1976) 249–263.
 
-use super::differential::{self, InputOde};
+use super::differential::{self, InputOde, InputOdeSensitivity};
 use super::{HysteresisOperator, Inversion};
 use crate::model::Parameter;
 use crate::model::ParameterSet;
@@ -100,6 +100,16 @@ impl BoucWen {
         Ok(())
     }
 
+    /// |w|ⁿ; the common n = 1 without the power function (x¹ is x exactly).
+    #[inline(always)]
+    fn power(&self, aw: f64) -> f64 {
+        if self.n == 1.0 {
+            aw
+        } else {
+            aw.powf(self.n)
+        }
+    }
+
     /// The bound of |w|: (A/(β + γ))^{1/n}.
     pub fn w_max(&self) -> f64 {
         (self.a / (self.beta + self.gamma)).powf(1.0 / self.n)
@@ -109,7 +119,7 @@ impl BoucWen {
 impl InputOde for BoucWen {
     fn slope(&self, _u: f64, w: f64, direction: f64) -> f64 {
         let s = if direction * w >= 0.0 { 1.0 } else { -1.0 };
-        self.a - (self.beta * s + self.gamma) * w.abs().powf(self.n)
+        self.a - (self.beta * s + self.gamma) * self.power(w.abs())
     }
     fn output(&self, u: f64, w: f64) -> f64 {
         self.kx * u + self.kw * w
@@ -125,6 +135,46 @@ impl InputOde for BoucWen {
     }
     fn inversion_span(&self) -> f64 {
         1e6 * self.w_max() / self.a
+    }
+}
+
+/// θ = (k_x, k_w, A, β, γ, n, w0): with s = sign(δ·w) and σ = β·s + γ,
+/// ∂F/∂w = −σ·n·|w|ⁿ⁻¹·sign w, ∂F/∂A = 1, ∂F/∂β = −s·|w|ⁿ, ∂F/∂γ = −|w|ⁿ,
+/// ∂F/∂n = −σ·|w|ⁿ·ln|w|; ∂y/∂w = k_w, ∂y/∂k_x = u, ∂y/∂k_w = w; ∂w(u\[0\])/∂w0 = 1.
+impl InputOdeSensitivity for BoucWen {
+    fn n_parameters(&self) -> usize {
+        7
+    }
+    fn slope_partials(&self, u: f64, w: f64, direction: f64, dtheta: &mut [f64]) -> (f64, f64) {
+        let f = self.slope(u, w, direction);
+        let s = if direction * w >= 0.0 { 1.0 } else { -1.0 };
+        let sigma = self.beta * s + self.gamma;
+        let aw = w.abs();
+        let wn = self.power(aw);
+        let sign_w = if w >= 0.0 { 1.0 } else { -1.0 };
+        let slope_w = if self.n == 1.0 {
+            1.0
+        } else {
+            self.n * aw.powf(self.n - 1.0)
+        };
+        let fw = -sigma * slope_w * sign_w;
+        dtheta.copy_from_slice(&[
+            0.0,
+            0.0,
+            1.0,
+            -s * wn,
+            -wn,
+            if aw > 0.0 { -sigma * wn * aw.ln() } else { 0.0 },
+            0.0,
+        ]);
+        (f, fw)
+    }
+    fn output_partials(&self, u: f64, w: f64, dtheta: &mut [f64]) -> f64 {
+        dtheta.copy_from_slice(&[u, w, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        self.kw
+    }
+    fn initial_state_partials(&self, dtheta: &mut [f64]) {
+        dtheta.copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
     }
 }
 

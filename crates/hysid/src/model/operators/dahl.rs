@@ -21,7 +21,7 @@
 //! * P. R. Dahl, "Solid friction damping of mechanical vibrations", AIAA J. 14 (1976)
 //!   1675–1682.
 
-use super::differential::{self, InputOde, LoopOrientation};
+use super::differential::{self, InputOde, InputOdeSensitivity, LoopOrientation};
 use super::{HysteresisOperator, Inversion};
 use crate::model::Parameter;
 use crate::model::ParameterSet;
@@ -102,6 +102,38 @@ impl InputOde for Dahl {
     }
     fn inversion_span(&self) -> f64 {
         60.0 * self.fc / self.sigma
+    }
+}
+
+/// θ = (σ, F_c, i, f0): with s = ±1 the orientation's sign, b = 1 − (F/F_c)·s·δ and
+/// F' = s·σ·i·|b|ⁱ⁻¹: ∂F/∂F = −F'·s·δ/F_c, ∂F/∂σ = s·sign(b)·|b|ⁱ, ∂F/∂F_c = F'·F·s·δ/F_c²,
+/// ∂F/∂i = s·σ·sign(b)·|b|ⁱ·ln|b|; the output is the state; ∂F(u\[0\])/∂f0 = 1.
+impl InputOdeSensitivity for Dahl {
+    fn n_parameters(&self) -> usize {
+        4
+    }
+    fn slope_partials(&self, u: f64, f: f64, direction: f64, dtheta: &mut [f64]) -> (f64, f64) {
+        let slope = self.slope(u, f, direction);
+        let s = -self.orientation.sign();
+        let sd = s * direction;
+        let base = 1.0 - f / self.fc * sd;
+        let ab = base.abs();
+        let power = base.signum() * ab.powf(self.i);
+        let db = s * self.sigma * self.i * ab.powf(self.i - 1.0);
+        dtheta.copy_from_slice(&[
+            s * power,
+            db * f * sd / (self.fc * self.fc),
+            if ab > 0.0 { slope * ab.ln() } else { 0.0 },
+            0.0,
+        ]);
+        (slope, -db * sd / self.fc)
+    }
+    fn output_partials(&self, _u: f64, _f: f64, dtheta: &mut [f64]) -> f64 {
+        dtheta.fill(0.0);
+        1.0
+    }
+    fn initial_state_partials(&self, dtheta: &mut [f64]) {
+        dtheta.copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
     }
 }
 

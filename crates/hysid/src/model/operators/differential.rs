@@ -23,17 +23,31 @@
 //! Jarratt 1971). A reference that no input within the family's inversion span reaches is
 //! clipped to the closest output found and listed.
 //!
+//! **Parameter sensitivities.** A family that also implements [`InputOdeSensitivity`] gives
+//! the partial derivatives ∂F/∂x, ∂F/∂θ, ∂h/∂x, ∂h/∂θ and ∂x₀/∂θ; [`simulate_with_sensitivities`]
+//! then carries the tangents S = ∂x/∂θ through the very Runge–Kutta steps that move the state
+//! (the derivative of the computed solution, "internal numerical differentiation", Bock 1981):
+//! every stage X_i = x + h·Σ a_ij·k_j has the tangent S_i = S + h·Σ a_ij·k'_j with
+//! k'_i = ∂F/∂x(X_i)·S_i + ∂F/∂θ(X_i), and the output's is ∂h/∂x·S + ∂h/∂θ. The state path is
+//! bit for bit that of [`simulate`], the sensitivities are exact derivatives of it (the step
+//! sizes held), and the cost is one simulation with p more scalars per stage instead of the
+//! p further simulations of finite differences.
+//!
 //! References: J. R. Dormand, P. J. Prince, "A family of embedded Runge–Kutta formulae",
 //! J. Comput. Appl. Math. 6 (1980) 19–26. A. Visintin, *Differential Models of Hysteresis*,
 //! Springer 1994. M. Dowell, P. Jarratt, "A modified regula falsi method for computing the
-//! root of an equation", BIT 11 (1971) 168–174.
+//! root of an equation", BIT 11 (1971) 168–174. H. G. Bock, "Numerical treatment of inverse
+//! problems in chemical reaction kinetics", in *Modelling of Chemical Reaction Systems*,
+//! Springer 1981, 102–125.
 
 use super::Inversion;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
-/// Relative (and, times the state scale, absolute) error tolerance of a sub-step.
-const TOLERANCE: f64 = 1e-10;
+/// Relative (and, times the state scale, absolute) error tolerance of a sub-step: the
+/// operator's own simulation. A coarser one ([`states_with_tolerance`]) serves where only an
+/// approximate output is needed, e.g. the global stage of a fit.
+pub const TOLERANCE: f64 = 1e-10;
 /// Sub-steps allowed in one sample interval before the integration is declared divergent.
 const MAX_SUBSTEPS: usize = 100_000;
 
@@ -98,6 +112,24 @@ pub trait InputOde: Sync {
     }
 }
 
+/// The most parameters an [`InputOdeSensitivity`] may have (the tangents live in fixed arrays).
+pub const MAX_SENSITIVITIES: usize = 8;
+
+/// An [`InputOde`] with the partial derivatives of its equations with respect to the state x
+/// and its parameters θ (in the order of the operator's `parameters()`), for
+/// [`simulate_with_sensitivities`].
+pub trait InputOdeSensitivity: InputOde {
+    /// The number p of parameters θ (at most [`MAX_SENSITIVITIES`]).
+    fn n_parameters(&self) -> usize;
+    /// F = dx/du (the same value as [`InputOde::slope`]) and ∂F/∂x; writes ∂F/∂θ_j into
+    /// `dtheta[j]`.
+    fn slope_partials(&self, u: f64, x: f64, direction: f64, dtheta: &mut [f64]) -> (f64, f64);
+    /// ∂h/∂x; writes ∂h/∂θ_j into `dtheta[j]`.
+    fn output_partials(&self, u: f64, x: f64, dtheta: &mut [f64]) -> f64;
+    /// Writes ∂x₀/∂θ_j into `dtheta[j]`.
+    fn initial_state_partials(&self, dtheta: &mut [f64]);
+}
+
 /// Checks a signal: not empty, every sample finite.
 pub fn check_signal(name: &str, v: &[f64]) -> Result<()> {
     if v.is_empty() {
@@ -117,20 +149,49 @@ pub fn check_signal(name: &str, v: &[f64]) -> Result<()> {
 
 /// The state after the input moves from `u0` to `u1`, starting from state `x`
 /// (Dormand–Prince 5(4) with error control; see the module doc).
-pub fn advance(ode: &dyn InputOde, x: f64, u0: f64, u1: f64) -> Result<f64> {
+pub fn advance<O: InputOde + ?Sized>(ode: &O, x: f64, u0: f64, u1: f64) -> Result<f64> {
     let mut budget = MAX_SUBSTEPS;
-    advance_within(ode, x, u0, u1, &mut budget)
+    advance_within(ode, x, u0, u1, TOLERANCE, &mut budget, &mut Plain)
+}
+
+/// How a sub-step is taken: the state alone ([`Plain`]) or with its tangents ([`Tangents`]).
+trait StepRule<O: ?Sized> {
+    /// One Dormand–Prince step of signed length `h` from (u, x): the 5th-order state and the
+    /// magnitude of the error estimate.
+    fn step(&mut self, ode: &O, u: f64, x: f64, h: f64, d: f64) -> (f64, f64);
+    /// The step just taken is accepted.
+    fn accept(&mut self);
+}
+
+/// The state alone.
+struct Plain;
+
+impl<O: InputOde + ?Sized> StepRule<O> for Plain {
+    #[inline(always)]
+    fn step(&mut self, ode: &O, u: f64, x: f64, h: f64, d: f64) -> (f64, f64) {
+        dormand_prince(ode, u, x, h, d)
+    }
+    #[inline(always)]
+    fn accept(&mut self) {}
 }
 
 /// [`advance`] with a budget of sub-steps, decreased by the sub-steps taken.
-fn advance_within(ode: &dyn InputOde, x: f64, u0: f64, u1: f64, budget: &mut usize) -> Result<f64> {
+fn advance_within<O: InputOde + ?Sized, R: StepRule<O>>(
+    ode: &O,
+    x: f64,
+    u0: f64,
+    u1: f64,
+    tolerance: f64,
+    budget: &mut usize,
+    rule: &mut R,
+) -> Result<f64> {
     let span = u1 - u0;
     if span == 0.0 {
         return Ok(x);
     }
     let direction = span.signum();
     let h_max = ode.max_substep().abs().max(f64::MIN_POSITIVE);
-    let atol = TOLERANCE * ode.state_scale().abs().max(f64::MIN_POSITIVE);
+    let atol = tolerance * ode.state_scale().abs().max(f64::MIN_POSITIVE);
     let (mut u, mut x) = (u0, x);
     let mut h = span.abs().min(h_max);
     while *budget > 0 {
@@ -141,7 +202,7 @@ fn advance_within(ode: &dyn InputOde, x: f64, u0: f64, u1: f64, budget: &mut usi
         }
         let last = h >= remaining;
         let step = if last { remaining } else { h };
-        let (x_new, err) = dormand_prince(ode, u, x, step * direction, direction);
+        let (x_new, err) = rule.step(ode, u, x, step * direction, direction);
         if !x_new.is_finite() || !err.is_finite() {
             if step <= 1e-14 * (u.abs() + h_max) {
                 return Err(diverged(u, "the slope dx/du is not finite"));
@@ -149,12 +210,15 @@ fn advance_within(ode: &dyn InputOde, x: f64, u0: f64, u1: f64, budget: &mut usi
             h = step * 0.25;
             continue;
         }
-        let tol = atol + TOLERANCE * x.abs().max(x_new.abs());
+        let tol = atol + tolerance * x.abs().max(x_new.abs());
         if err <= tol {
             u = if last { u1 } else { u + step * direction };
             x = x_new;
+            rule.accept();
         }
-        let factor = if err == 0.0 {
+        // 0.9·(tol/err)^{1/5} ≥ 5 whenever tol/err ≥ 5292: the power is only taken below
+        // (6000 leaves a margin for its rounding; the factor is the same).
+        let factor = if err * 6000.0 <= tol {
             5.0
         } else {
             (0.9 * (tol / err).powf(0.2)).clamp(0.2, 5.0)
@@ -183,7 +247,8 @@ fn diverged(u: f64, what: &str) -> Error {
 
 /// One Dormand–Prince 5(4) step of signed length `h`: the 5th-order state and the magnitude of
 /// the embedded error estimate.
-fn dormand_prince(ode: &dyn InputOde, u: f64, x: f64, h: f64, d: f64) -> (f64, f64) {
+#[inline(always)]
+fn dormand_prince<O: InputOde + ?Sized>(ode: &O, u: f64, x: f64, h: f64, d: f64) -> (f64, f64) {
     let f = |du: f64, xx: f64| ode.slope(u + du, xx, d);
     let k1 = f(0.0, x);
     let k2 = f(h / 5.0, x + h * k1 / 5.0);
@@ -219,7 +284,17 @@ fn dormand_prince(ode: &dyn InputOde, u: f64, x: f64, h: f64, d: f64) -> (f64, f
 }
 
 /// The states x_k along the input `u`, from the operator's initial state at u\[0\].
-pub fn states(ode: &dyn InputOde, u: &[f64]) -> Result<Vec<f64>> {
+pub fn states<O: InputOde + ?Sized>(ode: &O, u: &[f64]) -> Result<Vec<f64>> {
+    states_with_tolerance(ode, u, TOLERANCE)
+}
+
+/// [`states`] integrated to the relative error tolerance `tolerance` instead of
+/// [`TOLERANCE`].
+pub fn states_with_tolerance<O: InputOde + ?Sized>(
+    ode: &O,
+    u: &[f64],
+    tolerance: f64,
+) -> Result<Vec<f64>> {
     check_signal("input", u)?;
     let mut x = ode.initial_state();
     let mut out = Vec::with_capacity(u.len());
@@ -228,16 +303,161 @@ pub fn states(ode: &dyn InputOde, u: &[f64]) -> Result<Vec<f64>> {
     // point of a fit must fail quickly rather than take minutes.
     let mut budget = MAX_SUBSTEPS + 100 * u.len();
     for (k, w) in u.windows(2).enumerate() {
-        x = advance_within(ode, x, w[0], w[1], &mut budget).map_err(|e| at_sample(e, k + 1))?;
+        x = advance_within(ode, x, w[0], w[1], tolerance, &mut budget, &mut Plain)
+            .map_err(|e| at_sample(e, k + 1))?;
         out.push(x);
     }
     Ok(out)
 }
 
 /// The output y_k = h(u_k, x_k) along the input `u`.
-pub fn simulate(ode: &dyn InputOde, u: &[f64]) -> Result<Vec<f64>> {
-    let x = states(ode, u)?;
+pub fn simulate<O: InputOde + ?Sized>(ode: &O, u: &[f64]) -> Result<Vec<f64>> {
+    simulate_with_tolerance(ode, u, TOLERANCE)
+}
+
+/// [`simulate`] integrated to the relative error tolerance `tolerance` instead of
+/// [`TOLERANCE`].
+pub fn simulate_with_tolerance<O: InputOde + ?Sized>(
+    ode: &O,
+    u: &[f64],
+    tolerance: f64,
+) -> Result<Vec<f64>> {
+    let x = states_with_tolerance(ode, u, tolerance)?;
     Ok(u.iter().zip(&x).map(|(&u, &x)| ode.output(u, x)).collect())
+}
+
+/// The output ŷ_k and its sensitivities ∂ŷ_k/∂θ (p = [`InputOdeSensitivity::n_parameters`]
+/// values) along the input `u`, handed to `each(k, ŷ_k, ∂ŷ_k/∂θ)` sample by sample (see the
+/// module doc): nothing of the record's length is stored. `tolerance` is the integration's
+/// ([`TOLERANCE`] for the operator's own path).
+pub fn simulate_with_sensitivities<O: InputOdeSensitivity + ?Sized>(
+    ode: &O,
+    u: &[f64],
+    tolerance: f64,
+    mut each: impl FnMut(usize, f64, &[f64]),
+) -> Result<()> {
+    check_signal("input", u)?;
+    let p = ode.n_parameters();
+    if p > MAX_SENSITIVITIES {
+        return Err(Error::invalid_option(
+            "parameters",
+            p,
+            format!("at most {MAX_SENSITIVITIES} parameters carry sensitivities"),
+        ));
+    }
+    let mut rule = Tangents {
+        p,
+        s: [0.0; MAX_SENSITIVITIES],
+        pending: [0.0; MAX_SENSITIVITIES],
+    };
+    ode.initial_state_partials(&mut rule.s[..p]);
+    let mut x = ode.initial_state();
+    let mut dy = [0.0; MAX_SENSITIVITIES];
+    let mut emit =
+        |k: usize, x: f64, s: &[f64; MAX_SENSITIVITIES], dy: &mut [f64; MAX_SENSITIVITIES]| {
+            let hx = ode.output_partials(u[k], x, &mut dy[..p]);
+            for j in 0..p {
+                dy[j] += hx * s[j];
+            }
+            each(k, ode.output(u[k], x), &dy[..p]);
+        };
+    emit(0, x, &rule.s, &mut dy);
+    let mut budget = MAX_SUBSTEPS + 100 * u.len();
+    for (k, w) in u.windows(2).enumerate() {
+        x = advance_within(ode, x, w[0], w[1], tolerance, &mut budget, &mut rule)
+            .map_err(|e| at_sample(e, k + 1))?;
+        emit(k + 1, x, &rule.s, &mut dy);
+    }
+    Ok(())
+}
+
+/// The state with its tangents S = ∂x/∂θ (the `p` first entries).
+struct Tangents {
+    p: usize,
+    /// S at the current point.
+    s: [f64; MAX_SENSITIVITIES],
+    /// S at the end of the step last taken, until it is accepted.
+    pending: [f64; MAX_SENSITIVITIES],
+}
+
+impl<O: InputOdeSensitivity + ?Sized> StepRule<O> for Tangents {
+    fn step(&mut self, ode: &O, u: f64, x: f64, h: f64, d: f64) -> (f64, f64) {
+        // The stage states exactly as in `dormand_prince` (the same bits); beside each, its
+        // tangent S_i = S + h·Σ a_ij·k'_j and k'_i = F_x(X_i)·S_i + F_θ(X_i).
+        let mut k = [0.0; 6];
+        let mut dk = [[0.0; MAX_SENSITIVITIES]; 6];
+        let mut stage = |i: usize, du: f64, xi: f64, a: &[f64], k: &mut [f64; 6]| {
+            let mut si = self.s;
+            for (j, &aij) in a.iter().enumerate() {
+                for l in 0..self.p {
+                    si[l] += h * aij * dk[j][l];
+                }
+            }
+            let (f, fx) = ode.slope_partials(u + du, xi, d, &mut dk[i][..self.p]);
+            for l in 0..self.p {
+                dk[i][l] += fx * si[l];
+            }
+            k[i] = f;
+        };
+        stage(0, 0.0, x, &[], &mut k);
+        stage(1, h / 5.0, x + h * k[0] / 5.0, &[0.2], &mut k);
+        let a2 = [3.0 / 40.0, 9.0 / 40.0];
+        stage(
+            2,
+            0.3 * h,
+            x + h * (a2[0] * k[0] + a2[1] * k[1]),
+            &a2,
+            &mut k,
+        );
+        let a3 = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
+        let x3 = x + h * (44.0 / 45.0 * k[0] - 56.0 / 15.0 * k[1] + 32.0 / 9.0 * k[2]);
+        stage(3, 0.8 * h, x3, &a3, &mut k);
+        let a4 = [
+            19372.0 / 6561.0,
+            -25360.0 / 2187.0,
+            64448.0 / 6561.0,
+            -212.0 / 729.0,
+        ];
+        let x4 = x + h
+            * (19372.0 / 6561.0 * k[0] - 25360.0 / 2187.0 * k[1] + 64448.0 / 6561.0 * k[2]
+                - 212.0 / 729.0 * k[3]);
+        stage(4, 8.0 / 9.0 * h, x4, &a4, &mut k);
+        let a5 = [
+            9017.0 / 3168.0,
+            -355.0 / 33.0,
+            46732.0 / 5247.0,
+            49.0 / 176.0,
+            -5103.0 / 18656.0,
+        ];
+        let x5_stage = x + h
+            * (9017.0 / 3168.0 * k[0] - 355.0 / 33.0 * k[1]
+                + 46732.0 / 5247.0 * k[2]
+                + 49.0 / 176.0 * k[3]
+                - 5103.0 / 18656.0 * k[4]);
+        stage(5, h, x5_stage, &a5, &mut k);
+        let x5 = x + h
+            * (35.0 / 384.0 * k[0] + 500.0 / 1113.0 * k[2] + 125.0 / 192.0 * k[3]
+                - 2187.0 / 6784.0 * k[4]
+                + 11.0 / 84.0 * k[5]);
+        for (l, pending) in self.pending.iter_mut().enumerate().take(self.p) {
+            *pending = self.s[l]
+                + h * (35.0 / 384.0 * dk[0][l]
+                    + 500.0 / 1113.0 * dk[2][l]
+                    + 125.0 / 192.0 * dk[3][l]
+                    - 2187.0 / 6784.0 * dk[4][l]
+                    + 11.0 / 84.0 * dk[5][l]);
+        }
+        let k7 = ode.slope(u + h, x5, d);
+        let err = h
+            * (71.0 / 57600.0 * k[0] - 71.0 / 16695.0 * k[2] + 71.0 / 1920.0 * k[3]
+                - 17253.0 / 339200.0 * k[4]
+                + 22.0 / 525.0 * k[5]
+                - 1.0 / 40.0 * k7);
+        (x5, err.abs())
+    }
+    fn accept(&mut self) {
+        self.s = self.pending;
+    }
 }
 
 fn at_sample(e: Error, index: usize) -> Error {
@@ -249,7 +469,7 @@ fn at_sample(e: Error, index: usize) -> Error {
 
 /// The input that makes the operator follow `reference` (see the module doc), sample by
 /// sample from the initial state; unreachable samples are clipped and listed.
-pub fn invert(ode: &dyn InputOde, reference: &[f64]) -> Result<Inversion> {
+pub fn invert<O: InputOde + ?Sized>(ode: &O, reference: &[f64]) -> Result<Inversion> {
     check_signal("reference", reference)?;
     let x0 = ode.initial_state();
     let anchor = ode.anchor_input();
@@ -287,10 +507,10 @@ pub fn invert(ode: &dyn InputOde, reference: &[f64]) -> Result<Inversion> {
 /// Finds v with y(v) = r near `start`: (v, state, output, clipped).
 type Branch<'a> = dyn Fn(f64) -> Result<(f64, f64)> + 'a;
 
-fn solve_sample(
+fn solve_sample<O: InputOde + ?Sized>(
     branch: &Branch<'_>,
     start: f64,
-    ode: &dyn InputOde,
+    ode: &O,
     r: f64,
 ) -> Result<(f64, f64, f64, bool)> {
     let (y0, x0) = branch(start)?;

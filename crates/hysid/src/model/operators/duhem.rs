@@ -19,7 +19,7 @@
 //!   ferromagnetically soft materials", Int. J. Eng. Sci. 24 (1986) 897–919.
 //! * A. Visintin, *Differential Models of Hysteresis*, Springer 1994, ch. V (Duhem models).
 
-use super::differential::{self, InputOde};
+use super::differential::{self, InputOde, InputOdeSensitivity};
 use super::{HysteresisOperator, Inversion};
 use crate::model::Parameter;
 use crate::model::ParameterSet;
@@ -103,6 +103,27 @@ impl InputOde for Duhem {
         } else {
             0.0
         }
+    }
+}
+
+/// θ = (α, a, b, c, y0): ∂F/∂y = −α·δ, ∂F/∂α = δ·(a·u + b − y), ∂F/∂a = α·δ·u,
+/// ∂F/∂b = α·δ, ∂F/∂c = 1; the output is the state; ∂y(u\[0\])/∂y0 = 1.
+impl InputOdeSensitivity for Duhem {
+    fn n_parameters(&self) -> usize {
+        5
+    }
+    fn slope_partials(&self, u: f64, y: f64, direction: f64, dtheta: &mut [f64]) -> (f64, f64) {
+        let f = self.slope(u, y, direction);
+        let ad = self.alpha * direction;
+        dtheta.copy_from_slice(&[direction * (self.a * u + self.b - y), ad * u, ad, 1.0, 0.0]);
+        (f, -ad)
+    }
+    fn output_partials(&self, _u: f64, _y: f64, dtheta: &mut [f64]) -> f64 {
+        dtheta.fill(0.0);
+        1.0
+    }
+    fn initial_state_partials(&self, dtheta: &mut [f64]) {
+        dtheta.copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 1.0]);
     }
 }
 

@@ -41,7 +41,7 @@
 //! * J. Takács, "A phenomenological mathematical model of hysteresis", COMPEL 20 (2001)
 //!   1002–1015.
 
-use super::differential::{self, InputOde, LoopOrientation};
+use super::differential::{self, InputOde, InputOdeSensitivity, LoopOrientation};
 use super::{HysteresisOperator, Inversion};
 use crate::model::Parameter;
 use crate::model::ParameterSet;
@@ -213,6 +213,168 @@ impl InputOde for JilesAtherton {
     }
     fn inversion_span(&self) -> f64 {
         1e4 * (self.a + self.k)
+    }
+}
+
+/// A value with its derivatives with respect to (M, Mₛ, a, k, c, α): forward-mode
+/// differentiation of [`JilesAtherton::dm_dh`] for the sensitivities.
+#[derive(Clone, Copy)]
+struct Dual {
+    v: f64,
+    d: [f64; 6],
+}
+
+impl Dual {
+    fn constant(v: f64) -> Self {
+        Self { v, d: [0.0; 6] }
+    }
+    fn variable(v: f64, index: usize) -> Self {
+        let mut d = [0.0; 6];
+        d[index] = 1.0;
+        Self { v, d }
+    }
+    /// g(self) for g with value `g` and derivative `dg` at self.v (the chain rule).
+    fn map(self, g: f64, dg: f64) -> Self {
+        Self {
+            v: g,
+            d: self.d.map(|x| dg * x),
+        }
+    }
+    fn zip(self, o: Self, v: f64, f: impl Fn(f64, f64) -> f64) -> Self {
+        let mut d = [0.0; 6];
+        for (i, d) in d.iter_mut().enumerate() {
+            *d = f(self.d[i], o.d[i]);
+        }
+        Self { v, d }
+    }
+}
+
+impl std::ops::Add for Dual {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        self.zip(o, self.v + o.v, |a, b| a + b)
+    }
+}
+
+impl std::ops::Sub for Dual {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        self.zip(o, self.v - o.v, |a, b| a - b)
+    }
+}
+
+impl std::ops::Mul for Dual {
+    type Output = Self;
+    #[allow(clippy::suspicious_arithmetic_impl)] // the product rule
+    fn mul(self, o: Self) -> Self {
+        let (x, y) = (self.v, o.v);
+        self.zip(o, x * y, |a, b| a * y + x * b)
+    }
+}
+
+impl std::ops::Div for Dual {
+    type Output = Self;
+    #[allow(clippy::suspicious_arithmetic_impl)] // the quotient rule
+    fn div(self, o: Self) -> Self {
+        let (x, y) = (self.v, o.v);
+        self.zip(o, x / y, |a, b| (a * y - x * b) / (y * y))
+    }
+}
+
+/// L(x), L'(x) and L''(x) of the anhysteretic shape (Langevin or tanh). For the Langevin
+/// function L'' = −2/x³ + 2·coth x·csch² x is formed from coth x = L + 1/x and
+/// csch² x = 1/x² − L' (no further transcendental function), by its series near 0.
+fn shape_with_curvature(kind: Anhysteretic, x: f64) -> (f64, f64, f64) {
+    match kind {
+        Anhysteretic::Langevin => {
+            let (l, dl) = langevin(x);
+            let ddl = if x.abs() < 0.1 {
+                let x2 = x * x;
+                x * (-2.0 / 15.0 + x2 * (8.0 / 189.0 - x2 * 6.0 / 675.0))
+            } else {
+                let r = 1.0 / x;
+                -2.0 * r * r * r + 2.0 * (l + r) * (r * r - dl)
+            };
+            (l, dl, ddl)
+        }
+        Anhysteretic::Tanh => {
+            let t = x.tanh();
+            let dl = 1.0 - t * t;
+            (t, dl, -2.0 * t * dl)
+        }
+    }
+}
+
+impl JilesAtherton {
+    /// [`dm_dh`](Self::dm_dh) with its derivatives with respect to (M, Mₛ, a, k, c, α); None
+    /// where the model is not physical (the same tests as `dm_dh`).
+    fn dm_dh_dual(&self, h: f64, m: f64, delta: f64) -> Option<Dual> {
+        let one = Dual::constant(1.0);
+        let (m, ms, a, k, c, alpha) = (
+            Dual::variable(m, 0),
+            Dual::variable(self.ms, 1),
+            Dual::variable(self.a, 2),
+            Dual::variable(self.k, 3),
+            Dual::variable(self.c, 4),
+            Dual::variable(self.alpha, 5),
+        );
+        let x = (Dual::constant(h) + alpha * m) / a;
+        let (l, dl, ddl) = shape_with_curvature(self.anhysteretic, x.v);
+        let man = ms * x.map(l, dl);
+        let dman = ms / a * x.map(dl, ddl);
+        let mirr = (m - c * man) / (one - c);
+        let gap = man - mirr;
+        let dmirr = if gap.v * delta > 0.0 {
+            let den = Dual::constant(delta) * k - alpha * gap;
+            if den.v * delta <= 0.0 {
+                return None;
+            }
+            gap / den
+        } else {
+            Dual::constant(0.0)
+        };
+        let den = one - alpha * c * dman;
+        if den.v <= 0.0 {
+            return None;
+        }
+        Some(((one - c) * dmirr + c * dman) / den)
+    }
+}
+
+/// θ = (Mₛ, a, k, c, α, m0): the partials of dM/dH by forward-mode differentiation of its
+/// formula (module doc), with L'' = −2/x³ + 2·cosh x/sinh³ x (series near 0) or
+/// −2·tanh x·(1 − tanh² x); ∂B/∂M = μ₀ (∂M/∂M = 1); ∂M(u\[0\])/∂m0 = 1.
+impl InputOdeSensitivity for JilesAtherton {
+    fn n_parameters(&self) -> usize {
+        6
+    }
+    fn slope_partials(&self, u: f64, m: f64, direction: f64, dtheta: &mut [f64]) -> (f64, f64) {
+        let s = self.orientation.sign();
+        match self.dm_dh_dual(s * u, m, s * direction) {
+            Some(g) => {
+                // The value is `dm_dh`'s, operation for operation: the slope's very bits.
+                let f = s * g.v;
+                for (j, d) in dtheta.iter_mut().take(5).enumerate() {
+                    *d = s * g.d[j + 1];
+                }
+                dtheta[5] = 0.0;
+                (f, s * g.d[0])
+            }
+            None => {
+                dtheta.fill(f64::NAN);
+                (f64::NAN, f64::NAN)
+            }
+        }
+    }
+    fn output_partials(&self, _u: f64, _m: f64, dtheta: &mut [f64]) -> f64 {
+        dtheta.fill(0.0);
+        match self.output {
+            JaOutput::Magnetisation => 1.0,
+            JaOutput::FluxDensity => MU0,
+        }
+    }
+    fn initial_state_partials(&self, dtheta: &mut [f64]) {
+        dtheta.copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
     }
 }
 

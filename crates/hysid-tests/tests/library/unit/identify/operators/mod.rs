@@ -4,6 +4,7 @@ mod backlash;
 mod bouc_wen;
 mod compare;
 mod dahl;
+mod differential_fit;
 mod duhem;
 mod family;
 mod gpi;
