@@ -11,6 +11,7 @@
 
 use anyhow::{bail, Result};
 use hysid::identify::budget::Work;
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::OnceLock;
 
 /// The work budget: 10¹⁰ model steps (about a few minutes on one core for the built-in models).
@@ -20,6 +21,14 @@ pub const WORK_BUDGET: u64 = 10_000_000_000;
 pub const FALLBACK_MEMORY: u64 = 4 << 30;
 
 static ALLOW_LONG: OnceLock<bool> = OnceLock::new();
+
+/// The estimates checked so far (model steps), summed.
+static ESTIMATED: AtomicU64 = AtomicU64::new(0);
+
+/// The model steps the run's budget checks estimated, summed; `None` before any check.
+pub fn estimated() -> Option<u64> {
+    Some(ESTIMATED.load(Relaxed)).filter(|&e| e > 0)
+}
 
 /// Records `--allow-long` for the run (called once by `main`).
 pub fn init(allow_long: bool) {
@@ -44,6 +53,7 @@ fn mem_available(text: &str) -> Option<u64> {
 /// Refuses `work` (what the request is, e.g. "the grey-box fit") when it needs more memory
 /// than is available, or more work than the budget without `--allow-long`.
 pub fn check(what: &str, work: Work) -> Result<()> {
+    ESTIMATED.fetch_add(work.evaluations, Relaxed);
     check_against(
         what,
         work,

@@ -97,6 +97,14 @@ pub fn time_limit_warning() -> Option<String> {
 /// `report` with `search.termination` set to `time_limit` when the time limit stopped a search.
 pub fn mark_report(report: &Report) -> Report {
     let mut report = report.clone();
+    // The work the command performed, in the unit of the work budget, where the library did
+    // not count it itself.
+    if let Some(search) = &mut report.search {
+        search
+            .model_steps
+            .get_or_insert_with(hysid::identify::budget::counted);
+        search.estimated_model_steps = crate::budget::estimated();
+    }
     if let (true, Some(limit), Some(search)) = (time_limit_hit(), limit_s(), &mut report.search) {
         search.termination = TerminationSummary {
             code: "time_limit".into(),

@@ -14,4 +14,5 @@ mod inputs_sacred;
 mod operator_cascade_cli;
 mod outputs;
 mod report_schema;
+mod work_budget;
 mod zoo_cli;

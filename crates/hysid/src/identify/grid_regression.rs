@@ -160,6 +160,8 @@ impl<'a> EquationError<'a> {
         }
         let psi = &mut s.psi[..ds.len() * block];
         basis_signals_batch(self.form, &self.x[..n], alpha, ds, psi, &mut s.decay);
+        // One pass of the hysteresis basis over the record a point (the work count).
+        super::budget::count(u64::try_from(n * ds.len()).unwrap_or(u64::MAX));
         for (b, cost) in costs.iter_mut().take(ds.len()).enumerate() {
             *cost = self.cost_of(b * block, s);
         }

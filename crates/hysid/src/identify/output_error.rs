@@ -125,6 +125,13 @@ pub trait OutputErrorModel: Sync {
         false
     }
 
+    /// Model steps one sample of a simulation costs (integration sub-steps times the
+    /// evaluations of the equations per sub-step), for the work count of
+    /// [`budget::count`](super::budget::count); 1 (the default) for a recursion.
+    fn steps_per_sample(&self) -> u64 {
+        1
+    }
+
     /// Whether the output ŷ of the sensitivity pass ([`simulate_sensitivities`] and
     /// [`simulate_sensitivity_blocks`]) is bit for bit the output of [`simulate`] at the same
     /// θ. Then a long record's trial points take their residuals from that pass, whose
@@ -819,7 +826,22 @@ impl<'a> OutputErrorProblem<'a> {
         let outcome = self
             .model
             .simulate_sensitivities(theta, self.data, e, free, &mut sink)?;
+        self.count_steps(e, p);
         Some(outcome.map(|()| jac))
+    }
+
+    /// Counts one simulation of experiment `e` with `sensitivities` sensitivities in the
+    /// process's work count ([`budget::count`](super::budget::count)).
+    fn count_steps(&self, e: usize, sensitivities: usize) {
+        let samples = u64::try_from(self.data.experiment(e).len()).unwrap_or(u64::MAX);
+        let passes = u64::try_from(sensitivities)
+            .unwrap_or(u64::MAX)
+            .saturating_add(1);
+        super::budget::count(
+            samples
+                .saturating_mul(passes)
+                .saturating_mul(self.model.steps_per_sample()),
+        );
     }
 
     /// Simulated outputs of every experiment, `[experiment][output][t]`.
@@ -835,9 +857,10 @@ impl<'a> OutputErrorProblem<'a> {
             }
             None => self.new_buffers(),
         };
-        sims.par_iter_mut()
-            .enumerate()
-            .try_for_each(|(e, y)| self.model.simulate(theta, self.data, e, y))?;
+        sims.par_iter_mut().enumerate().try_for_each(|(e, y)| {
+            self.count_steps(e, 0);
+            self.model.simulate(theta, self.data, e, y)
+        })?;
         Ok(sims)
     }
 
@@ -907,6 +930,7 @@ impl<'a> OutputErrorProblem<'a> {
         let outcome = self
             .model
             .simulate_sensitivities(theta, self.data, e, free, &mut sink)?;
+        self.count_steps(e, p);
         Some(outcome.map(|()| acc.finish()))
     }
 
@@ -958,6 +982,7 @@ impl<'a> OutputErrorProblem<'a> {
         let outcome = self
             .model
             .simulate_sensitivity_blocks(theta, self.data, e, free, threads, &mut sink)?;
+        self.count_steps(e, free.len());
         Some(outcome.map(|()| acc.finish()))
     }
 }

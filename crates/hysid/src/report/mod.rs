@@ -246,6 +246,15 @@ pub struct SearchSummary {
     pub termination: TerminationSummary,
     /// Wall-clock seconds.
     pub elapsed_s: f64,
+    /// Model steps the command performed (samples × integration steps of every simulation,
+    /// a simulation with p sensitivities counting 1 + p), the unit of the work budget; set
+    /// by the command-line front end, absent where not counted.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_steps: Option<u64>,
+    /// The work budget's estimate of `model_steps`, made before the run; absent for a
+    /// command without a budget check.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub estimated_model_steps: Option<u64>,
 }
 
 /// Why a search stopped: a stable code and a sentence.
@@ -296,6 +305,8 @@ impl SearchSummary {
             evaluations: report.function_evaluations,
             termination: TerminationSummary::of(&report.termination),
             elapsed_s,
+            model_steps: None,
+            estimated_model_steps: None,
         }
     }
 
@@ -306,6 +317,8 @@ impl SearchSummary {
             evaluations: 1,
             termination: TerminationSummary::direct(),
             elapsed_s,
+            model_steps: None,
+            estimated_model_steps: None,
         }
     }
 }

@@ -45,6 +45,11 @@ pub fn operator_report(
         evaluations: fit.evaluations,
         termination: TerminationSummary::of(&fit.termination),
         elapsed_s: fit.elapsed_s,
+        // Every criterion evaluation simulates the operator over the record once.
+        model_steps: Some(
+            u64::try_from(fit.evaluations.saturating_mul(y.len())).unwrap_or(u64::MAX),
+        ),
+        estimated_model_steps: None,
     });
     report.uncertainty = Some(if fit.iterations == 0 {
         UncertaintySummary::least_squares()

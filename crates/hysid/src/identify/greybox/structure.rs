@@ -149,6 +149,21 @@ impl OutputErrorModel for GreyBox {
         true
     }
 
+    /// Sub-steps times stages: RK4 four evaluations a sub-step, Newmark one, Dormand–Prince
+    /// six stages at an assumed four steps a sample (the figure of the work estimate); a
+    /// discrete-time recursion one.
+    fn steps_per_sample(&self) -> u64 {
+        if self.model.discrete_time() {
+            return 1;
+        }
+        let (substeps, stages) = match self.sim.integrator {
+            Integrator::Rk4 { substeps } => (substeps, 4),
+            Integrator::Newmark { substeps } => (substeps, 1),
+            Integrator::Adaptive { .. } => (4, 6),
+        };
+        u64::try_from(substeps.max(1)).unwrap_or(u64::MAX) * stages
+    }
+
     fn simulate(
         &self,
         theta: &[f64],
