@@ -65,7 +65,7 @@ pub struct GreyBoxFit {
     /// Wall-clock time of the whole estimation.
     pub elapsed_s: f64,
     /// With zero-order hold of the input (the default): whether a band-limited input should
-    /// have been interpolated band-limited ([`super::hold_check`]); None with another
+    /// have been interpolated band-limited ([`super::hold_check`](mod@super::hold_check)); None with another
     /// interpolation and for a discrete-time model.
     pub hold_check: Option<HoldCheck>,
 }

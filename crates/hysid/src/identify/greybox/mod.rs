@@ -4,7 +4,7 @@
 //!   settings and its initial states per experiment, bound to data as an
 //!   [`OutputErrorModel`](crate::identify::OutputErrorModel).
 //! * [`estimate`]: output-error estimation with multi-start.
-//! * [`hold_check`]: whether the default zero-order hold of the input misleads the fit.
+//! * [`hold_check`](mod@hold_check): whether the default zero-order hold of the input misleads the fit.
 
 pub mod equations;
 pub mod estimate;
