@@ -411,3 +411,28 @@ fn bad_input_is_one_line_with_exit_code_1() {
     assert!(e.contains("not invertible: model kind 'ch_cascade'"), "{e}");
     assert!(!csv.exists());
 }
+
+/// The command line's family choices are the registry's: the help of `--family` and of
+/// `--hysteresis` names every family with its title.
+#[test]
+fn family_help_lists_the_registry() {
+    for (command, families) in [
+        (
+            ["identify", "operator"],
+            Family::ALL.iter().copied().collect::<Vec<_>>(),
+        ),
+        (["identify", "cascade"], Family::operators().collect()),
+    ] {
+        let out = hysid().args(command).arg("--help").output().unwrap();
+        assert!(out.status.success());
+        let help = String::from_utf8_lossy(&out.stdout)
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        for f in families {
+            let entry = format!("{} ({})", f.name(), f.title());
+            let entry = entry.split_whitespace().collect::<Vec<_>>().join(" ");
+            assert!(help.contains(&entry), "{command:?} --help lacks {entry}");
+        }
+    }
+}
