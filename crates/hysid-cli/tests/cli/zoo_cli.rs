@@ -417,10 +417,7 @@ fn bad_input_is_one_line_with_exit_code_1() {
 #[test]
 fn family_help_lists_the_registry() {
     for (command, families) in [
-        (
-            ["identify", "operator"],
-            Family::ALL.iter().copied().collect::<Vec<_>>(),
-        ),
+        (["identify", "operator"], Family::ALL.to_vec()),
         (["identify", "cascade"], Family::operators().collect()),
     ] {
         let out = hysid().args(command).arg("--help").output().unwrap();
