@@ -31,11 +31,14 @@ def write_rig(records, folder):
 
 
 def without_clock(report):
-    """The report without wall-clock figures and the data source (path vs arrays)."""
+    """The report without wall-clock figures, the work counts the command line adds
+    (``search.model_steps``, ``estimated_model_steps``: the process's accounting) and the
+    data source (path vs arrays)."""
     report = json.loads(json.dumps(report))
 
     def strip(r):
-        r.get("search", {}) and r["search"].pop("elapsed_s", None)
+        for key in ("elapsed_s", "model_steps", "estimated_model_steps"):
+            r.get("search", {}) and r["search"].pop(key, None)
         r.get("data", {}) and r["data"].pop("source", None)
         for step in (r.get("details") or {}).get("steps", []) if isinstance(r.get("details"), dict) else []:
             strip(step)

@@ -147,9 +147,12 @@ def test_record_objects_accepted(example1):
 
 
 def timeless(report):
-    """A report without its wall-clock figure and the data's names (a file vs numpy arrays)."""
+    """A report without its wall-clock figure, the command line's work counts
+    (``search.model_steps``, ``estimated_model_steps``) and the data's names (a file vs numpy
+    arrays)."""
     report = json.loads(json.dumps(report))
-    report["search"].pop("elapsed_s", None)
+    for key in ("elapsed_s", "model_steps", "estimated_model_steps"):
+        report["search"].pop(key, None)
     report["data"].pop("source", None)
     for e in report["fit"]["per_experiment"]:
         e.pop("experiment", None)
