@@ -60,6 +60,7 @@ fn identify_operator(
         let data = id_data(ts, vec![u], vec![y])?;
         let exp = data.experiment(0);
         let fitted = fit_operator(family, exp.input(0), exp.output(0), &options)?;
-        report::operator_report(&fitted, &data, source())?.to_json()
+        let simulated = report::operator_simulation(&fitted, &data)?;
+        report::operator_report(&fitted, &data, &simulated, source())?.to_json()
     })
 }

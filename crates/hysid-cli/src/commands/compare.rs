@@ -1,14 +1,14 @@
 //! `hysid compare`: several hysteresis families fitted to one record, ranked by validation
 //! fit %.
 
-use super::zoo::{family_options, load, loops, write_text};
+use super::zoo::{family_options, load, loops};
 use crate::cli_zoo::CompareArgs;
-use crate::progress::{mark_report, FitProgress};
+use crate::output::Outputs;
+use crate::progress::FitProgress;
 use anyhow::{Context, Result};
 use hysid::identify::operators::{
     compare, CompareOptions, CompareRow, Comparison, Family, FamilyOptions,
 };
-use hysid::io::atomic::OutputSet;
 use hysid::report::{DataSummary, Report, ValidationEntry};
 use serde_json::json;
 use std::path::Path;
@@ -27,26 +27,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     };
     let mut inputs = vec![args.data.data.as_path()];
     inputs.extend(args.validate.as_deref());
-    let mut files = OutputSet::new(&inputs)?;
-    // The directory first: a file inside it is then refused as a clash.
-    let plots_tmp = args
-        .output
-        .plots
-        .as_deref()
-        .map(|p| files.dir(p))
-        .transpose()?;
-    let json_tmp = args
-        .output
-        .json
-        .as_deref()
-        .map(|p| files.file(p))
-        .transpose()?;
-    let model_tmp = args
-        .output
-        .model_out
-        .as_deref()
-        .map(|p| files.file(p))
-        .transpose()?;
+    let o = &args.output;
+    let out = Outputs::new(
+        &inputs,
+        o.json.as_deref(),
+        o.model_out.as_deref(),
+        o.plots.as_deref(),
+    )?;
     let data = load(&args.data, &args.data.data)?;
     let validation = args
         .validate
@@ -83,32 +70,14 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         None => eprintln!("warning: no family could be fitted to these data"),
     }
     let report = report(args, &data, &comparison)?;
-    if let Some(dir) = &plots_tmp {
-        plot_loops(dir, &data, &comparison)?;
+    if let Some(dir) = &out.plots {
+        plot_loops(&dir.tmp, &data, &comparison)?;
     }
-    if let Some(path) = &json_tmp {
-        write_text(path, &mark_report(&report).to_json()?)?;
+    let model = best.and_then(|b| b.fitted.as_ref()).map(|f| &f.fit.model);
+    if out.model_out.is_some() && model.is_none() {
+        anyhow::bail!("--model-out: no family could be fitted, so there is no model to write");
     }
-    if let Some(path) = &model_tmp {
-        let model = best.and_then(|b| b.fitted.as_ref()).ok_or_else(|| {
-            anyhow::anyhow!("--model-out: no family could be fitted, so there is no model to write")
-        })?;
-        write_text(
-            path,
-            &serde_json::to_string_pretty(&model.fit.model.to_file())?,
-        )?;
-    }
-    files.commit()?;
-    for (what, path) in [
-        ("report", &args.output.json),
-        ("model", &args.output.model_out),
-        ("plots", &args.output.plots),
-    ] {
-        if let Some(p) = path {
-            println!("  {what}: {}", p.display());
-        }
-    }
-    Ok(())
+    out.finish(Some(&report), model)
 }
 
 fn print_table(rows: &[CompareRow]) {

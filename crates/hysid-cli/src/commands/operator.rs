@@ -1,12 +1,12 @@
 //! `hysid identify operator`: one hysteresis family fitted to a measured input and output.
 
-use super::zoo::{family_options, load, loops, signals, write_text};
+use super::zoo::{family_options, load, loops, signals};
 use crate::cli_zoo::OperatorArgs;
-use crate::progress::{mark_report, FitProgress};
+use crate::output::Outputs;
+use crate::progress::FitProgress;
 use crate::report::{print_table, Row};
 use anyhow::{Context, Result};
 use hysid::identify::operators::{fit_operator, Family, FittedOperator};
-use hysid::io::atomic::OutputSet;
 use hysid::report::{operator_report, operator_simulation, Report};
 
 /// Parameters printed before the table is cut short (a Preisach plane has hundreds).
@@ -16,26 +16,13 @@ const PRINTED_PARAMETERS: usize = 16;
 pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family).context("--family")?;
     let mut options = family_options(&args.options)?;
-    let mut files = OutputSet::new(&[args.data.data.as_path()])?;
-    // The directory first: a file inside it is then refused as a clash.
-    let plots_tmp = args
-        .output
-        .plots
-        .as_deref()
-        .map(|p| files.dir(p))
-        .transpose()?;
-    let json_tmp = args
-        .output
-        .json
-        .as_deref()
-        .map(|p| files.file(p))
-        .transpose()?;
-    let model_tmp = args
-        .output
-        .model_out
-        .as_deref()
-        .map(|p| files.file(p))
-        .transpose()?;
+    let o = &args.output;
+    let out = Outputs::new(
+        &[args.data.data.as_path()],
+        o.json.as_deref(),
+        o.model_out.as_deref(),
+        o.plots.as_deref(),
+    )?;
     let data = load(&args.data, &args.data.data)?;
     let exp = data.experiment(0);
     let (u, y) = (exp.input(0), exp.output(0));
@@ -46,9 +33,14 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
         .with_context(|| format!("identifying a {family} operator"))?;
     drop(progress);
     let yhat = operator_simulation(&fitted, &data)?;
-    let report = operator_report(&fitted, &data, vec![args.data.data.display().to_string()])?;
+    let report = operator_report(
+        &fitted,
+        &data,
+        &yhat,
+        vec![args.data.data.display().to_string()],
+    )?;
     print_summary(&fitted, &report);
-    if let Some(dir) = &plots_tmp {
+    if let Some(dir) = out.plots.as_ref().map(|d| &d.tmp) {
         let title = format!("{family}: measured and simulated loop");
         let names = (exp_name(&data, true), exp_name(&data, false));
         loops(
@@ -65,24 +57,7 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
             &[("measured", y), ("simulated", &yhat)],
         )?;
     }
-    if let Some(path) = &json_tmp {
-        write_text(path, &mark_report(&report).to_json()?)?;
-    }
-    if let Some(path) = &model_tmp {
-        let text = serde_json::to_string_pretty(&fitted.fit.model.to_file())?;
-        write_text(path, &text)?;
-    }
-    files.commit()?;
-    for (what, path) in [
-        ("report", &args.output.json),
-        ("model", &args.output.model_out),
-        ("plots", &args.output.plots),
-    ] {
-        if let Some(p) = path {
-            println!("  {what}: {}", p.display());
-        }
-    }
-    Ok(())
+    out.finish(Some(&report), Some(&fitted.fit.model))
 }
 
 fn exp_name(data: &hysid::data::IdData, input: bool) -> String {

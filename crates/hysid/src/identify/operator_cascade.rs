@@ -39,6 +39,7 @@
 
 use super::operators::differential_fit::linear_fit;
 use super::operators::family::{self, Family, FamilyOptions};
+use super::operators::linear_support::threshold_grid;
 use super::output_error::{OutputError, OutputErrorFit, OutputErrorModel};
 use crate::data::IdData;
 use crate::model::operators::{OperatorModel, Orientation};
@@ -257,6 +258,37 @@ impl OperatorCascadeIdentification {
         OperatorCascade::new(operator, linear)
     }
 
+    /// The rank-one start of an operator that is a superposition c₀u + Σ cᵢ e_{rᵢ}\[u\] + c of
+    /// elements `element(u, rᵢ)` (plays for PI, stops for Maxwell-slip) on the threshold grid
+    /// of `options` (the given grid, else the uniform one of `options.thresholds`): the grid,
+    /// A, B (b1 = 1), the linear parameters [c₀, c₁ … cₙ, c] oriented so that the slope
+    /// c₀ + … + cₙ is ≥ 0, and that orientation.
+    pub(crate) fn superposition_start(
+        &self,
+        u: &[f64],
+        y: &[f64],
+        options: &FamilyOptions,
+        element: impl Fn(&[f64], f64) -> Vec<f64>,
+    ) -> Result<SuperpositionStart> {
+        let grid = match &options.threshold_grid {
+            Some(grid) => grid.clone(),
+            None => threshold_grid(u, options.thresholds)?,
+        };
+        let n = grid.len();
+        let mut basis = vec![u.to_vec()];
+        basis.extend(grid.iter().map(|&r| element(u, r)));
+        basis.push(vec![1.0; u.len()]);
+        let RankOne { a, b, theta, .. } = self.rank_one(y, &basis)?;
+        let (theta, orientation) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
+        Ok(SuperpositionStart {
+            grid,
+            a,
+            b,
+            theta,
+            orientation,
+        })
+    }
+
     /// The start from an operator Γ₀ fitted to the loop (u, y): an ARX fit of y on past y and
     /// v₀ = Γ₀\[u\] gives A and an unnormalised B, whose b1 moves into Γ₀'s output scale
     /// ([`OperatorModel::scaled`]) where it has one.
@@ -277,6 +309,20 @@ impl OperatorCascadeIdentification {
 /// How the families linear in their weights start (the over-parameterised equation error and
 /// its rank-one factorisation, module doc).
 pub const RANK_ONE: &str = "equation-error least squares, rank-one factorisation";
+
+/// What [`OperatorCascadeIdentification::superposition_start`] finds.
+pub(crate) struct SuperpositionStart {
+    /// The thresholds rᵢ.
+    pub grid: Vec<f64>,
+    /// A's coefficients a1 … an.
+    pub a: Vec<f64>,
+    /// B's coefficients with b1 = 1.
+    pub b: Vec<f64>,
+    /// The operator's linear parameters [c₀, c₁ … cₙ, c], oriented.
+    pub theta: Vec<f64>,
+    /// The orientation that makes the slope non-negative.
+    pub orientation: Orientation,
+}
 
 /// The rank-one factorisation of the over-parameterised regression: A, B (b1 = 1), the
 /// operator's linear parameters θ and the equation error's residual sum of squares.

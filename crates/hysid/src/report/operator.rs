@@ -20,25 +20,25 @@ pub fn operator_simulation(fitted: &FittedOperator, data: &IdData) -> Result<Vec
         .swap_remove(0))
 }
 
-/// The report of `fitted` on the first experiment of `data` (read from `sources`): data,
-/// fit (of [`operator_simulation`]), search, uncertainty, the model, and `details` with the
-/// family, the number of estimated parameters, whether the search converged, AIC and FPE
-/// (null when not finite, e.g. the AIC of an exact fit).
+/// The report of `fitted` on the first experiment of `data` (read from `sources`), whose
+/// [`operator_simulation`] is `simulated`: data, fit, search, uncertainty, the model, and
+/// `details` with the family, the number of estimated parameters, whether the search
+/// converged, AIC and FPE (null when not finite, e.g. the AIC of an exact fit).
 pub fn operator_report(
     fitted: &FittedOperator,
     data: &IdData,
+    simulated: &[f64],
     sources: Vec<String>,
 ) -> Result<Report> {
     let exp = data.experiment(0);
     let y = exp.output(0);
-    let yhat = operator_simulation(fitted, data)?;
     let fit = &fitted.fit;
     let mut report = Report::new("identify operator");
     report.data = Some(DataSummary::of(data, sources));
     report.fit = Some(FitSummary::of(
         std::slice::from_ref(&exp.name),
         &[y],
-        &[&yhat],
+        &[simulated],
     )?);
     report.search = Some(SearchSummary {
         iterations: fit.iterations,

@@ -17,9 +17,7 @@ use super::linear_support::{
     check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator,
 };
 use super::OperatorFit;
-use crate::identify::operator_cascade::{
-    oriented, OperatorCascadeIdentification, RankOne, RANK_ONE,
-};
+use crate::identify::operator_cascade::{OperatorCascadeIdentification, RANK_ONE};
 use crate::model::operators::{stop, validate_thresholds, MaxwellSlip, Orientation};
 use crate::model::OperatorCascade;
 use crate::{Error, Result};
@@ -135,18 +133,16 @@ impl Identify for MaxwellSlip {
         y: &[f64],
         options: &FamilyOptions,
     ) -> Result<(OperatorCascade, &'static str)> {
-        let widths = match &options.threshold_grid {
-            Some(grid) => grid.clone(),
-            None => threshold_grid(u, options.thresholds)?,
-        };
-        let n = widths.len();
-        let mut basis = vec![u.to_vec()];
-        basis.extend(widths.iter().map(|&d| stop(u, d)));
-        basis.push(vec![1.0; u.len()]);
-        let RankOne { a, b, theta, .. } = cascade.rank_one(y, &basis)?;
-        let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
+        let start = cascade.superposition_start(u, y, options, stop)?;
+        let (theta, n) = (&start.theta, start.grid.len());
         let k: Vec<f64> = theta[1..=n].iter().map(|v| v.max(0.0)).collect();
-        let op = MaxwellSlip::new(theta[0].max(0.0), k, widths, theta[n + 1], o)?;
-        Ok((cascade.cascade(op.into(), a, b)?, RANK_ONE))
+        let op = MaxwellSlip::new(
+            theta[0].max(0.0),
+            k,
+            start.grid,
+            theta[n + 1],
+            start.orientation,
+        )?;
+        Ok((cascade.cascade(op.into(), start.a, start.b)?, RANK_ONE))
     }
 }

@@ -21,7 +21,7 @@ use super::linear_support::{
 };
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
-    monotone_weights, oriented, OperatorCascadeIdentification, RankOne, RANK_ONE,
+    monotone_weights, OperatorCascadeIdentification, RANK_ONE,
 };
 use crate::model::operators::{play, validate_thresholds, Orientation, PrandtlIshlinskii};
 use crate::model::OperatorCascade;
@@ -167,18 +167,10 @@ impl Identify for PrandtlIshlinskii {
         y: &[f64],
         options: &FamilyOptions,
     ) -> Result<(OperatorCascade, &'static str)> {
-        let grid = match &options.threshold_grid {
-            Some(grid) => grid.clone(),
-            None => threshold_grid(u, options.thresholds)?,
-        };
-        let n = grid.len();
-        let mut basis = vec![u.to_vec()];
-        basis.extend(grid.iter().map(|&r| play(u, r)));
-        basis.push(vec![1.0; u.len()]);
-        let RankOne { a, b, theta, .. } = cascade.rank_one(y, &basis)?;
-        let (theta, o) = oriented(theta, |t| t[..=n].iter().sum::<f64>());
+        let start = cascade.superposition_start(u, y, options, play)?;
+        let (theta, n) = (&start.theta, start.grid.len());
         let (a0, weights) = monotone_weights(theta[0], &theta[1..=n]);
-        let op = PrandtlIshlinskii::new(a0, weights, grid, theta[n + 1], o)?;
-        Ok((cascade.cascade(op.into(), a, b)?, RANK_ONE))
+        let op = PrandtlIshlinskii::new(a0, weights, start.grid, theta[n + 1], start.orientation)?;
+        Ok((cascade.cascade(op.into(), start.a, start.b)?, RANK_ONE))
     }
 }
