@@ -5,7 +5,7 @@
    `crates/hysid/src/**.rs`, outside `#[cfg(test)]` modules, comments and string literals,
    must name a layer at or below the file's own layer:
 
-       error  <  numerics = data  <  model  <  experiments  <  identify  <  report
+       error  <  numerics = data  <  model  <  experiments  <  identify  <  report  <  export
 
    `numerics` and `data` are peers (each may use the other). `crate::Error` and
    `crate::Result` are the re-exports of `error`.
@@ -43,6 +43,7 @@ RANK = {
     "experiments": 3,
     "identify": 4,
     "report": 5,
+    "export": 6,
 }
 # Items lib.rs re-exports at the crate root, with the layer they come from.
 ROOT_REEXPORTS = {"Error": "error", "Result": "error"}

@@ -18,6 +18,7 @@
 //!    grey-box output error with multi-start, the three-step actuator procedure, rigid-body
 //!    least squares, bootstrap, recursive least squares, residual analysis.
 //! 5. [`report`] — the one report schema every command writes (`hysid.report/1`).
+//! 6. [`export`] — a fitted model as C99, `no_std` Rust or an FMI Co-Simulation FMU.
 //!
 //! Results that do not converge are reported in the estimator's report, never hidden;
 //! bad input is an [`Error`] with a one-line message.
@@ -33,6 +34,7 @@
 pub mod data;
 pub mod error;
 pub mod experiments;
+pub mod export;
 pub mod identify;
 pub mod io;
 pub mod model;

@@ -143,6 +143,25 @@ pub struct ModelFile {
     /// the model predicts the drive signal from the measured position, as the fit did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inverse_dynamics: Option<InverseDynamics>,
+    /// The sample time in seconds of the data the model was fitted on (absent in files of
+    /// earlier versions, and for models fitted without one). `hysid export` takes the
+    /// exported step's period from it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_time: Option<f64>,
+    /// The names of the data columns the model was fitted on (absent in files of earlier
+    /// versions): an export names its inputs and outputs after them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub columns: Option<Columns>,
+}
+
+/// The data columns a model was fitted on, in the model's order of inputs and outputs.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Columns {
+    /// The input columns (`--input`), one per model input.
+    pub inputs: Vec<String>,
+    /// The measured output columns (`--output`), one per model output.
+    pub outputs: Vec<String>,
 }
 
 /// A saved model by its kind (the `kind` key of `hysid.model/1`): the parameters in the
@@ -395,7 +414,17 @@ impl ModelFile {
             model,
             prefilter: None,
             inverse_dynamics: None,
+            sample_time: None,
+            columns: None,
         }
+    }
+
+    /// The file with the sample time `ts` (seconds) and the column names of the data the
+    /// model was fitted on.
+    pub fn with_data(mut self, ts: f64, columns: Columns) -> Self {
+        self.sample_time = Some(ts);
+        self.columns = Some(columns);
+        self
     }
 
     /// The model kind (the `kind` key).
@@ -439,6 +468,24 @@ impl ModelFile {
             .map(serde_json::from_value)
             .transpose()
             .map_err(|e| bad(format!("\"inverse_dynamics\": {e}")))?;
+        let sample_time = match object.remove("sample_time") {
+            None | Some(serde_json::Value::Null) => None,
+            Some(value) => match value.as_f64() {
+                Some(ts) if ts.is_finite() && ts > 0.0 => Some(ts),
+                _ => {
+                    return Err(bad(format!(
+                        "\"sample_time\" is {value}; give the sample time in seconds, a \
+                         positive finite number"
+                    )))
+                }
+            },
+        };
+        let columns = object
+            .remove("columns")
+            .filter(|value| !value.is_null())
+            .map(serde_json::from_value::<Columns>)
+            .transpose()
+            .map_err(|e| bad(format!("\"columns\": {e}")))?;
         let read = |object: serde_json::Map<String, serde_json::Value>| {
             serde_json::from_value::<SavedModel>(serde_json::Value::Object(object))
         };
@@ -471,6 +518,8 @@ impl ModelFile {
             model,
             prefilter,
             inverse_dynamics,
+            sample_time,
+            columns,
         })
     }
 }

@@ -1,0 +1,135 @@
+//! Export: a fitted model leaves hysid as code that runs in a controller.
+//!
+//! The streaming form of every model (one sample in, one sample out, a fixed-size state; the
+//! library's own form is [`crate::model::stream`]) is written as
+//!
+//! * **C99** ([`Target::C`]): exactly two files, `NAME.h` and `NAME.c`, no heap, no globals,
+//!   only `<math.h>` and `<stddef.h>`. The header defines the state struct completely and
+//!   declares
+//!   `void NAME_init(NAME_state *s);` and
+//!   `void NAME_step(NAME_state *s, const double *u, double *y);`
+//!   with the constants `NAME_N_INPUTS`, `NAME_N_OUTPUTS` and `NAME_SAMPLE_TIME`;
+//! * **`no_std` Rust** ([`Target::Rust`]): a library crate `NAME/` depending on `libm` only,
+//!   with `pub struct Model`, `Model::new()`, `Model::step(&mut self, u: &[f64; N_IN]) ->
+//!   [f64; N_OUT]` and the constants `N_IN`, `N_OUT`, `SAMPLE_TIME`;
+//! * an **FMI 2.0 Co-Simulation FMU** ([`Target::Fmu`]): `NAME.fmu` with the C sources inside
+//!   and, unless asked not to, a binary built by the machine's C compiler.
+//!
+//! The step semantics are the same everywhere: `step` with input u_k returns y_k — the sample
+//! `hysid simulate` reports at k — and then advances the state to k + 1. With
+//! [`ExportOptions::inverse`] the same interface computes the compensator: the input is the
+//! reference r_k, the output the command u_k that makes the model follow it (references
+//! outside the reachable range are clipped, as `hysid compensate` does).
+//!
+//! Each model kind (and each operator family, through the family registry) supplies its step
+//! once; the emitters know targets, not families. Generated code is tested against the
+//! library sample by sample (`crates/hysid-tests/tests/export`).
+
+use crate::{Error, Result};
+use std::path::PathBuf;
+
+/// Where an exported model goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Target {
+    /// C99: `NAME.h` and `NAME.c`.
+    C,
+    /// A `no_std` Rust library crate `NAME/`.
+    Rust,
+    /// An FMI 2.0 Co-Simulation FMU `NAME.fmu`.
+    Fmu,
+}
+
+impl Target {
+    /// Every target, in the order the help lists them.
+    pub const ALL: [Target; 3] = [Target::C, Target::Rust, Target::Fmu];
+
+    /// The target's name on the command line (`c`, `rust`, `fmu`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::C => "c",
+            Target::Rust => "rust",
+            Target::Fmu => "fmu",
+        }
+    }
+
+    /// The target named `name`; the error lists the targets.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|t| t.name() == name)
+            .ok_or_else(|| Error::InvalidOption {
+                option: "target".into(),
+                value: name.into(),
+                reason: format!(
+                    "unknown export target; choose one of {}",
+                    Self::ALL.map(Target::name).join(", ")
+                ),
+            })
+    }
+}
+
+/// How a model is exported.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExportOptions {
+    /// Export the compensator (input: the reference; output: the command) instead of the
+    /// model.
+    pub inverse: bool,
+    /// The sample time in seconds when the model file has none (`--ts`); the model file's
+    /// `sample_time` wins when both are given and agree, and a disagreement is an error.
+    pub sample_time: Option<f64>,
+    /// Build the FMU's binary with the machine's C compiler (`--no-binary` turns it off).
+    pub binary: bool,
+}
+
+impl Default for ExportOptions {
+    fn default() -> Self {
+        Self {
+            inverse: false,
+            sample_time: None,
+            binary: true,
+        }
+    }
+}
+
+/// One file of an export, its path relative to the output directory.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GeneratedFile {
+    /// The path under the output directory (`NAME.h`, `NAME/src/lib.rs`, `NAME.fmu`).
+    pub path: PathBuf,
+    /// The contents.
+    pub contents: Vec<u8>,
+}
+
+/// Checks an export name: a C identifier (and so a Rust crate name), `[A-Za-z_][A-Za-z0-9_]*`,
+/// at most 64 characters, not a C or Rust keyword.
+pub fn check_name(name: &str) -> Result<()> {
+    let valid = !name.is_empty()
+        && name.len() <= 64
+        && name
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !KEYWORDS.contains(&name);
+    if valid {
+        Ok(())
+    } else {
+        Err(Error::InvalidOption {
+            option: "name".into(),
+            value: name.into(),
+            reason: "the name must be a C identifier: a letter or '_', then letters, digits or \
+                     '_', at most 64 characters, not a C or Rust keyword"
+                .into(),
+        })
+    }
+}
+
+/// C99 and Rust keywords an export name may not be.
+const KEYWORDS: &[&str] = &[
+    "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else",
+    "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long", "register",
+    "restrict", "return", "short", "signed", "sizeof", "static", "struct", "switch", "typedef",
+    "union", "unsigned", "void", "volatile", "while", "as", "crate", "fn", "impl", "let",
+    "loop", "match", "mod", "move", "mut", "pub", "ref", "self", "Self", "super", "trait",
+    "type", "unsafe", "use", "where", "core", "std", "libm",
+];
