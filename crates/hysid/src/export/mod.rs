@@ -100,6 +100,41 @@ pub struct GeneratedFile {
     pub contents: Vec<u8>,
 }
 
+/// The outside of an exported model: what a host (the FMU's model description, a test driver)
+/// needs to know about `NAME_step`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Interface {
+    /// The export name (a C identifier, [`check_name`]).
+    pub name: String,
+    /// The number of inputs of `NAME_step` (`NAME_N_INPUTS`).
+    pub n_inputs: usize,
+    /// The number of outputs of `NAME_step` (`NAME_N_OUTPUTS`).
+    pub n_outputs: usize,
+    /// The step's period in seconds (`NAME_SAMPLE_TIME`; 0 for a rate-independent operator
+    /// without a stored sample time).
+    pub sample_time: f64,
+    /// The input names: the columns the model was fitted on ([`crate::model::saved::Columns`]),
+    /// else `u` (`u1`, `u2`, … when several); the reference for a compensator.
+    pub inputs: Vec<String>,
+    /// The output names, likewise (`y`, or the command for a compensator).
+    pub outputs: Vec<String>,
+    /// The model's parameters as named in the model file, with their values.
+    pub parameters: Vec<(String, f64)>,
+    /// One line: the model's kind or family, forward or inverse, and the hysid version.
+    pub description: String,
+}
+
+/// The C target's two files and the interface they implement.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CCode {
+    /// `NAME.h`: the state struct, the constants and the two functions.
+    pub header: String,
+    /// `NAME.c`: includes only `NAME.h`, `<math.h>` and `<stddef.h>`.
+    pub source: String,
+    /// What the code implements.
+    pub interface: Interface,
+}
+
 /// Checks an export name: a C identifier (and so a Rust crate name), `[A-Za-z_][A-Za-z0-9_]*`,
 /// at most 64 characters, not a C or Rust keyword.
 pub fn check_name(name: &str) -> Result<()> {
