@@ -5,6 +5,8 @@ mod common;
 
 mod actuator_cli;
 mod commands;
+#[cfg(unix)] // SIGKILL
+mod crash_safety;
 mod equations_cli;
 mod exit_codes;
 mod hardening;

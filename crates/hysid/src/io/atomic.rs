@@ -16,9 +16,11 @@
 //! 2. each output is written to a temporary in its destination directory — a file to
 //!    `.NAME.hysid-tmp-PID-N`, a directory output to a sibling directory of that form — whose
 //!    path registration returns;
-//! 3. [`OutputSet::commit`] moves every previous output aside, renames every temporary into
-//!    place and only then deletes what was set aside; if a rename fails the previous outputs
-//!    are put back.
+//! 3. [`OutputSet::commit`] puts every temporary in place, each by one atomic replacement
+//!    (a file renamed over the previous one, a directory swapped with it), and only then
+//!    deletes the previous outputs; if a replacement fails the previous outputs are put
+//!    back. A run killed at any moment leaves each output path with its previous complete
+//!    content or the new one.
 //!
 //! Dropping the set without committing (an error, a `?`) removes every temporary, and so
 //! does SIGINT or SIGTERM (a handler is installed with the first set; the process then exits
@@ -240,6 +242,15 @@ impl OutputSet {
     /// Renames every temporary into place, replacing previous outputs. Every registered
     /// file must have been written. On an error the previous outputs are restored and the
     /// temporaries removed.
+    ///
+    /// Each replacement is atomic, so a run killed at any moment (SIGKILL, a power cut
+    /// after the data reached the disk) leaves every output path holding either its
+    /// previous complete content or the new one, never nothing and never a part:
+    /// a file is replaced by one `rename(2)` over it (its previous content stays reachable
+    /// through a hard link for the rollback); a directory is swapped with its temporary by
+    /// one `renameat2(RENAME_EXCHANGE)` on Linux (elsewhere, or on a file system without
+    /// it, it is moved aside and the temporary renamed in: a kill between the two leaves
+    /// the path empty and the previous directory beside it under a temporary name).
     pub fn commit(mut self) -> Result<()> {
         if let Some(missing) = self
             .outputs
@@ -251,31 +262,25 @@ impl OutputSet {
                 missing.target.display()
             )));
         }
-        let mut aside: Vec<(usize, PathBuf)> = Vec::new();
-        for (k, output) in self.outputs.iter().enumerate() {
-            if fs::symlink_metadata(&output.target).is_ok() {
-                let old = temporary_beside(&output.target);
-                if let Err(source) = fs::rename(&output.target, &old) {
-                    restore(&self.outputs, &aside, 0);
+        let mut replaced: Vec<Replaced> = Vec::with_capacity(self.outputs.len());
+        for output in &self.outputs {
+            match replace(output) {
+                Ok(done) => replaced.push(done),
+                Err(source) => {
+                    for (output, done) in self.outputs.iter().zip(&replaced).rev() {
+                        undo(output, done);
+                    }
                     return Err(io(&output.target, source));
                 }
-                aside.push((k, old));
-            }
-        }
-        for (k, output) in self.outputs.iter().enumerate() {
-            if let Err(source) = fs::rename(&output.staged, &output.target) {
-                restore(&self.outputs, &aside, k);
-                return Err(io(&output.target, source));
             }
         }
         self.committed = true;
         unregister(self.id);
-        for (k, old) in aside {
-            // The new outputs are in place; a leftover old copy is only untidy.
-            let _ = match self.outputs[k].kind {
-                Kind::File => fs::remove_file(&old),
-                Kind::Dir => fs::remove_dir_all(&old),
-            };
+        for done in replaced {
+            // The new outputs are in place; a leftover previous copy is only untidy.
+            if let Replaced::Previous(old) = done {
+                remove_any(&old);
+            }
         }
         Ok(())
     }
@@ -391,15 +396,98 @@ impl Drop for OutputSet {
     }
 }
 
-/// Undoes a failed commit: the first `moved` outputs go back to their temporaries, and
-/// what was set aside goes back in place.
-fn restore(outputs: &[Output], aside: &[(usize, PathBuf)], moved: usize) {
-    for output in &outputs[..moved] {
-        let _ = fs::rename(&output.target, &output.staged);
+/// What replacing one output left behind: nothing (the path was new), or the previous
+/// content under a temporary name.
+enum Replaced {
+    /// The output did not exist before.
+    New,
+    /// The previous output, kept at this path until the commit succeeds.
+    Previous(PathBuf),
+}
+
+/// Puts `output`'s temporary in place atomically (see [`OutputSet::commit`]).
+fn replace(output: &Output) -> std::io::Result<Replaced> {
+    if fs::symlink_metadata(&output.target).is_err() {
+        fs::rename(&output.staged, &output.target)?;
+        return Ok(Replaced::New);
     }
-    for (k, old) in aside {
-        let _ = fs::rename(old, &outputs[*k].target);
+    let old = temporary_beside(&output.target);
+    match output.kind {
+        Kind::File => {
+            if fs::hard_link(&output.target, &old).is_err() {
+                // No hard links here: the previous file is moved aside instead.
+                fs::rename(&output.target, &old)?;
+            }
+            fs::rename(&output.staged, &output.target)?;
+        }
+        Kind::Dir => {
+            if exchange(&output.staged, &output.target).is_ok() {
+                // The temporary's path now holds the previous directory.
+                return Ok(Replaced::Previous(output.staged.clone()));
+            }
+            fs::rename(&output.target, &old)?;
+            if let Err(e) = fs::rename(&output.staged, &output.target) {
+                let _ = fs::rename(&old, &output.target);
+                return Err(e);
+            }
+        }
     }
+    Ok(Replaced::Previous(old))
+}
+
+/// Undoes [`replace`] of `output` after a later output failed: the previous content goes
+/// back in place and the new one back to the temporary (which the set then removes).
+fn undo(output: &Output, done: &Replaced) {
+    match done {
+        Replaced::New => {
+            let _ = fs::rename(&output.target, &output.staged);
+        }
+        Replaced::Previous(old) if *old == output.staged => {
+            let _ = exchange(&output.staged, &output.target);
+        }
+        Replaced::Previous(old) => {
+            if output.kind == Kind::Dir {
+                let _ = fs::rename(&output.target, &output.staged);
+            }
+            let _ = fs::rename(old, &output.target);
+        }
+    }
+}
+
+/// Swaps the two existing paths `a` and `b` in one atomic step (Linux `renameat2` with
+/// `RENAME_EXCHANGE`, since 3.15); an error where the system or the file system lacks it.
+#[cfg(target_os = "linux")]
+fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
+    use std::ffi::CString;
+    use std::os::unix::ffi::OsStrExt;
+    let c = |p: &Path| {
+        CString::new(p.as_os_str().as_bytes())
+            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e))
+    };
+    let (a, b) = (c(a)?, c(b)?);
+    // SAFETY: both arguments are NUL-terminated strings that outlive the call; the system
+    // call reads them and touches no memory of ours.
+    let status = unsafe {
+        libc::syscall(
+            libc::SYS_renameat2,
+            libc::AT_FDCWD,
+            a.as_ptr(),
+            libc::AT_FDCWD,
+            b.as_ptr(),
+            libc::RENAME_EXCHANGE,
+        )
+    };
+    if status == 0 {
+        Ok(())
+    } else {
+        Err(std::io::Error::last_os_error())
+    }
+}
+
+/// Not available off Linux: directories are replaced in two renames.
+#[cfg(not(target_os = "linux"))]
+fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
+    Err(std::io::Error::from(std::io::ErrorKind::Unsupported))
 }
 
 /// The inodes of the files under the existing directory `dir` (symbolic links not
