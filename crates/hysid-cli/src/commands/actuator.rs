@@ -102,6 +102,10 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
 /// the first seconds prints only its error).
 fn run(steps: &ThreeSteps, records: &BTreeMap<usize, Record>) -> Result<ActuatorIdentification> {
     let progress = FitProgress::new("identifying actuator");
+    let steps = ThreeSteps {
+        observer: progress.observer(),
+        ..steps.clone()
+    };
     Ok(steps.run_reporting(records, &mut |stage| progress.show(stage))?)
 }
 

@@ -137,6 +137,9 @@ fn report(args: &CompareArgs, data: &hysid::data::IdData, c: &Comparison) -> Res
         "split": c.split,
         "split_text": c.split.to_string(),
         "best": c.best().map(|b| b.family),
+        // Set when `--time-limit` stopped the comparison: the families after it are listed
+        // with the error saying they were not fitted.
+        "stopped": crate::progress::time_limit_hit().then_some("time_limit"),
         "families": c.rows,
     });
     Ok(report)

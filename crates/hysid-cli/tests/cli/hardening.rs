@@ -301,6 +301,11 @@ fn a_time_limit_stops_an_operator_fit_and_a_comparison() {
                 .unwrap();
             assert_eq!(ja["converged"], false, "{ja}");
             assert_eq!(ja["termination"], "stopped by the caller", "{ja}");
+            // The families after the stop are not fitted, and say so.
+            let pi = rows.iter().find(|r| r["family"] == "pi").unwrap();
+            let error = pi["error"].as_str().unwrap();
+            assert!(error.contains("before this family was fitted"), "{pi}");
+            assert_eq!(report["details"]["stopped"], "time_limit");
         } else {
             assert_eq!(report["search"]["termination"]["code"], "time_limit");
         }

@@ -33,7 +33,7 @@ use crate::model::saved::FittedModel;
 use crate::model::ParameterSet;
 use crate::numerics::metrics::fit_percent;
 use crate::numerics::signal::gradient;
-use crate::numerics::{least_squares, Control, LmConfig};
+use crate::numerics::{least_squares, LmConfig, Observer};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use serde::Serialize;
@@ -66,6 +66,9 @@ pub struct ThreeSteps {
     pub lm: LmConfig,
     /// Simulation of step 3.
     pub simulation: Simulation,
+    /// Sees the iterations of step 3's fits ("iteration k/N") and may stop each at the
+    /// best point so far (a front end's time limit).
+    pub observer: Observer,
 }
 
 impl Default for ThreeSteps {
@@ -86,6 +89,7 @@ impl Default for ThreeSteps {
                 integrator: Integrator::Rk4 { substeps: 10 },
                 interpolation: InputInterpolation::ZeroOrderHold,
             },
+            observer: Observer::none(),
         }
     }
 }
@@ -453,7 +457,10 @@ impl ThreeSteps {
                 &data,
                 &params,
                 InitialStates::at_rest(3, 2),
-                &mut |_| Control::Continue,
+                &mut |r| {
+                    self.observer
+                        .report("iteration", r.iteration, self.lm.max_iterations)
+                },
             )?;
             out.insert(name.to_string(), fit);
         }

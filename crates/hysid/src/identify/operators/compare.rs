@@ -16,7 +16,7 @@
 
 use super::family::{fit_operator, Family, FamilyOptions, FittedOperator};
 use crate::model::saved::FittedModel;
-use crate::numerics::metrics;
+use crate::numerics::{metrics, Control};
 use crate::{Error, Result};
 use serde::Serialize;
 
@@ -116,6 +116,26 @@ pub struct CompareRow {
     pub validation_simulated: Vec<f64>,
 }
 
+impl CompareRow {
+    /// The row of a family that has no result, with the one-line `error` saying why.
+    fn failed(family: Family, error: &Error) -> Self {
+        Self {
+            family: family.name(),
+            validation_fit_percent: None,
+            validation_rmse: None,
+            train_fit_percent: None,
+            parameters: None,
+            aic: None,
+            fit_time_s: None,
+            converged: None,
+            termination: None,
+            error: Some(error.to_string()),
+            fitted: None,
+            validation_simulated: Vec::new(),
+        }
+    }
+}
+
 /// The ranked comparison.
 #[derive(Clone, Debug, Serialize)]
 pub struct Comparison {
@@ -175,11 +195,25 @@ pub fn compare(
         ));
     }
     let (split, train, valid) = split(u, y, validation, options.train_fraction)?;
-    let rows = options
-        .families
-        .iter()
-        .map(|&f| row(f, train, valid, &split, &options.family))
-        .collect::<Vec<_>>();
+    // The observer sees "family k/N" and may stop the comparison (a time limit): the
+    // families not fitted by then are listed as such, once at least one has a result.
+    let observer = &options.family.observer;
+    let total = options.families.len();
+    let mut rows: Vec<CompareRow> = Vec::with_capacity(total);
+    for (k, &family) in options.families.iter().enumerate() {
+        let stopped = observer.report("family", k, total) == Control::Stop;
+        if stopped && rows.iter().any(|r| r.fitted.is_some()) {
+            rows.push(CompareRow::failed(
+                family,
+                &Error::Cancelled(
+                    "the comparison was stopped (time limit) before this family was fitted".into(),
+                ),
+            ));
+        } else {
+            rows.push(row(family, train, valid, &split, &options.family));
+        }
+    }
+    observer.report("family", total, total);
     let validation_input = scored(&split, valid.0).to_vec();
     let validation_output = scored(&split, valid.1).to_vec();
     Ok(Comparison {
@@ -242,20 +276,7 @@ fn row(
     split: &Split,
     options: &FamilyOptions,
 ) -> CompareRow {
-    let failed = |e: Error| CompareRow {
-        family: family.name(),
-        validation_fit_percent: None,
-        validation_rmse: None,
-        train_fit_percent: None,
-        parameters: None,
-        aic: None,
-        fit_time_s: None,
-        converged: None,
-        termination: None,
-        error: Some(e.to_string()),
-        fitted: None,
-        validation_simulated: Vec::new(),
-    };
+    let failed = |e: Error| CompareRow::failed(family, &e);
     let fitted = match fit_operator(family, train.0, train.1, options) {
         Ok(f) => f,
         Err(e) => return failed(e),
