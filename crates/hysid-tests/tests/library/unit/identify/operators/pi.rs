@@ -141,3 +141,68 @@ fn bad_data_are_refused() {
         .contains("increasing"));
     assert!(fit(&u, &y[..400], &o).is_err());
 }
+
+/// A Preisach plant a PI operator can only approximate: its density depends on the centre
+/// (α + β)/2 of a relay as well as on its half-width (α − β)/2 (a density of the half-width
+/// alone would be a PI operator, Brokate & Sprekels 1996), so its loops are asymmetric and
+/// its minor loops not congruent. 20 levels over [−1.6, 1.6], driven by the 20 000-sample
+/// records of the differential tests (amplitude 1.5), 40 dB output noise.
+fn preisach_records() -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    use crate::unit::test_signals::{training_input, validation_input, with_noise};
+    use hysid::model::operators::Preisach;
+    let (lower, upper, n) = (-1.6, 1.6, 20);
+    let h = (upper - lower) / n as f64;
+    let mut w = Vec::new();
+    // Cells (i, j), j ≤ i: switching-up threshold α at level i, switching-down β at level j.
+    for i in 0..n {
+        for j in 0..=i {
+            let (alpha, beta) = (lower + (i as f64 + 0.5) * h, lower + (j as f64 + 0.5) * h);
+            let (centre, half) = ((alpha + beta) / 2.0, (alpha - beta) / 2.0);
+            w.push(0.08 * (-((centre - 0.2) / 0.8).powi(2) - (half / 0.6).powi(2)).exp());
+        }
+    }
+    let plant =
+        Preisach::new(lower, upper, n, w, 0.2, 0.0, Orientation::COUNTER_CLOCKWISE).unwrap();
+    let u = training_input(20_000, 1.5);
+    let v = validation_input(20_000, 1.5);
+    let y = with_noise(&plant.simulate(&u).unwrap(), 40.0, 7);
+    let yv = with_noise(&plant.simulate(&v).unwrap(), 40.0, 107);
+    (u, y, v, yv)
+}
+
+/// The best validation fit % of a PI operator on [`preisach_records`]: that of the lowest
+/// training criterion, the NNLS fit on a dense grid of 400 thresholds (the family's
+/// continuum limit: any threshold placement is within a 400th of the range of one of the
+/// grid's), found by `dense_pi_on_a_preisach_loop` below (run once with
+/// `-- --ignored --nocapture`; it printed 85.7555 % at the training fit 83.3212 %; 10, 20,
+/// 40 and 100 thresholds gave 85.7020, 85.8345, 85.8695 and 85.7660 %).
+const PREISACH_LOOP_BEST_PI: f64 = 85.7555;
+
+#[test]
+fn pi_reaches_its_best_on_a_preisach_loop() {
+    let (u, y, v, yv) = preisach_records();
+    let fit = fit(&u, &y, &PiOptions::default()).unwrap();
+    let got = metrics::fit_percent(&yv, &fit.model.simulate(&v).unwrap());
+    assert!(
+        got >= PREISACH_LOOP_BEST_PI - 0.1,
+        "validation fit {got:.4} % vs the family's best {PREISACH_LOOP_BEST_PI:.4} %"
+    );
+}
+
+#[test]
+#[ignore = "the one-off dense search behind PREISACH_LOOP_BEST_PI"]
+fn dense_pi_on_a_preisach_loop() {
+    let (u, y, v, yv) = preisach_records();
+    for thresholds in [10, 20, 40, 100, 400] {
+        let options = PiOptions {
+            thresholds,
+            ..PiOptions::default()
+        };
+        let fit = fit(&u, &y, &options).unwrap();
+        let got = metrics::fit_percent(&yv, &fit.model.simulate(&v).unwrap());
+        eprintln!(
+            "PI with {thresholds} thresholds: validation fit {got:.4} % (training {:.4} %)",
+            fit.fit_percent
+        );
+    }
+}
