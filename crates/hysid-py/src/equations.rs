@@ -94,12 +94,12 @@ fn equation_model_file(
         let model = EquationStateSpace::parse(text, "equation model")?;
         let parameters = checked_parameters(&model, &params)?;
         if x0.len() != model.states().len() {
-            return Err(Error::ModelMismatch(format!(
-                "x0 has {} values for the {} states of model '{}'",
-                x0.len(),
-                model.states().len(),
-                model.name()
-            )));
+            return Err(Error::CountMismatch {
+                model: format!("model '{}'", model.name()),
+                what: "states (values of x0)",
+                expected: model.states().len(),
+                given: x0.len(),
+            });
         }
         let file = FittedModel::Equations {
             equations: text.to_string(),

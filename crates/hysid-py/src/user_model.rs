@@ -191,11 +191,12 @@ type ModelSpec = (
 fn build(spec: ModelSpec) -> Result<(Arc<PythonModel>, Vec<f64>)> {
     let (rhs, output, states, n_inputs, n_outputs, params, x0) = spec;
     if x0.len() != states.len() {
-        return Err(Error::ModelMismatch(format!(
-            "x0 has {} values for {} states",
-            x0.len(),
-            states.len()
-        )));
+        return Err(Error::CountMismatch {
+            model: "the model".into(),
+            what: "states (values of x0)",
+            expected: states.len(),
+            given: x0.len(),
+        });
     }
     let model = PythonModel {
         rhs,

@@ -143,6 +143,37 @@ pub enum Error {
     #[error("{0}")]
     ModelMismatch(String),
 
+    /// A model and what it is applied to differ in a count: input or output channels,
+    /// initial-state values.
+    #[error("{model} has {expected} {what}; {given} given")]
+    CountMismatch {
+        /// The model ("the bouc_wen model", "an operator cascade").
+        model: String,
+        /// What is counted, plural ("input channels", "output channels", "initial-state
+        /// values per experiment").
+        what: &'static str,
+        /// How many the model has.
+        expected: usize,
+        /// How many were given.
+        given: usize,
+    },
+
+    /// Regressors of a least-squares problem are (nearly) linearly dependent, or one is zero
+    /// over the whole record.
+    #[error(
+        "regressors {columns} are {problem}; the data do not excite the model enough or it \
+         has too many parameters"
+    )]
+    DependentRegressors {
+        /// The regressors involved, by name (`'b1', 'a2'`).
+        columns: String,
+        /// What is wrong with them ("(nearly) linearly dependent (condition number
+        /// 1.2e13)", "zero or not finite over the whole record").
+        problem: String,
+        /// The condition number of the column-scaled problem (∞ for a zero column).
+        condition_number: f64,
+    },
+
     /// A parameter name that the model does not have.
     #[error("{0}")]
     UnknownParameter(String),
@@ -386,6 +417,7 @@ impl Error {
             | Error::InvalidOption { .. }
             | Error::InvalidModel(_)
             | Error::ModelMismatch(_)
+            | Error::CountMismatch { .. }
             | Error::UnknownParameter(_)
             | Error::Unsupported(_)
             | Error::UnsupportedKind { .. }
@@ -395,6 +427,7 @@ impl Error {
             Error::OutputClash(_) => Category::Usage,
             Error::Io { .. } => Category::Io,
             Error::Singular(_)
+            | Error::DependentRegressors { .. }
             | Error::Diverged { .. }
             | Error::NonFiniteOutput(_)
             | Error::NonFiniteResult { .. } => Category::Numerical,

@@ -578,10 +578,12 @@ impl<'a> OutputErrorProblem<'a> {
     ) -> Result<Self> {
         let ny = model.n_outputs();
         if data.output_channels().len() != ny {
-            return Err(Error::ModelMismatch(format!(
-                "the model has {ny} output(s) but the data have {}",
-                data.output_channels().len()
-            )));
+            return Err(Error::CountMismatch {
+                model: "the model".into(),
+                what: "output channels",
+                expected: ny,
+                given: data.output_channels().len(),
+            });
         }
         let mut n_residuals = 0;
         for exp in data.experiments() {

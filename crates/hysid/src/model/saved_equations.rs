@@ -59,12 +59,12 @@ pub(crate) fn simulate_outputs(
     simulation: &Simulation,
 ) -> Result<Vec<Vec<f64>>> {
     if inputs.len() != model.inputs().len() {
-        return Err(Error::ModelMismatch(format!(
-            "the {} model has {} input(s), {} given",
-            model.kind(),
-            model.inputs().len(),
-            inputs.len()
-        )));
+        return Err(Error::CountMismatch {
+            model: format!("the {} model", model.kind()),
+            what: "input channels",
+            expected: model.inputs().len(),
+            given: inputs.len(),
+        });
     }
     let track = InputTrack::new(inputs, simulation)?;
     let n_outputs = model.outputs().len();

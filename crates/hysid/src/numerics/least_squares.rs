@@ -44,8 +44,8 @@ impl LsSolution {
 
 /// Solves min ‖Φθ − y‖₂. `names` (one per column) make the error messages specific.
 ///
-/// Errors with [`Error::TooFewSamples`] when N < p and [`Error::Singular`] when a column is
-/// zero or the columns are (numerically) dependent, naming the columns involved.
+/// Errors with [`Error::TooFewSamples`] when N < p and [`Error::DependentRegressors`] when a
+/// column is zero or the columns are (numerically) dependent, naming the columns involved.
 ///
 /// ```
 /// use nalgebra::DMatrix;
@@ -182,19 +182,21 @@ fn column_name<'a>(names: &'a [&str]) -> impl Fn(usize) -> String + 'a {
     }
 }
 
-/// [`Error::Singular`] naming the first column whose norm (in `scale`) is zero or not finite.
+/// [`Error::DependentRegressors`] naming the first column whose norm (in `scale`) is zero or
+/// not finite.
 fn excited(scale: &[f64], name: &dyn Fn(usize) -> String) -> Result<()> {
     match scale.iter().position(|&s| s == 0.0 || !s.is_finite()) {
-        Some(j) => Err(Error::Singular(format!(
-            "regressor '{}' is zero or not finite over the whole record; the data do not excite it",
-            name(j)
-        ))),
+        Some(j) => Err(Error::DependentRegressors {
+            columns: format!("'{}'", name(j)),
+            problem: "zero or not finite over the whole record".into(),
+            condition_number: f64::INFINITY,
+        }),
         None => Ok(()),
     }
 }
 
 /// The condition number of the column-scaled triangular factor `r` (by its singular
-/// values), or [`Error::Singular`] naming the columns involved when it reaches
+/// values), or [`Error::DependentRegressors`] naming the columns involved when it reaches
 /// [`MAX_CONDITION`].
 fn condition_number(r: &DMatrix<f64>, name: &dyn Fn(usize) -> String) -> Result<f64> {
     let svd = r.clone().svd(false, true);
@@ -202,11 +204,13 @@ fn condition_number(r: &DMatrix<f64>, name: &dyn Fn(usize) -> String) -> Result<
     let smin = svd.singular_values.min();
     let condition_number = smax / smin;
     if condition_number.is_nan() || condition_number >= MAX_CONDITION {
-        return Err(Error::Singular(format!(
-            "regressors {} are (nearly) linearly dependent (condition number {condition_number:.3e}); \
-             the data do not excite the model enough or it has too many parameters",
-            dependent_columns(&svd, name)
-        )));
+        return Err(Error::DependentRegressors {
+            columns: dependent_columns(&svd, name),
+            problem: format!(
+                "(nearly) linearly dependent (condition number {condition_number:.3e})"
+            ),
+            condition_number,
+        });
     }
     Ok(condition_number)
 }

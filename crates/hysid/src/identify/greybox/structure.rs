@@ -60,22 +60,39 @@ impl GreyBox {
             model.outputs().len(),
             model.states().len(),
         );
-        if data.input_channels().len() != nu || data.output_channels().len() != ny {
-            return Err(Error::ModelMismatch(format!(
-                "the {} model has {nu} input(s) and {ny} output(s); the data have {} and {}",
-                model.kind(),
-                data.input_channels().len(),
-                data.output_channels().len()
-            )));
+        let model_name = || format!("the {} model", model.kind());
+        for (what, expected, given) in [
+            ("input channels", nu, data.input_channels().len()),
+            ("output channels", ny, data.output_channels().len()),
+        ] {
+            if given != expected {
+                return Err(Error::CountMismatch {
+                    model: model_name(),
+                    what,
+                    expected,
+                    given,
+                });
+            }
         }
-        if initial.values.len() != data.n_experiments()
-            || initial.values.iter().any(|v| v.len() != nx)
-            || initial.estimated.len() != nx
+        if initial.values.len() != data.n_experiments() {
+            return Err(Error::CountMismatch {
+                model: format!("the data ({} experiments)", data.n_experiments()),
+                what: "initial-state vectors, one per experiment",
+                expected: data.n_experiments(),
+                given: initial.values.len(),
+            });
+        }
+        let lengths = initial.values.iter().map(Vec::len);
+        if let Some(given) = lengths
+            .chain([initial.estimated.len()])
+            .find(|&len| len != nx)
         {
-            return Err(Error::ModelMismatch(format!(
-                "initial states: need {nx} values for each of the {} experiments",
-                data.n_experiments()
-            )));
+            return Err(Error::CountMismatch {
+                model: model_name(),
+                what: "states (initial-state values per experiment)",
+                expected: nx,
+                given,
+            });
         }
         let tracks = data
             .experiments()
