@@ -583,11 +583,12 @@ pub struct CascadeArgs {
     /// (the list is the registry's).
     #[arg(long, help = crate::cli_zoo::family_help("Hysteresis: ch4 (saturated Coleman–Hodgdon, 4 parameters), ch6, or an operator family"))]
     pub hysteresis: String,
-    /// Operator families: number of thresholds of pi and gpi, elements of maxwell-slip (10).
-    /// Range 1..=200.
+    /// Operator families with a threshold grid: number of thresholds (play or slip elements)
+    /// (10). Range 1..=200; refused for a family that has none, naming those that have.
     #[arg(long, value_parser = crate::options::count::<1, 200>)]
     pub thresholds: Option<usize>,
-    /// Operator family preisach: intervals of the Preisach grid (10). Range 1..=100.
+    /// Operator families on the Preisach plane: intervals of the grid (10). Range 1..=100;
+    /// refused for a family that has none, naming those that have.
     #[arg(long, alias = "levels", value_parser = crate::options::count::<1, 100>)]
     pub grid: Option<usize>,
     /// Order n of A(q⁻¹). Range 0..=50.

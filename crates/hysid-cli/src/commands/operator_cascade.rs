@@ -8,7 +8,7 @@ use crate::progress::FitProgress;
 use crate::report::{figures, print_table, Row};
 use anyhow::Result;
 use hysid::identify::operator_cascade::{OperatorCascadeFit, OperatorCascadeIdentification};
-use hysid::identify::operators::{Family, FamilyOptions};
+use hysid::identify::operators::{Family, FamilyOptions, FamilySetting};
 use hysid::report::plot::operator_cascade_figures;
 use hysid::report::{operator_cascade_model, operator_cascade_report};
 use serde_json::json;
@@ -24,17 +24,26 @@ fn identification(args: &CascadeArgs) -> Result<OperatorCascadeIdentification> {
             operators.join(", ")
         )
     })?;
-    let uses_thresholds = matches!(family, Family::Pi | Family::Gpi | Family::MaxwellSlip);
-    if args.thresholds.is_some() && !uses_thresholds {
-        anyhow::bail!("--thresholds applies to pi, gpi and maxwell-slip, not {name}");
-    }
-    if args.grid.is_some() && family != Family::Preisach {
-        anyhow::bail!("--grid applies to preisach, not {name}");
+    for (given, flag, setting) in [
+        (
+            args.thresholds.is_some(),
+            "--thresholds",
+            FamilySetting::Thresholds,
+        ),
+        (args.grid.is_some(), "--grid", FamilySetting::Grid),
+    ] {
+        if given && !family.settings().contains(&setting) {
+            let reading: Vec<&str> = Family::reading(setting)
+                .into_iter()
+                .map(Family::name)
+                .collect();
+            anyhow::bail!("{flag} applies to {}, not {name}", reading.join(", "));
+        }
     }
     let mut id = OperatorCascadeIdentification::new(family, args.na, args.nb, args.delay);
     id.options = FamilyOptions {
         thresholds: args.thresholds.unwrap_or(10),
-        // A cascade's Preisach plane is smaller than `identify operator`'s: its cells share
+        // A cascade's Preisach (and KP) plane is smaller than `identify operator`'s: its cells share
         // the record with the linear block's coefficients.
         grid: args.grid.unwrap_or(10),
         ..FamilyOptions::default()

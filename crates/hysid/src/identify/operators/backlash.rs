@@ -10,7 +10,7 @@
 //!
 //! Reference: M. A. Krasnosel'skii, A. V. Pokrovskii, *Systems with Hysteresis*, Springer 1989.
 
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{check_data, finish, orientation, range};
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
@@ -229,6 +229,8 @@ fn jacobian_gram(z: &[f64], s: &[f64], g: f64) -> Matrix3<f64> {
 }
 
 impl Identify for Backlash {
+    const SETTINGS: &'static [FamilySetting] = &[FamilySetting::Orientation];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

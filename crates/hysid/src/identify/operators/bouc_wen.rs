@@ -20,7 +20,7 @@
 //! [`crate::model::operators::bouc_wen`].
 
 use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopShape, Settings};
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::states_with_tolerance;
 use crate::model::operators::{BoucWen, LoopOrientation};
@@ -176,6 +176,8 @@ pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit
 }
 
 impl Identify for BoucWen {
+    const SETTINGS: &'static [FamilySetting] = &[];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

@@ -16,7 +16,7 @@
 //! References: Dahl (1968, 1976), see [`crate::model::operators::dahl`].
 
 use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopShape, Settings};
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::{Dahl, LoopOrientation};
@@ -149,6 +149,8 @@ pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Da
 }
 
 impl Identify for Dahl {
+    const SETTINGS: &'static [FamilySetting] = &[];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

@@ -14,7 +14,7 @@
 //! Reference: Coleman & Hodgdon (1986), see [`crate::model::operators::duhem`].
 
 use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopShape, Settings};
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::Duhem;
@@ -116,6 +116,8 @@ pub fn fit(u: &[f64], y: &[f64], options: &DuhemOptions) -> Result<OperatorFit<D
 }
 
 impl Identify for Duhem {
+    const SETTINGS: &'static [FamilySetting] = &[];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

@@ -125,6 +125,10 @@ impl FittedOperator {
 /// ([`crate::model::operators::registry`]) in the family's own module of
 /// [`crate::identify::operators`].
 pub trait Identify: OperatorFamily + Into<OperatorModel> {
+    /// The settings of [`FamilyOptions`] this family's fit reads; it ignores the others
+    /// (the command line refuses them for it, naming the families that read them).
+    const SETTINGS: &'static [FamilySetting];
+
     /// Fits the family to input `u` and output `y` from the data alone (no initial guess),
     /// with the user's `options` (the settings that do not apply to the family are ignored).
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>>;
@@ -146,6 +150,40 @@ pub trait Identify: OperatorFamily + Into<OperatorModel> {
         };
         let start = Self::identify(u, y, &options)?.model.into();
         Ok((cascade.family_arx_start(start, u, y)?, FAMILY_ARX))
+    }
+}
+
+/// A setting of [`FamilyOptions`] that some families read ([`Identify::SETTINGS`]; the
+/// observer is read by every family with a search).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FamilySetting {
+    /// [`FamilyOptions::thresholds`].
+    Thresholds,
+    /// [`FamilyOptions::threshold_grid`].
+    ThresholdGrid,
+    /// [`FamilyOptions::grid`].
+    Grid,
+    /// [`FamilyOptions::lambda`].
+    Lambda,
+    /// [`FamilyOptions::dead_zones`].
+    DeadZones,
+    /// [`FamilyOptions::orientation`].
+    Orientation,
+}
+
+impl Family {
+    /// The settings this family's fit reads (none for ch4 and ch6, which have no options).
+    pub fn settings(self) -> &'static [FamilySetting] {
+        by_family::settings(self)
+    }
+
+    /// The families whose fit reads `setting`, in the registry's order.
+    pub fn reading(setting: FamilySetting) -> Vec<Family> {
+        Family::ALL
+            .iter()
+            .copied()
+            .filter(|f| f.settings().contains(&setting))
+            .collect()
     }
 }
 
@@ -186,6 +224,13 @@ mod by_family {
 
     macro_rules! dispatch {
         ($($variant:ident: $ty:ty),* $(,)?) => {
+            pub(super) fn settings(family: Family) -> &'static [FamilySetting] {
+                match family {
+                    $(Family::$variant => <$ty as Identify>::SETTINGS,)*
+                    Family::Ch4 | Family::Ch6 => &[],
+                }
+            }
+
             pub(super) fn fit(
                 family: Family,
                 u: &[f64],

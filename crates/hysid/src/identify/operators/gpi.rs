@@ -19,7 +19,7 @@
 //! nonlinearities: a modified Prandtl–Ishlinskii approach", European Journal of Control 9
 //! (2003) 407–418.
 
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, threshold_grid, GramAccumulator,
 };
@@ -176,6 +176,13 @@ pub fn fit(u: &[f64], y: &[f64], options: &GpiOptions) -> Result<OperatorFit<Gen
 }
 
 impl Identify for GeneralizedPi {
+    const SETTINGS: &'static [FamilySetting] = &[
+        FamilySetting::Thresholds,
+        FamilySetting::ThresholdGrid,
+        FamilySetting::DeadZones,
+        FamilySetting::Orientation,
+    ];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

@@ -22,7 +22,7 @@
 //! [`crate::model::operators::jiles_atherton`].
 
 use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopShape, Settings};
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::jiles_atherton::{langevin, MU0};
@@ -219,6 +219,8 @@ fn inverse_langevin(t: f64) -> f64 {
 }
 
 impl Identify for JilesAtherton {
+    const SETTINGS: &'static [FamilySetting] = &[];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

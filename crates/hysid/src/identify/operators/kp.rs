@@ -33,7 +33,7 @@
 //! Problems in Engineering 3 (1997) 287–328; C. L. Lawson, R. J. Hanson, *Solving Least
 //! Squares Problems*, Prentice-Hall 1974.
 
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, GramAccumulator, WeightSolution,
 };
@@ -258,6 +258,12 @@ fn add_smoothness(g: &mut DMatrix<f64>, levels: usize, first: usize, lambda: f64
 }
 
 impl Identify for Kp {
+    const SETTINGS: &'static [FamilySetting] = &[
+        FamilySetting::Grid,
+        FamilySetting::Lambda,
+        FamilySetting::Orientation,
+    ];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

@@ -12,7 +12,7 @@
 //! model appropriate for control purposes", Proc. PhysCon 2003; F. Al-Bender, V. Lampaert,
 //! J. Swevers, IEEE Trans. Automatic Control 50 (2005) 1883–1887.
 
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator,
 };
@@ -112,6 +112,12 @@ pub fn fit(u: &[f64], y: &[f64], options: &MaxwellSlipOptions) -> Result<Operato
 }
 
 impl Identify for MaxwellSlip {
+    const SETTINGS: &'static [FamilySetting] = &[
+        FamilySetting::Thresholds,
+        FamilySetting::ThresholdGrid,
+        FamilySetting::Orientation,
+    ];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

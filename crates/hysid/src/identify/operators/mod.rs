@@ -25,7 +25,7 @@ use crate::numerics::Termination;
 use serde::Serialize;
 
 pub use compare::{compare, CompareOptions, CompareRow, Comparison, Split};
-pub use family::{fit_operator, Family, FamilyOptions, FittedOperator};
+pub use family::{fit_operator, Family, FamilyOptions, FamilySetting, FittedOperator};
 
 pub mod backlash;
 pub mod bouc_wen;

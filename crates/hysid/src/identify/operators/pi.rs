@@ -15,7 +15,7 @@
 //! nonlinearities: a modified Prandtl–Ishlinskii approach", European Journal of Control 9
 //! (2003) 407–418.
 
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator,
 };
@@ -145,6 +145,12 @@ fn fit_selected(
 }
 
 impl Identify for PrandtlIshlinskii {
+    const SETTINGS: &'static [FamilySetting] = &[
+        FamilySetting::Thresholds,
+        FamilySetting::ThresholdGrid,
+        FamilySetting::Orientation,
+    ];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

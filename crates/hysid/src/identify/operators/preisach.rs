@@ -15,7 +15,7 @@
 //!
 //! Reference: I. D. Mayergoyz, *Mathematical Models of Hysteresis*, Springer 1991.
 
-use super::family::{FamilyOptions, Identify};
+use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, GramAccumulator,
 };
@@ -168,6 +168,12 @@ fn add_smoothness(g: &mut DMatrix<f64>, grid: &Grid, first: usize, lambda: f64) 
 }
 
 impl Identify for Preisach {
+    const SETTINGS: &'static [FamilySetting] = &[
+        FamilySetting::Grid,
+        FamilySetting::Lambda,
+        FamilySetting::Orientation,
+    ];
+
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
             u,

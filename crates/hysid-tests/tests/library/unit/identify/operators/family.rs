@@ -74,3 +74,64 @@ fn pi_through_the_registry() {
     let yhat = back.simulate(&[&u], 1.0, None).unwrap();
     assert_eq!(yhat[0], fitted.fit.simulated);
 }
+
+/// Every family ignores the settings it does not declare ([`Identify::SETTINGS`], which the
+/// command line uses to refuse a flag for a family): its fit with all of them changed is
+/// bit for bit the fit with the defaults. Data: each family's registry example on a short
+/// record with minor loops.
+#[test]
+#[ignore = "long (Jiles–Atherton's fit twice, several seconds): run by `-- --ignored` and CI"]
+fn families_read_only_the_settings_they_declare() {
+    use crate::unit::test_signals::training_input;
+    let u = training_input(2_000, 1.5);
+    let changed = |declared: &[FamilySetting]| {
+        let mut options = FamilyOptions::default();
+        for setting in [
+            FamilySetting::Thresholds,
+            FamilySetting::ThresholdGrid,
+            FamilySetting::Grid,
+            FamilySetting::Lambda,
+            FamilySetting::DeadZones,
+            FamilySetting::Orientation,
+        ] {
+            if declared.contains(&setting) {
+                continue;
+            }
+            match setting {
+                FamilySetting::Thresholds => options.thresholds = 7,
+                FamilySetting::ThresholdGrid => {
+                    options.threshold_grid = Some(vec![0.1, 0.2, 0.4]);
+                    options.thresholds = 3;
+                }
+                FamilySetting::Grid => options.grid = 6,
+                FamilySetting::Lambda => options.lambda = 1e-2,
+                FamilySetting::DeadZones => options.dead_zones = 2,
+                FamilySetting::Orientation => options.orientation = Some(Orientation::CLOCKWISE),
+            }
+        }
+        options
+    };
+    for example in OperatorModel::examples().unwrap() {
+        let family = example.family();
+        let y = example.as_operator().simulate(&u).unwrap();
+        let settings = family.settings();
+        let base = fit_operator(family, &u, &y, &FamilyOptions::default()).unwrap();
+        let other = fit_operator(family, &u, &y, &changed(settings)).unwrap();
+        let bits = |f: &FittedOperator| -> Vec<u64> {
+            f.fit
+                .parameters
+                .values()
+                .iter()
+                .map(|v| v.to_bits())
+                .collect()
+        };
+        assert_eq!(
+            bits(&base),
+            bits(&other),
+            "{family} reads a setting it does not declare ({settings:?})"
+        );
+        for setting in settings {
+            assert!(Family::reading(*setting).contains(&family));
+        }
+    }
+}
