@@ -3,8 +3,8 @@
 //! (`to_bits` on every sample), on a seeded signal with nested minor loops; reset; the
 //! one-line errors.
 
-use hysid::model::compensate::compensate;
 use hysid::model::coleman_hodgdon::InitialOutput;
+use hysid::model::compensate::compensate;
 use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::models::GreyBoxKind;
 use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
@@ -30,21 +30,27 @@ fn signal(n: usize, scale: f64, seed: u64) -> Vec<f64> {
         .collect()
 }
 
-fn bits(v: &[f64]) -> Vec<u64> {
-    v.iter().map(|x| x.to_bits()).collect()
+/// Asserts `a` and `b` hold the same bits, naming the first sample where they differ.
+fn assert_same(a: &[f64], b: &[f64], what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: lengths");
+    if let Some(k) = (0..a.len()).find(|&k| a[k].to_bits() != b[k].to_bits()) {
+        panic!("{what}: sample {k}: {} against {}", a[k], b[k]);
+    }
 }
 
 /// The stepper of `model` run over `inputs` equals `simulate` to the bit (or both fail with
 /// the same message); run twice with a reset in between gives the same bits again.
 fn assert_streams(model: &FittedModel, inputs: &[&[f64]], ts: f64, y0: Option<f64>, what: &str) {
     let batch = model.simulate(inputs, ts, y0);
-    let mut stepper = model.stepper(ts, y0).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let mut stepper = model
+        .stepper(ts, y0)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
     let first = run(stepper.as_mut(), inputs);
     match (&batch, &first) {
         (Ok(b), Ok(s)) => {
             assert_eq!(b.len(), s.len(), "{what}: output count");
             for (bc, sc) in b.iter().zip(s) {
-                assert_eq!(bits(bc), bits(sc), "{what}: stepper differs from simulate");
+                assert_same(bc, sc, &format!("{what}: stepper against simulate"));
             }
         }
         (Err(b), Err(s)) => assert_eq!(b.to_string(), s.to_string(), "{what}"),
@@ -55,7 +61,7 @@ fn assert_streams(model: &FittedModel, inputs: &[&[f64]], ts: f64, y0: Option<f6
     match (first, second) {
         (Ok(a), Ok(b)) => {
             for (ac, bc) in a.iter().zip(&b) {
-                assert_eq!(bits(ac), bits(bc), "{what}: a reset stepper differs");
+                assert_same(ac, bc, &format!("{what}: a reset stepper"));
             }
         }
         (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{what}"),
@@ -67,19 +73,28 @@ fn assert_streams(model: &FittedModel, inputs: &[&[f64]], ts: f64, y0: Option<f6
 /// clipped samples and their count; again after a reset.
 fn assert_compensates(model: &FittedModel, reference: &[f64], what: &str) {
     let batch = compensate(model, reference).unwrap_or_else(|e| panic!("{what}: {e}"));
-    let mut compensator = model.compensator(1.0).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let mut compensator = model
+        .compensator(1.0)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
     for round in 0..2 {
         let stream = compensate_stream(compensator.as_mut(), reference)
             .unwrap_or_else(|e| panic!("{what}: {e}"));
-        assert_eq!(bits(&batch.u), bits(&stream.u), "{what}: u (round {round})");
+        assert_same(&batch.u, &stream.u, &format!("{what}: u (round {round})"));
+        let predicted = format!("{what}: predicted (round {round})");
+        assert_same(&batch.predicted, &stream.predicted, &predicted);
         assert_eq!(
-            bits(&batch.predicted),
-            bits(&stream.predicted),
-            "{what}: predicted (round {round})"
+            batch.clipped, stream.clipped,
+            "{what}: clipped (round {round})"
         );
-        assert_eq!(batch.clipped, stream.clipped, "{what}: clipped (round {round})");
-        assert_eq!(compensator.clipped(), batch.clipped.len(), "{what}: clipped count");
-        assert_eq!(batch.settled_from, stream.settled_from, "{what}: settled_from");
+        assert_eq!(
+            compensator.clipped(),
+            batch.clipped.len(),
+            "{what}: clipped count"
+        );
+        assert_eq!(
+            batch.settled_from, stream.settled_from,
+            "{what}: settled_from"
+        );
     }
 }
 
@@ -155,7 +170,10 @@ fn a_non_minimum_phase_cascade_has_no_compensator_and_says_so_as_the_batch_does(
     let stream = fitted.compensator(1.0).unwrap_err().to_string();
     let batch = compensate(&fitted, &[0.0, 0.1]).unwrap_err().to_string();
     assert_eq!(stream, batch);
-    assert!(stream.contains("not minimum phase") && !stream.contains('\n'), "{stream}");
+    assert!(
+        stream.contains("not minimum phase") && !stream.contains('\n'),
+        "{stream}"
+    );
 }
 
 fn coleman_hodgdon() -> [ColemanHodgdon; 2] {
@@ -193,14 +211,20 @@ fn coleman_hodgdon_hysteresis_and_cascades_stream_as_the_batch() {
         assert_streams(&fitted, &[&fast], 1.0, None, "ch cascade, too fast");
         let err = fitted.compensator(1.0).unwrap_err().to_string();
         assert_eq!(err, compensate(&fitted, &x).unwrap_err().to_string());
-        assert!(err.contains("not invertible") && !err.contains('\n'), "{err}");
+        assert!(
+            err.contains("not invertible") && !err.contains('\n'),
+            "{err}"
+        );
     }
 }
 
 /// The simulation settings the grey-box streams are checked with.
 fn simulations() -> Vec<Simulation> {
     let mut out = Vec::new();
-    for interpolation in [InputInterpolation::ZeroOrderHold, InputInterpolation::Linear] {
+    for interpolation in [
+        InputInterpolation::ZeroOrderHold,
+        InputInterpolation::Linear,
+    ] {
         for integrator in [
             Integrator::Rk4 { substeps: 4 },
             Integrator::Newmark { substeps: 2 },
@@ -247,7 +271,10 @@ fn built_in_grey_box_models_stream_as_they_simulate() {
                 // refused by the batch alike.
                 Err(e) => assert_eq!(
                     e.to_string(),
-                    fitted.simulate(&slices, 1e-3, None).unwrap_err().to_string()
+                    fitted
+                        .simulate(&slices, 1e-3, None)
+                        .unwrap_err()
+                        .to_string()
                 ),
             }
             assert!(fitted.streaming_differs().is_none(), "{what}");
@@ -320,7 +347,10 @@ fn equation_models_stream_as_they_simulate() {
                 Ok(_) => assert_streams(&fitted, &slices, 1e-2, None, &what),
                 Err(e) => assert_eq!(
                     e.to_string(),
-                    fitted.simulate(&slices, 1e-2, None).unwrap_err().to_string()
+                    fitted
+                        .simulate(&slices, 1e-2, None)
+                        .unwrap_err()
+                        .to_string()
                 ),
             }
         }
@@ -359,7 +389,10 @@ fn kinds_that_cannot_stream_or_invert_say_so_in_one_line() {
         initial_state: vec![0.0; model.states().len()],
     };
     let err = rigid.compensator(1.0).unwrap_err().to_string();
-    assert!(err.contains("not invertible") && !err.contains('\n'), "{err}");
+    assert!(
+        err.contains("not invertible") && !err.contains('\n'),
+        "{err}"
+    );
     let prefiltered = FittedModel::prefiltered(
         rigid,
         Some(hysid::model::record_filters::Prefilter {
@@ -409,5 +442,5 @@ fn a_preisach_stream_refuses_an_input_that_nests_deeper_than_its_memory() {
     stepper.reset();
     let depth = hysid::model::operators::preisach::STREAM_MEMORY - 2;
     let head = run(stepper.as_mut(), &[&u[..depth]]).unwrap();
-    assert_eq!(bits(&head[0]), bits(&batch[..depth]));
+    assert_same(&head[0], &batch[..depth], "preisach within its memory");
 }
