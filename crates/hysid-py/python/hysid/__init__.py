@@ -1124,5 +1124,7 @@ def actuator_rig(
     return [ActuatorRecord(k, free, tau, theta, t) for (k, free, t, tau, theta) in sets]
 
 
-from . import fleet  # noqa: E402, F401  (imports Result from this module)
-from . import stream  # noqa: E402  (Model.stepper, Model.compensator)
+from . import (  # noqa: E402
+    fleet,  # noqa: F401  (imports Result from this module)
+    stream,  # Model.stepper, Model.compensator
+)
