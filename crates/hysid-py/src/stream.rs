@@ -77,6 +77,9 @@ impl Stepper {
     }
 }
 
+/// A numpy array of float64.
+type Array<'py> = Bound<'py, PyArray1<f64>>;
+
 /// A saved model's compensator one sample at a time (`hysid::model::stream::Compensator`).
 #[pyclass(module = "hysid._hysid")]
 pub struct Compensator {
@@ -113,7 +116,7 @@ impl Compensator {
         &self,
         py: Python<'py>,
         r: PyReadonlyArray1<'py, f64>,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    ) -> PyResult<(Array<'py>, Array<'py>)> {
         let r = samples(&r);
         let (u, predicted) = run(py, || {
             let mut compensator = lock(&self.inner);
