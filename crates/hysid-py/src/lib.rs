@@ -24,6 +24,7 @@ pub mod equations;
 pub mod errors;
 pub mod pool;
 pub mod recipes;
+pub mod stream;
 pub mod user_model;
 pub mod zoo;
 
@@ -37,6 +38,7 @@ fn _hysid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     actuator::register(m)?;
     equations::register(m)?;
     zoo::register(m)?;
+    stream::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -447,7 +447,7 @@ fn simulate_model<'py>(
 }
 
 /// A model file's JSON, parsed.
-fn parse_model(text: &str) -> Result<ModelFile> {
+pub fn parse_model(text: &str) -> Result<ModelFile> {
     serde_json::from_str(text)
         .map_err(|e| Error::InvalidModel(format!("not a hysid.model/1 model file: {e}")))
 }

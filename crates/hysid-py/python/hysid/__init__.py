@@ -495,6 +495,15 @@ class Model:
             outs = _hysid.simulate_model(json.dumps(self.file), channels, ts, y0)
         return outs[0] if len(outs) == 1 else np.column_stack(outs)
 
+    def stepper(self, *, ts: Optional[float] = None, y0: Optional[float] = None) -> "stream.Stepper":
+        """The model one sample at a time (:mod:`hysid.stream`); ``ts`` defaults to the model
+        file's sample time."""
+        return stream.stepper(self, ts=ts, y0=y0)
+
+    def compensator(self, *, ts: Optional[float] = None) -> "stream.Compensator":
+        """The model's compensator one sample at a time (:mod:`hysid.stream`)."""
+        return stream.compensator(self, ts=ts)
+
     def save(self, path: "os.PathLike[str] | str") -> None:
         """Writes the model file (``hysid.model/1``) that ``hysid simulate --model`` reads."""
         if self._user is not None:
@@ -1115,4 +1124,7 @@ def actuator_rig(
     return [ActuatorRecord(k, free, tau, theta, t) for (k, free, t, tau, theta) in sets]
 
 
-from . import fleet  # noqa: E402, F401  (imports Result from this module)
+from . import (  # noqa: E402
+    fleet,  # noqa: F401  (imports Result from this module)
+    stream,  # Model.stepper, Model.compensator
+)

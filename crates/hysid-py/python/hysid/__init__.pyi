@@ -5,6 +5,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import fleet as fleet
+from . import stream as stream
 from ._families import FAMILIES as FAMILIES
 from ._families import FamilyName as FamilyName
 from ._hysid import CallbackError as CallbackError
@@ -74,6 +75,8 @@ class Model:
     @property
     def parameters(self) -> Dict[str, Parameter]: ...
     def simulate(self, u: _ArrayLike, *, ts: float, y0: Optional[float] = ...) -> npt.NDArray[np.float64]: ...
+    def stepper(self, *, ts: Optional[float] = ..., y0: Optional[float] = ...) -> stream.Stepper: ...
+    def compensator(self, *, ts: Optional[float] = ...) -> stream.Compensator: ...
     def save(self, path: "os.PathLike[str] | str") -> None: ...
 
 class Result:

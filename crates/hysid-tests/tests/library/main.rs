@@ -14,4 +14,5 @@ mod hysteresis_alone;
 mod model_files;
 mod preprocessing;
 mod properties;
+mod stream;
 mod unit;

@@ -21,10 +21,8 @@
 //! rate limit allows) is clipped to the nearest reachable output and listed in
 //! [`Compensation::clipped`], never silently.
 
-use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
-use crate::model::operators::{solve_monotone, Branch};
 use crate::model::saved::FittedModel;
-use crate::model::ColemanHodgdon;
+use crate::model::stream::compensate_stream;
 use crate::numerics::metrics;
 use crate::{Error, Result};
 use serde::Serialize;
@@ -75,8 +73,8 @@ impl Compensation {
     }
 }
 
-/// The input that makes `model` follow `reference` (see the module doc).
-pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation> {
+/// Refuses an empty reference or one with a non-finite sample (the checks of [`compensate`]).
+pub(crate) fn check_reference(reference: &[f64]) -> Result<()> {
     if reference.is_empty() {
         return Err(Error::InvalidData("the reference is empty".into()));
     }
@@ -87,14 +85,33 @@ pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation
             value: reference[k],
         });
     }
+    Ok(())
+}
+
+/// The error for a model kind [`compensate`] does not invert.
+pub(crate) fn not_invertible(model: &FittedModel) -> Error {
+    Error::NotInvertible {
+        kind: model.to_file().kind().to_string(),
+        reason: "compensation inverts hysteresis operators, the Coleman–Hodgdon \
+                 hysteresis alone and operator cascades with a minimum-phase linear \
+                 block; identify one of those"
+            .into(),
+    }
+}
+
+/// The input that makes `model` follow `reference` (see the module doc).
+pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation> {
+    check_reference(reference)?;
     let mut settled_from = 0;
     let (u, predicted, clipped) = match model {
         FittedModel::Operator { model, .. } => {
             let inv = model.as_operator().invert(reference)?;
             (inv.u, inv.predicted, inv.clipped)
         }
-        FittedModel::Hysteresis { model, initial, .. } => {
-            coleman_hodgdon_inverse(model, *initial, reference)
+        FittedModel::Hysteresis { .. } => {
+            // The per-sample solve of the module doc, one step of the stream at a time.
+            let stream = compensate_stream(model.compensator(0.0)?.as_mut(), reference)?;
+            (stream.u, stream.predicted, stream.clipped)
         }
         FittedModel::OperatorCascade { model, .. } => {
             // The linear block is inverted (minimum-phase B only) and the operator after it.
@@ -102,16 +119,7 @@ pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation
             settled_from = inv.delay;
             (inv.u, inv.predicted, inv.clipped)
         }
-        other => {
-            let kind = other.to_file().kind().to_string();
-            return Err(Error::NotInvertible {
-                kind,
-                reason: "compensation inverts hysteresis operators, the Coleman–Hodgdon \
-                         hysteresis alone and operator cascades with a minimum-phase linear \
-                         block; identify one of those"
-                    .into(),
-            });
-        }
+        other => return Err(not_invertible(other)),
     };
     Ok(Compensation {
         reference: reference.to_vec(),
@@ -120,67 +128,4 @@ pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation
         clipped,
         settled_from,
     })
-}
-
-type Solved = (Vec<f64>, Vec<f64>, Vec<usize>);
-
-/// The per-sample solve of the Coleman–Hodgdon recursion (module doc).
-fn coleman_hodgdon_inverse(ch: &ColemanHodgdon, initial: InitialOutput, r: &[f64]) -> Solved {
-    let y0 = match initial {
-        InitialOutput::Measured => r[0],
-        InitialOutput::Zero => 0.0,
-    };
-    let alpha = ch.alpha();
-    // The largest step the recursion admits; a model with α = 0 has none.
-    let reach = if alpha > 0.0 {
-        1.0 / alpha
-    } else {
-        f64::MAX.sqrt()
-    };
-    let mut x = vec![anhysteretic_inverse(ch, y0, reach)];
-    let mut y_prev = y0;
-    let mut clipped = Vec::new();
-    if (y0 - r[0]).abs() > 1e-12 * (1.0 + r[0].abs()) {
-        clipped.push(0);
-    }
-    for (t, &target) in r.iter().enumerate().skip(1) {
-        let x_prev = x[t - 1];
-        let step = |v: f64| ch.step(y_prev, x_prev, v.clamp(x_prev - reach, x_prev + reach));
-        let branch = Branch {
-            center: x_prev,
-            span: reach,
-            unbounded_below: false,
-            unbounded_above: false,
-        };
-        let (xt, clip) = solve_monotone(step, target, branch);
-        let xt = xt.clamp(x_prev - reach, x_prev + reach);
-        y_prev = ch.step(y_prev, x_prev, xt);
-        // The recursion need not be monotone on every branch of every model: a solve that
-        // missed counts as clipped too.
-        if clip || (y_prev - target).abs() > 1e-9 * (1.0 + target.abs()) {
-            clipped.push(t);
-        }
-        x.push(xt);
-    }
-    let predicted = simulate_switched(ch, &x, y0, None);
-    (x, predicted, clipped)
-}
-
-/// x with f(x) = v for the odd, piecewise-linear material function f, or 0 when f is flat.
-fn anhysteretic_inverse(ch: &ColemanHodgdon, v: f64, reach: f64) -> f64 {
-    let branch = Branch {
-        center: 0.0,
-        span: ch.d().abs().max(1.0).min(reach),
-        unbounded_below: true,
-        unbounded_above: true,
-    };
-    if ch.m1() <= 0.0 {
-        return 0.0;
-    }
-    let (x, _) = solve_monotone(|x| ch.f(x), v, branch);
-    if x.is_finite() {
-        x
-    } else {
-        0.0
-    }
 }

@@ -14,6 +14,7 @@
 //! * [`record_filters`]: the processing a fit applied to its records (pre-filter,
 //!   inverse-dynamics preprocessing), saved with the model.
 //! * [`saved`]: fitted models and the saved-model file.
+//! * [`stream`]: every model one sample at a time ([`stream::Stepper`], [`stream::Compensator`]).
 
 mod cascade;
 pub mod coleman_hodgdon;
@@ -26,6 +27,7 @@ mod parameters;
 pub mod record_filters;
 pub mod saved;
 mod saved_equations;
+pub mod stream;
 
 pub use cascade::{CascadeOutput, HysteresisCascade};
 pub use coleman_hodgdon::{Admissibility, ChForm, ColemanHodgdon};

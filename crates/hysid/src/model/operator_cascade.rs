@@ -166,6 +166,20 @@ impl OperatorCascade {
         Ok(CascadeOutput { v, y })
     }
 
+    /// Refuses a linear block that is not minimum phase (a zero of B on or outside the unit
+    /// circle): its inverse, which compensation runs, is unstable.
+    pub fn check_minimum_phase(&self) -> Result<()> {
+        let radius = self.zero_radius();
+        if radius >= 1.0 {
+            return Err(Error::InvalidModel(format!(
+                "the linear block is not minimum phase (a zero of B at |z| = {radius:.4} >= 1): \
+                 its inverse is unstable; compensate the hysteresis operator alone, or refit \
+                 with fewer B coefficients"
+            )));
+        }
+        Ok(())
+    }
+
     /// The largest modulus of the zeros of B (roots of b1 zᵐ⁻¹ + … + bm); < 1 means minimum
     /// phase.
     pub fn zero_radius(&self) -> f64 {
@@ -189,14 +203,7 @@ impl OperatorCascade {
                 value: reference[index],
             });
         }
-        let radius = self.zero_radius();
-        if radius >= 1.0 {
-            return Err(Error::InvalidModel(format!(
-                "the linear block is not minimum phase (a zero of B at |z| = {radius:.4} >= 1): \
-                 its inverse is unstable; compensate the hysteresis operator alone, or refit \
-                 with fewer B coefficients"
-            )));
-        }
+        self.check_minimum_phase()?;
         let v_desired = self.invert_linear(reference);
         let inversion = self.operator.as_operator().invert(&v_desired)?;
         let predicted = self.simulate(&inversion.u)?.y;

@@ -132,6 +132,14 @@ impl InputTrack {
         })
     }
 
+    /// Overwrites sample `k` of every channel with `values` (a streaming step's two-sample
+    /// track; not for a band-limited track, whose table is computed once).
+    pub(crate) fn set_sample(&mut self, k: usize, values: &[f64]) {
+        for (channel, &v) in self.samples.iter_mut().zip(values) {
+            channel[k] = v;
+        }
+    }
+
     /// Number of input channels.
     pub fn n_channels(&self) -> usize {
         self.samples.len()
@@ -257,7 +265,8 @@ pub fn simulate(
     Ok(())
 }
 
-/// ẋ at sample interval k, fraction τ, into `out`.
+/// ẋ at sample interval k of the track (interval `sample` of the record, which sets the
+/// time), fraction τ, into `out`.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn rate(
@@ -266,13 +275,52 @@ fn rate(
     input: &InputTrack,
     ts: f64,
     u: &mut [f64],
-    k: usize,
+    (k, sample): (usize, usize),
     tau: f64,
     x: &[f64],
     out: &mut [f64],
 ) {
     input.at(k, tau, u);
-    model.rhs((k as f64 + tau) * ts, x, u, theta, out);
+    model.rhs((sample as f64 + tau) * ts, x, u, theta, out);
+}
+
+/// Advances `x` over sample interval `sample` of a record (t_sample → t_sample+1) exactly as
+/// [`simulate`] does, the input read from `track`, a two-sample track [u_sample,
+/// u_sample+1]: the step of a streaming simulation (`crate::model::stream`). A discrete-time
+/// model takes its recursion's step (`next` is its scratch space, of the state's length).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn advance_interval(
+    model: &dyn StateSpaceModel,
+    theta: &[f64],
+    track: &InputTrack,
+    ts: f64,
+    integrator: Integrator,
+    sample: usize,
+    x: &mut [f64],
+    (u, next): (&mut [f64], &mut [f64]),
+) -> Result<()> {
+    if model.discrete_time() {
+        track.at(0, 0.0, u);
+        model.rhs(sample as f64 * ts, x, u, theta, next);
+        x.copy_from_slice(next);
+        return Ok(());
+    }
+    let mut stepper = Stepper::new(model, theta, track, ts, integrator)?;
+    stepper.first = sample;
+    stepper.advance(0, x)
+}
+
+/// Refuses an integrator the model cannot be simulated with, as [`simulate`] does (Coulomb
+/// friction needs RK4; Newmark a second-order mechanical model).
+pub(crate) fn check_integrator(
+    model: &dyn StateSpaceModel,
+    track: &InputTrack,
+    integrator: Integrator,
+) -> Result<()> {
+    if model.discrete_time() {
+        return Ok(());
+    }
+    Stepper::new(model, &[], track, 1.0, integrator).map(|_| ())
 }
 
 /// The input at a stage of RK4 sub-step j of m in sample interval k: from the input grid when
@@ -307,6 +355,8 @@ struct Stepper<'a> {
     input: &'a InputTrack,
     ts: f64,
     integrator: Integrator,
+    /// The record's sample at the track's position 0 (the time origin of a streaming step).
+    first: usize,
     u: Vec<f64>,
     rk4: StickSlip,
     k: [Vec<f64>; 7],
@@ -341,6 +391,7 @@ impl<'a> Stepper<'a> {
             input,
             ts,
             integrator,
+            first: 0,
             u: vec![0.0; input.n_channels()],
             rk4: StickSlip::new(n),
             k: std::array::from_fn(|_| vec![0.0; n]),
@@ -377,7 +428,7 @@ impl<'a> Stepper<'a> {
             self.input,
             self.ts,
             &mut self.u,
-            k,
+            (k, self.first + k),
             tau,
             x,
             &mut self.k[slot],
@@ -388,12 +439,13 @@ impl<'a> Stepper<'a> {
     /// [`super::stick_slip`]).
     fn rk4_step(&mut self, k: usize, j: usize, m: usize, x: &mut [f64]) {
         let (model, theta, input, ts) = (self.model, self.theta, self.input, self.ts);
+        let sample = self.first + k;
         let (tau, dtau) = (j as f64 / m as f64, 1.0 / m as f64);
         let u = &mut self.u;
         let mut f = |stage: Stage, x: &[f64], held: Option<f64>, out: &mut [f64]| {
             let tau = tau + stage.dt / ts;
             stage_input(input, m, k, j, stage, tau, u);
-            let t = (k as f64 + tau) * ts;
+            let t = (sample as f64 + tau) * ts;
             match held {
                 Some(d) => model.rhs_sliding(t, x, u, theta, d, out),
                 None => model.rhs(t, x, u, theta, out),
@@ -458,7 +510,7 @@ impl<'a> Stepper<'a> {
                 .lu()
                 .solve(&nalgebra::DVector::from_column_slice(&residual))
                 .ok_or_else(|| Error::Diverged {
-                    index: k,
+                    index: self.first + k,
                     reason: "the Newmark corrector's Newton matrix is singular".into(),
                 })?;
             for (u, d) in unknown.iter_mut().zip(delta.iter()) {
@@ -481,7 +533,7 @@ impl<'a> Stepper<'a> {
             guard += 1;
             if guard > 1_000_000 {
                 return Err(Error::Diverged {
-                    index: k,
+                    index: self.first + k,
                     reason: "the adaptive integrator's step size collapsed (stiff or discontinuous model)".into(),
                 });
             }
@@ -499,7 +551,7 @@ impl<'a> Stepper<'a> {
                 tau += dtau;
                 x.copy_from_slice(&y5);
                 if x.iter().any(|v| !v.is_finite()) {
-                    return Err(diverged(k));
+                    return Err(diverged(self.first + k));
                 }
             }
             let factor = if norm == 0.0 {

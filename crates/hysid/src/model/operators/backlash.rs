@@ -78,35 +78,43 @@ impl Backlash {
 }
 
 impl Core for Backlash {
-    fn forward(&self, u: &[f64]) -> Vec<f64> {
-        let mut z = 0.0;
-        u.iter()
-            .map(|&uk| {
-                z = play_step(z, uk, self.r);
-                self.offset + self.g * z
-            })
-            .collect()
+    /// The play state z.
+    type Forward = f64;
+    /// The play output w and the input u of the previous sample.
+    type Backward = (f64, f64);
+
+    fn orientation(&self) -> Orientation {
+        self.orientation
     }
 
-    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
-        let (mut z, mut u_prev) = (0.0, 0.0);
-        let u = v
-            .iter()
-            .map(|&vk| {
-                let w = (vk - self.offset) / self.g;
-                let uk = if w > z {
-                    w + self.r
-                } else if w < z {
-                    w - self.r
-                } else {
-                    u_prev
-                };
-                z = w;
-                u_prev = uk;
-                uk
-            })
-            .collect();
-        (u, Vec::new())
+    fn forward_state(&self, _horizon: Option<usize>) -> f64 {
+        0.0
+    }
+
+    /// c + g·zₖ, zₖ = max(uₖ − r, min(uₖ + r, zₖ₋₁)).
+    fn forward_step(&self, z: &mut f64, u: f64) -> f64 {
+        *z = play_step(*z, u, self.r);
+        self.offset + self.g * *z
+    }
+
+    fn backward_state(&self, _horizon: Option<usize>) -> (f64, f64) {
+        (0.0, 0.0)
+    }
+
+    /// The right inverse of the module doc: w = (v − c)/g; u = w ± r as w rises or falls,
+    /// the previous u while it holds.
+    fn backward_step(&self, (z, u_prev): &mut (f64, f64), v: f64) -> (f64, bool) {
+        let w = (v - self.offset) / self.g;
+        let u = if w > *z {
+            w + self.r
+        } else if w < *z {
+            w - self.r
+        } else {
+            *u_prev
+        };
+        *z = w;
+        *u_prev = u;
+        (u, false)
     }
 }
 
@@ -125,11 +133,11 @@ impl HysteresisOperator for Backlash {
     }
 
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
-        oriented_simulate(self, self.orientation, u)
+        oriented_simulate(self, u)
     }
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
-        oriented_invert(self, self.orientation, reference)
+        oriented_invert(self, reference)
     }
 }
 

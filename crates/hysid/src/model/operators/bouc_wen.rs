@@ -178,6 +178,8 @@ impl InputOdeSensitivity for BoucWen {
     }
 }
 
+super::streaming::differential_streaming!(BoucWen);
+
 impl HysteresisOperator for BoucWen {
     fn family(&self) -> &'static str {
         <Self as super::OperatorFamily>::NAME

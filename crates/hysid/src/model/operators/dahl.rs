@@ -137,6 +137,8 @@ impl InputOdeSensitivity for Dahl {
     }
 }
 
+super::streaming::differential_streaming!(Dahl);
+
 impl HysteresisOperator for Dahl {
     fn family(&self) -> &'static str {
         <Self as super::OperatorFamily>::NAME

@@ -40,6 +40,7 @@
 //! problems in chemical reaction kinetics", in *Modelling of Chemical Reaction Systems*,
 //! Springer 1981, 102–125.
 
+use super::streaming::CompensatorStep;
 use super::Inversion;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -467,33 +468,86 @@ fn at_sample(e: Error, index: usize) -> Error {
     }
 }
 
+/// The operator one sample at a time: the state x and the previous input (none before the
+/// first sample, where x is the initial state x₀ whatever the input).
+///
+/// Sample k integrates x from u_{k−1} to u_k exactly as [`simulate`] does (the same
+/// Dormand–Prince steps from the same end points, so the same bits) and gives h(u_k, x_k).
+/// The one difference is the divergence guard: a stream allows each sample interval
+/// 100 000 sub-steps, a batch shares 100 000 + 100 per sample over its record.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stream {
+    /// (u_{k−1}, x_{k−1}) after the first sample.
+    last: Option<(f64, f64)>,
+}
+
+impl Stream {
+    /// y_k for u_k = `u` (`k` the sample's index, for the errors); the state moves on.
+    pub fn step<O: InputOde + ?Sized>(&mut self, ode: &O, k: usize, u: f64) -> Result<f64> {
+        let x = match self.last {
+            None => ode.initial_state(),
+            Some((u_prev, x_prev)) => {
+                advance(ode, x_prev, u_prev, u).map_err(|e| at_sample(e, k))?
+            }
+        };
+        self.last = Some((u, x));
+        Ok(ode.output(u, x))
+    }
+}
+
+/// The inverse one sample at a time (see the module doc): the previous command and state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InverseStream {
+    /// (u_{k−1}, x_{k−1}) after the first sample.
+    last: Option<(f64, f64)>,
+}
+
+impl InverseStream {
+    /// The command for the reference r_k = `r`, what the operator makes of it, and whether
+    /// r_k was out of reach (clipped); the state moves on.
+    pub fn step<O: InputOde + ?Sized>(
+        &mut self,
+        ode: &O,
+        k: usize,
+        r: f64,
+    ) -> Result<CompensatorStep> {
+        let (u, x, predicted, clipped) = match self.last {
+            // The first sample: the state is x₀ whatever the input, only h(u, x₀) can be matched.
+            None => {
+                let x0 = ode.initial_state();
+                solve_sample(&|v| Ok((ode.output(v, x0), x0)), ode.anchor_input(), ode, r)?
+            }
+            Some((u_prev, x_prev)) => {
+                let branch = |v: f64| -> Result<(f64, f64)> {
+                    let xv = advance(ode, x_prev, u_prev, v)?;
+                    Ok((ode.output(v, xv), xv))
+                };
+                solve_sample(&branch, u_prev, ode, r).map_err(|e| at_sample(e, k))?
+            }
+        };
+        self.last = Some((u, x));
+        Ok(CompensatorStep {
+            u,
+            predicted,
+            clipped,
+        })
+    }
+}
+
 /// The input that makes the operator follow `reference` (see the module doc), sample by
-/// sample from the initial state; unreachable samples are clipped and listed.
+/// sample from the initial state ([`InverseStream`]); unreachable samples are clipped and
+/// listed.
 pub fn invert<O: InputOde + ?Sized>(ode: &O, reference: &[f64]) -> Result<Inversion> {
     check_signal("reference", reference)?;
-    let x0 = ode.initial_state();
-    let anchor = ode.anchor_input();
-    // The first sample: the state is x₀ whatever the input, only h(u, x₀) can be matched.
-    let first = solve_sample(&|v| Ok((ode.output(v, x0), x0)), anchor, ode, reference[0])?;
-    let mut u = vec![first.0];
-    let mut x = first.1;
-    let mut predicted = vec![first.2];
-    let mut clipped = Vec::new();
-    if first.3 {
-        clipped.push(0);
-    }
-    for (k, &r) in reference.iter().enumerate().skip(1) {
-        let (u_prev, x_prev) = (u[k - 1], x);
-        let branch = |v: f64| -> Result<(f64, f64)> {
-            let xv = advance(ode, x_prev, u_prev, v)?;
-            Ok((ode.output(v, xv), xv))
-        };
-        let (v, xv, yv, clip) =
-            solve_sample(&branch, u_prev, ode, r).map_err(|e| at_sample(e, k))?;
-        u.push(v);
-        x = xv;
-        predicted.push(yv);
-        if clip {
+    let mut stream = InverseStream::default();
+    let n = reference.len();
+    let (mut u, mut predicted, mut clipped) =
+        (Vec::with_capacity(n), Vec::with_capacity(n), Vec::new());
+    for (k, &r) in reference.iter().enumerate() {
+        let step = stream.step(ode, k, r)?;
+        u.push(step.u);
+        predicted.push(step.predicted);
+        if step.clipped {
             clipped.push(k);
         }
     }

@@ -127,6 +127,8 @@ impl InputOdeSensitivity for Duhem {
     }
 }
 
+super::streaming::differential_streaming!(Duhem);
+
 impl HysteresisOperator for Duhem {
     fn family(&self) -> &'static str {
         <Self as super::OperatorFamily>::NAME

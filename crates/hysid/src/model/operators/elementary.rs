@@ -163,82 +163,189 @@ impl Orientation {
     }
 }
 
-/// A family's core operator G (counter-clockwise, increasing) and its inverse, from which
-/// [`Orientation`] builds Γ.
+/// A family's core operator G (counter-clockwise, increasing) and its inverse, one sample at a
+/// time, from which [`Orientation`] builds Γ.
+///
+/// This is the family's streaming form: `forward_step` gives G\[u\]ₖ for the input uₖ and
+/// advances the state to k + 1, `backward_step` the same for G⁻¹. Every oriented simulation
+/// and inversion below is a loop over these steps, so a stream and a batch give the same bits.
+/// A state is fixed in size once built; `horizon` is the number of samples a batch will feed
+/// (None for a stream), which only a state whose memory grows with the input's history (the
+/// Preisach staircase) uses, to hold all of it.
 pub(crate) trait Core {
-    /// G[u] from the initial state.
-    fn forward(&self, u: &[f64]) -> Vec<f64>;
-    /// G⁻¹[v] from the consistent initial state; returns the input and the clipped indices.
-    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>);
+    /// The state of G (the play states, the kernel states, the Preisach memory).
+    type Forward: Clone + std::fmt::Debug + Send;
+    /// The state of G⁻¹, with what the inverse precomputes.
+    type Backward: Clone + std::fmt::Debug + Send;
+
+    /// The orientation Γ is built with.
+    fn orientation(&self) -> Orientation;
+    /// G's initial state.
+    fn forward_state(&self, horizon: Option<usize>) -> Self::Forward;
+    /// G\[u\]ₖ for uₖ = `u`; the state moves on to k + 1.
+    fn forward_step(&self, state: &mut Self::Forward, u: f64) -> f64;
+    /// G⁻¹'s initial state (consistent with G's).
+    fn backward_state(&self, horizon: Option<usize>) -> Self::Backward;
+    /// G⁻¹\[v\]ₖ for vₖ = `v`, and whether vₖ lay beyond G's reach and was clipped.
+    fn backward_step(&self, state: &mut Self::Backward, v: f64) -> (f64, bool);
+    /// True once a stream's state of fixed capacity could not hold the input's history (its
+    /// outputs are then no longer G's); never for a batch state.
+    fn overflowed(
+        &self,
+        _forward: Option<&Self::Forward>,
+        _backward: Option<&Self::Backward>,
+    ) -> bool {
+        false
+    }
+}
+
+/// The state of Γ = ±G or ±G⁻¹ for a stream: G's state, or G⁻¹'s for the inverse-operator
+/// parameterisation.
+#[derive(Clone, Debug)]
+pub(crate) enum OrientedState<C: Core> {
+    /// Γ = ±G.
+    Direct(C::Forward),
+    /// Γ = ±G⁻¹.
+    Inverse(C::Backward),
+}
+
+/// Γ's initial state.
+pub(crate) fn oriented_state<C: Core>(
+    core: &C,
+    o: Orientation,
+    horizon: Option<usize>,
+) -> OrientedState<C> {
+    if o.inverse {
+        OrientedState::Inverse(core.backward_state(horizon))
+    } else {
+        OrientedState::Direct(core.forward_state(horizon))
+    }
+}
+
+/// Γ\[u\]ₖ for uₖ = `u`, and whether uₖ lay outside the domain of G⁻¹ (only for Γ = ±G⁻¹).
+pub(crate) fn oriented_step<C: Core>(
+    core: &C,
+    o: Orientation,
+    state: &mut OrientedState<C>,
+    u: f64,
+) -> (f64, bool) {
+    let s = o.sign();
+    let (y, outside) = match state {
+        OrientedState::Direct(forward) => (core.forward_step(forward, u), false),
+        OrientedState::Inverse(backward) => core.backward_step(backward, u),
+    };
+    (s * y, outside)
+}
+
+/// The error for an input sample `u` at index `k` outside the domain of a clockwise Γ = ±G⁻¹.
+pub(crate) fn outside_domain(k: usize, u: f64) -> Error {
+    Error::InvalidData(format!(
+        "input sample {k} = {u} lies outside the range this (clockwise) operator \
+         can take; scale the input into the identification range"
+    ))
 }
 
 /// Γ[u] for a core in an orientation; an input outside the domain of G⁻¹ is an error.
-pub(crate) fn oriented_simulate(core: &impl Core, o: Orientation, u: &[f64]) -> Result<Vec<f64>> {
+pub(crate) fn oriented_simulate<C: Core>(core: &C, u: &[f64]) -> Result<Vec<f64>> {
     check_signal("u", u)?;
-    let s = o.sign();
-    let y = if o.inverse {
-        let (y, clipped) = core.backward(u);
-        if let Some(&k) = clipped.first() {
-            return Err(Error::InvalidData(format!(
-                "input sample {k} = {} lies outside the range this (clockwise) operator \
-                 can take; scale the input into the identification range",
-                u[k]
-            )));
+    let o = core.orientation();
+    let mut state = oriented_state(core, o, Some(u.len()));
+    let mut y = Vec::with_capacity(u.len());
+    for (k, &uk) in u.iter().enumerate() {
+        match oriented_step(core, o, &mut state, uk) {
+            (_, true) => return Err(outside_domain(k, uk)),
+            (yk, false) => y.push(yk),
         }
-        y
-    } else {
-        core.forward(u)
-    };
-    Ok(y.into_iter().map(|v| s * v).collect())
+    }
+    Ok(y)
 }
 
 /// Γ[u] for a core in an orientation, inputs outside the domain of G⁻¹ mapped to the
 /// saturation level (for fit reports on the estimation data); returns the number so mapped.
-pub(crate) fn oriented_simulate_saturating(
-    core: &impl Core,
+pub(crate) fn oriented_simulate_saturating<C: Core>(
+    core: &C,
     o: Orientation,
     u: &[f64],
 ) -> (Vec<f64>, usize) {
-    let s = o.sign();
-    let (y, n) = if o.inverse {
-        let (y, clipped) = core.backward(u);
-        (y, clipped.len())
-    } else {
-        (core.forward(u), 0)
-    };
-    (y.into_iter().map(|v| s * v).collect(), n)
+    let mut state = oriented_state(core, o, Some(u.len()));
+    let mut outside = 0;
+    let y = u
+        .iter()
+        .map(|&uk| {
+            let (yk, out) = oriented_step(core, o, &mut state, uk);
+            outside += usize::from(out);
+            yk
+        })
+        .collect();
+    (y, outside)
+}
+
+/// The state of Γ⁻¹ for a stream: both G's and G⁻¹'s states (one computes the command, the
+/// other what Γ makes of it), and for Γ = ±G⁻¹ the running scale of the clipping test.
+#[derive(Clone, Debug)]
+pub(crate) struct OrientedInverse<C: Core> {
+    forward: C::Forward,
+    backward: C::Backward,
+    scale: f64,
+}
+
+impl<C: Core> OrientedInverse<C> {
+    /// The states of G and G⁻¹ at their start.
+    pub(crate) fn new(core: &C, horizon: Option<usize>) -> Self {
+        Self {
+            forward: core.forward_state(horizon),
+            backward: core.backward_state(horizon),
+            scale: 1.0,
+        }
+    }
+
+    /// True once a stream's state of fixed capacity overflowed ([`Core::overflowed`]).
+    pub(crate) fn overflowed(&self, core: &C) -> bool {
+        core.overflowed(Some(&self.forward), Some(&self.backward))
+    }
+
+    /// One sample of Γ⁻¹ for the reference rₖ = `r`: (uₖ, Γ\[u\]ₖ, clipped).
+    ///
+    /// Γ = ±G: uₖ = G⁻¹\[±r\]ₖ (clipped where G⁻¹ clips) and Γ\[u\]ₖ = ±G\[u\]ₖ. Γ = ±G⁻¹:
+    /// uₖ = G\[±r\]ₖ, always defined, and Γ\[u\]ₖ = ±G⁻¹\[u\]ₖ, which misses ρₖ = ±rₖ where
+    /// ρ is not in G's range: the sample counts as clipped when |Γ\[u\]ₖ ∓ rₖ| > 1e-9·max(1,
+    /// |ρ₀|, …, |ρₖ|) (the scale of the references so far, so that a stream decides as the
+    /// batch does).
+    pub(crate) fn step(&mut self, core: &C, r: f64) -> (f64, f64, bool) {
+        let s = core.orientation().sign();
+        let rho = s * r;
+        if core.orientation().inverse {
+            let u = core.forward_step(&mut self.forward, rho);
+            let (y, _) = core.backward_step(&mut self.backward, u);
+            self.scale = self.scale.max(rho.abs());
+            (u, s * y, (y - rho).abs() > 1e-9 * self.scale)
+        } else {
+            let (u, clipped) = core.backward_step(&mut self.backward, rho);
+            (u, s * core.forward_step(&mut self.forward, u), clipped)
+        }
+    }
 }
 
 /// Γ⁻¹[reference] for a core in an orientation, with Γ of the result and the clipped samples.
-pub(crate) fn oriented_invert(
-    core: &impl Core,
-    o: Orientation,
-    reference: &[f64],
-) -> Result<Inversion> {
+pub(crate) fn oriented_invert<C: Core>(core: &C, reference: &[f64]) -> Result<Inversion> {
     check_signal("reference", reference)?;
-    let s = o.sign();
-    let rho: Vec<f64> = reference.iter().map(|v| s * v).collect();
-    if o.inverse {
-        let u = core.forward(&rho);
-        let (y, _) = core.backward(&u);
-        let scale = rho.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-        let clipped = (0..y.len())
-            .filter(|&k| (y[k] - rho[k]).abs() > 1e-9 * scale)
-            .collect();
-        Ok(Inversion {
-            u,
-            predicted: y.into_iter().map(|v| s * v).collect(),
-            clipped,
-        })
-    } else {
-        let (u, clipped) = core.backward(&rho);
-        let predicted = core.forward(&u).into_iter().map(|v| s * v).collect();
-        Ok(Inversion {
-            u,
-            predicted,
-            clipped,
-        })
+    let mut state = OrientedInverse::new(core, Some(reference.len()));
+    let n = reference.len();
+    let (mut u, mut predicted, mut clipped) =
+        (Vec::with_capacity(n), Vec::with_capacity(n), Vec::new());
+    for (k, &r) in reference.iter().enumerate() {
+        let (uk, yk, clip) = state.step(core, r);
+        u.push(uk);
+        predicted.push(yk);
+        if clip {
+            clipped.push(k);
+        }
     }
+    Ok(Inversion {
+        u,
+        predicted,
+        clipped,
+    })
 }
 
 /// Where to look for the solution of a monotone branch equation f(u) = target: f is

@@ -22,7 +22,7 @@
 //! (2003) 407–418.
 
 use super::elementary::{check_finite, oriented_invert, oriented_simulate, Core, Orientation};
-use super::pi::pi_parameters;
+use super::pi::{pi_parameters, PiBackward};
 use super::{HysteresisOperator, Inversion, PrandtlIshlinskii};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -163,17 +163,31 @@ impl GeneralizedPi {
 }
 
 impl Core for GeneralizedPi {
-    fn forward(&self, u: &[f64]) -> Vec<f64> {
-        Core::forward(&self.pi, u)
-            .into_iter()
-            .map(|v| self.dead_zones.eval(v))
-            .collect()
+    /// H's play states.
+    type Forward = Vec<f64>;
+    /// S⁻¹ (precomputed) and H⁻¹'s state.
+    type Backward = (DeadZones, PiBackward);
+
+    fn orientation(&self) -> Orientation {
+        self.orientation
     }
 
-    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
-        let inv = self.dead_zones.inverse();
-        let w: Vec<f64> = v.iter().map(|&x| inv.eval(x)).collect();
-        Core::backward(&self.pi, &w)
+    fn forward_state(&self, horizon: Option<usize>) -> Vec<f64> {
+        self.pi.forward_state(horizon)
+    }
+
+    /// S(H\[u\]ₖ).
+    fn forward_step(&self, z: &mut Vec<f64>, u: f64) -> f64 {
+        self.dead_zones.eval(self.pi.forward_step(z, u))
+    }
+
+    fn backward_state(&self, horizon: Option<usize>) -> (DeadZones, PiBackward) {
+        (self.dead_zones.inverse(), self.pi.backward_state(horizon))
+    }
+
+    /// H⁻¹\[S⁻¹(v)\]ₖ.
+    fn backward_step(&self, (inverse, pi): &mut (DeadZones, PiBackward), v: f64) -> (f64, bool) {
+        self.pi.backward_step(pi, inverse.eval(v))
     }
 }
 
@@ -203,11 +217,11 @@ impl HysteresisOperator for GeneralizedPi {
     }
 
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
-        oriented_simulate(self, self.orientation, u)
+        oriented_simulate(self, u)
     }
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
-        oriented_invert(self, self.orientation, reference)
+        oriented_invert(self, reference)
     }
 }
 

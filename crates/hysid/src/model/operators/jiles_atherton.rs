@@ -378,6 +378,8 @@ impl InputOdeSensitivity for JilesAtherton {
     }
 }
 
+super::streaming::differential_streaming!(JilesAtherton);
+
 impl HysteresisOperator for JilesAtherton {
     fn family(&self) -> &'static str {
         <Self as super::OperatorFamily>::NAME

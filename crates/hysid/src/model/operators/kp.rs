@@ -97,6 +97,7 @@ use super::{HysteresisOperator, Inversion};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
 
 /// The ridge ρ_a(x) = min(1, max(−1, 2x/a)), given 2/a.
 #[inline(always)]
@@ -367,18 +368,39 @@ fn pair(k: usize) -> (usize, usize) {
     (i, k - i * (i + 1) / 2)
 }
 
+/// The kernel states and, for the inverse, scratch space of one ramp per threshold (the
+/// trial evaluations of the solve).
+pub(crate) type KpBackward = (KernelStates, RefCell<Vec<f64>>);
+
 impl Core for Kp {
-    fn forward(&self, u: &[f64]) -> Vec<f64> {
-        let mut states = KernelStates::new(&self.thresholds, self.width);
-        u.iter()
-            .map(|&x| {
-                let s = states.advance_weighted(&self.weights, x);
-                self.offset + self.a0 * x + s
-            })
-            .collect()
+    type Forward = KernelStates;
+    type Backward = KpBackward;
+
+    fn orientation(&self) -> Orientation {
+        self.orientation
     }
 
-    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
+    fn forward_state(&self, _horizon: Option<usize>) -> KernelStates {
+        KernelStates::new(&self.thresholds, self.width)
+    }
+
+    /// (c + a₀u) + Σ μξ (the sum in four interleaved partial sums, see
+    /// [`KernelStates`]).
+    fn forward_step(&self, states: &mut KernelStates, u: f64) -> f64 {
+        let s = states.advance_weighted(&self.weights, u);
+        self.offset + self.a0 * u + s
+    }
+
+    fn backward_state(&self, _horizon: Option<usize>) -> KpBackward {
+        (
+            KernelStates::new(&self.thresholds, self.width),
+            RefCell::new(vec![0.0; self.levels()]),
+        )
+    }
+
+    /// The monotone branch from the current kernel states solved for v (module doc), then
+    /// the states advanced with the solution.
+    fn backward_step(&self, (states, scratch): &mut KpBackward, v: f64) -> (f64, bool) {
         let (lo, hi) = self.active_range();
         let branch = Branch {
             center: 0.5 * (lo + hi),
@@ -386,22 +408,13 @@ impl Core for Kp {
             unbounded_below: self.a0 > 0.0,
             unbounded_above: self.a0 > 0.0,
         };
-        let mut states = KernelStates::new(&self.thresholds, self.width);
-        let scratch = std::cell::RefCell::new(vec![0.0; self.levels()]);
-        let (mut u, mut clipped) = (Vec::with_capacity(v.len()), Vec::new());
-        for (k, &vk) in v.iter().enumerate() {
-            let trial = |x: f64| {
-                let mut ramps = scratch.borrow_mut();
-                let s = states.trial_weighted(&self.weights, x, &mut ramps);
-                self.offset + self.a0 * x + s
-            };
-            let (x, c) = solve_monotone(trial, vk, branch);
-            if c {
-                clipped.push(k);
-            }
-            states.advance(x);
-            u.push(x);
-        }
+        let trial = |x: f64| {
+            let mut ramps = scratch.borrow_mut();
+            let s = states.trial_weighted(&self.weights, x, &mut ramps);
+            self.offset + self.a0 * x + s
+        };
+        let (u, clipped) = solve_monotone(trial, v, branch);
+        states.advance(u);
         (u, clipped)
     }
 }
@@ -423,11 +436,11 @@ impl HysteresisOperator for Kp {
     }
 
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
-        oriented_simulate(self, self.orientation, u)
+        oriented_simulate(self, u)
     }
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
-        oriented_invert(self, self.orientation, reference)
+        oriented_invert(self, reference)
     }
 }
 

@@ -114,12 +114,25 @@ impl MaxwellSlip {
     }
 }
 
+/// The equivalent PI operator's steps ([`MaxwellSlip::as_pi`]).
 impl Core for MaxwellSlip {
-    fn forward(&self, u: &[f64]) -> Vec<f64> {
-        Core::forward(&self.pi, u)
+    type Forward = <PrandtlIshlinskii as Core>::Forward;
+    type Backward = <PrandtlIshlinskii as Core>::Backward;
+
+    fn orientation(&self) -> Orientation {
+        self.orientation
     }
-    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
-        Core::backward(&self.pi, v)
+    fn forward_state(&self, horizon: Option<usize>) -> Self::Forward {
+        self.pi.forward_state(horizon)
+    }
+    fn forward_step(&self, state: &mut Self::Forward, u: f64) -> f64 {
+        self.pi.forward_step(state, u)
+    }
+    fn backward_state(&self, horizon: Option<usize>) -> Self::Backward {
+        self.pi.backward_state(horizon)
+    }
+    fn backward_step(&self, state: &mut Self::Backward, v: f64) -> (f64, bool) {
+        self.pi.backward_step(state, v)
     }
 }
 
@@ -141,11 +154,11 @@ impl HysteresisOperator for MaxwellSlip {
     }
 
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
-        oriented_simulate(self, self.orientation, u)
+        oriented_simulate(self, u)
     }
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
-        oriented_invert(self, self.orientation, reference)
+        oriented_invert(self, reference)
     }
 }
 

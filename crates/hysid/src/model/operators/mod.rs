@@ -60,6 +60,7 @@ pub(crate) mod pi;
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod preisach;
 pub mod registry;
+pub(crate) mod streaming;
 
 pub use backlash::Backlash;
 pub use bouc_wen::BoucWen;
@@ -77,6 +78,7 @@ pub use pi::PrandtlIshlinskii;
 pub use preisach::Preisach;
 pub(crate) use registry::operator_families;
 pub use registry::{check_values, Family, OperatorFamily, OperatorModel};
+pub use streaming::CompensatorStep;
 
 /// The result of inverting an operator for feed-forward compensation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -159,61 +159,94 @@ impl PrandtlIshlinskii {
                 .map(|((a, r), &zi)| a * play_step(zi, u, *r))
                 .sum::<f64>()
     }
+}
 
-    /// G⁻¹ by the exact per-sample solve of the monotone branch (any âᵢ ≥ 0).
-    fn backward_numerical(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
-        let mut z = vec![0.0; self.weights.len()];
-        let (mut u_prev, mut clipped, mut u) = (0.0, Vec::new(), Vec::with_capacity(v.len()));
-        let r_max = self.thresholds.last().copied().unwrap_or(0.0);
-        let unbounded = self.final_slope() > 0.0;
-        for (k, &vk) in v.iter().enumerate() {
-            let branch = Branch {
-                center: u_prev,
-                span: 2.0 * r_max + 1e-9 * (1.0 + u_prev.abs()) + f64::MIN_POSITIVE,
-                unbounded_below: unbounded,
-                unbounded_above: unbounded,
-            };
-            let (uk, c) = solve_monotone(|x| self.branch(&z, x), vk, branch);
-            if c {
-                clipped.push(k);
-            }
-            for (zi, r) in z.iter_mut().zip(&self.thresholds) {
-                *zi = play_step(*zi, uk, *r);
-            }
-            u_prev = uk;
-            u.push(uk);
-        }
-        (u, clipped)
-    }
+/// The state of the PI inverse G⁻¹: the analytic one's plays on its thresholds sᵢ with its
+/// weights (b₀, bᵢ) precomputed, or the play states of G and the previous input for the
+/// per-sample solve (see the module doc).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum PiBackward {
+    /// G⁻¹\[v\] = b₀(v − c) + Σ bᵢ F_{sᵢ}\[v − c\] (Krejčí & Kuhnen 2001).
+    Analytic {
+        /// b₀ = 1/a₀.
+        b0: f64,
+        /// The plays' weights bᵢ.
+        b: Vec<f64>,
+        /// The plays' thresholds sᵢ.
+        s: Vec<f64>,
+        /// The plays' states.
+        z: Vec<f64>,
+    },
+    /// The exact per-sample solve of G's branch.
+    Numerical {
+        /// G's play states.
+        z: Vec<f64>,
+        /// The previous input (the bracket's centre).
+        u_prev: f64,
+    },
 }
 
 impl Core for PrandtlIshlinskii {
-    fn forward(&self, u: &[f64]) -> Vec<f64> {
-        let mut y: Vec<f64> = u.iter().map(|x| self.offset + self.a0 * x).collect();
-        for (a, &r) in self.weights.iter().zip(&self.thresholds) {
-            let mut z = 0.0;
-            for (yk, &uk) in y.iter_mut().zip(u) {
-                z = play_step(z, uk, r);
-                *yk += a * z;
-            }
+    /// The play states z₁ … zₙ.
+    type Forward = Vec<f64>;
+    type Backward = PiBackward;
+
+    fn orientation(&self) -> Orientation {
+        self.orientation
+    }
+
+    fn forward_state(&self, _horizon: Option<usize>) -> Vec<f64> {
+        vec![0.0; self.weights.len()]
+    }
+
+    /// y = (c + a₀u) + a₁z₁ + … + aₙzₙ, summed in that order.
+    fn forward_step(&self, z: &mut Vec<f64>, u: f64) -> f64 {
+        let mut y = self.offset + self.a0 * u;
+        for ((zi, a), &r) in z.iter_mut().zip(&self.weights).zip(&self.thresholds) {
+            *zi = play_step(*zi, u, r);
+            y += a * *zi;
         }
         y
     }
 
-    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
-        let Some((b0, b, s)) = self.inverse_parameters() else {
-            return self.backward_numerical(v);
-        };
-        let w: Vec<f64> = v.iter().map(|x| x - self.offset).collect();
-        let mut u: Vec<f64> = w.iter().map(|x| b0 * x).collect();
-        for (bi, &si) in b.iter().zip(&s) {
-            let mut z = 0.0;
-            for (uk, &wk) in u.iter_mut().zip(&w) {
-                z = play_step(z, wk, si);
-                *uk += bi * z;
+    fn backward_state(&self, _horizon: Option<usize>) -> PiBackward {
+        let z = vec![0.0; self.weights.len()];
+        match self.inverse_parameters() {
+            Some((b0, b, s)) => PiBackward::Analytic { b0, b, s, z },
+            None => PiBackward::Numerical { z, u_prev: 0.0 },
+        }
+    }
+
+    /// Analytic: u = b₀w + b₁F_{s₁}\[w\] + … (w = v − c), summed in that order. Numerical:
+    /// the branch from the current play states solved for v, then the plays advanced.
+    fn backward_step(&self, state: &mut PiBackward, v: f64) -> (f64, bool) {
+        match state {
+            PiBackward::Analytic { b0, b, s, z } => {
+                let w = v - self.offset;
+                let mut u = *b0 * w;
+                for ((zi, bi), &si) in z.iter_mut().zip(b.iter()).zip(s.iter()) {
+                    *zi = play_step(*zi, w, si);
+                    u += bi * *zi;
+                }
+                (u, false)
+            }
+            PiBackward::Numerical { z, u_prev } => {
+                let r_max = self.thresholds.last().copied().unwrap_or(0.0);
+                let unbounded = self.final_slope() > 0.0;
+                let branch = Branch {
+                    center: *u_prev,
+                    span: 2.0 * r_max + 1e-9 * (1.0 + u_prev.abs()) + f64::MIN_POSITIVE,
+                    unbounded_below: unbounded,
+                    unbounded_above: unbounded,
+                };
+                let (u, clipped) = solve_monotone(|x| self.branch(z, x), v, branch);
+                for (zi, r) in z.iter_mut().zip(&self.thresholds) {
+                    *zi = play_step(*zi, u, *r);
+                }
+                *u_prev = u;
+                (u, clipped)
             }
         }
-        (u, Vec::new())
     }
 }
 
@@ -234,11 +267,11 @@ impl HysteresisOperator for PrandtlIshlinskii {
     }
 
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
-        oriented_simulate(self, self.orientation, u)
+        oriented_simulate(self, u)
     }
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
-        oriented_invert(self, self.orientation, reference)
+        oriented_invert(self, reference)
     }
 }
 

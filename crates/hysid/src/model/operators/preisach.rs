@@ -32,6 +32,7 @@ use super::{HysteresisOperator, Inversion};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
+use std::cell::RefCell;
 
 /// The grid of a discrete Preisach plane: N equal intervals over [x₀, x_N].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -86,12 +87,19 @@ impl Grid {
     }
 }
 
+/// The corners a streaming Preisach state holds ([`Preisach`]'s stepper): the staircase of at
+/// most 32 nested minor loops. A batch simulation holds every corner its record can make.
+pub const STREAM_MEMORY: usize = 64;
+
 /// The staircase memory: alternating extrema [m₀ = x₀, M₁, m₁, M₂, …, current input], the input
-/// clamped to the grid.
+/// clamped to the grid, at most `capacity` of them (its storage is reserved when it is built
+/// and never grows; a memory that would need more corners is marked overflowed).
 #[derive(Clone, Debug, PartialEq)]
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub struct Memory {
     points: Vec<f64>,
+    capacity: usize,
+    overflowed: bool,
 }
 
 impl Memory {
@@ -100,11 +108,39 @@ impl Memory {
     pub fn points(&self) -> &[f64] {
         &self.points
     }
-    /// Negative saturation.
+    /// Negative saturation, with room for every corner a record can make.
     pub fn new(grid: &Grid) -> Self {
         Self {
             points: vec![grid.lower],
+            capacity: usize::MAX,
+            overflowed: false,
         }
+    }
+
+    /// Negative saturation, with room for `capacity` corners (≥ 1): storage for them (and
+    /// the one a step holds before it wipes out) is reserved now.
+    pub fn with_capacity(grid: &Grid, capacity: usize) -> Self {
+        let capacity = capacity.max(1);
+        let mut points = Vec::with_capacity(capacity.saturating_add(1));
+        points.push(grid.lower);
+        Self {
+            points,
+            capacity,
+            overflowed: false,
+        }
+    }
+
+    /// True once the input made more corners than the capacity (the memory no longer
+    /// represents the plane).
+    pub fn overflowed(&self) -> bool {
+        self.overflowed
+    }
+
+    /// Becomes a copy of `other` without allocating (the storage reserved stays).
+    fn copy_from(&mut self, other: &Memory) {
+        self.points.clone_from(&other.points);
+        self.capacity = other.capacity;
+        self.overflowed = other.overflowed;
     }
 
     /// Moves the input to x, wiping out the extrema it passes; returns the index of the first
@@ -141,6 +177,9 @@ impl Memory {
             p.drain(n - 3..n - 1);
             first = first.min(n - 3);
         }
+        if p.len() > self.capacity {
+            self.overflowed = true;
+        }
         first
     }
 
@@ -166,17 +205,36 @@ impl Memory {
 /// The memory with the running sums of the strips' Everett integrals
 /// Σ_{t≤s} [E(M_t, m_{t−1}) − E(M_t, m_t)], so that a sample costs only the strips it changes.
 #[derive(Clone, Debug)]
-struct State {
+pub(crate) struct State {
     memory: Memory,
     prefix: Vec<f64>,
 }
 
 impl State {
-    fn new(grid: &Grid) -> Self {
+    /// Negative saturation with room for `capacity` corners.
+    fn new(grid: &Grid, capacity: usize) -> Self {
         Self {
-            memory: Memory::new(grid),
-            prefix: Vec::new(),
+            memory: Memory::with_capacity(grid, capacity),
+            prefix: Vec::with_capacity(capacity / 2 + 1),
         }
+    }
+
+    /// The state of a batch (`horizon` its samples: storage grows with the corners the record
+    /// makes, never overflowing) or of a stream (None: [`STREAM_MEMORY`] corners reserved).
+    fn for_horizon(grid: &Grid, horizon: Option<usize>) -> Self {
+        match horizon {
+            Some(_) => Self {
+                memory: Memory::new(grid),
+                prefix: Vec::new(),
+            },
+            None => Self::new(grid, STREAM_MEMORY),
+        }
+    }
+
+    /// Becomes a copy of `other` without allocating.
+    fn copy_from(&mut self, other: &State) {
+        self.memory.copy_from(&other.memory);
+        self.prefix.clone_from(&other.prefix);
     }
 
     /// Moves the input to x and returns the integral of μ over S⁺.
@@ -372,41 +430,66 @@ pub fn regressors(grid: &Grid, memory: &Memory, phi: &mut [f64]) {
     }
 }
 
+/// The inverse's state: the plane's, and scratch space for the solve's trial steps.
+#[derive(Clone, Debug)]
+pub(crate) struct PreisachBackward {
+    state: State,
+    trial: RefCell<State>,
+}
+
 impl Core for Preisach {
-    fn forward(&self, u: &[f64]) -> Vec<f64> {
-        let mut state = State::new(&self.grid);
-        u.iter()
-            .map(|&x| {
-                let up = state.advance(self, x);
-                self.output(up, x)
-            })
-            .collect()
+    /// The staircase memory and the running sums of its strips' Everett integrals.
+    type Forward = State;
+    type Backward = PreisachBackward;
+
+    fn orientation(&self) -> Orientation {
+        self.orientation
     }
 
-    fn backward(&self, v: &[f64]) -> (Vec<f64>, Vec<usize>) {
+    fn forward_state(&self, horizon: Option<usize>) -> State {
+        State::for_horizon(&self.grid, horizon)
+    }
+
+    /// c + a₀u + 2·Σₖ [E(Mₖ, mₖ₋₁) − E(Mₖ, mₖ)] − Σw, the strips' sums accumulated oldest
+    /// first (module doc).
+    fn forward_step(&self, state: &mut State, u: f64) -> f64 {
+        let up = state.advance(self, u);
+        self.output(up, u)
+    }
+
+    fn backward_state(&self, horizon: Option<usize>) -> PreisachBackward {
+        let state = State::for_horizon(&self.grid, horizon);
+        PreisachBackward {
+            trial: RefCell::new(state.clone()),
+            state,
+        }
+    }
+
+    /// The branch from the current memory solved for v by trial steps on a copy of the
+    /// state, then the state advanced with the solution.
+    fn backward_step(&self, backward: &mut PreisachBackward, v: f64) -> (f64, bool) {
         let g = self.grid;
-        let mut state = State::new(&g);
         let branch = Branch {
             center: 0.5 * (g.lower + g.upper),
             span: 0.5 * (g.upper - g.lower) * (1.0 + 1e-12),
             unbounded_below: self.a0 > 0.0,
             unbounded_above: self.a0 > 0.0,
         };
-        let (mut u, mut clipped) = (Vec::with_capacity(v.len()), Vec::new());
-        for (k, &vk) in v.iter().enumerate() {
-            let trial = |x: f64| {
-                let mut trial_state = state.clone();
-                let up = trial_state.advance(self, x);
-                self.output(up, x)
-            };
-            let (x, c) = solve_monotone(trial, vk, branch);
-            if c {
-                clipped.push(k);
-            }
-            state.advance(self, x);
-            u.push(x);
-        }
+        let state = &backward.state;
+        let trial = |x: f64| {
+            let mut trial_state = backward.trial.borrow_mut();
+            trial_state.copy_from(state);
+            let up = trial_state.advance(self, x);
+            self.output(up, x)
+        };
+        let (u, clipped) = solve_monotone(trial, v, branch);
+        backward.state.advance(self, u);
         (u, clipped)
+    }
+
+    fn overflowed(&self, forward: Option<&State>, backward: Option<&PreisachBackward>) -> bool {
+        forward.is_some_and(|s| s.memory.overflowed())
+            || backward.is_some_and(|b| b.state.memory.overflowed())
     }
 }
 
@@ -430,11 +513,11 @@ impl HysteresisOperator for Preisach {
     }
 
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
-        oriented_simulate(self, self.orientation, u)
+        oriented_simulate(self, u)
     }
 
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
-        oriented_invert(self, self.orientation, reference)
+        oriented_invert(self, reference)
     }
 }
 

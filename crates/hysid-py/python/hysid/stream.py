@@ -1,0 +1,107 @@
+"""Streaming models: a saved model one sample at a time, as a controller runs it.
+
+``Model.stepper()`` returns a :class:`Stepper` whose ``step(u)`` gives the model's output
+for one input sample (exactly the sample ``Model.simulate`` gives there) and then advances
+its state; ``Model.compensator()`` a :class:`Compensator` whose ``step(r)`` gives the
+command that makes the model follow the reference ``r`` (clipped to the reachable range as
+``hysid compensate`` clips, and counted in ``.clipped``). Both have ``run(array)``, which
+feeds a whole record from the current state, and ``reset()``, back to the model's initial
+state. The semantics are the library's (``hysid::model::stream``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import TYPE_CHECKING, Any, Optional
+
+import numpy as np
+
+from . import _hysid
+
+if TYPE_CHECKING:  # pragma: no cover
+    from . import Model
+
+
+class Stepper:
+    """A model one sample at a time (see the module doc)."""
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+
+    @property
+    def n_inputs(self) -> int:
+        return int(self._inner.n_inputs)
+
+    @property
+    def n_outputs(self) -> int:
+        return int(self._inner.n_outputs)
+
+    def reset(self) -> None:
+        """Back to the model's initial state."""
+        self._inner.reset()
+
+    def step(self, u: Any) -> Any:
+        """The output for one input sample (a float, or one value per input); a float for a
+        model of one output, else an array."""
+        values = [float(v) for v in np.atleast_1d(np.asarray(u, dtype=np.float64))]
+        y = self._inner.step(values)
+        return y[0] if len(y) == 1 else np.asarray(y)
+
+    def run(self, u: Any) -> np.ndarray:
+        """The outputs for the input samples ``u`` (1-D, or 2-D (samples, inputs)) from the
+        current state: 1-D for one output, ``(samples, outputs)`` otherwise."""
+        a = np.asarray(u, dtype=np.float64)
+        channels = [np.ascontiguousarray(a)] if a.ndim == 1 else [np.ascontiguousarray(c) for c in a.T]
+        outs = self._inner.run(channels)
+        return outs[0] if len(outs) == 1 else np.column_stack(outs)
+
+
+class Compensator:
+    """A model's compensator one sample at a time (see the module doc)."""
+
+    def __init__(self, inner: Any) -> None:
+        self._inner = inner
+
+    @property
+    def clipped(self) -> int:
+        """How many references were clipped since the last reset."""
+        return int(self._inner.clipped)
+
+    @property
+    def preview(self) -> int:
+        """How many samples ahead the reference is given (a cascade's delay; 0 otherwise)."""
+        return int(self._inner.preview)
+
+    def reset(self) -> None:
+        """Back to the model's initial state (and ``clipped`` to 0)."""
+        self._inner.reset()
+
+    def step(self, r: float) -> float:
+        """The command for the reference sample ``r``."""
+        u, _, _ = self._inner.step(float(r))
+        return float(u)
+
+    def run(self, r: Any) -> np.ndarray:
+        """The commands for the references ``r`` (1-D) from the current state."""
+        u, _ = self._inner.run(np.ascontiguousarray(np.asarray(r, dtype=np.float64)))
+        return u
+
+
+def _ts(model: "Model", ts: Optional[float]) -> float:
+    """The sample time: the given one, else the model file's, else NaN (refused by the
+    models that need one, unused by the others)."""
+    if ts is not None:
+        return float(ts)
+    saved = model.file.get("sample_time")
+    return float(saved) if saved is not None else math.nan
+
+
+def stepper(model: "Model", *, ts: Optional[float] = None, y0: Optional[float] = None) -> Stepper:
+    """The :class:`Stepper` of ``model``."""
+    return Stepper(_hysid.model_stepper(json.dumps(model.file), _ts(model, ts), None if y0 is None else float(y0)))
+
+
+def compensator(model: "Model", *, ts: Optional[float] = None) -> Compensator:
+    """The :class:`Compensator` of ``model``."""
+    return Compensator(_hysid.model_compensator(json.dumps(model.file), _ts(model, ts)))

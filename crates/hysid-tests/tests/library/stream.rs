@@ -1,0 +1,446 @@
+//! Streaming models (`hysid::model::stream`): every kind's `Stepper` against the batch
+//! `FittedModel::simulate`, every compensator against the batch `compensate`, to the bit
+//! (`to_bits` on every sample), on a seeded signal with nested minor loops; reset; the
+//! one-line errors.
+
+use hysid::model::coleman_hodgdon::InitialOutput;
+use hysid::model::compensate::compensate;
+use hysid::model::greybox::equation_model::EquationStateSpace;
+use hysid::model::greybox::models::GreyBoxKind;
+use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::operators::OperatorModel;
+use hysid::model::saved::FittedModel;
+use hysid::model::stream::{compensate_stream, run, Stepper};
+use hysid::model::{ColemanHodgdon, HysteresisCascade, LinearBlock, OperatorCascade};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+
+/// A seeded signal of amplitude about `scale`: a decaying sweep (nested minor loops), a
+/// second tone and a little noise.
+fn signal(n: usize, scale: f64, seed: u64) -> Vec<f64> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    (0..n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            let envelope = 1.0 - 0.8 * t;
+            let s = envelope * (2.0 * std::f64::consts::PI * 7.0 * t).sin()
+                + 0.15 * (2.0 * std::f64::consts::PI * 31.0 * t).sin();
+            scale * (s + 0.01 * rng.random_range(-1.0..1.0))
+        })
+        .collect()
+}
+
+/// Asserts `a` and `b` hold the same bits, naming the first sample where they differ.
+fn assert_same(a: &[f64], b: &[f64], what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: lengths");
+    if let Some(k) = (0..a.len()).find(|&k| a[k].to_bits() != b[k].to_bits()) {
+        panic!("{what}: sample {k}: {} against {}", a[k], b[k]);
+    }
+}
+
+/// The stepper of `model` run over `inputs` equals `simulate` to the bit (or both fail with
+/// the same message); run twice with a reset in between gives the same bits again.
+fn assert_streams(model: &FittedModel, inputs: &[&[f64]], ts: f64, y0: Option<f64>, what: &str) {
+    let batch = model.simulate(inputs, ts, y0);
+    let mut stepper = model
+        .stepper(ts, y0)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    let first = run(stepper.as_mut(), inputs);
+    match (&batch, &first) {
+        (Ok(b), Ok(s)) => {
+            assert_eq!(b.len(), s.len(), "{what}: output count");
+            for (bc, sc) in b.iter().zip(s) {
+                assert_same(bc, sc, &format!("{what}: stepper against simulate"));
+            }
+        }
+        (Err(b), Err(s)) => assert_eq!(b.to_string(), s.to_string(), "{what}"),
+        (b, s) => panic!("{what}: batch {b:?} but stream {s:?}"),
+    }
+    stepper.reset();
+    let second = run(stepper.as_mut(), inputs);
+    match (first, second) {
+        (Ok(a), Ok(b)) => {
+            for (ac, bc) in a.iter().zip(&b) {
+                assert_same(ac, bc, &format!("{what}: a reset stepper"));
+            }
+        }
+        (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{what}"),
+        (a, b) => panic!("{what}: first run {a:?}, second {b:?}"),
+    }
+}
+
+/// The compensator of `model` equals `compensate` to the bit: commands, predicted outputs,
+/// clipped samples and their count; again after a reset.
+fn assert_compensates(model: &FittedModel, reference: &[f64], what: &str) {
+    let batch = compensate(model, reference).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let mut compensator = model
+        .compensator(1.0)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    for round in 0..2 {
+        let stream = compensate_stream(compensator.as_mut(), reference)
+            .unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert_same(&batch.u, &stream.u, &format!("{what}: u (round {round})"));
+        let predicted = format!("{what}: predicted (round {round})");
+        assert_same(&batch.predicted, &stream.predicted, &predicted);
+        assert_eq!(
+            batch.clipped, stream.clipped,
+            "{what}: clipped (round {round})"
+        );
+        assert_eq!(
+            compensator.clipped(),
+            batch.clipped.len(),
+            "{what}: clipped count"
+        );
+        assert_eq!(
+            batch.settled_from, stream.settled_from,
+            "{what}: settled_from"
+        );
+    }
+}
+
+fn no_std(n: usize) -> Vec<f64> {
+    vec![f64::NAN; n]
+}
+
+/// Every operator of the registry, and of every linear-in-weights family its clockwise
+/// (inverse-operator) form too: (name, operator, an input inside its domain).
+fn operators() -> Vec<(String, OperatorModel, Vec<f64>)> {
+    let u = signal(600, 1.0, 7);
+    let mut out = Vec::new();
+    for model in OperatorModel::examples().unwrap() {
+        let name = model.family().name().to_string();
+        let mut structure = model.structure().unwrap();
+        if let Some(o) = structure.get_mut("orientation").filter(|o| o.is_object()) {
+            o["inverse"] = serde_json::Value::Bool(true);
+            let clockwise = OperatorModel::from_structure(&name, &structure).unwrap();
+            // Γ = G⁻¹ takes G's outputs: the counter-clockwise operator's on the signal.
+            let inside = model.as_operator().simulate(&u).unwrap();
+            out.push((format!("{name} (clockwise)"), clockwise, inside));
+        }
+        out.push((name, model, u.clone()));
+    }
+    out
+}
+
+#[test]
+fn every_operator_streams_as_it_simulates_and_inverts() {
+    let families = operators();
+    assert!(families.len() >= hysid::model::operators::Family::operators().count());
+    for (name, model, u) in families {
+        let n = model.as_operator().parameters().len();
+        let fitted = FittedModel::operator(model.clone(), no_std(n));
+        assert_streams(&fitted, &[&u], 1.0, None, &name);
+        // A reachable reference (the operator's own output) and one beyond a saturation
+        // level (clipped where the family saturates).
+        let y = model.as_operator().simulate(&u).unwrap();
+        assert_compensates(&fitted, &y, &name);
+        let far: Vec<f64> = y.iter().map(|v| 3.0 * v).collect();
+        assert_compensates(&fitted, &far, &format!("{name}, far reference"));
+    }
+}
+
+fn linear(b2: f64) -> LinearBlock {
+    LinearBlock::new(vec![-0.6, 0.08], vec![1.0, b2], 1).unwrap()
+}
+
+#[test]
+fn operator_cascades_stream_and_compensate_as_the_batch() {
+    for (name, model, u) in operators() {
+        let cascade = OperatorCascade::new(model, linear(0.4)).unwrap();
+        let n = cascade.parameters().len();
+        let fitted = FittedModel::OperatorCascade {
+            model: cascade.clone(),
+            std: no_std(n),
+        };
+        assert_streams(&fitted, &[&u], 1.0, None, &format!("{name} cascade"));
+        let r = cascade.simulate(&u).unwrap().y;
+        assert_compensates(&fitted, &r, &format!("{name} cascade"));
+    }
+}
+
+#[test]
+fn a_non_minimum_phase_cascade_has_no_compensator_and_says_so_as_the_batch_does() {
+    let model = OperatorModel::examples().unwrap().remove(0);
+    let cascade = OperatorCascade::new(model, linear(1.5)).unwrap();
+    let n = cascade.parameters().len();
+    let fitted = FittedModel::OperatorCascade {
+        model: cascade,
+        std: no_std(n),
+    };
+    let stream = fitted.compensator(1.0).unwrap_err().to_string();
+    let batch = compensate(&fitted, &[0.0, 0.1]).unwrap_err().to_string();
+    assert_eq!(stream, batch);
+    assert!(
+        stream.contains("not minimum phase") && !stream.contains('\n'),
+        "{stream}"
+    );
+}
+
+fn coleman_hodgdon() -> [ColemanHodgdon; 2] {
+    [
+        ColemanHodgdon::saturated(0.3, 1.0, 0.5, 3.0).unwrap(),
+        ColemanHodgdon::general(0.4, 1.2, 0.15, 0.6, 0.1, 2.0).unwrap(),
+    ]
+}
+
+#[test]
+fn coleman_hodgdon_hysteresis_and_cascades_stream_as_the_batch() {
+    let x = signal(800, 2.0, 11);
+    for ch in coleman_hodgdon() {
+        for initial in [InitialOutput::Measured, InitialOutput::Zero] {
+            let fitted = FittedModel::Hysteresis {
+                model: ch.clone(),
+                initial,
+                std: no_std(ch.params().len()),
+            };
+            let what = format!("{:?} {initial:?}", ch.form());
+            assert_streams(&fitted, &[&x], 1.0, Some(0.25), &what);
+            let y = fitted.simulate(&[&x], 1.0, Some(0.25)).unwrap().remove(0);
+            assert_compensates(&fitted, &y, &what);
+            let far: Vec<f64> = y.iter().map(|v| 4.0 * v).collect();
+            assert_compensates(&fitted, &far, &format!("{what}, far reference"));
+        }
+        let cascade = HysteresisCascade::new(ch.clone(), linear(0.4)).unwrap();
+        let fitted = FittedModel::Cascade {
+            std: no_std(cascade.params().len()),
+            model: cascade,
+        };
+        assert_streams(&fitted, &[&x], 1.0, None, "ch cascade");
+        // A step faster than the rate limit 1/α: the same error, at the same sample.
+        let fast: Vec<f64> = x.iter().map(|v| 10.0 * v).collect();
+        assert_streams(&fitted, &[&fast], 1.0, None, "ch cascade, too fast");
+        let err = fitted.compensator(1.0).unwrap_err().to_string();
+        assert_eq!(err, compensate(&fitted, &x).unwrap_err().to_string());
+        assert!(
+            err.contains("not invertible") && !err.contains('\n'),
+            "{err}"
+        );
+    }
+}
+
+/// The simulation settings the grey-box streams are checked with.
+fn simulations() -> Vec<Simulation> {
+    let mut out = Vec::new();
+    for interpolation in [
+        InputInterpolation::ZeroOrderHold,
+        InputInterpolation::Linear,
+    ] {
+        for integrator in [
+            Integrator::Rk4 { substeps: 4 },
+            Integrator::Newmark { substeps: 2 },
+            Integrator::Adaptive {
+                rtol: 1e-6,
+                atol: 1e-9,
+            },
+        ] {
+            out.push(Simulation {
+                integrator,
+                interpolation,
+            });
+        }
+    }
+    out
+}
+
+/// The input channels of a model: seeded signals of amplitude `scale`.
+fn channels(n_inputs: usize, scale: f64) -> Vec<Vec<f64>> {
+    (0..n_inputs)
+        .map(|c| signal(300, scale, 100 + c as u64))
+        .collect()
+}
+
+#[test]
+fn built_in_grey_box_models_stream_as_they_simulate() {
+    for kind in GreyBoxKind::ALL {
+        let model = kind.model();
+        let parameters = model.parameters();
+        let inputs = channels(model.inputs().len(), 1.0);
+        let slices: Vec<&[f64]> = inputs.iter().map(Vec::as_slice).collect();
+        for simulation in simulations() {
+            let fitted = FittedModel::GreyBox {
+                kind: kind.name().to_string(),
+                std: no_std(parameters.len()),
+                parameters: parameters.clone(),
+                simulation,
+                initial_state: vec![0.0; model.states().len()],
+            };
+            let what = format!("{} {simulation:?}", kind.name());
+            match fitted.stepper(1e-3, None) {
+                Ok(_) => assert_streams(&fitted, &slices, 1e-3, None, &what),
+                // Refused settings (Newmark for a model that is not mechanical, …) are
+                // refused by the batch alike.
+                Err(e) => assert_eq!(
+                    e.to_string(),
+                    fitted
+                        .simulate(&slices, 1e-3, None)
+                        .unwrap_err()
+                        .to_string()
+                ),
+            }
+            assert!(fitted.streaming_differs().is_none(), "{what}");
+        }
+    }
+}
+
+/// An equation file that reads the time t, and a discrete-time one.
+const TIMED: &str = r#"
+[model]
+name = "forced"
+states = ["x", "v"]
+inputs = ["u"]
+outputs = ["y"]
+
+[parameters]
+k = { value = 4.0 }
+c = { value = 0.3 }
+
+[equations]
+x = "v"
+v = "-k*x - c*v*abs(v) + u + 0.5*sin(20*t)"
+
+[output]
+y = "x + 0.1*u"
+"#;
+const DISCRETE: &str = r#"
+[model]
+name = "recursion"
+states = ["x"]
+inputs = ["u"]
+outputs = ["y"]
+time = "discrete"
+
+[parameters]
+a = { value = 0.7 }
+
+[equations]
+x = "a*x + u - 0.1*x^3"
+
+[output]
+y = "x"
+"#;
+
+#[test]
+fn equation_models_stream_as_they_simulate() {
+    let texts = [
+        std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/equations/bouc_wen.toml"
+        ))
+        .unwrap(),
+        TIMED.to_string(),
+        DISCRETE.to_string(),
+    ];
+    for text in texts {
+        let model = EquationStateSpace::parse(&text, "test").unwrap();
+        let inputs = channels(model.inputs().len(), 1.0);
+        let slices: Vec<&[f64]> = inputs.iter().map(Vec::as_slice).collect();
+        for simulation in simulations() {
+            let fitted = FittedModel::Equations {
+                equations: text.clone(),
+                parameters: model.parameters(),
+                std: no_std(model.parameters().len()),
+                simulation,
+                initial_state: model.initial_values(),
+            };
+            let what = format!("{} {simulation:?}", model.name());
+            match fitted.stepper(1e-2, None) {
+                Ok(_) => assert_streams(&fitted, &slices, 1e-2, None, &what),
+                Err(e) => assert_eq!(
+                    e.to_string(),
+                    fitted
+                        .simulate(&slices, 1e-2, None)
+                        .unwrap_err()
+                        .to_string()
+                ),
+            }
+        }
+    }
+}
+
+#[test]
+fn band_limited_interpolation_is_reported_as_differing() {
+    let kind = GreyBoxKind::BoucWen;
+    let model = kind.model();
+    let fitted = FittedModel::GreyBox {
+        kind: kind.name().into(),
+        std: no_std(model.parameters().len()),
+        parameters: model.parameters(),
+        simulation: Simulation {
+            integrator: Integrator::Rk4 { substeps: 4 },
+            interpolation: InputInterpolation::BandLimited,
+        },
+        initial_state: vec![0.0; model.states().len()],
+    };
+    let why = fitted.streaming_differs().unwrap();
+    assert!(why.contains("band-limited") && !why.contains('\n'), "{why}");
+    // It still streams (with linear interpolation).
+    assert!(fitted.stepper(1e-3, None).is_ok());
+}
+
+#[test]
+fn kinds_that_cannot_stream_or_invert_say_so_in_one_line() {
+    let kind = GreyBoxKind::RigidBody;
+    let model = kind.model();
+    let rigid = FittedModel::GreyBox {
+        kind: kind.name().into(),
+        std: no_std(model.parameters().len()),
+        parameters: model.parameters(),
+        simulation: Simulation::default(),
+        initial_state: vec![0.0; model.states().len()],
+    };
+    let err = rigid.compensator(1.0).unwrap_err().to_string();
+    assert!(
+        err.contains("not invertible") && !err.contains('\n'),
+        "{err}"
+    );
+    let prefiltered = FittedModel::prefiltered(
+        rigid,
+        Some(hysid::model::record_filters::Prefilter {
+            remove_mean: true,
+            cutoff_hz: Some(10.0),
+            order: 2,
+        }),
+    );
+    for err in [
+        prefiltered.stepper(1e-3, None).unwrap_err().to_string(),
+        prefiltered.compensator(1e-3).unwrap_err().to_string(),
+    ] {
+        assert!(err.contains("zero phase") && !err.contains('\n'), "{err}");
+    }
+}
+
+#[test]
+fn bad_samples_are_one_line_errors() {
+    let model = OperatorModel::examples().unwrap().remove(0);
+    let mut stepper = model.stepper().unwrap();
+    let mut y = [0.0];
+    let err = stepper.step(&[f64::NAN], &mut y).unwrap_err().to_string();
+    assert!(err.contains("input 1") && !err.contains('\n'), "{err}");
+    let err = stepper.step(&[0.0, 1.0], &mut y).unwrap_err().to_string();
+    assert!(err.contains("1 input(s)"), "{err}");
+    let mut compensator = model.compensator().unwrap();
+    let err = compensator.step(f64::INFINITY).unwrap_err().to_string();
+    assert!(err.contains("reference") && !err.contains('\n'), "{err}");
+}
+
+#[test]
+fn a_preisach_stream_refuses_an_input_that_nests_deeper_than_its_memory() {
+    let model = OperatorModel::examples()
+        .unwrap()
+        .into_iter()
+        .find(|m| m.family().name() == "preisach")
+        .unwrap();
+    // Shrinking oscillations: every reversal a new corner of the staircase.
+    let u: Vec<f64> = (0..200)
+        .map(|k| 0.9 * (-1f64).powi(k) * (1.0 - k as f64 / 250.0))
+        .collect();
+    let batch = model.as_operator().simulate(&u).unwrap();
+    let mut stepper: Box<dyn Stepper> = model.stepper().unwrap();
+    let err = run(stepper.as_mut(), &[&u]).unwrap_err().to_string();
+    assert!(err.contains("minor loops") && !err.contains('\n'), "{err}");
+    // Up to the capacity it is the batch's.
+    stepper.reset();
+    let depth = hysid::model::operators::preisach::STREAM_MEMORY - 2;
+    let head = run(stepper.as_mut(), &[&u[..depth]]).unwrap();
+    assert_same(&head[0], &batch[..depth], "preisach within its memory");
+}

@@ -1,0 +1,125 @@
+//! Operators one sample at a time: each family's streaming form
+//! ([`StreamingOperator`](crate::model::operators::streaming::StreamingOperator), supplied in
+//! the family's own model file), dispatched from [`OperatorModel`] by the registry's
+//! `operator_families!` list.
+
+use super::{Compensator, CompensatorStep, Guarded, GuardedInverse, InverseKernel, Kernel};
+use crate::model::operators::streaming::StreamingOperator;
+use crate::model::operators::OperatorModel;
+use crate::Result;
+
+/// Γ of one family, streamed.
+#[derive(Clone, Debug)]
+pub(super) struct OperatorStream<F: StreamingOperator> {
+    operator: F,
+    initial: F::Forward,
+    state: F::Forward,
+}
+
+impl<F: StreamingOperator> OperatorStream<F> {
+    /// The operator at its initial state.
+    pub(super) fn new(operator: F) -> Result<Self> {
+        let initial = operator.forward_stream()?;
+        Ok(Self {
+            operator,
+            state: initial.clone(),
+            initial,
+        })
+    }
+
+    /// Γ\[u\]ₖ; the state moves on.
+    pub(super) fn next(&mut self, k: usize, u: f64) -> Result<f64> {
+        self.operator.forward_sample(&mut self.state, k, u)
+    }
+
+    /// Back to the initial state.
+    pub(super) fn restart(&mut self) {
+        self.state.clone_from(&self.initial);
+    }
+}
+
+impl<F: StreamingOperator + Send + std::fmt::Debug> Kernel for OperatorStream<F> {
+    fn reset(&mut self) {
+        self.restart();
+    }
+    fn step(&mut self, k: usize, u: &[f64], y: &mut [f64]) -> Result<()> {
+        y[0] = self.next(k, u[0])?;
+        Ok(())
+    }
+}
+
+/// Γ⁻¹ of one family, streamed.
+#[derive(Clone, Debug)]
+pub(super) struct OperatorInverse<F: StreamingOperator> {
+    operator: F,
+    initial: F::Inverse,
+    state: F::Inverse,
+}
+
+impl<F: StreamingOperator> OperatorInverse<F> {
+    /// The inverse at its initial state.
+    pub(super) fn new(operator: F) -> Result<Self> {
+        let initial = operator.inverse_stream()?;
+        Ok(Self {
+            operator,
+            state: initial.clone(),
+            initial,
+        })
+    }
+}
+
+impl<F: StreamingOperator + Send + std::fmt::Debug> InverseKernel for OperatorInverse<F> {
+    fn reset(&mut self) {
+        self.state.clone_from(&self.initial);
+    }
+    fn step(&mut self, k: usize, r: f64) -> Result<CompensatorStep> {
+        self.operator.inverse_sample(&mut self.state, k, r)
+    }
+}
+
+/// An operator of any family streamed, the family's type erased: what a cascade holds.
+pub(super) type AnyOperatorStream = Box<dyn Kernel>;
+/// An operator's inverse of any family streamed, the family's type erased.
+pub(super) type AnyOperatorInverse = Box<dyn InverseKernel>;
+
+/// `OperatorModel::stream` and `OperatorModel::inverse_stream`, one arm per family of the
+/// registry.
+macro_rules! dispatch {
+    ($($variant:ident: $ty:ty),* $(,)?) => {
+        impl OperatorModel {
+            /// The operator one sample at a time, from its documented initial state (the
+            /// kernel a cascade's stream holds).
+            pub(super) fn stream(&self) -> Result<AnyOperatorStream> {
+                Ok(match self {
+                    $(OperatorModel::$variant(m) => Box::new(OperatorStream::new(m.clone())?),)*
+                })
+            }
+
+            /// The operator's inverse one sample at a time.
+            pub(super) fn inverse_stream(&self) -> Result<AnyOperatorInverse> {
+                Ok(match self {
+                    $(OperatorModel::$variant(m) => Box::new(OperatorInverse::new(m.clone())?),)*
+                })
+            }
+        }
+    };
+}
+crate::model::operators::operator_families!(dispatch);
+
+impl OperatorModel {
+    /// The operator as a [`Stepper`](super::Stepper): Γ\[u\]ₖ for each uₖ, from the family's
+    /// documented initial state; equal to the batch [`simulate`] to the bit.
+    ///
+    /// [`simulate`]: crate::model::operators::HysteresisOperator::simulate
+    pub fn stepper(&self) -> Result<Box<dyn super::Stepper>> {
+        Ok(Box::new(Guarded::new(self.stream()?, 1, 1)))
+    }
+
+    /// The operator's inverse as a [`Compensator`]: the command uₖ with Γ\[u\]ₖ = rₖ, clipped
+    /// where the batch [`invert`] clips; equal to it to the bit.
+    ///
+    /// [`invert`]: crate::model::operators::HysteresisOperator::invert
+    pub fn compensator(&self) -> Result<Box<dyn Compensator>> {
+        Ok(Box::new(GuardedInverse::new(self.inverse_stream()?)))
+    }
+}
