@@ -38,12 +38,15 @@ Errors are :class:`HysidError` subclasses; bad data and bad settings are also
 
 Modules: ``parameters`` (:class:`Parameter`), ``models`` (:class:`Model`), ``greybox``
 (:class:`GreyBoxModel`), ``results`` (:class:`Result`), ``recipes`` (the seed papers'
-recipes), ``actuator``, ``zoo`` (the hysteresis families), ``fleet`` (Dask); every public
-name is importable from ``hysid`` itself.
+recipes), ``actuator``, ``zoo`` (the hysteresis families: :func:`identify_operator`,
+:func:`compare`, :func:`compensate`), ``comparison`` (:class:`Comparison`),
+``compensation`` (:class:`Compensation`), ``plot`` (matplotlib figures), ``fleet`` (Dask);
+every public name is importable from ``hysid`` itself.
 """
 
-from . import _hysid, fleet
+from . import _hysid, fleet, plot
 from ._families import FAMILIES, FamilyName
+from ._fields import ReportError
 from ._hysid import (
     CallbackError,
     ConfigError,
@@ -54,6 +57,8 @@ from ._hysid import (
     NumericalError,
 )
 from .actuator import ACTUATOR_GEAR_RATIO, ACTUATOR_SADDLE_MASS, ActuatorRecord, actuator_rig, actuator_three_steps
+from .comparison import CompareRow, Comparison
+from .compensation import Compensation
 from .greybox import GreyBoxModel
 from .models import Model, load_model
 from .parameters import Parameter
@@ -67,8 +72,8 @@ from .recipes import (
     rigid_body_ls,
     set_num_threads,
 )
-from .results import Result
-from .zoo import identify_operator
+from .results import Record, Result, ValidationEntry
+from .zoo import compare, compensate, identify_operator
 
 __version__: str = _hysid.__version__
 
@@ -76,6 +81,11 @@ __all__ = [
     "FAMILIES",
     "FamilyName",
     "identify_operator",
+    "compare",
+    "compensate",
+    "Comparison",
+    "CompareRow",
+    "Compensation",
     "identify_cascade",
     "identify_hysteresis",
     "greybox_fit",
@@ -90,6 +100,9 @@ __all__ = [
     "Parameter",
     "GreyBoxModel",
     "Result",
+    "Record",
+    "ValidationEntry",
+    "ReportError",
     "Model",
     "HysidError",
     "DataError",
@@ -99,6 +112,7 @@ __all__ = [
     "CallbackError",
     "InternalError",
     "fleet",
+    "plot",
     "BOUC_WEN_FS",
     "ACTUATOR_GEAR_RATIO",
     "ACTUATOR_SADDLE_MASS",

@@ -7,7 +7,7 @@ import copy
 import json
 import math
 import os
-from typing import Any, Callable, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, List, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -16,6 +16,12 @@ from ._hysid import CallbackError, ConfigError, DataError, ModelFileError
 from ._inputs import FloatArray, array, choice, count
 from .models import CallbackSpec, Model
 from .parameters import Parameter
+
+#: How a continuous-time model is integrated between samples.
+Integrator = Literal["rk4", "newmark"]
+
+#: What the input does between samples: held, interpolated, or band-limited.
+Interpolation = Literal["zoh", "linear", "band-limited"]
 
 #: A model function f(t, x, u, p) -> array.
 ModelFunction = Callable[[float, FloatArray, FloatArray, FloatArray], Any]
@@ -166,7 +172,9 @@ class GreyBoxModel:
             raise ModelFileError(f"cannot read equation file {os.fspath(path)}: {e.strerror}") from None
         return cls.from_equations(text, origin=os.fspath(path))
 
-    def to_model(self, *, integrator: str = "rk4", substeps: int = 10, interpolation: str = "zoh") -> "Model":
+    def to_model(
+        self, *, integrator: Integrator = "rk4", substeps: int = 10, interpolation: Interpolation = "zoh"
+    ) -> "Model":
         """The model with its current parameter values as a :class:`Model` (simulate, save;
         an equation model's file is the ``equations`` kind the CLI reads)."""
         sim = (choice(integrator, "integrator"), count(substeps, "substeps"), choice(interpolation, "interpolation"))
@@ -189,7 +197,13 @@ class GreyBoxModel:
         return Model(file, self)
 
     def simulate(
-        self, u: Any, *, ts: float, integrator: str = "rk4", substeps: int = 10, interpolation: str = "zoh"
+        self,
+        u: Any,
+        *,
+        ts: float,
+        integrator: Integrator = "rk4",
+        substeps: int = 10,
+        interpolation: Interpolation = "zoh",
     ) -> FloatArray:
         """The output for input ``u`` (1-D, or 2-D (samples, inputs)) sampled every ``ts``
         seconds, from ``x0`` with the current parameter values (RK4 with ``substeps`` per

@@ -53,20 +53,6 @@ class Parameter:
         if math.isnan(self.lower) or math.isnan(self.upper) or self.lower > self.upper:
             raise ConfigError(f"parameter {name}: bounds [{self.lower}, {self.upper}] are not an interval")
 
-    @classmethod
-    def from_record(cls, rec: Dict[str, Any]) -> "Parameter":
-        """The parameter of a model file's record (null bounds are infinite)."""
-        lo, hi = rec.get("lower"), rec.get("upper")
-        return cls(
-            rec["name"],
-            rec["value"],
-            lower=-math.inf if lo is None else lo,
-            upper=math.inf if hi is None else hi,
-            fixed=rec.get("fixed", False),
-            unit=rec.get("unit", ""),
-            std=rec.get("std"),
-        )
-
     def to_record(self) -> Dict[str, Any]:
         """The model file's record of the parameter (infinite bounds are null)."""
         return {

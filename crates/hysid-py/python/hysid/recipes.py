@@ -8,14 +8,16 @@ from __future__ import annotations
 import copy
 import json
 import math
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
+import typing
+from typing import Any, Dict, Iterable, List, Literal, Optional, Sequence, Tuple, Union
 
 from . import _hysid
 from . import _inputs as check
+from ._families import FAMILIES, FamilyName
 from ._hysid import ConfigError, DataError
-from .greybox import GreyBoxModel
+from .greybox import GreyBoxModel, Integrator, Interpolation
 from .parameters import Parameter
-from .results import Result
+from .results import Record, Result
 
 
 def set_num_threads(n: Optional[int]) -> None:
@@ -33,56 +35,103 @@ def get_num_threads() -> int:
     return int(_hysid.get_num_threads())
 
 
+#: The Coleman–Hodgdon forms of the seed paper's pipeline (every other family of the
+#: registry is an operator: :func:`identify_cascade` fits it as an operator cascade).
+ChForm = Literal["ch4", "ch6"]
+CH_FORMS: Tuple[str, ...] = typing.get_args(ChForm)
+
+#: How the standard deviations of a cascade are obtained.
+UncertaintyMethod = Literal["asymptotic", "bootstrap"]
+
+#: The built-in grey-box models of :func:`greybox_fit`.
+BuiltinModel = Literal["bouc-wen", "rigid-body", "actuator-fixed", "actuator-free"]
+
+#: What a Coleman–Hodgdon hysteresis starts from.
+InitialOutput = Literal["measured", "zero"]
+
+
 def identify_cascade(
     x: Any,
     y: Any = None,
     *,
-    hysteresis: str = "ch4",
+    hysteresis: FamilyName = "ch4",
     na: int,
     nb: int,
     delay: int,
     ts: float = 1.0,
-    uncertainty: str = "asymptotic",
+    uncertainty: UncertaintyMethod = "asymptotic",
     seed: int = 0,
     replicates: int = 30,
+    thresholds: Optional[int] = None,
+    grid: Optional[int] = None,
     threads: Optional[int] = None,
 ) -> Result:
-    """Identifies a Coleman–Hodgdon hysteresis + linear-block cascade (Vörös 2015).
+    """Identifies a hysteresis + linear-block cascade: v(k) = H[x](k), A(q⁻¹) y(k) =
+    q⁻ᵈᵉˡᵃʸ B(q⁻¹) v(k) with ``na`` denominator and ``nb`` numerator coefficients.
 
-    v(k) = H[x](k) is a Coleman–Hodgdon hysteresis of form ``hysteresis`` (``ch1``…``ch4``);
-    A(q⁻¹) y(k) = q⁻ᵈᵉˡᵃʸ B(q⁻¹) v(k) with ``na`` denominator and ``nb`` numerator
-    coefficients. Estimation: a grid over the switching threshold, the paper's key-term
-    separation iteration, then output error (Levenberg–Marquardt) from the best candidates.
-    ``uncertainty``: ``"asymptotic"`` (σ²(JᵀJ)⁻¹) or ``"bootstrap"`` (parametric bootstrap,
-    ``replicates`` re-identifications seeded by ``seed``). ``x`` may be a record with
-    ``.u``, ``.y`` (then ``y`` is omitted). Runs with the GIL released; ``threads``: worker
-    threads (None: the process default, all cores; 1 for concurrent fits).
-    The report is the CLI's ``identify cascade`` report.
+    ``hysteresis``: ``"ch4"`` or ``"ch6"``, the Coleman–Hodgdon hysteresis of Vörös (2015),
+    estimated by a grid over the switching threshold, the paper's key-term separation
+    iteration, then output error (Levenberg–Marquardt) from the best candidates; or any
+    operator family of :data:`FAMILIES` (``"pi"``, ``"bouc-wen"``, …), estimated from the
+    family's own start and ARX, then output error (the CLI's ``identify cascade
+    --hysteresis FAMILY``). ``uncertainty``: ``"asymptotic"`` (σ²(JᵀJ)⁻¹) or, for ch4/ch6,
+    ``"bootstrap"`` (parametric bootstrap, ``replicates`` re-identifications seeded by
+    ``seed``). ``thresholds`` (PI, GPI, Maxwell-slip; default 10) and ``grid`` (Preisach;
+    default 10) size an operator's structure. ``x`` may be a record with ``.u``, ``.y``
+    (then ``y`` is omitted). Runs with the GIL released; ``threads``: worker threads
+    (None: the process default, all cores; 1 for concurrent fits). The report is the CLI's
+    ``identify cascade`` report.
     """
     x, y, ts = check.pair(x, y, ("x", "y"), ts)
-    text = _hysid.identify_cascade(
-        x,
-        y,
-        check.choice(hysteresis, "hysteresis"),
-        check.count(na, "na"),
-        check.count(nb, "nb"),
-        check.count(delay, "delay"),
-        check.sample_time(ts, 1.0),
-        check.choice(uncertainty, "uncertainty"),
-        check.count(replicates, "replicates"),
-        check.count(seed, "seed"),
-        check.threads(threads),
-    )
-    return Result(json.loads(text))
+    step = check.sample_time(ts, 1.0)
+    name = check.choice(hysteresis, "hysteresis", FAMILIES)
+    method = check.choice(uncertainty, "uncertainty", typing.get_args(UncertaintyMethod))
+    orders = (check.count(na, "na"), check.count(nb, "nb"), check.count(delay, "delay"))
+    if name in CH_FORMS:
+        for option, value in (("thresholds", thresholds), ("grid", grid)):
+            if value is not None:
+                raise ConfigError(f"{option} applies to operator cascades, not to {name}")
+        text = _hysid.identify_cascade(
+            x,
+            y,
+            name,
+            *orders,
+            step,
+            method,
+            check.count(replicates, "replicates"),
+            check.count(seed, "seed"),
+            check.threads(threads),
+        )
+    else:
+        if method != "asymptotic":
+            raise ConfigError(
+                f"uncertainty={method!r} is available for ch4 and ch6; operator cascades report "
+                "asymptotic standard deviations (use uncertainty='asymptotic')"
+            )
+        if thresholds is not None and name not in ("pi", "gpi", "maxwell-slip"):
+            raise ConfigError(f"thresholds applies to pi, gpi and maxwell-slip, not {name}")
+        if grid is not None and name != "preisach":
+            raise ConfigError(f"grid applies to preisach, not {name}")
+        text = _hysid.identify_operator_cascade(
+            x,
+            y,
+            name,
+            *orders,
+            step,
+            10 if thresholds is None else check.count(thresholds, "thresholds"),
+            10 if grid is None else check.count(grid, "grid"),
+            check.threads(threads),
+        )
+    return Result(json.loads(text), data=Record(x, y, step))
 
 
 def identify_hysteresis(
     x: Any,
     y: Any = None,
     *,
-    hysteresis: str = "ch4",
+    hysteresis: ChForm = "ch4",
     ts: float = 1.0,
-    initial_output: str = "measured",
+    initial_output: InitialOutput = "measured",
     threads: Optional[int] = None,
 ) -> Result:
     """Identifies a Coleman–Hodgdon hysteresis y = H[x] alone: separated linear regression
@@ -90,18 +139,24 @@ def identify_hysteresis(
     ``"measured"`` (the model starts from y[0]) or ``"zero"``. ``threads``: as for
     :func:`identify_cascade`."""
     x, y, ts = check.pair(x, y, ("x", "y"), ts)
+    step = check.sample_time(ts, 1.0)
     text = _hysid.identify_hysteresis(
         x,
         y,
-        check.choice(hysteresis, "hysteresis"),
-        check.sample_time(ts, 1.0),
-        check.choice(initial_output, "initial_output"),
+        check.choice(hysteresis, "hysteresis", CH_FORMS),
+        step,
+        check.choice(initial_output, "initial_output", typing.get_args(InitialOutput)),
         check.threads(threads),
     )
-    return Result(json.loads(text))
+    return Result(json.loads(text), data=Record(x, y, step))
 
 
-def _configure(params: List[Parameter], init, fix, bounds) -> List[Parameter]:
+def _configure(
+    params: List[Parameter],
+    init: Optional[Dict[str, float]],
+    fix: Union[str, Iterable[str]],
+    bounds: Optional[Dict[str, Tuple[float, float]]],
+) -> List[Parameter]:
     by_name = {p.name: p for p in params}
 
     def get(name: str, what: str) -> Parameter:
@@ -131,7 +186,7 @@ def _configure(params: List[Parameter], init, fix, bounds) -> List[Parameter]:
 
 
 def greybox_fit(
-    model: Any,
+    model: Union[BuiltinModel, GreyBoxModel],
     u: Any,
     y: Any = None,
     *,
@@ -141,9 +196,9 @@ def greybox_fit(
     bounds: Optional[Dict[str, Tuple[float, float]]] = None,
     starts: int = 1,
     seed: int = 0,
-    integrator: str = "rk4",
+    integrator: Integrator = "rk4",
     substeps: int = 10,
-    interpolation: str = "zoh",
+    interpolation: Interpolation = "zoh",
     threads: Optional[int] = None,
 ) -> Result:
     """Output-error fit of a continuous-time grey-box model ẋ = f(t, x, u, θ), y = h(x, u, θ).
