@@ -9,7 +9,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, TypedDict
 
 from ._fields import Fields, ReportError
 from ._inputs import FloatArray
-from .models import Model
+from .models import Model, model_in
 from .plot import Axes, Figure
 from .results import REPORT_SCHEMA, Record, Result
 
@@ -90,8 +90,7 @@ class Comparison:
         kind = None if split is None else split.get("kind", str)
         train = split.get("train", int) if split is not None and kind == "fraction" else len(training.u)
         self.table = [_row(r) for r in details.objects("families")]
-        model = f.raw("model")
-        self.model = None if model is None else Model(model)
+        self.model = model_in(f.raw("model"), "report.model")
         if [name for name, _ in results] != [r["family"] for r in self.table] or len(simulated) != len(self.table):
             raise ReportError("compare: the families' results do not match the report's rows")
         fitted = Record(training.u[:train], training.y[:train], training.ts)

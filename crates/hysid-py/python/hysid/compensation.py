@@ -10,7 +10,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 from ._fields import Fields, ReportError
 from ._inputs import FloatArray
-from .models import Model
+from .models import Model, model_in
 from .plot import Axes, Figure
 from .results import REPORT_SCHEMA
 
@@ -42,10 +42,10 @@ class Compensation:
         f = Fields(report, "report")
         if f.get("schema", str) != REPORT_SCHEMA or f.get("command", str) != "compensate":
             raise ReportError("report: not the hysid.report/1 report of compensate")
-        model = f.object("model")
+        model = model_in(f.raw("model"), "report.model")
         if model is None:
             raise ReportError("report.model is null; a compensation names its model")
-        self.model = Model(model.mapping())
+        self.model = model
         details = f.object("details")
         if details is None:
             raise ReportError("report.details is null; a compensation holds its figures there")

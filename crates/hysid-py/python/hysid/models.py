@@ -122,6 +122,17 @@ class Model:
         return (_model_from_json, (json.dumps(self.file), self._user))
 
 
+def model_in(value: Any, where: str, user: Optional[Callbacks] = None) -> Optional[Model]:
+    """The model file ``value`` held by the report field ``where`` (None when null); errors
+    name the field in the report."""
+    if value is None:
+        return None
+    try:
+        return Model(value, user)
+    except ReportError as e:
+        raise ReportError(f"{where}{str(e)[len('model') :]}") from None
+
+
 def _callback_simulation(fields: Fields) -> Tuple[str, int, str]:
     """(integrator, substeps, interpolation) of a model written as Python functions, as
     the extension module takes them."""

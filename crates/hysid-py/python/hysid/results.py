@@ -14,7 +14,7 @@ from typing import Any, Dict, List, NamedTuple, Optional, Tuple, TypedDict
 
 from ._fields import Fields, ReportError
 from ._inputs import FloatArray
-from .models import Callbacks, Model
+from .models import Callbacks, Model, model_in
 from .parameters import Parameter
 from .plot import Axes, Figure
 
@@ -95,8 +95,7 @@ class Result:
         if schema != REPORT_SCHEMA:
             raise ReportError(f"report.schema is {schema!r}; this hysid reads {REPORT_SCHEMA!r}")
         self.command = f.get("command", str)
-        model = f.raw("model")
-        self.model = None if model is None else Model(model, user)
+        self.model = model_in(f.raw("model"), "report.model", user)
         self.parameters = self.model.parameters if self.model is not None else {}
         fit = f.object("fit")
         self.fit_percent = None if fit is None else fit.get("fit_percent", float)
