@@ -8,7 +8,7 @@ from typing import Any, Dict, List, Mapping, Optional, Type, TypeVar
 
 from ._hysid import HysidError
 
-T = TypeVar("T", str, int, float, bool, dict, list)
+T = TypeVar("T", str, int, float, bool, Dict[str, Any], List[Any])
 
 
 class ReportError(HysidError, ValueError):
@@ -18,7 +18,7 @@ class ReportError(HysidError, ValueError):
 
 ReportError.__module__ = "hysid"
 
-_NAMES = {
+_NAMES: Dict[type, str] = {
     str: "a string",
     int: "an integer",
     float: "a number",

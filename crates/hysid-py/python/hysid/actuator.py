@@ -6,20 +6,25 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
 from . import _hysid
 from . import _inputs as check
 from ._hysid import ConfigError, DataError, ModelFileError
+from ._inputs import FloatArray
 from .results import Result
 
 #: Gear ratio r [m/rad] and saddle mass m [kg] of the actuator of Gunnar et al. (2006).
 ACTUATOR_GEAR_RATIO, ACTUATOR_SADDLE_MASS = 1.867e-3, 1.2
 
 
-def _actuator_sets(records: Any, ts: Optional[float]):
+#: A data set as the extension module takes it: (torque, angle, sample time).
+DataSet = Tuple[FloatArray, FloatArray, float]
+
+
+def _actuator_sets(records: Any, ts: Optional[float]) -> Tuple[List[DataSet], str, Optional[Dict[str, float]]]:
     """(sets [(torque, angle, ts)] for data sets 1–8, source, truth from rig.json or None)."""
     if isinstance(records, (str, os.PathLike)):
         folder = os.fspath(records)
@@ -151,10 +156,10 @@ class ActuatorRecord:
     def __repr__(self) -> str:
         return f"ActuatorRecord(set {self.set}, {self.u.size} samples at {1 / self.sampling_time:g} Hz)"
 
-    def __getstate__(self):
+    def __getstate__(self) -> Tuple[Any, ...]:
         return tuple(getattr(self, s) for s in self.__slots__)
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: Tuple[Any, ...]) -> None:
         for name, v in zip(self.__slots__, state):
             object.__setattr__(self, name, v)
 

@@ -23,7 +23,9 @@ from .parameters import Parameter, ParameterTuple
 
 #: A model written as Python functions, as the extension module takes it: (rhs, output,
 #: state names, inputs, outputs, parameters, initial state).
-CallbackSpec = Tuple[Callable[..., Any], Callable[..., Any], List[str], int, int, List[ParameterTuple], List[float]]
+CallbackSpec = Tuple[
+    Optional[Callable[..., Any]], Optional[Callable[..., Any]], List[str], int, int, List[ParameterTuple], List[float]
+]
 
 
 #: The model file format this package reads and writes.

@@ -11,7 +11,7 @@ and :class:`hysid.Compensation` call these.
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING, Any, List, Optional, Tuple
+from typing import TYPE_CHECKING, Any, List, Optional, Tuple, cast
 
 import numpy as np
 
@@ -28,6 +28,8 @@ if TYPE_CHECKING:
 else:  # matplotlib is optional: without it the annotations still resolve at run time
     Axes = Figure = Any
 
+__all__ = ["Axes", "Figure", "RESIDUAL_LAGS", "fit", "loop", "residuals", "comparison", "compensation"]
+
 #: Largest lag of the residual analysis (the grey-box reports').
 RESIDUAL_LAGS = 25
 
@@ -43,13 +45,13 @@ def _pyplot() -> Any:
 def _axes(ax: Optional[Axes], panels: int) -> Tuple[Figure, List[Axes]]:
     """``ax`` and its figure, or a new figure of ``panels`` stacked axes (the first taller)."""
     if ax is not None:
-        return ax.figure, [ax]
+        return cast(Figure, ax.figure), [ax]
     plt = _pyplot()
     ratios = [3] + [1] * (panels - 1)
     fig, axes = plt.subplots(
         panels, 1, squeeze=False, figsize=(8, 3 + 1.5 * panels), gridspec_kw={"height_ratios": ratios}
     )
-    return fig, list(axes[:, 0])
+    return cast(Figure, fig), list(axes[:, 0])
 
 
 def _fitted(result: "Result") -> Tuple[FloatArray, FloatArray, FloatArray, float]:

@@ -82,8 +82,8 @@ def identify_cascade(
     (None: the process default, all cores; 1 for concurrent fits). The report is the CLI's
     ``identify cascade`` report.
     """
-    x, y, ts = check.pair(x, y, ("x", "y"), ts)
-    step = check.sample_time(ts, 1.0)
+    x, y, given_ts = check.pair(x, y, ("x", "y"), ts)
+    step = check.sample_time(given_ts, 1.0)
     name = check.choice(hysteresis, "hysteresis", FAMILIES)
     method = check.choice(uncertainty, "uncertainty", typing.get_args(UncertaintyMethod))
     orders = (check.count(na, "na"), check.count(nb, "nb"), check.count(delay, "delay"))
@@ -138,8 +138,8 @@ def identify_hysteresis(
     with the switching threshold re-estimated, then output error. ``initial_output``:
     ``"measured"`` (the model starts from y[0]) or ``"zero"``. ``threads``: as for
     :func:`identify_cascade`."""
-    x, y, ts = check.pair(x, y, ("x", "y"), ts)
-    step = check.sample_time(ts, 1.0)
+    x, y, given_ts = check.pair(x, y, ("x", "y"), ts)
+    step = check.sample_time(given_ts, 1.0)
     text = _hysid.identify_hysteresis(
         x,
         y,
@@ -240,9 +240,9 @@ def greybox_fit(
     if not isinstance(model, str):
         raise TypeError(f"model: give a built-in model name or a hysid.GreyBoxModel, got {type(model).__name__}")
     defaults, _, _ = _hysid.model_parameters(model)
-    params = [Parameter(n, v, lower=lo, upper=hi, fixed=f, unit=unit) for (n, v, lo, hi, f, unit) in defaults]
-    params = _configure(params, init, fix, bounds)
-    text = _hysid.greybox_fit(model, u, y, ts, [p.as_tuple() for p in params], *args, check.threads(threads))
+    built_in = [Parameter(n, v, lower=lo, upper=hi, fixed=f, unit=unit) for (n, v, lo, hi, f, unit) in defaults]
+    chosen = _configure(built_in, init, fix, bounds)
+    text = _hysid.greybox_fit(model, u, y, ts, [p.as_tuple() for p in chosen], *args, check.threads(threads))
     return Result(json.loads(text))
 
 

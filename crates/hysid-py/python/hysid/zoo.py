@@ -79,8 +79,8 @@ def identify_operator(
     dead zones per side. ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
     An unknown family or an option out of range is a :class:`ConfigError` (a ``ValueError``).
     """
-    u, y, ts = check.pair(u, y, ("u", "y"), ts)
-    step = check.sample_time(ts, 1.0)
+    u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
+    step = check.sample_time(given_ts, 1.0)
     name = _family(family)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
     text = _hysid.identify_operator(u, y, name, step, *options, check.threads(threads))
@@ -111,8 +111,8 @@ def compare(
     or a list of names. The options are :func:`identify_operator`'s. A family whose fit
     fails keeps its error in its row (:attr:`Comparison.errors`); the others go on.
     """
-    u, y, ts = check.pair(u, y, ("u", "y"), ts)
-    step = check.sample_time(ts, 1.0)
+    u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
+    step = check.sample_time(given_ts, 1.0)
     names = _families(families)
     u_val: Optional[check.FloatArray] = None
     y_val: Optional[check.FloatArray] = None
