@@ -48,6 +48,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_model, m)?)?;
     m.add_function(wrap_pyfunction!(load_model, m)?)?;
     m.add_function(wrap_pyfunction!(check_model, m)?)?;
+    m.add_function(wrap_pyfunction!(residual_analysis, m)?)?;
     Ok(())
 }
 
@@ -469,5 +470,34 @@ fn check_model(py: Python<'_>, model_json: &str) -> PyResult<String> {
         let model = FittedModel::from_file(&parse_model(model_json)?)?;
         serde_json::to_string_pretty(&model.to_file())
             .map_err(|e| Error::Serialization(format!("model: {e}")))
+    })
+}
+
+/// The residual analysis of the simulated output `yhat` against the measured `y` for input
+/// `u` (auto-correlation of the residual, its cross-correlation with the input, the 99 %
+/// band; `max_lag` lags) as JSON text: what the grey-box reports hold in
+/// `details.residual_analysis`.
+#[pyfunction]
+fn residual_analysis(
+    py: Python<'_>,
+    u: PyReadonlyArray1<'_, f64>,
+    y: PyReadonlyArray1<'_, f64>,
+    yhat: PyReadonlyArray1<'_, f64>,
+    ts: f64,
+    max_lag: usize,
+) -> PyResult<String> {
+    let (u, y, yhat) = (samples(&u), samples(&y), samples(&yhat));
+    guard(py, || {
+        if yhat.len() != y.len() {
+            return Err(Error::InvalidData(format!(
+                "the simulated output has {} samples and the measured {}; give equal lengths",
+                yhat.len(),
+                y.len()
+            )));
+        }
+        let data = id_data(ts, vec![u], vec![y])?;
+        let analysis = hysid::identify::validate::residual_analysis(&data, 0, 0, &yhat, max_lag);
+        serde_json::to_string(&analysis)
+            .map_err(|e| Error::Serialization(format!("residual analysis: {e}")))
     })
 }

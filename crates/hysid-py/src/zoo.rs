@@ -1,19 +1,31 @@
-//! The hysteresis model zoo behind `hysid.identify_operator` and `hysid.FAMILIES`: the
-//! families are the library's registry (`hysid::model::operators::Family`), the report the
-//! one `hysid identify operator` writes (`hysid::report::operator_report`).
+//! The hysteresis model zoo behind `hysid.identify_operator`, `hysid.compare`,
+//! `hysid.compensate`, the operator cascades of `hysid.identify_cascade` and
+//! `hysid.FAMILIES`: the families are the library's registry
+//! (`hysid::model::operators::Family`), the reports the ones `hysid identify operator`,
+//! `hysid compare`, `hysid compensate` and `hysid identify cascade --hysteresis FAMILY` write.
 
 use crate::errors::guard;
 use crate::pool::run_on;
-use crate::recipes::{id_data, samples, source};
-use hysid::identify::operators::{fit_operator, Family, FamilyOptions};
+use crate::recipes::{id_data, parse_model, quiet, samples, source};
+use hysid::data::IdData;
+use hysid::identify::operator_cascade::OperatorCascadeIdentification;
+use hysid::identify::operators::{
+    compare as compare_families, fit_operator, CompareOptions, Family, FamilyOptions, Split,
+};
+use hysid::model::compensate::compensate as invert;
+use hysid::model::saved::FittedModel;
 use hysid::report;
-use numpy::PyReadonlyArray1;
+use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
+use serde_json::json;
 
 /// Registers this module's functions.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(families, m)?)?;
     m.add_function(wrap_pyfunction!(identify_operator, m)?)?;
+    m.add_function(wrap_pyfunction!(identify_operator_cascade, m)?)?;
+    m.add_function(wrap_pyfunction!(compare, m)?)?;
+    m.add_function(wrap_pyfunction!(compensate, m)?)?;
     Ok(())
 }
 
@@ -21,6 +33,29 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyfunction]
 fn families() -> Vec<(&'static str, &'static str)> {
     Family::ALL.iter().map(|f| (f.name(), f.title())).collect()
+}
+
+/// The recipes' options as Python passes them: `threshold_grid` empty means the uniform
+/// grid of `thresholds` thresholds.
+fn family_options(
+    thresholds: usize,
+    threshold_grid: Vec<f64>,
+    grid: usize,
+    lambda: f64,
+    dead_zones: usize,
+) -> FamilyOptions {
+    FamilyOptions {
+        thresholds: if threshold_grid.is_empty() {
+            thresholds
+        } else {
+            threshold_grid.len()
+        },
+        threshold_grid: (!threshold_grid.is_empty()).then_some(threshold_grid),
+        grid,
+        lambda,
+        dead_zones,
+        ..FamilyOptions::default()
+    }
 }
 
 /// Fits the hysteresis family `family` to input `u` and output `y`: the report of `hysid
@@ -44,23 +79,174 @@ fn identify_operator(
 ) -> PyResult<String> {
     let (u, y) = (samples(&u), samples(&y));
     let family = guard(py, || Family::parse(family))?;
-    let options = FamilyOptions {
-        thresholds: if threshold_grid.is_empty() {
-            thresholds
-        } else {
-            threshold_grid.len()
-        },
-        threshold_grid: (!threshold_grid.is_empty()).then_some(threshold_grid),
-        grid,
-        lambda: lambda_,
-        dead_zones,
-        ..FamilyOptions::default()
-    };
+    let options = family_options(thresholds, threshold_grid, grid, lambda_, dead_zones);
     run_on(py, threads, move || {
         let data = id_data(ts, vec![u], vec![y])?;
-        let exp = data.experiment(0);
-        let fitted = fit_operator(family, exp.input(0), exp.output(0), &options)?;
-        let simulated = report::operator_simulation(&fitted, &data)?;
-        report::operator_report(&fitted, &data, &simulated, source())?.to_json()
+        operator_report(family, &data, &options)?.to_json()
     })
+}
+
+/// `family` fitted to the first experiment of `data`, and its `identify operator` report.
+fn operator_report(
+    family: Family,
+    data: &IdData,
+    options: &FamilyOptions,
+) -> hysid::Result<report::Report> {
+    let exp = data.experiment(0);
+    let fitted = fit_operator(family, exp.input(0), exp.output(0), options)?;
+    let simulated = report::operator_simulation(&fitted, data)?;
+    report::operator_report(&fitted, data, &simulated, source())
+}
+
+/// Identifies an operator of `family` (not ch4/ch6) followed by a linear block with `na`,
+/// `nb` coefficients and delay `delay`: the report of `hysid identify cascade --hysteresis
+/// FAMILY` as JSON text.
+#[pyfunction]
+#[pyo3(signature = (x, y, family, na, nb, delay, ts, thresholds, grid, threads=0))]
+#[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
+fn identify_operator_cascade(
+    py: Python<'_>,
+    x: PyReadonlyArray1<'_, f64>,
+    y: PyReadonlyArray1<'_, f64>,
+    family: &str,
+    na: usize,
+    nb: usize,
+    delay: usize,
+    ts: f64,
+    thresholds: usize,
+    grid: usize,
+    threads: usize,
+) -> PyResult<String> {
+    let (x, y) = (samples(&x), samples(&y));
+    let family = guard(py, || Family::parse_operator(family))?;
+    run_on(py, threads, move || {
+        let data = id_data(ts, vec![x], vec![y])?;
+        let mut id = OperatorCascadeIdentification::new(family, na, nb, delay);
+        id.options = FamilyOptions {
+            thresholds,
+            grid,
+            ..FamilyOptions::default()
+        };
+        let fit = id.estimate(&data, &mut quiet())?;
+        let extra = json!({"input": ["x"], "output": ["y"]});
+        report::operator_cascade_report(family.name(), &fit, &data, source(), extra)?.to_json()
+    })
+}
+
+/// What `compare` returns: the `hysid compare` report; per family in the ranked order,
+/// (name, its `identify operator` report on the training samples, or None when it failed);
+/// the validation samples' input and output; each family's simulated validation output.
+type Compared<'py> = (
+    String,
+    Vec<(String, Option<String>)>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Vec<Bound<'py, PyArray1<f64>>>,
+);
+
+/// Fits `families` to (u, y) and ranks them by validation fit % on (u_val, y_val), or on
+/// the last 40 % of (u, y) when those are None (`hysid compare`).
+#[pyfunction]
+#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0))]
+#[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
+fn compare<'py>(
+    py: Python<'py>,
+    u: PyReadonlyArray1<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    u_val: Option<PyReadonlyArray1<'py, f64>>,
+    y_val: Option<PyReadonlyArray1<'py, f64>>,
+    families: Vec<String>,
+    ts: f64,
+    thresholds: usize,
+    threshold_grid: Vec<f64>,
+    grid: usize,
+    lambda_: f64,
+    dead_zones: usize,
+    threads: usize,
+) -> PyResult<Compared<'py>> {
+    let (u, y) = (samples(&u), samples(&y));
+    let validation = u_val.zip(y_val).map(|(a, b)| (samples(&a), samples(&b)));
+    let families = guard(py, || families.iter().map(|f| Family::parse(f)).collect())?;
+    let options = CompareOptions {
+        families,
+        family: family_options(thresholds, threshold_grid, grid, lambda_, dead_zones),
+        ..CompareOptions::default()
+    };
+    let (text, results, comparison) = run_on(py, threads, move || {
+        let data = id_data(ts, vec![u.clone()], vec![y.clone()])?;
+        let held_out = validation
+            .as_ref()
+            .map(|(a, b)| (a.as_slice(), b.as_slice()));
+        let comparison = compare_families(&u, &y, held_out, &options)?;
+        let what = if held_out.is_some() {
+            "validation record"
+        } else {
+            "validation samples"
+        };
+        let text = report::compare_report(&data, &comparison, source(), what)?.to_json()?;
+        let train = match comparison.split {
+            Split::Fraction { train, .. } => train,
+            Split::Record { train, .. } => train,
+        };
+        let train_data = id_data(ts, vec![u[..train].to_vec()], vec![y[..train].to_vec()])?;
+        let results = comparison
+            .rows
+            .iter()
+            .map(|row| {
+                let text = match &row.fitted {
+                    Some(fitted) => {
+                        let simulated = report::operator_simulation(fitted, &train_data)?;
+                        let r = report::operator_report(fitted, &train_data, &simulated, source())?;
+                        Some(r.to_json()?)
+                    }
+                    None => None,
+                };
+                Ok((row.family.to_string(), text))
+            })
+            .collect::<hysid::Result<Vec<_>>>()?;
+        Ok((text, results, comparison))
+    })?;
+    let simulated = comparison
+        .rows
+        .iter()
+        .map(|r| PyArray1::from_slice(py, &r.validation_simulated))
+        .collect();
+    Ok((
+        text,
+        results,
+        PyArray1::from_slice(py, &comparison.validation_input),
+        PyArray1::from_slice(py, &comparison.validation_output),
+        simulated,
+    ))
+}
+
+/// What `compensate` returns: the `hysid compensate` report (the clipped samples in its
+/// details), the compensating input u, the model's output for it.
+type Compensated<'py> = (String, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// The input that makes the model `model_json` follow `reference` (`hysid compensate`).
+#[pyfunction]
+#[pyo3(signature = (model_json, reference, ts, model_source))]
+fn compensate<'py>(
+    py: Python<'py>,
+    model_json: &str,
+    reference: PyReadonlyArray1<'py, f64>,
+    ts: f64,
+    model_source: &str,
+) -> PyResult<Compensated<'py>> {
+    let reference = samples(&reference);
+    let (model_json, model_source) = (model_json.to_string(), model_source.to_string());
+    let (text, c) = crate::errors::run(py, move || {
+        let model = FittedModel::from_file(&parse_model(&model_json)?)?;
+        let data = id_data(ts, vec![reference], Vec::new())?;
+        let c = invert(&model, data.experiment(0).input(0))?;
+        let r =
+            report::compensation_report(&model, &data, &c, source(), "reference", &model_source);
+        Ok((r.to_json()?, c))
+    })?;
+    Ok((
+        text,
+        PyArray1::from_vec(py, c.u),
+        PyArray1::from_vec(py, c.predicted),
+    ))
 }

@@ -13,4 +13,5 @@ python3 -m venv "$venv"
 cd "$here"
 "$venv/bin/ruff" format --check python tests examples
 "$venv/bin/ruff" check python tests examples
+"$venv/bin/mypy" --strict python/hysid
 "$venv/bin/python" -m pytest -q -rs -s tests "$@"

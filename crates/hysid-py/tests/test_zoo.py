@@ -36,7 +36,7 @@ def _stub_literal():
     for node in tree.body:
         if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "FamilyName" for t in node.targets):
             return tuple(ast.literal_eval(e) for e in node.value.slice.elts)
-    raise AssertionError("FamilyName is not in __init__.pyi")
+    raise AssertionError("FamilyName is not in _families.py")
 
 
 def test_family_names_are_the_registry():

@@ -9,8 +9,7 @@ use anyhow::{Context, Result};
 use hysid::identify::operators::{
     compare, CompareOptions, CompareRow, Comparison, Family, FamilyOptions,
 };
-use hysid::report::{DataSummary, Report, ValidationEntry};
-use serde_json::json;
+use hysid::report::{compare_report, Report};
 use std::path::Path;
 
 /// Fits the families, prints the ranked table, writes the report, best model and plot.
@@ -120,29 +119,7 @@ fn first_words(e: &str) -> String {
 fn report(args: &CompareArgs, data: &hysid::data::IdData, c: &Comparison) -> Result<Report> {
     let mut sources = vec![args.data.data.display().to_string()];
     sources.extend(args.validate.iter().map(|p| p.display().to_string()));
-    let mut report = Report::new("compare");
-    report.data = Some(DataSummary::of(data, sources));
-    if let Some(best) = c.best() {
-        if let Some(fitted) = &best.fitted {
-            report.model = Some(fitted.fit.model.to_file());
-        }
-        report.validation.push(ValidationEntry::of(
-            format!("{} ({})", best.family, validation_source(args)),
-            &c.validation_output,
-            &best.validation_simulated,
-            None,
-        )?);
-    }
-    report.details = json!({
-        "split": c.split,
-        "split_text": c.split.to_string(),
-        "best": c.best().map(|b| b.family),
-        // Set when `--time-limit` stopped the comparison: the families after it are listed
-        // with the error saying they were not fitted.
-        "stopped": crate::progress::time_limit_hit().then_some("time_limit"),
-        "families": c.rows,
-    });
-    Ok(report)
+    Ok(compare_report(data, c, sources, &validation_source(args))?)
 }
 
 fn validation_source(args: &CompareArgs) -> String {

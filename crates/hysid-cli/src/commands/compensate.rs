@@ -7,8 +7,7 @@ use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::io::atomic::OutputSet;
 use hysid::model::compensate::compensate;
 use hysid::model::saved::{FittedModel, SavedModel};
-use hysid::report::{DataSummary, Report};
-use serde_json::json;
+use hysid::report::compensation_report;
 
 /// Clipped ranges printed in the warning before it is cut short (the report lists all).
 const PRINTED_RANGES: usize = 5;
@@ -69,22 +68,14 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
             shown.join(", ")
         );
     }
-    let mut report = Report::new("compensate");
-    report.data = Some(DataSummary::of(
+    let report = compensation_report(
+        &model,
         &data,
+        &c,
         vec![args.data.display().to_string()],
-    ));
-    report.model = Some(file);
-    report.details = json!({
-        "reference_column": args.reference,
-        "model_source": args.model.display().to_string(),
-        "tracking_error": { "rms": rms, "max": max },
-        "clipped": {
-            "count": c.clipped.len(),
-            "indices": c.clipped,
-            "ranges": ranges,
-        },
-    });
+        &args.reference,
+        &args.model.display().to_string(),
+    );
     write_csv(
         &csv_tmp,
         &["reference", "u", "predicted"],

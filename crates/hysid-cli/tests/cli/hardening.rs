@@ -305,7 +305,7 @@ fn a_time_limit_stops_an_operator_fit_and_a_comparison() {
             let pi = rows.iter().find(|r| r["family"] == "pi").unwrap();
             let error = pi["error"].as_str().unwrap();
             assert!(error.contains("before this family was fitted"), "{pi}");
-            assert_eq!(report["details"]["stopped"], "time_limit");
+            assert_eq!(report["details"]["stopped"], true);
         } else {
             assert_eq!(report["search"]["termination"]["code"], "time_limit");
         }

@@ -46,6 +46,34 @@ def identify_operator(
     dead_zones: int,
     threads: int = 0,
 ) -> str: ...
+def identify_operator_cascade(
+    x: _Array,
+    y: _Array,
+    family: str,
+    na: int,
+    nb: int,
+    delay: int,
+    ts: float,
+    thresholds: int,
+    grid: int,
+    threads: int = 0,
+) -> str: ...
+def compare(
+    u: _Array,
+    y: _Array,
+    u_val: Optional[_Array],
+    y_val: Optional[_Array],
+    families: Sequence[str],
+    ts: float,
+    thresholds: int,
+    threshold_grid: Sequence[float],
+    grid: int,
+    lambda_: float,
+    dead_zones: int,
+    threads: int = 0,
+) -> Tuple[str, List[Tuple[str, Optional[str]]], _Array, _Array, List[_Array]]: ...
+def compensate(model_json: str, reference: _Array, ts: float, model_source: str) -> Tuple[str, _Array, _Array]: ...
+def residual_analysis(u: _Array, y: _Array, yhat: _Array, ts: float, max_lag: int) -> str: ...
 def identify_hysteresis(
     x: _Array, y: _Array, hysteresis: str, ts: float, initial_output: str, threads: int = 0
 ) -> str: ...

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import os
 import time
-from typing import Any, Callable, List, Optional, Sequence
+from typing import Any, Callable, Dict, Iterator, List, Optional, Sequence, Tuple
 
 
 class Failure:
@@ -47,10 +47,10 @@ class Failure:
             other.message,
         )
 
-    def __getstate__(self):
+    def __getstate__(self) -> Tuple[int, str, str]:
         return (self.index, self.error, self.message)
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: Tuple[int, str, str]) -> None:
         self.index, self.error, self.message = state
 
 
@@ -68,10 +68,10 @@ class FleetResult:
     def failures(self) -> List[Failure]:
         return [r for r in self.results if isinstance(r, Failure)]
 
-    def summary(self):
+    def summary(self) -> Any:
         rows = []
         for i, r in enumerate(self.results):
-            row: dict = {"record": i}
+            row: Dict[str, Any] = {"record": i}
             if isinstance(r, Failure):
                 row["error"] = f"{r.error}: {r.message}"
             elif hasattr(r, "parameters"):
@@ -89,19 +89,24 @@ class FleetResult:
     def __len__(self) -> int:
         return len(self.results)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Any]:
         return iter(self.results)
 
-    def __getitem__(self, i):
+    def __getitem__(self, i: int) -> Any:
         return self.results[i]
 
 
-def _guarded(fit: Callable, index: int, record: Any):
+def _guarded(fit: Callable[[Any], Any], index: int, record: Any) -> Any:
     """Runs ``fit(record)``; an exception becomes a Failure (the run goes on)."""
     try:
         return fit(record)
     except Exception as e:  # noqa: BLE001 — reported in the record's place
         return Failure(index, type(e).__name__, str(e))
+
+
+def _gather(client: Any, fit: Callable[[Any], Any], records: List[Any]) -> List[Any]:
+    futures = client.map(_guarded, [fit] * len(records), range(len(records)), records, pure=False)
+    return list(client.gather(futures))
 
 
 def identify_many(
@@ -125,21 +130,19 @@ def identify_many(
         raise TypeError("fit: give a callable applied to each record")
     records = list(datasets)
     clock = time.perf_counter()
-    own = client is None
-    cluster = None
-    if own:
-        cluster = LocalCluster(
+    if client is not None:
+        results = _gather(client, fit, records)
+    else:
+        cluster = LocalCluster(  # type: ignore[no-untyped-call]
             n_workers=n_workers or os.cpu_count() or 1,
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
         )
-        client = Client(cluster)
-    try:
-        futures = client.map(_guarded, [fit] * len(records), range(len(records)), records, pure=False)
-        results = client.gather(futures)
-    finally:
-        if own:
-            client.close()
+        own = Client(cluster)  # type: ignore[no-untyped-call]
+        try:
+            results = _gather(own, fit, records)
+        finally:
+            own.close()  # type: ignore[no-untyped-call]
             cluster.close()
     return FleetResult(list(results), time.perf_counter() - clock)

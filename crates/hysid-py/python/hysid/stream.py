@@ -20,7 +20,7 @@ import numpy as np
 from . import _hysid
 
 if TYPE_CHECKING:  # pragma: no cover
-    from . import Model
+    from .models import Model
 
 
 class Stepper:
@@ -85,7 +85,7 @@ class Compensator:
     def run(self, r: Any) -> np.ndarray:
         """The commands for the references ``r`` (1-D) from the current state."""
         u, _ = self._inner.run(np.ascontiguousarray(np.asarray(r, dtype=np.float64)))
-        return u
+        return np.asarray(u, dtype=np.float64)
 
 
 def _ts(model: "Model", ts: Optional[float]) -> float:

@@ -26,6 +26,8 @@
 
 pub mod actuator;
 pub mod cascade;
+pub mod compare;
+pub mod compensation;
 pub mod greybox;
 pub mod operator;
 pub mod plot;
@@ -35,6 +37,8 @@ pub mod simulate;
 pub use cascade::{
     cascade_report, hysteresis_report, operator_cascade_model, operator_cascade_report,
 };
+pub use compare::compare_report;
+pub use compensation::compensation_report;
 pub use greybox::{bouc_wen_benchmark_report, greybox_report, greybox_residuals};
 pub use operator::{operator_report, operator_simulation};
 pub use rigid_body::{rigid_body_model, rigid_body_report, RigidBodyRecord};

@@ -149,6 +149,9 @@ pub struct Comparison {
     /// Measured output of the scored validation samples.
     #[serde(skip)]
     pub validation_output: Vec<f64>,
+    /// True when the observer stopped the comparison (a time limit): the families after
+    /// the stop have rows saying they were not fitted.
+    pub stopped: bool,
 }
 
 impl Comparison {
@@ -200,8 +203,9 @@ pub fn compare(
     let observer = &options.family.observer;
     let total = options.families.len();
     let mut rows: Vec<CompareRow> = Vec::with_capacity(total);
+    let mut stopped = false;
     for (k, &family) in options.families.iter().enumerate() {
-        let stopped = observer.report("family", k, total) == Control::Stop;
+        stopped |= observer.report("family", k, total) == Control::Stop;
         if stopped && rows.iter().any(|r| r.fitted.is_some()) {
             rows.push(CompareRow::failed(
                 family,
@@ -221,6 +225,7 @@ pub fn compare(
         rows: ranked(rows),
         validation_input,
         validation_output,
+        stopped,
     })
 }
 

@@ -1,0 +1,177 @@
+"""The hysteresis model zoo: every family of the library's registry fitted from Python
+(:func:`identify_operator`), compared on one record (:func:`compare`) and inverted
+(:func:`compensate`), as ``hysid identify operator``, ``hysid compare`` and ``hysid
+compensate`` do: the same library calls, the same reports."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from typing import Any, List, Literal, NamedTuple, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _hysid
+from . import _inputs as check
+from ._families import FAMILIES, FamilyName
+from ._hysid import ConfigError
+from .comparison import Comparison
+from .compensation import Compensation
+from .models import Model, load_model
+from .results import Record, Result
+
+#: ``families="all"``: every family of the registry.
+AllFamilies = Literal["all"]
+
+
+class _FamilyOptions(NamedTuple):
+    """The families' options as the extension module takes them."""
+
+    thresholds: int
+    threshold_grid: List[float]
+    grid: int
+    lambda_: float
+    dead_zones: int
+
+
+def _family_options(
+    thresholds: Union[int, Sequence[float]], grid: int, lambda_: float, dead_zones: int
+) -> _FamilyOptions:
+    if isinstance(thresholds, (int, np.integer)) and not isinstance(thresholds, bool):
+        count, values = check.count(thresholds, "thresholds"), []
+    else:
+        values = [float(r) for r in check.array(thresholds, "thresholds")]
+        count = len(values)
+    lam = float(lambda_)
+    if not (math.isfinite(lam) and lam >= 0.0):
+        raise ConfigError(f"lambda_={lambda_!r}: the Preisach smoothness must be finite and >= 0")
+    return _FamilyOptions(count, values, check.count(grid, "grid"), lam, check.count(dead_zones, "dead_zones"))
+
+
+def _family(name: Any, what: str = "family") -> str:
+    value = check.choice(name, what)
+    if value not in FAMILIES:
+        raise ConfigError(f"{what}={name!r}: unknown hysteresis family; use one of {', '.join(FAMILIES)}")
+    return value
+
+
+def identify_operator(
+    u: Any,
+    y: Any = None,
+    *,
+    family: FamilyName,
+    ts: float = 1.0,
+    thresholds: Union[int, Sequence[float]] = 10,
+    grid: int = 20,
+    lambda_: float = 1e-6,
+    dead_zones: int = 4,
+    threads: Optional[int] = None,
+) -> Result:
+    """Fits one hysteresis family y = Γ[u] to a measured input ``u`` and output ``y`` from
+    the data alone (no initial guess): the CLI's ``hysid identify operator``, the same
+    estimates and report.
+
+    ``family``: one of :data:`FAMILIES` (``"pi"``, ``"preisach"``, ``"bouc-wen"``, …; see
+    ``docs/zoo.md``). ``thresholds``: PI/GPI thresholds and Maxwell-slip elements, a count
+    (a uniform grid over the input range) or the thresholds themselves (strictly increasing,
+    > 0). ``grid``: Preisach intervals; ``lambda_``: Preisach smoothness; ``dead_zones``: GPI
+    dead zones per side. ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
+    An unknown family or an option out of range is a :class:`ConfigError` (a ``ValueError``).
+    """
+    u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
+    step = check.sample_time(given_ts, 1.0)
+    name = _family(family)
+    options = _family_options(thresholds, grid, lambda_, dead_zones)
+    text = _hysid.identify_operator(u, y, name, step, *options, check.threads(threads))
+    return Result(json.loads(text), data=Record(u, y, step))
+
+
+def compare(
+    u: Any,
+    y: Any = None,
+    *,
+    validate: Any = None,
+    families: Union[AllFamilies, Sequence[FamilyName]] = "all",
+    ts: float = 1.0,
+    thresholds: Union[int, Sequence[float]] = 10,
+    grid: int = 20,
+    lambda_: float = 1e-6,
+    dead_zones: int = 4,
+    threads: Optional[int] = None,
+) -> Comparison:
+    """Fits several hysteresis families to one record and ranks them by how well they
+    predict data they were not fitted to: the CLI's ``hysid compare``, the same ranking
+    and report.
+
+    ``validate``: a separate validation record, a pair ``(u_val, y_val)`` or an object with
+    ``.u`` and ``.y``; without it the first 60 % of (u, y) trains every family and the rest
+    validates it (each model simulated over the whole record, so the memory built on the
+    training part carries over). ``families``: ``"all"`` (the registry's, :data:`FAMILIES`)
+    or a list of names. The options are :func:`identify_operator`'s. A family whose fit
+    fails keeps its error in its row (:attr:`Comparison.errors`); the others go on.
+    """
+    u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
+    step = check.sample_time(given_ts, 1.0)
+    names = _families(families)
+    u_val: Optional[check.FloatArray] = None
+    y_val: Optional[check.FloatArray] = None
+    if validate is not None:
+        if hasattr(validate, "u") and hasattr(validate, "y"):
+            pair = (validate.u, validate.y)
+        elif isinstance(validate, (tuple, list)) and len(validate) == 2:
+            pair = (validate[0], validate[1])
+        else:
+            raise TypeError("validate: give a pair (u_val, y_val) or a record with .u and .y")
+        u_val, y_val, _ = check.pair(pair[0], pair[1], ("validate u", "validate y"), None)
+    options = _family_options(thresholds, grid, lambda_, dead_zones)
+    report, results, v_in, v_out, simulated = _hysid.compare(
+        u, y, u_val, y_val, names, step, *options, check.threads(threads)
+    )
+    return Comparison.from_extension(report, results, Record(v_in, v_out, step), simulated, Record(u, y, step))
+
+
+def _families(families: Any) -> List[str]:
+    if isinstance(families, str):
+        if families == "all":
+            return list(FAMILIES)
+        raise ConfigError(f"families={families!r}: give 'all' or a list of family names")
+    try:
+        names = list(families)
+    except TypeError:
+        raise TypeError(f"families: give 'all' or a list of family names, got {type(families).__name__}") from None
+    if not names:
+        raise ConfigError("families=[]: no family to compare; name at least one")
+    return [_family(n, "families") for n in names]
+
+
+def compensate(
+    model: Union[Model, Result, str, "os.PathLike[str]"],
+    reference: Any,
+    *,
+    ts: Optional[float] = None,
+) -> Compensation:
+    """The input u that makes a fitted hysteresis model's output follow ``reference``: the
+    CLI's ``hysid compensate``, the same library inverse and report.
+
+    ``model``: a :class:`Model`, a :class:`Result` (its model) or the path of a model file;
+    an operator of any family, a Coleman–Hodgdon hysteresis (ch4/ch6) or an operator
+    cascade with a minimum-phase linear block (other kinds are a :class:`NumericalError`).
+    ``ts``: the reference's sample time (default 1). A reference sample the model cannot
+    reach is clipped to the nearest reachable output and listed in
+    :attr:`Compensation.clipped`, never silently.
+    """
+    if isinstance(model, (str, os.PathLike)):
+        source, model = os.fspath(model), load_model(model)
+    else:
+        source = "python (hysid.Model)"
+    if isinstance(model, Result):
+        if model.model is None:
+            raise TypeError("model: this result has no model to compensate with")
+        model = model.model
+    if not isinstance(model, Model):
+        raise TypeError(f"model: give a hysid.Model, a hysid.Result or a model file's path, got {type(model).__name__}")
+    r = check.array(reference, "reference")
+    step = check.sample_time(ts, 1.0)
+    report, u, predicted = _hysid.compensate(json.dumps(model.file), r, step, source)
+    return Compensation(json.loads(report), r, u, predicted, step)

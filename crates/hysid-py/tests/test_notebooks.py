@@ -1,0 +1,24 @@
+"""The tutorial notebooks run top to bottom without error (nbclient, a fresh kernel), so
+they cannot rot."""
+
+import pathlib
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat")
+nbclient = pytest.importorskip("nbclient")
+
+NOTEBOOKS = pathlib.Path(__file__).resolve().parent.parent / "examples" / "notebooks"
+
+
+@pytest.mark.parametrize("name", ["piezo_compensation.ipynb", "bouc_wen_benchmark.ipynb"])
+def test_notebook_runs(name, monkeypatch):
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    book = nbformat.read(NOTEBOOKS / name, as_version=4)
+    client = nbclient.NotebookClient(
+        book, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(NOTEBOOKS)}}
+    )
+    client.execute()
+    errors = [o for c in book.cells if c.cell_type == "code" for o in c.get("outputs", []) if o.output_type == "error"]
+    assert not errors
+    assert sum(c.cell_type == "code" for c in book.cells) >= 4
