@@ -398,11 +398,12 @@ fn grey_box(
 /// its current state and returns its output channels.
 pub fn run(stepper: &mut dyn Stepper, inputs: &[&[f64]]) -> Result<Vec<Vec<f64>>> {
     if inputs.len() != stepper.n_inputs() {
-        return Err(Error::ModelMismatch(format!(
-            "the model has {} input(s), {} given",
-            stepper.n_inputs(),
-            inputs.len()
-        )));
+        return Err(Error::CountMismatch {
+            model: "the model".into(),
+            what: "input channels",
+            expected: stepper.n_inputs(),
+            given: inputs.len(),
+        });
     }
     let n = inputs.first().map_or(0, |c| c.len());
     if inputs.iter().any(|c| c.len() != n) {
