@@ -25,6 +25,12 @@
 //! once; the emitters know targets, not families. Generated code is tested against the
 //! library sample by sample (`crates/hysid-tests/tests/export`).
 
+pub mod fmu;
+mod pending;
+pub mod zip;
+
+pub use pending::{c_code, export};
+
 use crate::{Error, Result};
 use std::path::PathBuf;
 
@@ -164,7 +170,7 @@ const KEYWORDS: &[&str] = &[
     "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else",
     "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long", "register",
     "restrict", "return", "short", "signed", "sizeof", "static", "struct", "switch", "typedef",
-    "union", "unsigned", "void", "volatile", "while", "as", "crate", "fn", "impl", "let",
-    "loop", "match", "mod", "move", "mut", "pub", "ref", "self", "Self", "super", "trait",
-    "type", "unsafe", "use", "where", "core", "std", "libm",
+    "union", "unsigned", "void", "volatile", "while", "as", "crate", "fn", "impl", "let", "loop",
+    "match", "mod", "move", "mut", "pub", "ref", "self", "Self", "super", "trait", "type",
+    "unsafe", "use", "where", "core", "std", "libm",
 ];
