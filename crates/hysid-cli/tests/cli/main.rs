@@ -7,6 +7,7 @@ mod actuator_cli;
 mod commands;
 mod equations_cli;
 mod exit_codes;
+mod export_cli;
 mod hardening;
 mod hold_check_cli;
 #[cfg(unix)] // symbolic links

@@ -26,6 +26,7 @@
 //! library sample by sample (`crates/hysid-tests/tests/export`).
 
 pub mod fmu;
+pub mod output;
 mod pending;
 pub mod zip;
 
