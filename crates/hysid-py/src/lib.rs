@@ -22,6 +22,7 @@ use pyo3::prelude::*;
 pub mod actuator;
 pub mod equations;
 pub mod errors;
+pub mod export;
 pub mod pool;
 pub mod recipes;
 pub mod user_model;
@@ -37,6 +38,7 @@ fn _hysid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     actuator::register(m)?;
     equations::register(m)?;
     zoo::register(m)?;
+    export::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1116,3 +1116,6 @@ def actuator_rig(
 
 
 from . import fleet  # noqa: E402, F401  (imports Result from this module)
+from .export import export as _export  # noqa: E402
+
+Model.export = _export  # Model.export(target, name, out, *, inverse, ts, binary): hysid/export.py

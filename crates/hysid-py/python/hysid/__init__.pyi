@@ -75,6 +75,16 @@ class Model:
     def parameters(self) -> Dict[str, Parameter]: ...
     def simulate(self, u: _ArrayLike, *, ts: float, y0: Optional[float] = ...) -> npt.NDArray[np.float64]: ...
     def save(self, path: "os.PathLike[str] | str") -> None: ...
+    def export(
+        self,
+        target: str,
+        name: str,
+        out: "os.PathLike[str] | str",
+        *,
+        inverse: bool = ...,
+        ts: Optional[float] = ...,
+        binary: bool = ...,
+    ) -> List[str]: ...
 
 class Result:
     parameters: Dict[str, Parameter]
