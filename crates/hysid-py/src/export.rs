@@ -23,6 +23,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// the directory `out` (created; refused when it holds any file); returns the paths written.
 #[pyfunction]
 #[pyo3(signature = (model_json, target, name, out, inverse, ts, binary))]
+#[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn export_model(
     py: Python<'_>,
     model_json: &str,
