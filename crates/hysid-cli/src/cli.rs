@@ -64,6 +64,13 @@ pub enum Command {
     /// The input that makes a fitted hysteresis model follow a reference (feed-forward
     /// compensation by the model's inverse).
     Compensate(crate::cli_zoo::CompensateArgs),
+    /// Write a saved model (or its compensator) as C99 code, a no_std Rust crate or an FMI 2.0
+    /// Co-Simulation FMU. Exit codes: 0 written; 1 a model or request that cannot be
+    /// exported (a kind without an exporter, --inverse on a model without an inverse, a
+    /// non-minimum-phase cascade, a missing or contradicting sample time, a non-empty --out,
+    /// no C compiler for the FMU's binary); 2 usage (an unknown target, --out that is or
+    /// holds the model file); 4 I/O.
+    Export(ExportArgs),
 }
 
 /// Actuator commands.
@@ -636,6 +643,50 @@ pub enum InitialArg {
     Measured,
     /// Zero.
     Zero,
+}
+
+/// Options of `hysid export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// Model file written by `--model-out` (`hysid.model/1`), or a report (`--json`) whose
+    /// model is exported.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// What to write: c (DIR/NAME.h and DIR/NAME.c, C99), rust (the no_std crate DIR/NAME/),
+    /// fmu (DIR/NAME.fmu, FMI 2.0 Co-Simulation with its sources and a binary built by $CC,
+    /// else cc).
+    #[arg(long, value_enum)]
+    pub target: TargetArg,
+    /// Name of the exported model (the C prefix, the crate and the FMU): a C identifier of at
+    /// most 64 characters, not a C or Rust keyword.
+    #[arg(long)]
+    pub name: String,
+    /// Output directory: created if missing, refused if it holds any file; written beside
+    /// and renamed into place when complete.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Export the compensator (input: the reference; output: the command) instead of the
+    /// model.
+    #[arg(long)]
+    pub inverse: bool,
+    /// Sample time [s] of the exported step, required when the model file has none (files
+    /// of earlier versions); must equal the file's when it has one. Range (0, 1e12].
+    #[arg(long, value_parser = crate::options::positive)]
+    pub ts: Option<f64>,
+    /// With --target fmu: leave the binary out (a source-only FMU; no C compiler needed).
+    #[arg(long = "no-binary")]
+    pub no_binary: bool,
+}
+
+/// Export targets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TargetArg {
+    /// C99: NAME.h and NAME.c.
+    C,
+    /// A no_std Rust library crate NAME/.
+    Rust,
+    /// An FMI 2.0 Co-Simulation FMU NAME.fmu.
+    Fmu,
 }
 
 /// Options of `hysid simulate`.

@@ -96,7 +96,7 @@ pub fn classify(error: &anyhow::Error) -> ExitClass {
 
 /// The command-line flag of a library setting ([`Error::InvalidOption`]'s `option`), where
 /// the CLI has one.
-const FLAGS: [(&str, &str); 12] = [
+const FLAGS: [(&str, &str); 14] = [
     ("cutoff_hz", "--cutoff"),
     ("starts", "--starts"),
     ("start_factor", "--start-factor"),
@@ -109,6 +109,8 @@ const FLAGS: [(&str, &str); 12] = [
     ("model", "--model"),
     ("substeps", "--substeps"),
     ("noise", "--noise"),
+    ("ts", "--ts"),
+    ("name", "--name"),
 ];
 
 /// The flag a library error is about, when it is a setting the CLI has a flag for: the
@@ -135,7 +137,14 @@ pub fn remember_args(args: &[std::ffi::OsString]) {
 
 /// The output options of every command, by role (the rest of a command's path options are
 /// inputs).
-const OUTPUT_FLAGS: [&str; 5] = ["--json", "--model-out", "--csv", "--plots", "--data-out"];
+const OUTPUT_FLAGS: [&str; 6] = [
+    "--json",
+    "--model-out",
+    "--csv",
+    "--plots",
+    "--data-out",
+    "--out",
+];
 
 /// The flags whose value is `path` on the command line (`--flag PATH` or `--flag=PATH`),
 /// among the output flags or among the others; else the output flags whose value is a

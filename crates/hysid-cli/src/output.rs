@@ -4,8 +4,9 @@
 //! temporary, and renamed into place together with the others at the end — or not at all.
 
 use anyhow::{Context, Result};
+use hysid::data::IdData;
 use hysid::io::atomic::OutputSet;
-use hysid::model::saved::FittedModel;
+use hysid::model::saved::{Columns, FittedModel, ModelFile};
 use hysid::report::plot::Svg;
 use hysid::report::Report;
 use std::path::{Path, PathBuf};
@@ -29,6 +30,9 @@ pub struct Outputs {
     pub model_out: Option<Staged>,
     /// The plot directory, when asked for.
     pub plots: Option<Staged>,
+    /// The sample time and column names of the data the model was fitted on, saved with it
+    /// in the model file and the report's `model` ([`Outputs::fitted_on`]).
+    data: Option<(f64, Columns)>,
 }
 
 impl Outputs {
@@ -44,6 +48,7 @@ impl Outputs {
             json: None,
             model_out: None,
             plots: None,
+            data: None,
         };
         // The directory first: a file inside it is then refused as a clash, even before
         // the directory exists.
@@ -79,6 +84,24 @@ impl Outputs {
         })
     }
 
+    /// Saves the sample time and the channel names of `data`, the data the model is fitted
+    /// on, with the model (`sample_time`, `columns`: `hysid export` takes the step's period
+    /// and the FMU's variable names from them).
+    pub fn fitted_on(&mut self, data: &IdData) {
+        let names =
+            |channels: &[hysid::data::Channel]| channels.iter().map(|c| c.name.clone()).collect();
+        let columns = Columns {
+            inputs: names(data.input_channels()),
+            outputs: names(data.output_channels()),
+        };
+        self.fitted_on_columns(data.ts(), columns);
+    }
+
+    /// [`Outputs::fitted_on`] for a model whose columns are not those of an [`IdData`].
+    pub fn fitted_on_columns(&mut self, ts: f64, columns: Columns) {
+        self.data = Some((ts, columns));
+    }
+
     /// Writes the plots into the plot directory, when one was asked for.
     pub fn figures(&self, figures: impl FnOnce() -> hysid::Result<Vec<Svg>>) -> Result<()> {
         if let Some(dir) = &self.plots {
@@ -90,11 +113,17 @@ impl Outputs {
     /// Writes the report and the model file when asked for, renames every output into
     /// place and says where they are.
     pub fn finish(self, report: Option<&Report>, model: Option<&FittedModel>) -> Result<()> {
+        let with_data = |file: ModelFile| match &self.data {
+            Some((ts, columns)) => file.with_data(*ts, columns.clone()),
+            None => file,
+        };
         if let (Some(out), Some(report)) = (&self.json, report) {
-            write_report(out, report)?;
+            let mut report = report.clone();
+            report.model = report.model.map(with_data);
+            write_report(out, &report)?;
         }
         if let (Some(out), Some(model)) = (&self.model_out, model) {
-            write_model(out, model)?;
+            write_model(out, &with_data(model.to_file()))?;
         }
         let (json, model_out, plots) = (
             self.json.clone(),
@@ -122,16 +151,15 @@ pub fn write_report(out: &Staged, report: &Report) -> Result<()> {
     write_text(out, &text).context("writing the JSON report")
 }
 
-/// Writes the saved-model file of `model`, refused when a parameter is not finite.
-pub fn write_model(out: &Staged, model: &FittedModel) -> Result<()> {
-    let file = model.to_file();
+/// Writes the saved-model file `file`, refused when a parameter is not finite.
+pub fn write_model(out: &Staged, file: &ModelFile) -> Result<()> {
     if let Some(p) = file.parameters().iter().find(|p| !p.value.is_finite()) {
         anyhow::bail!(
             "the estimate of {} is not finite; no model file written",
             p.name
         );
     }
-    let text = serde_json::to_string_pretty(&file).context("serialising the model file")?;
+    let text = serde_json::to_string_pretty(file).context("serialising the model file")?;
     write_text(out, &text).context("writing the model file")
 }
 

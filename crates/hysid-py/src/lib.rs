@@ -22,6 +22,7 @@ use pyo3::prelude::*;
 pub mod actuator;
 pub mod equations;
 pub mod errors;
+pub mod export;
 pub mod pool;
 pub mod recipes;
 pub mod stream;
@@ -39,6 +40,7 @@ fn _hysid(m: &Bound<'_, PyModule>) -> PyResult<()> {
     equations::register(m)?;
     zoo::register(m)?;
     stream::register(m)?;
+    export::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -457,9 +457,9 @@ pub fn parse_model(text: &str) -> Result<ModelFile> {
 #[pyfunction]
 fn load_model(py: Python<'_>, path: std::path::PathBuf) -> PyResult<String> {
     guard(py, || {
-        let model = FittedModel::load(&path)?;
-        serde_json::to_string(&model.to_file())
-            .map_err(|e| Error::Serialization(format!("model: {e}")))
+        // The file as written, checked: its sample time and columns included.
+        let file = ModelFile::load(&path)?;
+        serde_json::to_string(&file).map_err(|e| Error::Serialization(format!("model: {e}")))
     })
 }
 
@@ -467,8 +467,18 @@ fn load_model(py: Python<'_>, path: std::path::PathBuf) -> PyResult<String> {
 #[pyfunction]
 fn check_model(py: Python<'_>, model_json: &str) -> PyResult<String> {
     guard(py, || {
-        let model = FittedModel::from_file(&parse_model(model_json)?)?;
-        serde_json::to_string_pretty(&model.to_file())
+        let file = parse_model(model_json)?;
+        let model = FittedModel::from_file(&file)?;
+        let saved = model.to_file();
+        let saved = match (file.sample_time, file.columns) {
+            (Some(ts), Some(columns)) => saved.with_data(ts, columns),
+            (ts, columns) => ModelFile {
+                sample_time: ts,
+                columns,
+                ..saved
+            },
+        };
+        serde_json::to_string_pretty(&saved)
             .map_err(|e| Error::Serialization(format!("model: {e}")))
     })
 }

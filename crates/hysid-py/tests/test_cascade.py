@@ -149,11 +149,14 @@ def test_record_objects_accepted(example1):
 def timeless(report):
     """A report without its wall-clock figure, the command line's work counts
     (``search.model_steps``, ``estimated_model_steps``) and the data's names (a file vs numpy
-    arrays)."""
+    arrays: the command line also saves the record's sample time and columns with the
+    model)."""
     report = json.loads(json.dumps(report))
     for key in ("elapsed_s", "model_steps", "estimated_model_steps"):
         report["search"].pop(key, None)
     report["data"].pop("source", None)
+    for key in ("sample_time", "columns"):
+        report["model"].pop(key, None)
     for e in report["fit"]["per_experiment"]:
         e.pop("experiment", None)
     return report

@@ -30,13 +30,14 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
     };
     let mut inputs = vec![train.as_path()];
     inputs.extend(args.test.iter().map(|p| p.as_path()));
-    let out = Outputs::new(
+    let mut out = Outputs::new(
         &inputs,
         args.json.as_deref(),
         args.model_out.as_deref(),
         args.plots.as_deref(),
     )?;
     let data = record(train)?;
+    out.fitted_on(&data);
     let tests = args
         .test
         .iter()

@@ -27,13 +27,14 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let mut inputs = vec![args.data.data.as_path()];
     inputs.extend(args.validate.as_deref());
     let o = &args.output;
-    let out = Outputs::new(
+    let mut out = Outputs::new(
         &inputs,
         o.json.as_deref(),
         o.model_out.as_deref(),
         o.plots.as_deref(),
     )?;
     let data = load(&args.data, &args.data.data)?;
+    out.fitted_on(&data);
     let validation = args
         .validate
         .as_deref()

@@ -31,13 +31,14 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     };
     let mut inputs = vec![args.data.data.as_path()];
     inputs.extend(args.model_file.as_deref());
-    let out = Outputs::new(
+    let mut out = Outputs::new(
         &inputs,
         args.json.as_deref(),
         args.model_out.as_deref(),
         args.plots.as_deref(),
     )?;
     let data = load(&args.data)?;
+    out.fitted_on(&data);
     let params = configure(
         model.parameters(),
         &args.fix,

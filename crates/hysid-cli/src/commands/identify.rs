@@ -72,8 +72,9 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         return super::operator_cascade::identify(args);
     }
     let form = ChForm::parse(&args.hysteresis)?;
-    let out = register(&args.data, &args.output)?;
+    let mut out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
+    out.fitted_on(&data);
     let mut id = CascadeIdentification::new(form, args.na, args.nb, args.delay);
     id.uncertainty = uncertainty(args.uncertainty, args.replicates);
     id.bootstrap_seed = args.seed;
@@ -114,8 +115,9 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
 /// `hysid identify hysteresis`.
 pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
     let form = ChForm::parse(&args.hysteresis)?;
-    let out = register(&args.data, &args.output)?;
+    let mut out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
+    out.fitted_on(&data);
     let mut id = HysteresisIdentification::new(form);
     id.initial = match args.initial_output {
         InitialArg::Measured => InitialOutput::Measured,

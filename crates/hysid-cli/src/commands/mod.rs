@@ -6,6 +6,7 @@ mod cascade;
 mod compare;
 mod compensate;
 mod demo;
+mod export;
 mod generate;
 mod greybox;
 mod identify;
@@ -36,5 +37,6 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Identify(Identify::Operator(args)) => operator::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Compensate(args) => compensate::run(&args),
+        Command::Export(args) => export::run(&args),
     }
 }

@@ -17,13 +17,14 @@ pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family).context("--family")?;
     let mut options = family_options(&args.options)?;
     let o = &args.output;
-    let out = Outputs::new(
+    let mut out = Outputs::new(
         &[args.data.data.as_path()],
         o.json.as_deref(),
         o.model_out.as_deref(),
         o.plots.as_deref(),
     )?;
     let data = load(&args.data, &args.data.data)?;
+    out.fitted_on(&data);
     let exp = data.experiment(0);
     let (u, y) = (exp.input(0), exp.output(0));
     crate::progress::note(&format!("fitting {family} to {} samples …", u.len()));

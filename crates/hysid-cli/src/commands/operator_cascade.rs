@@ -59,8 +59,9 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
         "--uncertainty bootstrap is available for ch4 and ch6; operator cascades report \
          asymptotic standard deviations (use --uncertainty asymptotic)"
     );
-    let out = register(&args.data, &args.output)?;
+    let mut out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
+    out.fitted_on(&data);
     let fit = {
         let progress = FitProgress::new("identifying cascade");
         let mut callback = progress.callback();

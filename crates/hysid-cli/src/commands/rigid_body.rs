@@ -14,7 +14,7 @@ use std::path::Path;
 pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
     let mut inputs = vec![args.data.as_path()];
     inputs.extend(args.validate.iter().map(|p| p.as_path()));
-    let out = Outputs::new(
+    let mut out = Outputs::new(
         &inputs,
         args.json.as_deref(),
         args.model_out.as_deref(),
@@ -31,6 +31,14 @@ pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
         border: args.border,
     };
     let (q, u, ts) = record(&args.data, args)?;
+    // The model predicts the drive signal from the position (as `simulate` runs it).
+    out.fitted_on_columns(
+        ts,
+        hysid::model::saved::Columns {
+            inputs: vec![args.position.clone()],
+            outputs: vec![args.input.clone()],
+        },
+    );
     let estimate = ls
         .estimate(&q, &u, ts)
         .with_context(|| args.data.display().to_string())?;

@@ -9,6 +9,7 @@ mod commands;
 mod crash_safety;
 mod equations_cli;
 mod exit_codes;
+mod export_cli;
 mod hardening;
 mod hold_check_cli;
 #[cfg(unix)] // symbolic links

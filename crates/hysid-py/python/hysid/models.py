@@ -19,6 +19,7 @@ from . import _hysid
 from ._fields import Fields, ReportError
 from ._hysid import ModelFileError
 from ._inputs import FloatArray, channels, sample_time
+from .export import Target, export
 from .parameters import Parameter, ParameterTuple
 from .stream import Compensator, Stepper, compensator, stepper
 
@@ -122,6 +123,20 @@ class Model:
     def compensator(self, *, ts: Optional[float] = None) -> Compensator:
         """The model's compensator one sample at a time (:mod:`hysid.stream`)."""
         return compensator(self, ts=ts)
+
+    def export(
+        self,
+        target: Target,
+        name: str,
+        out: "os.PathLike[str] | str",
+        *,
+        inverse: bool = False,
+        ts: Optional[float] = None,
+        binary: bool = True,
+    ) -> List[str]:
+        """The model as C99, a ``no_std`` Rust crate or an FMI 2.0 FMU (:mod:`hysid.export`,
+        the command line's ``hysid export``); returns the paths written."""
+        return export(self, target, name, out, inverse=inverse, ts=ts, binary=binary)
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Model) and self.file == other.file

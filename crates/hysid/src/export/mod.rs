@@ -25,6 +25,13 @@
 //! once; the emitters know targets, not families. Generated code is tested against the
 //! library sample by sample (`crates/hysid-tests/tests/export`).
 
+pub mod fmu;
+pub mod output;
+mod pending;
+pub mod zip;
+
+pub use pending::{c_code, export};
+
 use crate::{Error, Result};
 use std::path::PathBuf;
 

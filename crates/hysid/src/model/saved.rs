@@ -1209,6 +1209,29 @@ impl FittedModel {
 
     /// Reads a model file, or the `model` object of a report.
     pub fn load(path: &Path) -> Result<Self> {
+        let file = ModelFile::read(path)?;
+        Self::from_file(&file).map_err(|e| Error::ModelFile {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+    }
+}
+
+impl ModelFile {
+    /// Reads a model file, or the `model` object of a report, and checks that it describes
+    /// a model ([`FittedModel::from_file`]); the errors name `path`. Unlike
+    /// [`FittedModel::load`] it keeps everything the file holds (`sample_time`, `columns`).
+    pub fn load(path: &Path) -> Result<Self> {
+        let file = Self::read(path)?;
+        FittedModel::from_file(&file).map_err(|e| Error::ModelFile {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        Ok(file)
+    }
+
+    /// The model file at `path` (or the `model` of the report there), parsed, not checked.
+    fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
             path: path.to_path_buf(),
             source,
@@ -1239,7 +1262,7 @@ impl FittedModel {
             _ if value.is_null() => return Err(no_model()),
             _ => serde_json::from_str(&text).map_err(not_a_model)?,
         };
-        Self::from_file(&file).map_err(|e| bad(e.to_string()))
+        Ok(file)
     }
 }
 

@@ -6,6 +6,7 @@
 
 mod data;
 mod experiments;
+mod export;
 mod generic_path;
 mod identify;
 mod model;

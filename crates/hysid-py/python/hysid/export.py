@@ -1,0 +1,56 @@
+"""``Model.export``: a fitted model as C99, a no_std Rust crate or an FMI 2.0 FMU (the
+command line's ``hysid export``)."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import TYPE_CHECKING, List, Literal, Optional
+
+from . import _hysid
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .models import Model
+
+Target = Literal["c", "rust", "fmu"]
+
+
+def export(
+    self: Model,
+    target: Target,
+    name: str,
+    out: "os.PathLike[str] | str",
+    *,
+    inverse: bool = False,
+    ts: Optional[float] = None,
+    binary: bool = True,
+) -> List[str]:
+    """Writes the model as ``target`` (``"c"``: ``NAME.h`` and ``NAME.c``; ``"rust"``: the
+    crate ``NAME/``; ``"fmu"``: ``NAME.fmu``) into the directory ``out``, created if missing
+    and refused if it holds any file; returns the paths written.
+
+    ``inverse`` exports the compensator (input: the reference; output: the command).
+    ``ts`` is the sample time in seconds, needed when the model file has none and equal to
+    its own when it has one. ``binary=False`` leaves the FMU's compiled binary out (a
+    source-only FMU; the binary is built with ``$CC``, else ``cc``). Errors: ``ConfigError``
+    for a model or request that cannot be exported (a kind without an exporter, no inverse,
+    a missing sample time, no C compiler), ``ModelFileError`` for an output directory that
+    holds files.
+    """
+    if self._user is not None:
+        raise _hysid.ModelFileError(
+            "a model written as Python functions cannot be exported (its equations are Python "
+            "code); write it as an equation file (GreyBoxModel.from_equations) to export it"
+        )
+    if not isinstance(out, (str, os.PathLike)):
+        raise TypeError(f"out: expected a str or path, got {type(out).__name__}")
+    paths = _hysid.export_model(
+        json.dumps(self.file),
+        str(target),
+        str(name),
+        os.fspath(out),
+        bool(inverse),
+        None if ts is None else float(ts),
+        bool(binary),
+    )
+    return [os.fspath(p) for p in paths]

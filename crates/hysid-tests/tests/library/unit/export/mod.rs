@@ -1,0 +1,4 @@
+//! The export's modules.
+
+mod fmu;
+mod zip;
