@@ -25,7 +25,17 @@
 //! once; the emitters know targets, not families. Generated code is tested against the
 //! library sample by sample (`crates/hysid-tests/tests/export`).
 
+pub mod code;
+pub mod families;
+pub mod interface;
+pub mod kinds;
+pub mod program;
+pub mod render;
+pub mod solve;
+
+use crate::model::saved::{FittedModel, ModelFile};
 use crate::{Error, Result};
+use interface::SampleTime;
 use std::path::PathBuf;
 
 /// Where an exported model goes.
@@ -164,7 +174,91 @@ const KEYWORDS: &[&str] = &[
     "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else",
     "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long", "register",
     "restrict", "return", "short", "signed", "sizeof", "static", "struct", "switch", "typedef",
-    "union", "unsigned", "void", "volatile", "while", "as", "crate", "fn", "impl", "let",
-    "loop", "match", "mod", "move", "mut", "pub", "ref", "self", "Self", "super", "trait",
-    "type", "unsafe", "use", "where", "core", "std", "libm",
+    "union", "unsigned", "void", "volatile", "while", "as", "crate", "fn", "impl", "let", "loop",
+    "match", "mod", "move", "mut", "pub", "ref", "self", "Self", "super", "trait", "type",
+    "unsafe", "use", "where", "core", "std", "libm",
 ];
+
+/// The program, interface and opening comment of the export `name` of `file`.
+fn prepare(
+    file: &ModelFile,
+    name: &str,
+    options: &ExportOptions,
+) -> Result<(program::Program, Interface, String)> {
+    check_name(name)?;
+    let sample_time = SampleTime::of(file, options)?;
+    let model = FittedModel::from_file(file)?;
+    let program = kinds::program(&model, options.inverse)?;
+    program.check()?;
+    let sizes = if options.inverse {
+        (program.n_outputs, program.n_inputs)
+    } else {
+        (program.n_inputs, program.n_outputs)
+    };
+    let interface = interface::interface(file, name, options, sample_time, sizes);
+    let comment = interface::comment(file, &interface, options, sample_time);
+    Ok((program, interface, comment))
+}
+
+/// The C99 code of the model (or, with [`ExportOptions::inverse`], of its compensator):
+/// `NAME.h` and `NAME.c` (see the module docs and `docs/export.md`).
+pub fn c_code(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<CCode> {
+    let (program, interface, comment) = prepare(file, name, options)?;
+    let (header, source) = render::c::render(&program, name, &comment, interface.sample_time);
+    Ok(CCode {
+        header,
+        source,
+        interface,
+    })
+}
+
+/// The `no_std` Rust crate of the model (or of its compensator): `NAME/Cargo.toml` and
+/// `NAME/src/lib.rs`, depending on `libm` only.
+pub fn rust_crate(
+    file: &ModelFile,
+    name: &str,
+    options: &ExportOptions,
+) -> Result<Vec<GeneratedFile>> {
+    let (program, interface, comment) = prepare(file, name, options)?;
+    let lib = render::rust::lib_rs(&program, &comment, interface.sample_time);
+    let cargo = render::rust::cargo_toml(name, &interface.description);
+    Ok(vec![
+        GeneratedFile {
+            path: PathBuf::from(name).join("Cargo.toml"),
+            contents: cargo.into_bytes(),
+        },
+        GeneratedFile {
+            path: PathBuf::from(name).join("src").join("lib.rs"),
+            contents: lib.into_bytes(),
+        },
+    ])
+}
+
+/// The files of the export of `file` to `target` under the name `name`, paths relative to
+/// the output directory.
+pub fn export(
+    file: &ModelFile,
+    target: Target,
+    name: &str,
+    options: &ExportOptions,
+) -> Result<Vec<GeneratedFile>> {
+    match target {
+        Target::C => {
+            let code = c_code(file, name, options)?;
+            Ok(vec![
+                GeneratedFile {
+                    path: PathBuf::from(format!("{name}.h")),
+                    contents: code.header.into_bytes(),
+                },
+                GeneratedFile {
+                    path: PathBuf::from(format!("{name}.c")),
+                    contents: code.source.into_bytes(),
+                },
+            ])
+        }
+        Target::Rust => rust_crate(file, name, options),
+        Target::Fmu => Err(Error::Unsupported(
+            "the fmu target is not merged yet".into(),
+        )),
+    }
+}

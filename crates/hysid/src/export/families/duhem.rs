@@ -1,0 +1,14 @@
+//! TODO
+use super::Emit;
+use crate::export::program::{Ns, Program};
+use crate::model::operators::Duhem;
+use crate::{Error, Result};
+
+impl Emit for Duhem {
+    fn emit_forward(&self, _ns: &Ns, _prog: &mut Program) -> Result<String> {
+        Err(Error::Unsupported("not yet".into()))
+    }
+    fn emit_inverse(&self, _ns: &Ns, _prog: &mut Program) -> Result<String> {
+        Err(Error::Unsupported("not yet".into()))
+    }
+}
