@@ -183,6 +183,12 @@ impl From<f64> for Expr {
     }
 }
 
+impl From<usize> for Expr {
+    fn from(i: usize) -> Self {
+        Expr::Index(i)
+    }
+}
+
 /// A double literal.
 pub fn lit(v: f64) -> Expr {
     Expr::F64(v)
