@@ -1,6 +1,6 @@
 //! C99 rendering: `NAME.h` (the state struct, the constants, the two functions) and `NAME.c`
 //! (the tables as `static const`, the helpers as `static` functions taking the state, init and
-//! step). No heap, no globals; `NAME.c` includes only `NAME.h`, `<math.h>` and `<stddef.h>`.
+//! step; in `NAME.c` the state is the parameter `state`, a name no emitter gives a local). No heap, no globals; `NAME.c` includes only `NAME.h`, `<math.h>` and `<stddef.h>`.
 //! An array field or table of length 0 is given one unused element (C has no empty arrays).
 
 use super::{comment_lines, Printer, Syntax, ATOM, UNARY};
@@ -22,7 +22,7 @@ fn c_type(ty: Ty) -> &'static str {
 
 impl Syntax for C<'_> {
     fn state(&self, field: &str) -> String {
-        format!("s->{field}")
+        format!("state->{field}")
     }
     fn table(&self, name: &str) -> String {
         format!("{}_{name}", self.name)
@@ -31,7 +31,7 @@ impl Syntax for C<'_> {
         f.name().into()
     }
     fn call(&self, name: &str, args: &[String]) -> String {
-        let mut all = vec!["s".to_string()];
+        let mut all = vec!["state".to_string()];
         all.extend(args.iter().cloned());
         format!("{}_{name}({})", self.name, all.join(", "))
     }
@@ -141,7 +141,7 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
         c.push('\n');
     }
     let signature = |f: &crate::export::code::Function| {
-        let mut params = vec![format!("{name}_state *s")];
+        let mut params = vec![format!("{name}_state *state")];
         params.extend(f.params.iter().map(|(n, t)| format!("{} {n}", c_type(*t))));
         let ret = f.ret.map_or("void", c_type);
         format!("static {ret} {name}_{}({})", f.name, params.join(", "))
@@ -153,14 +153,14 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
         c.push('\n');
     }
     for f in &program.functions {
-        c.push_str(&format!("{} {{\n    (void)s;\n", signature(f)));
+        c.push_str(&format!("{} {{\n    (void)state;\n", signature(f)));
         for (n, _) in &f.params {
             c.push_str(&format!("    (void){n};\n"));
         }
         p.stmts(&f.body, 1, &mut c);
         c.push_str("}\n\n");
     }
-    c.push_str(&format!("void {name}_init({name}_state *s) {{\n"));
+    c.push_str(&format!("void {name}_init({name}_state *state) {{\n"));
     for f in &program.fields {
         let zero = match f.ty {
             Ty::F64 => "0.0",
@@ -168,17 +168,17 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
         };
         match f.len {
             Some(n) => c.push_str(&format!(
-                "    for (size_t i = 0; i < {}; i++) {{\n        s->{}[i] = {zero};\n    }}\n",
+                "    for (size_t i = 0; i < {}; i++) {{\n        state->{}[i] = {zero};\n    }}\n",
                 n.max(1),
                 f.name
             )),
-            None => c.push_str(&format!("    s->{} = {zero};\n", f.name)),
+            None => c.push_str(&format!("    state->{} = {zero};\n", f.name)),
         }
     }
     p.stmts(&program.init, 1, &mut c);
     c.push_str("}\n\n");
     c.push_str(&format!(
-        "void {name}_step({name}_state *s, const double *u, double *y) {{\n    (void)u;\n"
+        "void {name}_step({name}_state *state, const double *u, double *y) {{\n    (void)u;\n"
     ));
     p.stmts(&program.step, 1, &mut c);
     c.push_str("}\n");
