@@ -52,3 +52,60 @@ fn the_interface_names_the_columns_and_the_sample_time() {
     let e = c_code(&file, "stage", &disagreeing).expect_err("a disagreeing --ts");
     assert!(e.to_string().contains("--ts"), "{e}");
 }
+
+#[test]
+fn a_rate_independent_operator_exports_without_a_sample_time_and_a_cascade_does_not() {
+    let mut file = cases::named_pi();
+    file.sample_time = None;
+    let code = c_code(&file, "stage", &ExportOptions::default()).expect("c");
+    assert_eq!(code.interface.sample_time, 0.0);
+    let cascade = hysid::model::OperatorCascade::new(
+        hysid::model::operators::OperatorModel::examples()
+            .expect("examples")
+            .remove(0),
+        cases::block(),
+    )
+    .expect("cascade");
+    let n = cascade.parameters().len();
+    let file = hysid::model::saved::FittedModel::OperatorCascade {
+        model: cascade,
+        std: vec![f64::NAN; n],
+    }
+    .to_file();
+    let e = c_code(&file, "stage", &ExportOptions::default()).expect_err("no sample time");
+    assert!(e.to_string().contains("--ts"), "{e}");
+}
+
+#[test]
+fn a_compensator_is_refused_for_a_model_without_an_inverse_and_a_non_minimum_phase_cascade() {
+    let op = hysid::model::operators::OperatorModel::examples()
+        .expect("examples")
+        .remove(0);
+    let block = hysid::model::LinearBlock::new(vec![-0.5], vec![1.0, 2.0], 1).expect("block");
+    let cascade = hysid::model::OperatorCascade::new(op, block).expect("cascade");
+    let n = cascade.parameters().len();
+    let file = hysid::model::saved::FittedModel::OperatorCascade {
+        model: cascade,
+        std: vec![f64::NAN; n],
+    }
+    .to_file();
+    let options = ExportOptions {
+        inverse: true,
+        sample_time: Some(1e-3),
+        ..ExportOptions::default()
+    };
+    let e = c_code(&file, "stage", &options).expect_err("non-minimum-phase");
+    assert!(e.to_string().contains("minimum phase"), "{e}");
+    let ch = hysid::model::ColemanHodgdon::general(2.0, 1.0, 0.3, 0.4, 0.1, 0.5).expect("ch");
+    let cascade = hysid::model::HysteresisCascade::new(ch, cases::block()).expect("cascade");
+    let n = cascade.params().len();
+    let file = hysid::model::saved::FittedModel::Cascade {
+        model: cascade,
+        std: vec![f64::NAN; n],
+    }
+    .to_file();
+    let e = c_code(&file, "stage", &options).expect_err("no inverse");
+    assert!(e.to_string().contains("not invertible"), "{e}");
+    let e = export(&file, Target::Fmu, "stage", &options).expect_err("fmu");
+    assert!(!e.to_string().is_empty());
+}

@@ -1,9 +1,11 @@
 //! The models exported by the tests and what the library says they do.
 
 use hysid::export::ExportOptions;
+use hysid::model::coleman_hodgdon::InitialOutput;
 use hysid::model::compensate::compensate;
 use hysid::model::operators::OperatorModel;
 use hysid::model::saved::{Columns, FittedModel, ModelFile};
+use hysid::model::{ColemanHodgdon, HysteresisCascade, LinearBlock, OperatorCascade};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
 
@@ -54,8 +56,13 @@ fn file_of(model: &FittedModel) -> ModelFile {
     model.to_file()
 }
 
-/// The model's forward case and, where it has an inverse, its compensator's case.
+/// The model's forward case and, where it has an inverse, its compensator's case (fed the
+/// reference `preview` samples ahead: the linear block's delay of an operator cascade).
 fn cases_of(label: &str, model: &FittedModel, input: &[f64]) -> Vec<Case> {
+    let preview = match model {
+        FittedModel::OperatorCascade { model, .. } => model.linear.delay(),
+        _ => 0,
+    };
     let file = file_of(model);
     let simulated = model
         .simulate(&[input], 1e-3, input.first().copied())
@@ -64,7 +71,10 @@ fn cases_of(label: &str, model: &FittedModel, input: &[f64]) -> Vec<Case> {
     let mut out = vec![Case {
         name: format!("{label}_forward"),
         file: file.clone(),
-        options: ExportOptions::default(),
+        options: ExportOptions {
+            sample_time: Some(1e-3),
+            ..ExportOptions::default()
+        },
         input: input.to_vec(),
         expected: y.clone(),
     }];
@@ -74,17 +84,75 @@ fn cases_of(label: &str, model: &FittedModel, input: &[f64]) -> Vec<Case> {
             file,
             options: ExportOptions {
                 inverse: true,
+                sample_time: Some(1e-3),
                 ..ExportOptions::default()
             },
-            input: y,
+            input: (0..y.len())
+                .map(|s| y[(s + preview).min(y.len() - 1)])
+                .collect(),
             expected: comp.u,
         });
     }
     out
 }
 
+/// A stable, minimum-phase linear block with a delay.
+pub fn block() -> LinearBlock {
+    LinearBlock::new(vec![-0.6, 0.08], vec![1.0, 0.4], 1).expect("a valid block")
+}
+
+/// A Coleman–Hodgdon hysteresis (ch6) whose rate limit the test signal respects.
+fn hysteresis() -> ColemanHodgdon {
+    ColemanHodgdon::general(2.0, 1.0, 0.3, 0.4, 0.1, 0.5).expect("a valid hysteresis")
+}
+
+/// The model kinds besides the operators: operator cascades (one per family), the
+/// Coleman–Hodgdon hysteresis (from 0, and from the measured output: compensator only) and
+/// its cascade.
+fn kinds(u: &[f64]) -> Vec<Case> {
+    let mut out = Vec::new();
+    for op in OperatorModel::examples().expect("the registry's examples") {
+        let label = format!("cascade_{}", op.family().name().replace('-', "_"));
+        let cascade = OperatorCascade::new(op, block()).expect("a cascade");
+        let n = cascade.parameters().len();
+        let model = FittedModel::OperatorCascade {
+            model: cascade,
+            std: vec![f64::NAN; n],
+        };
+        out.extend(cases_of(&label, &model, u));
+    }
+    let ch = hysteresis();
+    let n = ch.params().len();
+    for (label, initial) in [
+        ("ch", InitialOutput::Zero),
+        ("ch_measured", InitialOutput::Measured),
+    ] {
+        let model = FittedModel::Hysteresis {
+            model: ch.clone(),
+            initial,
+            std: vec![f64::NAN; n],
+        };
+        let mut cases = cases_of(label, &model, u);
+        if initial == InitialOutput::Measured {
+            cases.retain(|c| c.options.inverse);
+        }
+        out.extend(cases);
+    }
+    let cascade = HysteresisCascade::new(ch, block()).expect("a cascade");
+    let n = cascade.params().len();
+    out.extend(cases_of(
+        "ch_cascade",
+        &FittedModel::Cascade {
+            model: cascade,
+            std: vec![f64::NAN; n],
+        },
+        u,
+    ));
+    out
+}
+
 /// Every case: each family of the registry (its example, and its clockwise-decreasing form
-/// where it has one), forward and inverse.
+/// where it has one), forward and inverse; then the other kinds.
 pub fn all() -> Vec<Case> {
     let u = signal(3000, 27);
     let mut out = Vec::new();
@@ -101,6 +169,7 @@ pub fn all() -> Vec<Case> {
             out.extend(cases_of(&format!("{label}_cw"), &model, &u));
         }
     }
+    out.extend(kinds(&u));
     out
 }
 

@@ -26,9 +26,11 @@
 //! library sample by sample (`crates/hysid-tests/tests/export`).
 
 pub mod code;
+pub mod coleman_hodgdon;
 pub mod families;
 pub mod interface;
 pub mod kinds;
+pub mod linear;
 pub mod program;
 pub mod render;
 pub mod solve;
