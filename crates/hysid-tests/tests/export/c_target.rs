@@ -2,6 +2,8 @@
 
 use crate::cases::{self, Case};
 use hysid::export::c_code;
+use hysid::model::operators::OperatorModel;
+use hysid::model::saved::FittedModel;
 use std::path::Path;
 use std::process::Command;
 
@@ -80,4 +82,43 @@ fn generated_c_equals_the_library() {
         })
         .collect();
     cases::check("C", &results);
+}
+
+#[test]
+fn a_preisach_memory_beyond_its_capacity_sets_the_error_flag() {
+    let op = OperatorModel::examples()
+        .expect("examples")
+        .into_iter()
+        .find(|op| op.family().name() == "preisach")
+        .expect("the registry has preisach");
+    let n = op.as_operator().parameters().len();
+    let model = FittedModel::operator(op, vec![f64::NAN; n]);
+    // Ever smaller alternations: each sample leaves one more nested extremum.
+    let input: Vec<f64> = (0..150)
+        .map(|k| if k % 2 == 0 { 1.0 } else { -1.0 } * (0.95 - k as f64 / 200.0))
+        .collect();
+    let expected = model.simulate(&[&input], 1.0, None).expect("simulate")[0].clone();
+    let case = Case {
+        name: "preisach_deep".into(),
+        file: model.to_file(),
+        options: hysid::export::ExportOptions::default(),
+        input,
+        expected,
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (y, error) = run(&case, dir.path());
+    assert!(
+        error,
+        "64 memory points were exceeded without the error flag"
+    );
+    let fits = hysid::export::families::preisach::MEMORY_POINTS - 1;
+    assert_eq!(
+        y[..fits],
+        case.expected[..fits],
+        "the outputs before the overflow"
+    );
+    assert!(
+        y[fits..].iter().all(|v| *v == y[fits - 1]),
+        "the outputs hold after the overflow"
+    );
 }

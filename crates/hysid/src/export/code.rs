@@ -14,7 +14,7 @@
 //! let z = b.let_("z", Expr::from(u - r).max((u + r).min(ns.state("z"))));
 //! ```
 
-use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::ops::{Add, Div, Mul, Neg, Not, Sub};
 
 /// The type of a value: a double, an array index, or a flag.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -319,10 +319,6 @@ impl Expr {
     pub fn or(self, other: impl Into<Expr>) -> Expr {
         self.bin(BinOp::Or, other)
     }
-    /// !self
-    pub fn not(self) -> Expr {
-        Expr::Not(Box::new(self))
-    }
 
     /// Every double literal of the expression, for the finiteness check.
     pub(crate) fn literals(&self, out: &mut Vec<f64>) {
@@ -374,6 +370,14 @@ macro_rules! arithmetic {
     )*};
 }
 arithmetic!(Add add Add, Sub sub Sub, Mul mul Mul, Div div Div);
+
+/// !self, for a flag.
+impl Not for Expr {
+    type Output = Expr;
+    fn not(self) -> Expr {
+        Expr::Not(Box::new(self))
+    }
+}
 
 impl Neg for Expr {
     type Output = Expr;

@@ -17,6 +17,7 @@ use super::{coleman_hodgdon, families, linear};
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::saved::FittedModel;
 use crate::{Error, Result};
+use std::ops::Not;
 
 /// The streaming program of `model`, or of its compensator when `inverse`.
 pub fn program(model: &FittedModel, inverse: bool) -> Result<Program> {

@@ -7,6 +7,7 @@
 use super::code::{idx, lit, local, Expr, Ty};
 use super::program::{Ns, Program};
 use crate::Result;
+use std::ops::Not;
 
 /// Emits `ns.solve(target, center, span, unbounded_below, unbounded_above) -> f64`, the root
 /// of `branch(x) = target` for the helper `branch` (a non-decreasing function of x that only

@@ -15,6 +15,7 @@ use crate::export::code::{call, idx, lit, local, select, Block, Expr, Ty};
 use crate::export::program::{Ns, Program, ERROR_FIELD};
 use crate::model::operators::differential::{InputOde, TOLERANCE};
 use crate::Result;
+use std::ops::Not;
 
 /// The sub-steps one sample interval may take.
 pub const SUBSTEP_BUDGET: usize = 100_000;

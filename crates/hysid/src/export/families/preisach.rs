@@ -20,6 +20,7 @@ use crate::export::solve;
 use crate::model::operators::preisach::{prefix_sums, Grid};
 use crate::model::operators::{Orientation, Preisach};
 use crate::Result;
+use std::ops::Not;
 
 /// The points of one staircase memory the generated code holds.
 pub const MEMORY_POINTS: usize = 64;
