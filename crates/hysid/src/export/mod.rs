@@ -1,7 +1,7 @@
 //! Export: a fitted model leaves hysid as code that runs in a controller.
 //!
 //! The streaming form of every model (one sample in, one sample out, a fixed-size state; the
-//! library's own form is [`crate::model::stream`]) is written as
+//! library's own form is `model::stream`) is written as
 //!
 //! * **C99** ([`Target::C`]): exactly two files, `NAME.h` and `NAME.c`, no heap, no globals,
 //!   only `<math.h>` and `<stddef.h>`. The header defines the state struct completely and
@@ -49,6 +49,7 @@ pub mod linear;
 pub mod program;
 pub mod render;
 pub mod solve;
+pub mod stmt;
 
 use crate::model::saved::{FittedModel, ModelFile};
 use crate::{Error, Result};

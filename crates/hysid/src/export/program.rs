@@ -28,7 +28,7 @@ pub struct Table {
 }
 
 /// The name of the state's error flag: set when a step could not be computed (see
-/// [`Program::fallible`]); every program has it.
+/// [`Program::fallible_step`]); every program has it.
 pub const ERROR_FIELD: &str = "error";
 /// The name of the state's copy of the last outputs, held while the error flag is set.
 const HELD_FIELD: &str = "held";

@@ -1,6 +1,6 @@
 //! The renderers: a [`Program`](super::program::Program) printed as C99 ([`c`]) or as `no_std`
-//! Rust ([`rust`]). Both print expressions and statements through one printer ([`Printer`])
-//! that asks a [`Syntax`] for the few things the two languages spell differently (state
+//! Rust ([`rust`]). Both print expressions and statements through one printer (`Printer`)
+//! that asks a `Syntax` for the few things the two languages spell differently (state
 //! access `s->x` / `self.x`, `fabs` / `libm::fabs`, casts, the conditional expression,
 //! declarations and loops).
 
