@@ -100,7 +100,7 @@ fn a_file_without_sample_time_needs_ts() {
         .arg("--out")
         .arg(&out);
     let err = fails_with(&mut cmd, 1);
-    assert!(err.contains("--ts") && err.contains("sample_time"), "{err}");
+    assert!(err.contains("--ts") && err.contains("sample time"), "{err}");
     assert_eq!(tree(tmp.path()), Vec::<String>::new());
 }
 

@@ -1,7 +1,7 @@
 //! Export: a fitted model leaves hysid as code that runs in a controller.
 //!
 //! The streaming form of every model (one sample in, one sample out, a fixed-size state; the
-//! library's own form is [`crate::model::stream`]) is written as
+//! library's own form is `model::stream`) is written as
 //!
 //! * **C99** ([`Target::C`]): exactly two files, `NAME.h` and `NAME.c`, no heap, no globals,
 //!   only `<math.h>` and `<stddef.h>`. The header defines the state struct completely and
@@ -21,18 +21,42 @@
 //! reference r_k, the output the command u_k that makes the model follow it (references
 //! outside the reachable range are clipped, as `hysid compensate` does).
 //!
-//! Each model kind (and each operator family, through the family registry) supplies its step
-//! once; the emitters know targets, not families. Generated code is tested against the
-//! library sample by sample (`crates/hysid-tests/tests/export`).
+//! The API: [`c_code`] (the two C files and their [`Interface`], which the FMU packager
+//! uses), [`rust_crate`] and [`export`] (the files of any target, paths relative to the
+//! output directory). The sample time is the model file's, else
+//! [`ExportOptions::sample_time`], else 0 for a rate-independent `operator` file; any other
+//! kind without one is an error asking for `--ts` ([`interface::SampleTime::of`]). Every
+//! state carries an error flag, set once a step cannot be computed where the library's
+//! simulation would fail (an integration beyond its sub-step budget, a Preisach memory beyond
+//! its capacity, a non-finite output); the outputs then hold their last values until the
+//! state is initialised again. The compensator of an operator cascade with delay k takes the
+//! reference k samples ahead ([`linear`]). Grey-box and equation-file models are not exported
+//! by this version ([`Error::UnsupportedKind`]). See `docs/export.md`.
+//!
+//! How it is built: a language-neutral program ([`code`], [`program`]) that the renderers
+//! ([`render`]) print as C or Rust; each model kind ([`kinds`]) and each operator family,
+//! through the family registry ([`families`]), supplies its step once, transliterating the
+//! library's computation in its order of operations; the emitters know models, the renderers
+//! targets. Generated code is tested against the library sample by sample
+//! (`crates/hysid-tests/tests/export`): bit-identical as C, within 2e-14 of the range as Rust.
 
+pub mod code;
+pub mod coleman_hodgdon;
+pub mod families;
 pub mod fmu;
+pub mod interface;
+pub mod kinds;
+pub mod linear;
 pub mod output;
-mod pending;
+pub mod program;
+pub mod render;
+pub mod solve;
+pub mod stmt;
 pub mod zip;
 
-pub use pending::{c_code, export};
-
+use crate::model::saved::{FittedModel, ModelFile};
 use crate::{Error, Result};
+use interface::SampleTime;
 use std::path::PathBuf;
 
 /// Where an exported model goes.
@@ -175,3 +199,85 @@ const KEYWORDS: &[&str] = &[
     "match", "mod", "move", "mut", "pub", "ref", "self", "Self", "super", "trait", "type",
     "unsafe", "use", "where", "core", "std", "libm",
 ];
+
+/// The program, interface and opening comment of the export `name` of `file`.
+fn prepare(
+    file: &ModelFile,
+    name: &str,
+    options: &ExportOptions,
+) -> Result<(program::Program, Interface, String)> {
+    check_name(name)?;
+    let sample_time = SampleTime::of(file, options)?;
+    let model = FittedModel::from_file(file)?;
+    let program = kinds::program(&model, options.inverse)?;
+    program.check()?;
+    let sizes = if options.inverse {
+        (program.n_outputs, program.n_inputs)
+    } else {
+        (program.n_inputs, program.n_outputs)
+    };
+    let interface = interface::interface(file, name, options, sample_time, sizes);
+    let comment = interface::comment(file, &interface, options, sample_time);
+    Ok((program, interface, comment))
+}
+
+/// The C99 code of the model (or, with [`ExportOptions::inverse`], of its compensator):
+/// `NAME.h` and `NAME.c` (see the module docs and `docs/export.md`).
+pub fn c_code(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<CCode> {
+    let (program, interface, comment) = prepare(file, name, options)?;
+    let (header, source) = render::c::render(&program, name, &comment, interface.sample_time);
+    Ok(CCode {
+        header,
+        source,
+        interface,
+    })
+}
+
+/// The `no_std` Rust crate of the model (or of its compensator): `NAME/Cargo.toml` and
+/// `NAME/src/lib.rs`, depending on `libm` only.
+pub fn rust_crate(
+    file: &ModelFile,
+    name: &str,
+    options: &ExportOptions,
+) -> Result<Vec<GeneratedFile>> {
+    let (program, interface, comment) = prepare(file, name, options)?;
+    let lib = render::rust::lib_rs(&program, &comment, interface.sample_time);
+    let cargo = render::rust::cargo_toml(name, &interface.description);
+    Ok(vec![
+        GeneratedFile {
+            path: PathBuf::from(name).join("Cargo.toml"),
+            contents: cargo.into_bytes(),
+        },
+        GeneratedFile {
+            path: PathBuf::from(name).join("src").join("lib.rs"),
+            contents: lib.into_bytes(),
+        },
+    ])
+}
+
+/// The files of the export of `file` to `target` under the name `name`, paths relative to
+/// the output directory.
+pub fn export(
+    file: &ModelFile,
+    target: Target,
+    name: &str,
+    options: &ExportOptions,
+) -> Result<Vec<GeneratedFile>> {
+    match target {
+        Target::C => {
+            let code = c_code(file, name, options)?;
+            Ok(vec![
+                GeneratedFile {
+                    path: PathBuf::from(format!("{name}.h")),
+                    contents: code.header.into_bytes(),
+                },
+                GeneratedFile {
+                    path: PathBuf::from(format!("{name}.c")),
+                    contents: code.source.into_bytes(),
+                },
+            ])
+        }
+        Target::Rust => rust_crate(file, name, options),
+        Target::Fmu => fmu::fmu_files(&c_code(file, name, options)?, options),
+    }
+}

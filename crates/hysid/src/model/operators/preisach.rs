@@ -394,8 +394,9 @@ impl Preisach {
     }
 }
 
-/// q[a·N + b] = Σ_{a ≤ j ≤ i ≤ b} w_{ij} for a ≤ b.
-fn prefix_sums(grid: &Grid, w: &[f64]) -> Vec<f64> {
+/// q[a·N + b] = Σ_{a ≤ j ≤ i ≤ b} w_{ij} for a ≤ b (also the exported code's table,
+/// `export::families::preisach`).
+pub(crate) fn prefix_sums(grid: &Grid, w: &[f64]) -> Vec<f64> {
     let n = grid.n;
     let mut q = vec![0.0; n * n];
     for a in 0..n {

@@ -1,0 +1,111 @@
+//! The API's refusals, the interface and the determinism of the generated files.
+
+use crate::cases;
+use hysid::export::{c_code, export, ExportOptions, Target};
+
+#[test]
+fn an_invalid_name_is_refused() {
+    let file = cases::named_pi();
+    for name in ["", "1pi", "pi-model", "static", "fn", "x y"] {
+        let e = c_code(&file, name, &ExportOptions::default()).expect_err(name);
+        assert!(e.to_string().contains("C identifier"), "{name}: {e}");
+    }
+}
+
+#[test]
+fn exporting_twice_gives_identical_files() {
+    let file = cases::named_pi();
+    for target in [Target::C, Target::Rust] {
+        let options = ExportOptions::default();
+        let a = export(&file, target, "stage", &options).expect("export");
+        let b = export(&file, target, "stage", &options).expect("export");
+        assert_eq!(a, b, "{target:?}");
+    }
+}
+
+#[test]
+fn the_interface_names_the_columns_and_the_sample_time() {
+    let file = cases::named_pi();
+    let forward = c_code(&file, "stage", &ExportOptions::default()).expect("c");
+    assert_eq!(forward.interface.inputs, ["voltage"]);
+    assert_eq!(forward.interface.outputs, ["position"]);
+    assert_eq!(forward.interface.sample_time, 1e-4);
+    assert!(forward.header.contains("#define stage_SAMPLE_TIME 0.0001"));
+    let options = ExportOptions {
+        inverse: true,
+        ..ExportOptions::default()
+    };
+    let inverse = c_code(&file, "stage", &options).expect("c");
+    assert_eq!(inverse.interface.inputs, ["position_reference"]);
+    assert_eq!(inverse.interface.outputs, ["voltage"]);
+    let names: Vec<&str> = inverse
+        .interface
+        .parameters
+        .iter()
+        .map(|p| p.0.as_str())
+        .collect();
+    assert_eq!(names.first(), Some(&"a0"));
+    let disagreeing = ExportOptions {
+        sample_time: Some(1e-3),
+        ..ExportOptions::default()
+    };
+    let e = c_code(&file, "stage", &disagreeing).expect_err("a disagreeing --ts");
+    assert!(e.to_string().contains("--ts"), "{e}");
+}
+
+#[test]
+fn a_rate_independent_operator_exports_without_a_sample_time_and_a_cascade_does_not() {
+    let mut file = cases::named_pi();
+    file.sample_time = None;
+    let code = c_code(&file, "stage", &ExportOptions::default()).expect("c");
+    assert_eq!(code.interface.sample_time, 0.0);
+    let cascade = hysid::model::OperatorCascade::new(
+        hysid::model::operators::OperatorModel::examples()
+            .expect("examples")
+            .remove(0),
+        cases::block(),
+    )
+    .expect("cascade");
+    let n = cascade.parameters().len();
+    let file = hysid::model::saved::FittedModel::OperatorCascade {
+        model: cascade,
+        std: vec![f64::NAN; n],
+    }
+    .to_file();
+    let e = c_code(&file, "stage", &ExportOptions::default()).expect_err("no sample time");
+    assert!(e.to_string().contains("--ts"), "{e}");
+}
+
+#[test]
+fn a_compensator_is_refused_for_a_model_without_an_inverse_and_a_non_minimum_phase_cascade() {
+    let op = hysid::model::operators::OperatorModel::examples()
+        .expect("examples")
+        .remove(0);
+    let block = hysid::model::LinearBlock::new(vec![-0.5], vec![1.0, 2.0], 1).expect("block");
+    let cascade = hysid::model::OperatorCascade::new(op, block).expect("cascade");
+    let n = cascade.parameters().len();
+    let file = hysid::model::saved::FittedModel::OperatorCascade {
+        model: cascade,
+        std: vec![f64::NAN; n],
+    }
+    .to_file();
+    let options = ExportOptions {
+        inverse: true,
+        sample_time: Some(1e-3),
+        ..ExportOptions::default()
+    };
+    let e = c_code(&file, "stage", &options).expect_err("non-minimum-phase");
+    assert!(e.to_string().contains("minimum phase"), "{e}");
+    let ch = hysid::model::ColemanHodgdon::general(2.0, 1.0, 0.3, 0.4, 0.1, 0.5).expect("ch");
+    let cascade = hysid::model::HysteresisCascade::new(ch, cases::block()).expect("cascade");
+    let n = cascade.params().len();
+    let file = hysid::model::saved::FittedModel::Cascade {
+        model: cascade,
+        std: vec![f64::NAN; n],
+    }
+    .to_file();
+    let e = c_code(&file, "stage", &options).expect_err("no inverse");
+    assert!(e.to_string().contains("not invertible"), "{e}");
+    let e = export(&file, Target::Fmu, "stage", &options).expect_err("fmu");
+    assert!(!e.to_string().is_empty());
+}

@@ -1,0 +1,124 @@
+//! The generated C, compiled with the contract's flags and run by a small driver.
+
+use crate::cases::{self, Case};
+use hysid::export::c_code;
+use hysid::model::operators::OperatorModel;
+use hysid::model::saved::FittedModel;
+use std::path::Path;
+use std::process::Command;
+
+/// The flags of the contract.
+const FLAGS: [&str; 6] = [
+    "-std=c99",
+    "-Wall",
+    "-Wextra",
+    "-Werror",
+    "-pedantic",
+    "-O2",
+];
+
+fn driver(name: &str) -> String {
+    format!(
+        "#include <stdio.h>\n#include \"{name}.h\"\n\
+         int main(int argc, char **argv) {{\n\
+         \x20   {name}_state s;\n    double u[{name}_N_INPUTS];\n    double y[{name}_N_OUTPUTS];\n\
+         \x20   FILE *in = argc > 1 ? fopen(argv[1], \"r\") : NULL;\n\
+         \x20   if (in == NULL) {{\n        return 3;\n    }}\n\
+         \x20   {name}_init(&s);\n\
+         \x20   while (fscanf(in, \"%lf\", &u[0]) == 1) {{\n\
+         \x20       {name}_step(&s, u, y);\n        printf(\"%.17g\\n\", y[0]);\n    }}\n\
+         \x20   fclose(in);\n    if (s.error) {{\n        printf(\"error\\n\");\n    }}\n    return 0;\n}}\n"
+    )
+}
+
+/// Compiles and runs the C of `case` in `dir`: the outputs and the error flag.
+fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool) {
+    let name = &case.name;
+    let code = c_code(&case.file, name, &case.options)
+        .unwrap_or_else(|e| panic!("{name}: c_code failed: {e}"));
+    std::fs::write(dir.join(format!("{name}.h")), &code.header).expect("write");
+    std::fs::write(dir.join(format!("{name}.c")), &code.source).expect("write");
+    std::fs::write(dir.join(format!("{name}_driver.c")), driver(name)).expect("write");
+    std::fs::write(
+        dir.join(format!("{name}.in")),
+        cases::input_text(&case.input),
+    )
+    .expect("write");
+    let exe = dir.join(name);
+    let compiled = Command::new("cc")
+        .args(FLAGS)
+        .arg("-o")
+        .arg(&exe)
+        .arg(dir.join(format!("{name}.c")))
+        .arg(dir.join(format!("{name}_driver.c")))
+        .arg("-lm")
+        .output()
+        .expect("the C compiler `cc` is needed by this test (install gcc or clang)");
+    assert!(
+        compiled.status.success(),
+        "{name}: cc failed:\n{}",
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+    let ran = Command::new(&exe)
+        .arg(dir.join(format!("{name}.in")))
+        .output()
+        .expect("run the driver");
+    assert!(ran.status.success(), "{name}: the driver failed");
+    cases::parse_outputs(&String::from_utf8_lossy(&ran.stdout))
+}
+
+#[test]
+fn generated_c_equals_the_library() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let results: Vec<(String, f64, bool)> = cases::all()
+        .iter()
+        .map(|case| {
+            let (y, error) = run(case, dir.path());
+            (
+                case.name.clone(),
+                cases::relative_difference(&y, &case.expected),
+                error,
+            )
+        })
+        .collect();
+    cases::check("C", &results);
+}
+
+#[test]
+fn a_preisach_memory_beyond_its_capacity_sets_the_error_flag() {
+    let op = OperatorModel::examples()
+        .expect("examples")
+        .into_iter()
+        .find(|op| op.family().name() == "preisach")
+        .expect("the registry has preisach");
+    let n = op.as_operator().parameters().len();
+    let model = FittedModel::operator(op, vec![f64::NAN; n]);
+    // Ever smaller alternations: each sample leaves one more nested extremum.
+    let input: Vec<f64> = (0..150)
+        .map(|k| if k % 2 == 0 { 1.0 } else { -1.0 } * (0.95 - k as f64 / 200.0))
+        .collect();
+    let expected = model.simulate(&[&input], 1.0, None).expect("simulate")[0].clone();
+    let case = Case {
+        name: "preisach_deep".into(),
+        file: model.to_file(),
+        options: hysid::export::ExportOptions::default(),
+        input,
+        expected,
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (y, error) = run(&case, dir.path());
+    assert!(
+        error,
+        "64 memory points were exceeded without the error flag"
+    );
+    let fits = hysid::export::families::preisach::MEMORY_POINTS - 1;
+    assert_eq!(
+        y[..fits],
+        case.expected[..fits],
+        "the outputs before the overflow"
+    );
+    assert!(
+        y[fits..].iter().all(|v| *v == y[fits - 1]),
+        "the outputs hold after the overflow"
+    );
+}

@@ -1,0 +1,257 @@
+//! The models exported by the tests and what the library says they do.
+
+use hysid::export::ExportOptions;
+use hysid::model::coleman_hodgdon::InitialOutput;
+use hysid::model::compensate::compensate;
+use hysid::model::operators::{MaxwellSlip, OperatorModel, Orientation};
+use hysid::model::saved::{Columns, FittedModel, ModelFile};
+use hysid::model::{ColemanHodgdon, HysteresisCascade, LinearBlock, OperatorCascade};
+use rand::rngs::Xoshiro256PlusPlus;
+use rand::{RngExt, SeedableRng};
+
+/// The bar: max |generated − library| ÷ (max − min of the library's signal).
+pub const BAR: f64 = 1e-12;
+
+/// One export to check.
+pub struct Case {
+    /// The export name (also the label in the table).
+    pub name: String,
+    /// The model file.
+    pub file: ModelFile,
+    /// The export options.
+    pub options: ExportOptions,
+    /// The step's input signal.
+    pub input: Vec<f64>,
+    /// What the library gives for it.
+    pub expected: Vec<f64>,
+}
+
+/// A seeded input with nested minor loops over about ±1, `n` samples.
+pub fn signal(n: usize, seed: u64) -> Vec<f64> {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let tau = std::f64::consts::TAU;
+    (0..n)
+        .map(|k| {
+            let t = k as f64;
+            let envelope = 0.6 + 0.4 * (tau * t / 1700.0).cos();
+            0.85 * envelope * (tau * t / 500.0).sin()
+                + 0.12 * (tau * t / 37.0).sin()
+                + 0.01 * rng.random_range(-1.0..1.0)
+        })
+        .collect()
+}
+
+/// The operator with its orientation flipped to the clockwise, decreasing one (for the
+/// families whose structure has an `orientation` of that form).
+fn flipped(op: &OperatorModel) -> Option<OperatorModel> {
+    let mut structure = op.structure().ok()?;
+    let o = structure.get_mut("orientation")?.as_object_mut()?;
+    o.get("inverse")?;
+    o.insert("inverse".into(), true.into());
+    o.insert("decreasing".into(), true.into());
+    OperatorModel::from_structure(op.family().name(), &structure).ok()
+}
+
+fn file_of(model: &FittedModel) -> ModelFile {
+    model.to_file()
+}
+
+/// The model's forward case and, where it has an inverse, its compensator's case (fed the
+/// reference `preview` samples ahead: the linear block's delay of an operator cascade).
+fn cases_of(label: &str, model: &FittedModel, input: &[f64]) -> Vec<Case> {
+    let preview = match model {
+        FittedModel::OperatorCascade { model, .. } => model.linear.delay(),
+        _ => 0,
+    };
+    let file = file_of(model);
+    let simulated = model
+        .simulate(&[input], 1e-3, input.first().copied())
+        .unwrap_or_else(|e| panic!("{label}: the library's simulate failed: {e}"));
+    let y = simulated[0].clone();
+    let mut out = vec![Case {
+        name: format!("{label}_forward"),
+        file: file.clone(),
+        options: ExportOptions {
+            sample_time: Some(1e-3),
+            ..ExportOptions::default()
+        },
+        input: input.to_vec(),
+        expected: y.clone(),
+    }];
+    if let Ok(comp) = compensate(model, &y) {
+        out.push(Case {
+            name: format!("{label}_inverse"),
+            file,
+            options: ExportOptions {
+                inverse: true,
+                sample_time: Some(1e-3),
+                ..ExportOptions::default()
+            },
+            input: (0..y.len())
+                .map(|s| y[(s + preview).min(y.len() - 1)])
+                .collect(),
+            expected: comp.u,
+        });
+    }
+    out
+}
+
+/// A stable, minimum-phase linear block with a delay.
+pub fn block() -> LinearBlock {
+    LinearBlock::new(vec![-0.6, 0.08], vec![1.0, 0.4], 1).expect("a valid block")
+}
+
+/// A Coleman–Hodgdon hysteresis (ch6) whose rate limit the test signal respects.
+fn hysteresis() -> ColemanHodgdon {
+    ColemanHodgdon::general(2.0, 1.0, 0.3, 0.4, 0.1, 0.5).expect("a valid hysteresis")
+}
+
+/// The model kinds besides the operators: operator cascades (one per family), the
+/// Coleman–Hodgdon hysteresis (from 0, and from the measured output: compensator only) and
+/// its cascade.
+fn kinds(u: &[f64]) -> Vec<Case> {
+    let mut out = Vec::new();
+    for op in OperatorModel::examples().expect("the registry's examples") {
+        let label = format!("cascade_{}", op.family().name().replace('-', "_"));
+        let cascade = OperatorCascade::new(op, block()).expect("a cascade");
+        let n = cascade.parameters().len();
+        let model = FittedModel::OperatorCascade {
+            model: cascade,
+            std: vec![f64::NAN; n],
+        };
+        out.extend(cases_of(&label, &model, u));
+    }
+    // Maxwell-slip without a linear spring saturates: the PI inverse is the per-sample solve.
+    let saturating = MaxwellSlip::new(
+        0.0,
+        vec![1.0, 0.5],
+        vec![0.1, 0.4],
+        0.0,
+        Orientation::default(),
+    )
+    .expect("a valid Maxwell-slip operator");
+    let model = FittedModel::operator(saturating.into(), vec![f64::NAN; 6]);
+    out.extend(cases_of("maxwell_slip_saturating", &model, u));
+    let ch = hysteresis();
+    let n = ch.params().len();
+    for (label, initial) in [
+        ("ch", InitialOutput::Zero),
+        ("ch_measured", InitialOutput::Measured),
+    ] {
+        let model = FittedModel::Hysteresis {
+            model: ch.clone(),
+            initial,
+            std: vec![f64::NAN; n],
+        };
+        let mut cases = cases_of(label, &model, u);
+        if initial == InitialOutput::Measured {
+            cases.retain(|c| c.options.inverse);
+        }
+        out.extend(cases);
+    }
+    let cascade = HysteresisCascade::new(ch, block()).expect("a cascade");
+    let n = cascade.params().len();
+    out.extend(cases_of(
+        "ch_cascade",
+        &FittedModel::Cascade {
+            model: cascade,
+            std: vec![f64::NAN; n],
+        },
+        u,
+    ));
+    out
+}
+
+/// Every case: each family of the registry (its example, and its clockwise-decreasing form
+/// where it has one), forward and inverse; then the other kinds.
+pub fn all() -> Vec<Case> {
+    let u = signal(3000, 27);
+    let mut out = Vec::new();
+    for op in OperatorModel::examples().expect("the registry's examples") {
+        let label = op.family().name().replace('-', "_");
+        let model = FittedModel::operator(
+            op.clone(),
+            vec![f64::NAN; op.as_operator().parameters().len()],
+        );
+        out.extend(cases_of(&label, &model, &u));
+        if let Some(cw) = flipped(&op) {
+            let n = cw.as_operator().parameters().len();
+            let model = FittedModel::operator(cw, vec![f64::NAN; n]);
+            out.extend(cases_of(&format!("{label}_cw"), &model, &u));
+        }
+    }
+    out.extend(kinds(&u));
+    out
+}
+
+/// A PI operator's model file with the data's sample time and column names.
+pub fn named_pi() -> ModelFile {
+    let op = OperatorModel::examples().expect("examples").remove(0);
+    let n = op.as_operator().parameters().len();
+    FittedModel::operator(op, vec![f64::NAN; n])
+        .to_file()
+        .with_data(
+            1e-4,
+            Columns {
+                inputs: vec!["voltage".into()],
+                outputs: vec!["position".into()],
+            },
+        )
+}
+
+/// max |a − b| ÷ (max − min of b); infinite when the lengths differ.
+pub fn relative_difference(got: &[f64], expected: &[f64]) -> f64 {
+    if got.len() != expected.len() {
+        return f64::INFINITY;
+    }
+    let (lo, hi) = expected
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(*v), h.max(*v))
+        });
+    let diff = got
+        .iter()
+        .zip(expected)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    diff / (hi - lo)
+}
+
+/// The input as text, one round-trip decimal a line.
+pub fn input_text(input: &[f64]) -> String {
+    input.iter().map(|v| format!("{v:?}\n")).collect()
+}
+
+/// The outputs a driver printed, one a line; a last line `error` when the error flag was set.
+pub fn parse_outputs(text: &str) -> (Vec<f64>, bool) {
+    let mut error = false;
+    let mut values = Vec::new();
+    for line in text.lines() {
+        if line.trim() == "error" {
+            error = true;
+        } else {
+            values.push(line.trim().parse::<f64>().unwrap_or(f64::NAN));
+        }
+    }
+    (values, error)
+}
+
+/// Checks every result against the bar, after printing the table of figures.
+pub fn check(target: &str, results: &[(String, f64, bool)]) {
+    println!("{target}: max |generated - library| / range");
+    for (name, d, error) in results {
+        println!(
+            "  {name:<28} {d:.3e}{}",
+            if *error { "  (error flag)" } else { "" }
+        );
+    }
+    let bad: Vec<String> = results
+        .iter()
+        .filter(|(_, d, error)| *error || d.is_nan() || *d > BAR)
+        .map(|(n, d, _)| format!("{n} ({d:e})"))
+        .collect();
+    assert!(
+        bad.is_empty(),
+        "{target}: above the bar {BAR:e}: {}",
+        bad.join(", ")
+    );
+}

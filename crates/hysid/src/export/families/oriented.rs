@@ -1,0 +1,66 @@
+//! The orientation wrapper of the rate-independent families (as the library's
+//! `oriented_simulate` and `oriented_invert`): with the core G of a family and the sign s = ±1
+//! of its [`Orientation`],
+//!
+//! | orientation | forward Γ\[u\] | inverse |
+//! |---|---|---|
+//! | Γ = ±G | s·G\[u\] | G⁻¹\[s·r\] |
+//! | Γ = ±G⁻¹ | s·G⁻¹\[u\] | G\[s·r\] |
+//!
+//! An input outside the domain of G⁻¹ in the forward step (the library's simulate refuses the
+//! record) sets the error flag.
+
+use super::Emit;
+use crate::export::code::{lit, local, Expr, Ty};
+use crate::export::program::{Ns, Program, ERROR_FIELD};
+use crate::model::operators::Orientation;
+use crate::Result;
+
+/// A core operator G, emitted as streaming code.
+pub trait EmitCore {
+    /// The orientation mapping G onto Γ.
+    fn orientation(&self) -> Orientation;
+    /// Emits `ns.g(x) -> f64`: G's output for the input x, advancing G's state. Returns the
+    /// helper's name.
+    fn emit_core(&self, ns: &Ns, prog: &mut Program) -> Result<String>;
+    /// Emits `ns.g_inv(v) -> f64`: G⁻¹'s output for v, advancing its state; returns the
+    /// helper's name and, for an inverse that can clip, the name of the flag field it sets
+    /// when it clipped.
+    fn emit_core_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<(String, Option<String>)>;
+}
+
+impl<T: EmitCore> Emit for T {
+    fn emit_forward(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
+        let o = self.orientation();
+        let s = o.sign();
+        if o.inverse {
+            let (g_inv, clipped) = self.emit_core_inverse(ns, prog)?;
+            prog.function(&ns.name("step"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
+                let v = b.let_("v", Expr::Call(g_inv, vec![local("x")]));
+                if let Some(clipped) = clipped {
+                    b.if_(Expr::State(clipped), |b| {
+                        b.set_state(ERROR_FIELD, Expr::Flag(true))
+                    });
+                }
+                b.ret(lit(s) * v);
+            })
+        } else {
+            let g = self.emit_core(ns, prog)?;
+            prog.function(&ns.name("step"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
+                b.ret(lit(s) * Expr::Call(g, vec![local("x")]));
+            })
+        }
+    }
+
+    fn emit_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
+        let o = self.orientation();
+        let helper = if o.inverse {
+            self.emit_core(ns, prog)?
+        } else {
+            self.emit_core_inverse(ns, prog)?.0
+        };
+        prog.function(&ns.name("inverse"), &[("r", Ty::F64)], Some(Ty::F64), |b| {
+            b.ret(Expr::Call(helper, vec![lit(o.sign()) * local("r")]));
+        })
+    }
+}

@@ -1,0 +1,355 @@
+//! The discrete Preisach plane (`model::operators::preisach`): the staircase memory with
+//! wiping-out, the running sums of the strips' Everett integrals and the Everett function
+//! from the triangle's prefix sums, transliterated with the library's order of operations;
+//! G⁻¹ is the library's monotone per-sample solve on a trial copy of the memory.
+//!
+//! **A bounded memory.** The library keeps the alternating dominant extrema in a growing
+//! list. Within a cell of uniform density the output depends on where every corner of the
+//! staircase lies, so no fixed-size summary (relay states on the grid, areas per cell) is
+//! exact, and the number of nested extrema a continuous input can leave has no bound. The
+//! generated code keeps up to [`MEMORY_POINTS`] points (the input's current value and 63
+//! extrema: 31 nested minor loops inside the major one), exactly the library's list while
+//! it fits; an input that would need more sets the error flag (the outputs then hold).
+//! The state holds two such memories: the operator's, and the trial copy the inverse's
+//! solve evaluates.
+
+use super::oriented::EmitCore;
+use crate::export::code::{call, idx, local, select, Block, Expr, Ty};
+use crate::export::program::{Ns, Program, ERROR_FIELD};
+use crate::export::solve;
+use crate::model::operators::preisach::{prefix_sums, Grid};
+use crate::model::operators::{Orientation, Preisach};
+use crate::Result;
+use std::ops::Not;
+
+/// The points of one staircase memory the generated code holds.
+pub const MEMORY_POINTS: usize = 64;
+/// The strips (running sums) of one memory: half the points.
+const STRIPS: usize = MEMORY_POINTS / 2;
+
+/// The names of the memory's fields and helpers.
+struct Memory {
+    pts: String,
+    len: String,
+    prefix: String,
+    plen: String,
+}
+
+impl Memory {
+    fn declare(prog: &mut Program, ns: &Ns) -> Result<Self> {
+        Ok(Self {
+            pts: prog.field(
+                &ns.name("pts"),
+                Ty::F64,
+                Some(2 * MEMORY_POINTS),
+                "the staircase memories (the operator's, then the trial copy): alternating extrema, the input last",
+            )?,
+            len: prog.field(&ns.name("len"), Ty::Index, Some(2), "the points of each memory")?,
+            prefix: prog.field(
+                &ns.name("prefix"),
+                Ty::F64,
+                Some(2 * STRIPS),
+                "the running sums of the strips' Everett integrals of each memory",
+            )?,
+            plen: prog.field(&ns.name("plen"), Ty::Index, Some(2), "the running sums held")?,
+        })
+    }
+    /// Point i of memory m.
+    fn p(&self, m: &Expr, i: Expr) -> Expr {
+        Expr::StateAt(self.pts.clone(), Box::new(m.clone() * MEMORY_POINTS + i))
+    }
+    fn set_p(&self, b: &mut Block, m: &Expr, i: Expr, v: Expr) {
+        b.set_at(&self.pts, m.clone() * MEMORY_POINTS + i, v);
+    }
+    fn len(&self, m: &Expr) -> Expr {
+        Expr::StateAt(self.len.clone(), Box::new(m.clone()))
+    }
+    fn q(&self, m: &Expr, i: Expr) -> Expr {
+        Expr::StateAt(self.prefix.clone(), Box::new(m.clone() * STRIPS + i))
+    }
+    fn plen(&self, m: &Expr) -> Expr {
+        Expr::StateAt(self.plen.clone(), Box::new(m.clone()))
+    }
+}
+
+/// Emits the Everett function `ns.everett(alpha, beta)` (`Preisach::everett`).
+fn everett(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<String> {
+    let g = *op.grid();
+    let n = g.n;
+    let h = (g.upper - g.lower) / n as f64;
+    let levels: Vec<f64> = (0..=n)
+        .map(|k| {
+            if k >= n {
+                g.upper
+            } else {
+                g.lower + k as f64 * h
+            }
+        })
+        .collect();
+    let level = prog.table(&ns.table("level"), levels)?;
+    let w = prog.table(&ns.table("w"), op.weights().to_vec())?;
+    let q = prog.table(&ns.table("q"), prefix_sums(&g, op.weights()))?;
+    let t = |name: &str, i: Expr| Expr::Table(name.into(), Box::new(i));
+    let interval = prog.function(
+        &ns.name("interval"),
+        &[("x", Ty::F64)],
+        Some(Ty::Index),
+        |b| {
+            let k = ((local("x") - g.lower) / h).floor().max(0.0);
+            b.ret(k.min((n - 1) as f64).to_index());
+        },
+    )?;
+    let hh = h * h;
+    let level_c = level.clone();
+    let fraction = prog.function(
+        &ns.name("fraction"),
+        &[
+            ("i", Ty::Index),
+            ("j", Ty::Index),
+            ("b_lo", Ty::F64),
+            ("a_hi", Ty::F64),
+        ],
+        Some(Ty::F64),
+        move |b| {
+            let (i, j) = (local("i"), local("j"));
+            let bl = b.let_("bl", t(&level_c, j.clone()).max(local("b_lo")));
+            let bh = b.let_("bh", t(&level_c, j.clone() + idx(1)));
+            let al = b.let_("al", t(&level_c, i.clone()));
+            let ah = b.let_("ah", t(&level_c, i.clone() + idx(1)).min(local("a_hi")));
+            b.if_(
+                bl.clone().ge(bh.clone()).or(al.clone().ge(ah.clone())),
+                |b| b.ret(0.0),
+            );
+            b.if_(i.gt(j), |b| {
+                b.ret((bh.clone() - bl.clone()) * (ah.clone() - al.clone()) / hh)
+            });
+            b.if_(ah.clone().gt(bl.clone()), |b| {
+                let tt = b.let_("t", bh.clone().min(ah.clone()));
+                let d1 = b.let_("d1", ah.clone() - bl.clone());
+                let d2 = b.let_("d2", ah.clone() - tt);
+                b.ret((d1.clone() * d1 - d2.clone() * d2) / hh);
+            });
+            b.ret(0.0);
+        },
+    )?;
+    let cell = |i: Expr, j: Expr| i.clone() * (i + idx(1)) / idx(2) + j;
+    prog.function(
+        &ns.name("everett"),
+        &[("alpha_in", Ty::F64), ("beta_in", Ty::F64)],
+        Some(Ty::F64),
+        |b| {
+            let alpha = b.let_("alpha", local("alpha_in").min(g.upper));
+            let beta = b.let_("beta", local("beta_in").max(g.lower));
+            b.if_(alpha.clone().le(beta.clone()), |b| b.ret(0.0));
+            let ii = b.local("ii", Ty::Index, false, call(&interval, vec![alpha.clone()]));
+            let jj = b.local("jj", Ty::Index, false, call(&interval, vec![beta.clone()]));
+            let full = b.var("full", 0.0);
+            b.if_((jj.clone() + idx(1)).lt(ii.clone()), |b| {
+                b.set("full", t(&q, (jj.clone() + idx(1)) * n + ii.clone() - 1));
+            });
+            let row = b.var("row", 0.0);
+            b.for_("j", jj.clone(), ii.clone() + idx(1), |b, j| {
+                let f = call(
+                    &fraction,
+                    vec![ii.clone(), j.clone(), beta.clone(), alpha.clone()],
+                );
+                b.set("row", row.clone() + t(&w, cell(ii.clone(), j)) * f);
+            });
+            let col = b.var("col", 0.0);
+            b.for_("i", jj.clone(), ii.clone(), |b, i| {
+                let f = call(
+                    &fraction,
+                    vec![i.clone(), jj.clone(), beta.clone(), alpha.clone()],
+                );
+                b.set("col", col.clone() + t(&w, cell(i, jj.clone())) * f);
+            });
+            b.ret(full + row + col);
+        },
+    )
+}
+
+/// Emits `ns.apply(m, x) -> index` (`Memory::apply` on memory m: the first point that
+/// changed) and `ns.advance(m, x) -> f64` (`State::advance`: the integral over S⁺).
+fn advance(op: &Preisach, ns: &Ns, prog: &mut Program, mem: &Memory) -> Result<String> {
+    let g = *op.grid();
+    let everett = everett(op, ns, prog)?;
+    let m = local("m");
+    let apply = prog.function(
+        &ns.name("apply"),
+        &[("m", Ty::Index), ("x", Ty::F64)],
+        Some(Ty::Index),
+        |b| {
+            let v = b.let_("v", local("x").clamp(g.lower, g.upper));
+            let len = b.local("n0", Ty::Index, false, mem.len(&m));
+            let cur = b.let_("cur", mem.p(&m, len.clone() - idx(1)));
+            b.if_(v.clone().eq(cur.clone()), |b| b.ret(len.clone()));
+            let continuing = len.clone().ge(idx(2)).and(
+                cur.clone()
+                    .gt(mem.p(&m, len.clone() - idx(2)))
+                    .eq(v.clone().gt(cur.clone())),
+            );
+            let first = b.local("first", Ty::Index, true, len.clone());
+            b.if_else(
+                continuing,
+                |b| {
+                    mem.set_p(b, &m, len.clone() - idx(1), v.clone());
+                    b.set("first", len.clone() - idx(1));
+                },
+                |b| {
+                    b.if_(len.clone().ge(idx(MEMORY_POINTS)), |b| {
+                        b.set_state(ERROR_FIELD, Expr::Flag(true));
+                        b.ret(len.clone());
+                    });
+                    mem.set_p(b, &m, len.clone(), v.clone());
+                    b.set_at(&mem.len, m.clone(), len.clone() + idx(1));
+                },
+            );
+            b.while_(mem.len(&m).ge(idx(3)), |b| {
+                let n = b.local("n", Ty::Index, false, mem.len(&m));
+                let rising = b.local(
+                    "rising",
+                    Ty::Flag,
+                    false,
+                    mem.p(&m, n.clone() - idx(1))
+                        .gt(mem.p(&m, n.clone() - idx(2))),
+                );
+                let older = mem.p(&m, n.clone() - idx(3));
+                let passes = select(
+                    rising.clone(),
+                    v.clone().ge(older.clone()),
+                    v.clone().le(older),
+                );
+                b.if_(passes.not(), |b| b.break_());
+                b.if_(n.clone().eq(idx(3)).and(rising.clone().not()), |b| {
+                    b.set_at(&mem.len, m.clone(), idx(1));
+                    b.set("first", idx(1));
+                    b.break_();
+                });
+                mem.set_p(b, &m, n.clone() - idx(3), mem.p(&m, n.clone() - idx(1)));
+                b.set_at(&mem.len, m.clone(), n.clone() - idx(2));
+                b.if_((n.clone() - idx(3)).lt(first.clone()), |b| {
+                    b.set("first", n.clone() - idx(3))
+                });
+            });
+            b.ret(first);
+        },
+    )?;
+    prog.function(
+        &ns.name("advance"),
+        &[("m", Ty::Index), ("x", Ty::F64)],
+        Some(Ty::F64),
+        |b| {
+            let first = b.local(
+                "first",
+                Ty::Index,
+                false,
+                call(&apply, vec![m.clone(), local("x")]),
+            );
+            let keep = select(
+                first.clone().ge(idx(2)),
+                (first.clone() - idx(2)) / idx(2),
+                idx(0),
+            );
+            b.if_(keep.clone().lt(mem.plen(&m)), |b| {
+                b.set_at(&mem.plen, m.clone(), keep)
+            });
+            let strips = mem.len(&m) / idx(2);
+            b.for_("strip", mem.plen(&m), strips, |b, s| {
+                let k = b.local("k", Ty::Index, false, s * idx(2) + idx(1));
+                let next = select(
+                    (k.clone() + idx(1)).lt(mem.len(&m)),
+                    mem.p(&m, k.clone() + idx(1)),
+                    mem.p(&m, k.clone()),
+                );
+                let m_next = b.let_("m_next", next);
+                let big = b.let_("big", mem.p(&m, k.clone()));
+                let m_prev = b.let_("m_prev", mem.p(&m, k - idx(1)));
+                let a = b.let_(
+                    "a",
+                    call(&everett, vec![big.clone(), m_prev]) - call(&everett, vec![big, m_next]),
+                );
+                let pl = b.local("pl", Ty::Index, false, mem.plen(&m));
+                let before = select(pl.clone().gt(idx(0)), mem.q(&m, pl.clone() - idx(1)), 0.0);
+                b.set_at(&mem.prefix, m.clone() * STRIPS + pl.clone(), before + a);
+                b.set_at(&mem.plen, m.clone(), pl + idx(1));
+            });
+            let pl = b.local("pl", Ty::Index, false, mem.plen(&m));
+            b.ret(select(pl.clone().gt(idx(0)), mem.q(&m, pl - idx(1)), 0.0));
+        },
+    )
+}
+
+/// Initialises both memories to negative saturation (one point, the grid's lower end).
+fn init(prog: &mut Program, mem: &Memory, lower: f64) {
+    prog.init(|b| {
+        for m in 0..2 {
+            mem.set_p(b, &idx(m), idx(0), lower.into());
+            b.set_at(&mem.len, idx(m), idx(1));
+        }
+    });
+}
+
+impl EmitCore for Preisach {
+    fn orientation(&self) -> Orientation {
+        Preisach::orientation(self)
+    }
+
+    fn emit_core(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
+        let mem = Memory::declare(prog, ns)?;
+        init(prog, &mem, self.lower());
+        let advance = advance(self, ns, prog, &mem)?;
+        let (c, a0, q_last) = (self.offset(), self.a0(), last_prefix(self));
+        prog.function(&ns.name("g"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
+            let up = b.let_("up", call(&advance, vec![idx(0), local("x")]));
+            b.ret(c + a0 * local("x") + 2.0 * up - q_last);
+        })
+    }
+
+    fn emit_core_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<(String, Option<String>)> {
+        let mem = Memory::declare(prog, ns)?;
+        init(prog, &mem, self.lower());
+        let advance = advance(self, ns, prog, &mem)?;
+        let (c, a0, q_last) = (self.offset(), self.a0(), last_prefix(self));
+        let one = idx(1);
+        let trial = prog.function(&ns.name("trial"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
+            b.set_at(&mem.len, one.clone(), mem.len(&idx(0)));
+            b.for_("i", idx(0), mem.len(&idx(0)), |b, i| {
+                mem.set_p(b, &one, i.clone(), mem.p(&idx(0), i));
+            });
+            b.set_at(&mem.plen, one.clone(), mem.plen(&idx(0)));
+            b.for_("i", idx(0), mem.plen(&idx(0)), |b, i| {
+                b.set_at(
+                    &mem.prefix,
+                    one.clone() * STRIPS + i.clone(),
+                    mem.q(&idx(0), i),
+                );
+            });
+            let up = b.let_("up", call(&advance, vec![one.clone(), local("x")]));
+            b.ret(c + a0 * local("x") + 2.0 * up - q_last);
+        })?;
+        let solve = solve::emit(prog, ns, &trial)?;
+        let (lower, upper) = (self.lower(), self.upper());
+        let center = 0.5 * (lower + upper);
+        let span = 0.5 * (upper - lower) * (1.0 + 1e-12);
+        let unbounded = Expr::Flag(a0 > 0.0);
+        let name = prog.function(&ns.name("g_inv"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
+            let args = vec![
+                local("v"),
+                center.into(),
+                span.into(),
+                unbounded.clone(),
+                unbounded,
+            ];
+            let x = b.let_("u", call(&solve, args));
+            b.call(&advance, vec![idx(0), x.clone()]);
+            b.ret(x);
+        })?;
+        Ok((name, Some(ns.name("clipped"))))
+    }
+}
+
+/// q\[N − 1\] = Σ w: the output's constant −Σ w (all relays down).
+fn last_prefix(op: &Preisach) -> f64 {
+    let g: Grid = *op.grid();
+    prefix_sums(&g, op.weights())[g.n - 1]
+}

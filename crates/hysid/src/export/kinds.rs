@@ -1,0 +1,105 @@
+//! The program of each model kind: which components (an operator of the registry, a linear
+//! block, the Coleman–Hodgdon recursion) a model is made of and how its step chains them.
+//!
+//! | kind | forward | compensator |
+//! |---|---|---|
+//! | `operator` | the family's step | the family's inverse step |
+//! | `operator_cascade` | operator, then the linear block | the block's inverse (the reference k samples ahead), then the operator's inverse; refused unless B is minimum-phase |
+//! | `coleman_hodgdon` | the recursion (from 0: `initial_output: zero`) | the per-sample solve |
+//! | `ch_cascade` | the recursion from 0, then the linear block | none (as `hysid compensate`) |
+//!
+//! Every step sets the error flag where the library's `simulate` errors on a non-finite
+//! output. Grey-box and equation-file models are not exported by this version.
+
+use super::code::{call, Expr};
+use super::program::{Ns, Program, ERROR_FIELD};
+use super::{coleman_hodgdon, families, linear};
+use crate::model::coleman_hodgdon::InitialOutput;
+use crate::model::saved::FittedModel;
+use crate::{Error, Result};
+use std::ops::Not;
+
+/// The streaming program of `model`, or of its compensator when `inverse`.
+pub fn program(model: &FittedModel, inverse: bool) -> Result<Program> {
+    let mut prog = Program::new(1, 1);
+    let (op, lin, ch) = (Ns::new("op_"), Ns::new("lin_"), Ns::new("ch_"));
+    let kind = || model.to_file().kind().to_string();
+    // The helpers applied in turn to the step's input.
+    let chain: Vec<String> = match (model, inverse) {
+        (FittedModel::Operator { model, .. }, false) => {
+            vec![families::forward(model, &op, &mut prog)?]
+        }
+        (FittedModel::Operator { model, .. }, true) => {
+            vec![families::inverse(model, &op, &mut prog)?]
+        }
+        (FittedModel::OperatorCascade { model, .. }, false) => vec![
+            families::forward(&model.operator, &op, &mut prog)?,
+            linear::forward(&model.linear, &lin, &mut prog)?,
+        ],
+        (FittedModel::OperatorCascade { model, .. }, true) => {
+            let radius = model.zero_radius();
+            if radius >= 1.0 {
+                return Err(Error::NotInvertible {
+                    kind: kind(),
+                    reason: format!(
+                        "the linear block is not minimum phase (a zero of B at |z| = {radius:.4} \
+                         >= 1), so its inverse is unstable; export the operator's compensator \
+                         alone, or refit with fewer B coefficients"
+                    ),
+                });
+            }
+            vec![
+                linear::inverse(&model.linear, &lin, &mut prog)?,
+                families::inverse(&model.operator, &op, &mut prog)?,
+            ]
+        }
+        (FittedModel::Hysteresis { model, initial, .. }, false) => {
+            if *initial == InitialOutput::Measured {
+                return Err(Error::UnsupportedKind {
+                    kind: kind(),
+                    operation: "a forward export starting from the measured output (a stream \
+                                has none); save the model with \"initial_output\": \"zero\", or \
+                                export its compensator with --inverse"
+                        .into(),
+                });
+            }
+            vec![coleman_hodgdon::forward(model, 0.0, &ch, &mut prog)?]
+        }
+        (FittedModel::Hysteresis { model, initial, .. }, true) => {
+            vec![coleman_hodgdon::inverse(model, *initial, &ch, &mut prog)?]
+        }
+        (FittedModel::Cascade { model, .. }, false) => vec![
+            coleman_hodgdon::forward(&model.hysteresis, 0.0, &ch, &mut prog)?,
+            linear::forward(&model.linear, &lin, &mut prog)?,
+        ],
+        (FittedModel::Cascade { .. }, true) => {
+            return Err(Error::NotInvertible {
+                kind: kind(),
+                reason: "compensation inverts hysteresis operators, the Coleman–Hodgdon \
+                         hysteresis alone and operator cascades with a minimum-phase linear \
+                         block; identify one of those"
+                    .into(),
+            })
+        }
+        _ => {
+            return Err(Error::UnsupportedKind {
+                kind: kind(),
+                operation: "export as code (this version exports operators, operator cascades \
+                            and Coleman–Hodgdon models; grey-box and equation-file models are \
+                            not yet exported)"
+                    .into(),
+            })
+        }
+    };
+    prog.fallible_step(|b| {
+        let mut value = Expr::Input(0);
+        for (i, helper) in chain.iter().enumerate() {
+            value = b.let_(&format!("stage{i}"), call(helper, vec![value]));
+        }
+        let y = b.let_("y0", value);
+        b.if_(y.is_finite().not(), |b| {
+            b.set_state(ERROR_FIELD, Expr::Flag(true))
+        });
+    })?;
+    Ok(prog)
+}

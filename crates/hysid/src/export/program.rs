@@ -1,0 +1,234 @@
+//! A streaming program in the language-neutral code of [`super::code`]: the fields of its
+//! fixed-size state, its constant tables, its helper functions, the initialisation and the
+//! step. The model kinds and families build one; a renderer prints it as C or Rust.
+
+use super::code::{literals, Block, Expr, Function, Stmt, Ty};
+use crate::{Error, Result};
+
+/// A field of the state struct: a scalar, or an array of fixed length.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Field {
+    /// Its name (a C identifier).
+    pub name: String,
+    /// Its type.
+    pub ty: Ty,
+    /// The array length, or None for a scalar.
+    pub len: Option<usize>,
+    /// What it holds, one line (a comment in the header).
+    pub doc: String,
+}
+
+/// A constant table (`static const double` / `const [f64; N]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// Its name (upper case).
+    pub name: String,
+    /// Its values.
+    pub values: Vec<f64>,
+}
+
+/// The name of the state's error flag: set when a step could not be computed (see
+/// [`Program::fallible_step`]); every program has it.
+pub const ERROR_FIELD: &str = "error";
+/// The name of the state's copy of the last outputs, held while the error flag is set.
+const HELD_FIELD: &str = "held";
+
+/// A streaming program: state, tables, helpers, initialisation and step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Program {
+    /// The number of inputs of the step.
+    pub n_inputs: usize,
+    /// The number of outputs of the step.
+    pub n_outputs: usize,
+    /// The state's fields, the error flag first.
+    pub fields: Vec<Field>,
+    /// The constant tables.
+    pub tables: Vec<Table>,
+    /// The helper functions, in the order they were added.
+    pub functions: Vec<Function>,
+    /// The initialisation, after every field has been set to zero.
+    pub init: Vec<Stmt>,
+    /// The step: reads the inputs, writes every output.
+    pub step: Vec<Stmt>,
+}
+
+impl Program {
+    /// An empty program of `n_inputs` inputs and `n_outputs` outputs.
+    pub fn new(n_inputs: usize, n_outputs: usize) -> Self {
+        let mut program = Self {
+            n_inputs,
+            n_outputs,
+            fields: Vec::new(),
+            tables: Vec::new(),
+            functions: Vec::new(),
+            init: Vec::new(),
+            step: Vec::new(),
+        };
+        program.fields.push(Field {
+            name: ERROR_FIELD.into(),
+            ty: Ty::Flag,
+            len: None,
+            doc: "nonzero once a step could not be computed; the outputs then hold their last \
+                  values until the next init"
+                .into(),
+        });
+        program
+    }
+
+    fn check_new(&self, name: &str) -> Result<()> {
+        let taken = self.fields.iter().any(|f| f.name == name)
+            || self.tables.iter().any(|t| t.name == name)
+            || self.functions.iter().any(|f| f.name == name);
+        if taken {
+            return Err(Error::Unsupported(format!(
+                "export: the generated name '{name}' is used twice; this is a bug of hysid's \
+                 exporter, please report it"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Adds a state field; returns its name.
+    pub fn field(&mut self, name: &str, ty: Ty, len: Option<usize>, doc: &str) -> Result<String> {
+        self.check_new(name)?;
+        self.fields.push(Field {
+            name: name.into(),
+            ty,
+            len,
+            doc: doc.into(),
+        });
+        Ok(name.into())
+    }
+
+    /// Adds a constant table; returns its name.
+    pub fn table(&mut self, name: &str, values: Vec<f64>) -> Result<String> {
+        self.check_new(name)?;
+        self.tables.push(Table {
+            name: name.into(),
+            values,
+        });
+        Ok(name.into())
+    }
+
+    /// Adds a helper function; returns its name.
+    pub fn function(
+        &mut self,
+        name: &str,
+        params: &[(&str, Ty)],
+        ret: Option<Ty>,
+        body: impl FnOnce(&mut Block),
+    ) -> Result<String> {
+        self.check_new(name)?;
+        self.functions.push(Function {
+            name: name.into(),
+            params: params.iter().map(|(n, t)| (n.to_string(), *t)).collect(),
+            ret,
+            body: Block::build(body),
+        });
+        Ok(name.into())
+    }
+
+    /// True when a helper `name` exists.
+    pub fn has_function(&self, name: &str) -> bool {
+        self.functions.iter().any(|f| f.name == name)
+    }
+
+    /// Appends initialisation statements.
+    pub fn init(&mut self, build: impl FnOnce(&mut Block)) {
+        self.init.extend(Block::build(build));
+    }
+
+    /// Makes the step fallible: once a helper has set the error flag the outputs hold their
+    /// last values (a field `held`) and later steps compute nothing until the next init.
+    /// `body` computes the outputs into the locals `y0`, `y1`, … that it declares.
+    pub fn fallible_step(&mut self, body: impl FnOnce(&mut Block)) -> Result<()> {
+        let n = self.n_outputs;
+        let held = self.field(HELD_FIELD, Ty::F64, Some(n), "the last outputs")?;
+        let error = Expr::State(ERROR_FIELD.into());
+        let hold = |b: &mut Block| {
+            for i in 0..n {
+                b.output(i, Expr::StateAt(held.clone(), Box::new(Expr::Index(i))));
+            }
+        };
+        self.step = Block::build(|b| {
+            b.if_else(error.clone(), hold, |b| {
+                body(b);
+                b.if_else(error.clone(), hold, |b| {
+                    for i in 0..n {
+                        let y = Expr::Local(format!("y{i}"));
+                        b.set_at(&held, Expr::Index(i), y.clone());
+                        b.output(i, y);
+                    }
+                });
+            });
+        });
+        Ok(())
+    }
+
+    /// The step without failure: `body` writes every output.
+    pub fn infallible_step(&mut self, body: impl FnOnce(&mut Block)) {
+        self.step = Block::build(body);
+    }
+
+    /// Refuses a program with a non-finite literal (a model whose derived constants
+    /// overflow).
+    pub fn check(&self) -> Result<()> {
+        let mut values: Vec<f64> = self.tables.iter().flat_map(|t| t.values.clone()).collect();
+        literals(&self.init, &mut values);
+        literals(&self.step, &mut values);
+        for f in &self.functions {
+            literals(&f.body, &mut values);
+        }
+        match values.iter().find(|v| !v.is_finite()) {
+            Some(v) => Err(Error::InvalidModel(format!(
+                "a constant of the model is {v}; the exported code needs finite constants \
+                 (refit or rescale the model)"
+            ))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The names of one component of a program (an operator, a linear block): every field,
+/// table and helper it adds carries its prefix, so that components never collide.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Ns {
+    prefix: String,
+}
+
+impl Ns {
+    /// The namespace with prefix `prefix` (e.g. `op_`).
+    pub fn new(prefix: &str) -> Self {
+        Self {
+            prefix: prefix.into(),
+        }
+    }
+    /// A nested namespace, `prefix` + `inner` + `_`.
+    pub fn sub(&self, inner: &str) -> Self {
+        Self::new(&format!("{}{inner}_", self.prefix))
+    }
+    /// The full name of `name` in this namespace.
+    pub fn name(&self, name: &str) -> String {
+        format!("{}{name}", self.prefix)
+    }
+    /// The full, upper-case name of the table `name`.
+    pub fn table(&self, name: &str) -> String {
+        self.name(name).to_ascii_uppercase()
+    }
+    /// The scalar field `name`.
+    pub fn state(&self, name: &str) -> Expr {
+        Expr::State(self.name(name))
+    }
+    /// Element `i` of the array field `name`.
+    pub fn at(&self, name: &str, i: Expr) -> Expr {
+        Expr::StateAt(self.name(name), Box::new(i))
+    }
+    /// Element `i` of the table `name`.
+    pub fn tab(&self, name: &str, i: Expr) -> Expr {
+        Expr::Table(self.table(name), Box::new(i))
+    }
+    /// A call of the helper `name` of this namespace.
+    pub fn call(&self, name: &str, args: Vec<Expr>) -> Expr {
+        Expr::Call(self.name(name), args)
+    }
+}

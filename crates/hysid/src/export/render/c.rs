@@ -1,0 +1,186 @@
+//! C99 rendering: `NAME.h` (the state struct, the constants, the two functions) and `NAME.c`
+//! (the tables as `static const`, the helpers as `static` functions taking the state, init and
+//! step; in `NAME.c` the state is the parameter `state`, a name no emitter gives a local). No heap, no globals; `NAME.c` includes only `NAME.h`, `<math.h>` and `<stddef.h>`.
+//! An array field or table of length 0 is given one unused element (C has no empty arrays).
+
+use super::{comment_lines, Printer, Syntax, ATOM, UNARY};
+use crate::export::code::{Math, Ty};
+use crate::export::program::Program;
+
+/// The C spelling, for the export `name`.
+struct C<'a> {
+    name: &'a str,
+}
+
+fn c_type(ty: Ty) -> &'static str {
+    match ty {
+        Ty::F64 => "double",
+        Ty::Index => "size_t",
+        Ty::Flag => "int",
+    }
+}
+
+impl Syntax for C<'_> {
+    fn state(&self, field: &str) -> String {
+        format!("state->{field}")
+    }
+    fn table(&self, name: &str) -> String {
+        format!("{}_{name}", self.name)
+    }
+    fn math(&self, f: Math) -> String {
+        f.name().into()
+    }
+    fn call(&self, name: &str, args: &[String]) -> String {
+        let mut all = vec!["state".to_string()];
+        all.extend(args.iter().cloned());
+        format!("{}_{name}({})", self.name, all.join(", "))
+    }
+    fn flag(&self, v: bool) -> &'static str {
+        if v {
+            "1"
+        } else {
+            "0"
+        }
+    }
+    fn nan(&self) -> &'static str {
+        "NAN"
+    }
+    fn is_finite(&self, x: (String, u8)) -> (String, u8) {
+        (format!("isfinite({})", x.0), ATOM)
+    }
+    fn cast(&self, x: (String, u8), ty: Ty) -> (String, u8) {
+        let operand = if x.1 > UNARY {
+            x.0
+        } else {
+            format!("({})", x.0)
+        };
+        (format!("({}){operand}", c_type(ty)), UNARY)
+    }
+    fn select(&self, c: String, a: String, b: String) -> (String, u8) {
+        (format!("({c}) ? ({a}) : ({b})"), 0)
+    }
+    fn declare(&self, name: &str, ty: Ty, _mutable: bool, value: String) -> String {
+        format!("{} {name} = {value};", c_type(ty))
+    }
+    fn for_head(&self, var: &str, from: String, to: String) -> String {
+        format!("for (size_t {var} = {from}; {var} < {to}; {var}++)")
+    }
+    fn cond_head(&self, keyword: &str, c: String) -> String {
+        format!("{keyword} ({c})")
+    }
+}
+
+/// The two files (`NAME.h`, `NAME.c`) of `program`, each opening with `comment`.
+pub fn render(program: &Program, name: &str, comment: &str, sample_time: f64) -> (String, String) {
+    (
+        header(program, name, comment, sample_time),
+        source(program, name, comment),
+    )
+}
+
+fn block_comment(text: &str) -> String {
+    format!("/*\n{} */\n", comment_lines(text, " * "))
+}
+
+fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> String {
+    let guard = format!("{}_H_INCLUDED", name.to_ascii_uppercase());
+    let mut h = block_comment(comment);
+    h.push_str(&format!(
+        "#ifndef {guard}\n#define {guard}\n\n#include <stddef.h>\n\n"
+    ));
+    h.push_str(&format!(
+        "/* The number of inputs and outputs of {name}_step, and its period in seconds. */\n\
+         #define {name}_N_INPUTS {}\n#define {name}_N_OUTPUTS {}\n#define {name}_SAMPLE_TIME {:?}\n\n",
+        program.n_inputs, program.n_outputs, sample_time
+    ));
+    h.push_str(&format!(
+        "/* The model's whole state: it may live on the stack or in a static. */\n\
+         typedef struct {name}_state {{\n"
+    ));
+    for f in &program.fields {
+        let len = f.len.map(|n| format!("[{}]", n.max(1))).unwrap_or_default();
+        h.push_str(&format!(
+            "    {} {}{len}; /* {} */\n",
+            c_type(f.ty),
+            f.name,
+            f.doc
+        ));
+    }
+    h.push_str(&format!("}} {name}_state;\n\n"));
+    h.push_str(&format!(
+        "/* Sets *s to the model's initial state. */\n\
+         void {name}_init({name}_state *s);\n\n\
+         /* One sample: reads u[0 .. {name}_N_INPUTS), writes y[0 .. {name}_N_OUTPUTS) (the\n\
+         \x20* output at this sample) and advances *s to the next sample. */\n\
+         void {name}_step({name}_state *s, const double *u, double *y);\n\n\
+         #endif /* {guard} */\n"
+    ));
+    h
+}
+
+fn source(program: &Program, name: &str, comment: &str) -> String {
+    let syntax = C { name };
+    let p = Printer::new(&syntax);
+    let mut c = block_comment(comment);
+    c.push_str(&format!(
+        "#include \"{name}.h\"\n#include <math.h>\n#include <stddef.h>\n\n"
+    ));
+    for t in &program.tables {
+        let mut values: Vec<String> = t.values.iter().map(|v| format!("{v:?}")).collect();
+        if values.is_empty() {
+            values.push("0.0".into());
+        }
+        c.push_str(&format!(
+            "static const double {}[{}] = {{{}}};\n",
+            syntax.table(&t.name),
+            values.len(),
+            values.join(", ")
+        ));
+    }
+    if !program.tables.is_empty() {
+        c.push('\n');
+    }
+    let signature = |f: &crate::export::code::Function| {
+        let mut params = vec![format!("{name}_state *state")];
+        params.extend(f.params.iter().map(|(n, t)| format!("{} {n}", c_type(*t))));
+        let ret = f.ret.map_or("void", c_type);
+        format!("static {ret} {name}_{}({})", f.name, params.join(", "))
+    };
+    for f in &program.functions {
+        c.push_str(&format!("{};\n", signature(f)));
+    }
+    if !program.functions.is_empty() {
+        c.push('\n');
+    }
+    for f in &program.functions {
+        c.push_str(&format!("{} {{\n    (void)state;\n", signature(f)));
+        for (n, _) in &f.params {
+            c.push_str(&format!("    (void){n};\n"));
+        }
+        p.stmts(&f.body, 1, &mut c);
+        c.push_str("}\n\n");
+    }
+    c.push_str(&format!("void {name}_init({name}_state *state) {{\n"));
+    for f in &program.fields {
+        let zero = match f.ty {
+            Ty::F64 => "0.0",
+            Ty::Index | Ty::Flag => "0",
+        };
+        match f.len {
+            Some(n) => c.push_str(&format!(
+                "    for (size_t i = 0; i < {}; i++) {{\n        state->{}[i] = {zero};\n    }}\n",
+                n.max(1),
+                f.name
+            )),
+            None => c.push_str(&format!("    state->{} = {zero};\n", f.name)),
+        }
+    }
+    p.stmts(&program.init, 1, &mut c);
+    c.push_str("}\n\n");
+    c.push_str(&format!(
+        "void {name}_step({name}_state *state, const double *u, double *y) {{\n    (void)u;\n"
+    ));
+    p.stmts(&program.step, 1, &mut c);
+    c.push_str("}\n");
+    c
+}

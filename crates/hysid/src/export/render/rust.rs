@@ -1,0 +1,181 @@
+//! `no_std` Rust rendering: `src/lib.rs` of a crate with `pub struct Model` (the state),
+//! `Model::new`, `Model::reset`, `Model::step`, `Model::error`, the constants `N_IN`, `N_OUT`,
+//! `SAMPLE_TIME`, the tables as `const` arrays and the helpers as private methods; and its
+//! `Cargo.toml`, whose one dependency is `libm` (the math functions of `core`-only Rust).
+
+use super::{comment_lines, Printer, Syntax, ATOM};
+use crate::export::code::{Math, Ty};
+use crate::export::program::Program;
+
+/// The Rust spelling.
+struct Rust;
+
+fn rust_type(ty: Ty) -> &'static str {
+    match ty {
+        Ty::F64 => "f64",
+        Ty::Index => "usize",
+        Ty::Flag => "bool",
+    }
+}
+
+fn zero(ty: Ty) -> &'static str {
+    match ty {
+        Ty::F64 => "0.0",
+        Ty::Index => "0",
+        Ty::Flag => "false",
+    }
+}
+
+impl Syntax for Rust {
+    fn state(&self, field: &str) -> String {
+        format!("self.{field}")
+    }
+    fn table(&self, name: &str) -> String {
+        name.into()
+    }
+    fn math(&self, f: Math) -> String {
+        format!("libm::{}", f.name())
+    }
+    fn call(&self, name: &str, args: &[String]) -> String {
+        format!("self.{name}({})", args.join(", "))
+    }
+    fn flag(&self, v: bool) -> &'static str {
+        if v {
+            "true"
+        } else {
+            "false"
+        }
+    }
+    fn nan(&self) -> &'static str {
+        "f64::NAN"
+    }
+    fn is_finite(&self, x: (String, u8)) -> (String, u8) {
+        let receiver = if x.1 >= ATOM {
+            x.0
+        } else {
+            format!("({})", x.0)
+        };
+        (format!("{receiver}.is_finite()"), ATOM)
+    }
+    fn cast(&self, x: (String, u8), ty: Ty) -> (String, u8) {
+        let operand = if x.1 >= ATOM {
+            x.0
+        } else {
+            format!("({})", x.0)
+        };
+        // `x as usize < y` would read as generic arguments: a cast is always parenthesised
+        // inside a larger expression.
+        (format!("{operand} as {}", rust_type(ty)), 0)
+    }
+    fn select(&self, c: String, a: String, b: String) -> (String, u8) {
+        (format!("if {c} {{ {a} }} else {{ {b} }}"), 0)
+    }
+    fn declare(&self, name: &str, ty: Ty, mutable: bool, value: String) -> String {
+        let m = if mutable { "mut " } else { "" };
+        format!("let {m}{name}: {} = {value};", rust_type(ty))
+    }
+    fn for_head(&self, var: &str, from: String, to: String) -> String {
+        format!("for {var} in {from}..{to}")
+    }
+    fn cond_head(&self, keyword: &str, c: String) -> String {
+        format!("{keyword} {c}")
+    }
+}
+
+/// `Cargo.toml` of the crate `name`.
+pub fn cargo_toml(name: &str, description: &str) -> String {
+    format!(
+        "[package]\nname = \"{name}\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\
+         description = \"{}\"\npublish = false\n\n[lib]\npath = \"src/lib.rs\"\n\n\
+         [dependencies]\nlibm = \"0.2\"\n",
+        description.replace('\\', "\\\\").replace('"', "\\\"")
+    )
+}
+
+/// `src/lib.rs` of `program`, opening with `comment` as the crate's documentation.
+pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
+    let p = Printer::new(&Rust);
+    let mut r = comment_lines(comment, "//! ");
+    r.push_str("#![no_std]\n\n");
+    r.push_str(&format!(
+        "/// The number of inputs of [`Model::step`].\npub const N_IN: usize = {};\n\
+         /// The number of outputs of [`Model::step`].\npub const N_OUT: usize = {};\n\
+         /// The period of a step in seconds.\npub const SAMPLE_TIME: f64 = {:?};\n\n",
+        program.n_inputs, program.n_outputs, sample_time
+    ));
+    for t in &program.tables {
+        let values: Vec<String> = t.values.iter().map(|v| format!("{v:?}")).collect();
+        r.push_str(&format!(
+            "const {}: [f64; {}] = [{}];\n",
+            t.name,
+            t.values.len(),
+            values.join(", ")
+        ));
+    }
+    if !program.tables.is_empty() {
+        r.push('\n');
+    }
+    r.push_str(
+        "/// The model's whole state (fixed size, no allocation).\n\
+         #[derive(Clone, Debug, PartialEq)]\npub struct Model {\n",
+    );
+    for f in &program.fields {
+        let ty = match f.len {
+            Some(n) => format!("[{}; {n}]", rust_type(f.ty)),
+            None => rust_type(f.ty).to_string(),
+        };
+        r.push_str(&format!("    /// {}\n    {}: {ty},\n", f.doc, f.name));
+    }
+    r.push_str("}\n\nimpl Default for Model {\n    fn default() -> Self {\n        Self::new()\n    }\n}\n\n");
+    r.push_str("impl Model {\n    /// The model in its initial state.\n    pub fn new() -> Self {\n        let mut model = Model {\n");
+    for f in &program.fields {
+        let value = match f.len {
+            Some(n) => format!("[{}; {n}]", zero(f.ty)),
+            None => zero(f.ty).to_string(),
+        };
+        r.push_str(&format!("            {}: {value},\n", f.name));
+    }
+    r.push_str("        };\n        model.reset();\n        model\n    }\n\n");
+    r.push_str("    /// Returns the model to its initial state.\n    pub fn reset(&mut self) {\n");
+    for f in &program.fields {
+        let value = match f.len {
+            Some(n) => format!("[{}; {n}]", zero(f.ty)),
+            None => zero(f.ty).to_string(),
+        };
+        r.push_str(&format!("        self.{} = {value};\n", f.name));
+    }
+    p.stmts(&program.init, 2, &mut r);
+    r.push_str("    }\n\n");
+    r.push_str(
+        "    /// True once a step could not be computed; the outputs then hold their last\n\
+         \x20   /// values until [`Model::reset`].\n    pub fn error(&self) -> bool {\n        self.error\n    }\n\n",
+    );
+    r.push_str(
+        "    /// One sample: the output at this sample for the input `u`; then the state\n\
+         \x20   /// advances to the next sample.\n\
+         \x20   pub fn step(&mut self, u: &[f64; N_IN]) -> [f64; N_OUT] {\n\
+         \x20       let mut y = [0.0; N_OUT];\n",
+    );
+    p.stmts(&program.step, 2, &mut r);
+    r.push_str("        y\n    }\n");
+    for f in &program.functions {
+        let params: Vec<String> = f
+            .params
+            .iter()
+            .map(|(n, t)| format!("{n}: {}", rust_type(*t)))
+            .collect();
+        let ret = f
+            .ret
+            .map(|t| format!(" -> {}", rust_type(t)))
+            .unwrap_or_default();
+        r.push_str(&format!(
+            "\n    #[allow(unused_variables)]\n    fn {}(&mut self, {}){ret} {{\n",
+            f.name,
+            params.join(", ")
+        ));
+        p.stmts(&f.body, 2, &mut r);
+        r.push_str("    }\n");
+    }
+    r.push_str("}\n");
+    r
+}

@@ -1,0 +1,140 @@
+//! The monotone per-sample solve of the rate-independent inverses, emitted once per operator
+//! that needs it: a transliteration of `model::operators::solve_monotone` (bracketing by
+//! doubling steps, then the Illinois variant of regula falsi, at most 300 iterations), with
+//! the same constants and the same order of operations, so the generated inverse picks the
+//! library's root to the bit.
+
+use super::code::{idx, lit, local, Expr, Ty};
+use super::program::{Ns, Program};
+use crate::Result;
+use std::ops::Not;
+
+/// Emits `ns.solve(target, center, span, unbounded_below, unbounded_above) -> f64`, the root
+/// of `branch(x) = target` for the helper `branch` (a non-decreasing function of x that only
+/// reads the state). It sets the flag field `ns.clipped` when the target lay beyond a
+/// saturation level. Returns the solver's name.
+pub fn emit(prog: &mut Program, ns: &Ns, branch: &str) -> Result<String> {
+    let clipped = prog.field(
+        &ns.name("clipped"),
+        Ty::Flag,
+        None,
+        "the last solve clipped its target to a saturation level",
+    )?;
+    let f = |x: Expr| Expr::Call(branch.into(), vec![x]);
+    let illinois = prog.function(
+        &ns.name("illinois"),
+        &[
+            ("target", Ty::F64),
+            ("a", Ty::F64),
+            ("fa", Ty::F64),
+            ("b", Ty::F64),
+            ("fb", Ty::F64),
+        ],
+        Some(Ty::F64),
+        |b| {
+            let target = local("target");
+            let lo = b.var("lo", local("a"));
+            let flo = b.var("flo", local("fa") - target.clone());
+            let hi = b.var("hi", local("b"));
+            let fhi = b.var("fhi", local("fb") - target.clone());
+            b.if_(flo.clone().eq(0.0), |b| b.ret(lo.clone()));
+            b.if_(fhi.clone().eq(0.0), |b| b.ret(hi.clone()));
+            let side = b.var("side", 0.0);
+            b.for_("_iteration", idx(0), idx(300), |b, _| {
+                let width = lit(2.0)
+                    * lit(f64::EPSILON)
+                    * lo.clone().abs().max(hi.clone().abs()).max(1e-300);
+                b.if_((hi.clone() - lo.clone()).le(width), |b| b.break_());
+                let m = b.var(
+                    "m",
+                    (lo.clone() * fhi.clone() - hi.clone() * flo.clone())
+                        / (fhi.clone() - flo.clone()),
+                );
+                b.if_(
+                    m.clone().gt(lo.clone()).and(m.clone().lt(hi.clone())).not(),
+                    |b| b.set("m", 0.5 * (lo.clone() + hi.clone())),
+                );
+                let fm = b.let_("fm", f(m.clone()) - target.clone());
+                b.if_(fm.clone().eq(0.0), |b| b.ret(m.clone()));
+                b.if_else(
+                    fm.clone().lt(0.0),
+                    |b| {
+                        b.set("lo", m.clone());
+                        b.set("flo", fm.clone());
+                        b.if_(side.clone().eq(-1.0), |b| b.set("fhi", fhi.clone() * 0.5));
+                        b.set("side", -1.0);
+                    },
+                    |b| {
+                        b.set("hi", m.clone());
+                        b.set("fhi", fm.clone());
+                        b.if_(side.clone().eq(1.0), |b| b.set("flo", flo.clone() * 0.5));
+                        b.set("side", 1.0);
+                    },
+                );
+            });
+            b.if_(
+                (f(lo.clone()) - target.clone())
+                    .abs()
+                    .le((f(hi.clone()) - target.clone()).abs()),
+                |b| b.ret(lo.clone()),
+            );
+            b.ret(hi);
+        },
+    )?;
+    prog.function(
+        &ns.name("solve"),
+        &[
+            ("target", Ty::F64),
+            ("center", Ty::F64),
+            ("half_width", Ty::F64),
+            ("unbounded_below", Ty::Flag),
+            ("unbounded_above", Ty::Flag),
+        ],
+        Some(Ty::F64),
+        |b| {
+            let target = local("target");
+            let w = local("half_width");
+            let span = b.let_(
+                "span",
+                crate::export::code::select(w.clone().gt(0.0).and(w.clone().is_finite()), w, 1.0),
+            );
+            let lo = b.var("lo", local("center") - span.clone());
+            let hi = b.var("hi", local("center") + span.clone());
+            let flo = b.var("flo", f(lo.clone()));
+            let fhi = b.var("fhi", f(hi.clone()));
+            let tol = b.let_("tol", 1e-12 * (1.0 + target.clone().abs()));
+            let step = b.var("step", span.clone());
+            b.while_(fhi.clone().lt(target.clone()), |b| {
+                b.if_(
+                    local("unbounded_above").not().or(step.clone().gt(1e150)),
+                    |b| {
+                        b.set_state(&clipped, (target.clone() - fhi.clone()).gt(tol.clone()));
+                        b.ret(hi.clone());
+                    },
+                );
+                b.set("lo", hi.clone());
+                b.set("flo", fhi.clone());
+                b.set("step", step.clone() * 2.0);
+                b.set("hi", hi.clone() + step.clone());
+                b.set("fhi", f(hi.clone()));
+            });
+            b.set("step", span);
+            b.while_(flo.clone().gt(target.clone()), |b| {
+                b.if_(
+                    local("unbounded_below").not().or(step.clone().gt(1e150)),
+                    |b| {
+                        b.set_state(&clipped, (flo.clone() - target.clone()).gt(tol.clone()));
+                        b.ret(lo.clone());
+                    },
+                );
+                b.set("hi", lo.clone());
+                b.set("fhi", flo.clone());
+                b.set("step", step.clone() * 2.0);
+                b.set("lo", lo.clone() - step.clone());
+                b.set("flo", f(lo.clone()));
+            });
+            b.set_state(&clipped, Expr::Flag(false));
+            b.ret(Expr::Call(illinois.clone(), vec![target, lo, flo, hi, fhi]));
+        },
+    )
+}
