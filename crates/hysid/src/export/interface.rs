@@ -47,8 +47,8 @@ impl SampleTime {
                     "ts",
                     given,
                     format!(
-                        "the model file's sample time is {stored} s; leave --ts out or give \
-                         the same value"
+                        "the model file's sample time is {stored} s; leave the sample time \
+                         out or give the same value"
                     ),
                 ))
             }
@@ -59,8 +59,8 @@ impl SampleTime {
                 "ts",
                 "none",
                 format!(
-                    "the {} model file holds no sample time (a file of an earlier version); \
-                     pass the sample time of its data with --ts",
+                    "the {} model file holds no sample_time (a file of an earlier version); \
+                     give the sample time of the data it was fitted on",
                     file.kind()
                 ),
             )),
