@@ -50,7 +50,10 @@ fn the_interface_names_the_columns_and_the_sample_time() {
         ..ExportOptions::default()
     };
     let e = c_code(&file, "stage", &disagreeing).expect_err("a disagreeing --ts");
-    assert!(names_ts(&e) && e.to_string().contains("sample time is"), "{e}");
+    assert!(
+        names_ts(&e) && e.to_string().contains("sample time is"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -73,7 +76,10 @@ fn a_rate_independent_operator_exports_without_a_sample_time_and_a_cascade_does_
     }
     .to_file();
     let e = c_code(&file, "stage", &ExportOptions::default()).expect_err("no sample time");
-    assert!(names_ts(&e) && e.to_string().contains("no sample_time"), "{e}");
+    assert!(
+        names_ts(&e) && e.to_string().contains("no sample_time"),
+        "{e}"
+    );
 }
 
 /// The error is about the sample-time option (`--ts` on the command line, `ts=` in Python).
