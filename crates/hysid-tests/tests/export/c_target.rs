@@ -68,6 +68,7 @@ fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool) {
 }
 
 #[test]
+#[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
 fn generated_c_equals_the_library() {
     let dir = tempfile::tempdir().expect("temp dir");
     let results: Vec<(String, f64, bool)> = cases::all()
@@ -85,6 +86,7 @@ fn generated_c_equals_the_library() {
 }
 
 #[test]
+#[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
 fn a_preisach_memory_beyond_its_capacity_sets_the_error_flag() {
     let op = OperatorModel::examples()
         .expect("examples")

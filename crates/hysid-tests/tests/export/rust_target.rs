@@ -24,6 +24,7 @@ fn write_crate(case: &Case, dir: &Path) -> String {
 }
 
 #[test]
+#[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
 fn generated_rust_equals_the_library() {
     let all = cases::all();
     let dir = tempfile::tempdir().expect("temp dir");
