@@ -57,7 +57,10 @@ fn reference_models() -> Vec<(&'static str, FittedModel)> {
     };
     vec![
         ("pi_20_plays", operator(OperatorModel::Pi(pi))),
-        ("preisach_20x20", operator(OperatorModel::Preisach(preisach))),
+        (
+            "preisach_20x20",
+            operator(OperatorModel::Preisach(preisach)),
+        ),
         ("bouc_wen_greybox_rk4_4", grey_box),
     ]
 }

@@ -44,6 +44,7 @@ pub mod code;
 pub mod coleman_hodgdon;
 pub mod families;
 pub mod fmu;
+pub mod greybox;
 pub mod interface;
 pub mod kinds;
 pub mod linear;
@@ -209,7 +210,7 @@ fn prepare(
     check_name(name)?;
     let sample_time = SampleTime::of(file, options)?;
     let model = FittedModel::from_file(file)?;
-    let program = kinds::program(&model, options.inverse)?;
+    let program = kinds::program(&model, options.inverse, sample_time.seconds())?;
     program.check()?;
     let sizes = if options.inverse {
         (program.n_outputs, program.n_inputs)
