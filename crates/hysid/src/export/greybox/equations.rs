@@ -96,8 +96,8 @@ fn binary(f: Fn2, a: Expr, b: Expr) -> Expr {
         Fn2::Mul => a * b,
         Fn2::Div => a / b,
         Fn2::Pow => match b {
-            Expr::F64(e) if e == 1.0 => a,
-            Expr::F64(e) if e == 0.0 => lit(1.0),
+            Expr::F64(1.0) => a,
+            Expr::F64(0.0) => lit(1.0),
             Expr::F64(_) => a.powf(b),
             _ => select(
                 b.clone().eq(1.0),

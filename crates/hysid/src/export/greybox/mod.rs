@@ -111,8 +111,16 @@ impl Driver {
     }
 }
 
+/// A grey-box or equation model to export: its code, its simulation settings and its
+/// initial state.
+struct Exported<'a> {
+    code: Box<dyn EmitStateSpace>,
+    simulation: Simulation,
+    x0: &'a [f64],
+}
+
 /// The grey-box or equation model `model` as code, or None for another kind.
-fn emitter(model: &FittedModel) -> Result<Option<(Box<dyn EmitStateSpace>, Simulation, &[f64])>> {
+fn emitter(model: &FittedModel) -> Result<Option<Exported<'_>>> {
     Ok(match model {
         FittedModel::GreyBox {
             kind,
@@ -123,8 +131,11 @@ fn emitter(model: &FittedModel) -> Result<Option<(Box<dyn EmitStateSpace>, Simul
         } => {
             let kind = GreyBoxKind::parse(kind)
                 .ok_or_else(|| Error::InvalidModel(format!("unknown grey-box model '{kind}'")))?;
-            let code = models::BuiltIn::new(kind, parameters.values());
-            Some((Box::new(code), *simulation, initial_state))
+            Some(Exported {
+                code: Box::new(models::BuiltIn::new(kind, parameters.values())),
+                simulation: *simulation,
+                x0: initial_state,
+            })
         }
         FittedModel::Equations {
             equations,
@@ -134,8 +145,11 @@ fn emitter(model: &FittedModel) -> Result<Option<(Box<dyn EmitStateSpace>, Simul
             ..
         } => {
             let parsed = EquationStateSpace::parse(equations, "saved model")?;
-            let code = equations::Equations::new(parsed, parameters.values());
-            Some((Box::new(code), *simulation, initial_state))
+            Some(Exported {
+                code: Box::new(equations::Equations::new(parsed, parameters.values())),
+                simulation: *simulation,
+                x0: initial_state,
+            })
         }
         _ => None,
     })
@@ -145,7 +159,12 @@ fn emitter(model: &FittedModel) -> Result<Option<(Box<dyn EmitStateSpace>, Simul
 /// None for another kind. Refused: the compensator (no grey-box model is invertible), a
 /// `band_limited` model, Newmark integration.
 pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Program>> {
-    let Some((code, simulation, x0)) = emitter(model)? else {
+    let Some(Exported {
+        code,
+        simulation,
+        x0,
+    }) = emitter(model)?
+    else {
         return Ok(None);
     };
     let kind = || model.to_file().kind().to_string();
@@ -156,8 +175,8 @@ pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Pro
         return Err(Error::UnsupportedKind {
             kind: kind(),
             operation: format!(
-                "export as code: {why}; save it with \"interpolation\": \"linear\" (or \
-                 \"zero_order_hold\") to export the stream hysid simulates"
+                "export as code: {why}; refit it with --interpolation linear (or save it with \
+                 \"interpolation\": \"linear\") and export that"
             ),
         });
     }
@@ -188,8 +207,8 @@ pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Pro
                 return Err(Error::UnsupportedKind {
                     kind: kind(),
                     operation: "export with the Newmark integrator (its Newton corrector is \
-                                not exported); save the model with --integrator rk4 or \
-                                adaptive and export that"
+                                not exported); refit it with --integrator rk4 (or save it \
+                                with the adaptive integrator) and export that"
                         .into(),
                 })
             }

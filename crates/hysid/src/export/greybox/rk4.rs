@@ -5,7 +5,7 @@
 //! * sub-step j of m has length h = (1/m)·ts; its stages read the input on the half-step
 //!   grid (node 2j, 2j + 1, 2j + 2 of 2m per interval) and the time
 //!   t = (k − 1 + j/m + dt/ts)·ts;
-//! * with Coulomb friction (the model's friction velocity v = x[iv]), a sub-step that starts
+//! * with Coulomb friction (the model's friction velocity v = x\[iv\]), a sub-step that starts
 //!   sliding holds the friction direction in all four stages; when it would end with v on
 //!   the other side of zero it is cut where v = 0 (Illinois regula falsi on the fraction φ
 //!   of the step, at most 60 iterations), v is set to 0 and the rest of the sub-step is taken
