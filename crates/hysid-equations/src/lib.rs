@@ -224,12 +224,15 @@ pub mod ast;
 mod dag;
 mod error;
 mod file;
+mod listing;
 mod lower;
 mod model;
 mod num;
 mod tape;
 
 pub use error::EquationError;
+pub use listing::{Listing, Operand, Operation};
 pub use model::{
     BoundColumns, ColumnTape, EquationModel, InitialSpec, ParameterSpec, Scratch, TimeDomain,
 };
+pub use num::{apply1, apply2, powi, Fn1, Fn2};

@@ -8,6 +8,7 @@ use crate::ast;
 use crate::dag::{Graph, Id};
 use crate::error::{line_column, EquationError};
 use crate::file::{self, ExprText, FileModel, Named};
+use crate::listing::{self, Listing};
 use crate::lower::{lower, Binding, Scope};
 use crate::num::finite_or_zero;
 use crate::tape::{Tape, SMALL};
@@ -633,6 +634,19 @@ impl EquationModel {
     /// [`Self::output_with`] with this thread's scratch.
     pub fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
         self.with_thread_scratch(|s| self.output_with(s, x, u, theta, y));
+    }
+
+    /// The operations that compute f (ẋ, or the next state in discrete time), in the order
+    /// [`Self::rhs`] performs them, one result per state: what a code generator prints to
+    /// compute f as this model does, to the bit ([`Listing`]).
+    pub fn rhs_listing(&self) -> Listing {
+        listing::of(&self.tapes.f, self.states.len(), self.inputs.len())
+    }
+
+    /// The operations that compute h, in the order [`Self::output`] performs them, one
+    /// result per output (they never read the time).
+    pub fn output_listing(&self) -> Listing {
+        listing::of(&self.tapes.h, self.states.len(), self.inputs.len())
     }
 
     /// [`Self::rhs_jacobians_with`] with this thread's scratch.

@@ -11,7 +11,7 @@ use crate::num::{self, Fn1, Fn2};
 /// One instruction; operands are register numbers. One variant per operation (rather
 /// than an operation code inside a variant) so that evaluation dispatches once.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Instr {
+pub(crate) enum Instr {
     Neg(u32),
     Sin(u32),
     Cos(u32),
@@ -351,6 +351,12 @@ impl Tape {
             let v = instr.value(|i| regs[usize::from(i as u8)]);
             regs[usize::from((first + k) as u8)] = v;
         }
+    }
+
+    /// The number of input slots (t, x, u, θ), the constants and the instructions, for
+    /// [`crate::listing`].
+    pub(crate) fn parts(&self) -> (usize, &[f64], &[Instr]) {
+        (self.inputs, &self.consts, &self.code)
     }
 
     /// Registers the tape needs.

@@ -120,3 +120,56 @@ fn a_compensator_is_refused_for_a_model_without_an_inverse_and_a_non_minimum_pha
     let e = export(&file, Target::Fmu, "stage", &options).expect_err("fmu");
     assert!(!e.to_string().is_empty());
 }
+
+/// The Bouc–Wen oscillator saved with `simulation`.
+fn bouc_wen(simulation: hysid::model::greybox::Simulation) -> hysid::model::saved::ModelFile {
+    use hysid::model::greybox::models::GreyBoxKind;
+    let model = GreyBoxKind::BoucWen.model();
+    let parameters = model.parameters();
+    hysid::model::saved::FittedModel::GreyBox {
+        kind: "bouc_wen".into(),
+        std: vec![f64::NAN; parameters.len()],
+        parameters,
+        simulation,
+        initial_state: vec![0.0; 3],
+    }
+    .to_file()
+}
+
+#[test]
+fn grey_box_exports_refuse_band_limited_newmark_and_a_compensator_in_one_line() {
+    use hysid::model::greybox::{InputInterpolation, Integrator, Simulation};
+    let with_ts = ExportOptions {
+        sample_time: Some(1e-3),
+        ..ExportOptions::default()
+    };
+    let band_limited = bouc_wen(Simulation {
+        integrator: Integrator::Rk4 { substeps: 4 },
+        interpolation: InputInterpolation::BandLimited,
+    });
+    let e = c_code(&band_limited, "bw", &with_ts).expect_err("band-limited");
+    let text = e.to_string();
+    assert!(
+        text.contains("band-limited") && text.contains("\"linear\"") && !text.contains('\n'),
+        "{text}"
+    );
+    let newmark = bouc_wen(Simulation {
+        integrator: Integrator::Newmark { substeps: 2 },
+        interpolation: InputInterpolation::ZeroOrderHold,
+    });
+    let e = c_code(&newmark, "bw", &with_ts).expect_err("Newmark");
+    assert!(
+        e.to_string().contains("rk4") && !e.to_string().contains('\n'),
+        "{e}"
+    );
+    let rk4 = bouc_wen(Simulation::default());
+    let inverse = ExportOptions {
+        inverse: true,
+        ..with_ts.clone()
+    };
+    let e = c_code(&rk4, "bw", &inverse).expect_err("no compensator");
+    assert!(e.to_string().contains("not invertible"), "{e}");
+    let e = c_code(&rk4, "bw", &ExportOptions::default()).expect_err("no sample time");
+    assert!(e.to_string().contains("--ts"), "{e}");
+    assert!(c_code(&rk4, "bw", &with_ts).is_ok());
+}

@@ -124,3 +124,36 @@ fn a_preisach_memory_beyond_its_capacity_sets_the_error_flag() {
         "the outputs hold after the overflow"
     );
 }
+
+#[test]
+fn a_diverging_grey_box_sets_the_error_flag_where_the_library_fails() {
+    // x' = a·x² + u blows up in finite time: the library's simulate fails at a sample, the
+    // generated step sets the flag there and holds the last finite output.
+    let text = "[model]\nstates = [\"x\"]\ninputs = [\"u\"]\noutputs = [\"y\"]\n\
+                [parameters]\na = 5.0\n[equations]\nx = \"a*x*x + u\"\n[output]\ny = \"x\"\n";
+    let model = crate::greybox::equations(text, hysid::model::greybox::Simulation::default());
+    let input = vec![1.0; 400];
+    let failed = model
+        .simulate(&[&input], 0.01, None)
+        .expect_err("a blow-up");
+    let case = Case {
+        name: "blowup".into(),
+        file: model.to_file(),
+        options: hysid::export::ExportOptions {
+            sample_time: Some(0.01),
+            ..hysid::export::ExportOptions::default()
+        },
+        input,
+        expected: Vec::new(),
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (y, error) = run(&case, dir.path());
+    assert!(error, "no error flag although the library failed: {failed}");
+    assert!(
+        y.iter().all(|v| v.is_finite()),
+        "the outputs hold finite values"
+    );
+    let last = *y.last().expect("outputs");
+    let held = y.iter().rev().take_while(|v| **v == last).count();
+    assert!(held > 1, "the outputs hold after the failure");
+}

@@ -163,7 +163,8 @@ fn kinds(u: &[f64]) -> Vec<Case> {
 }
 
 /// Every case: each family of the registry (its example, and its clockwise-decreasing form
-/// where it has one), forward and inverse; then the other kinds.
+/// where it has one), forward and inverse; then the other kinds; then the grey-box and
+/// equation-file models ([`crate::greybox`]).
 pub fn all() -> Vec<Case> {
     let u = signal(3000, 27);
     let mut out = Vec::new();
@@ -181,6 +182,7 @@ pub fn all() -> Vec<Case> {
         }
     }
     out.extend(kinds(&u));
+    out.extend(crate::greybox::cases());
     out
 }
 

@@ -7,4 +7,5 @@
 mod api;
 mod c_target;
 mod cases;
+mod greybox;
 mod rust_target;

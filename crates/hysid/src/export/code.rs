@@ -116,6 +116,14 @@ pub enum Math {
     Tanh,
     /// sinh x
     Sinh,
+    /// sin x
+    Sin,
+    /// cos x
+    Cos,
+    /// tan x
+    Tan,
+    /// atan x
+    Atan,
     /// |x| with the sign of y
     Copysign,
 }
@@ -134,6 +142,10 @@ impl Math {
             Math::Log => "log",
             Math::Tanh => "tanh",
             Math::Sinh => "sinh",
+            Math::Sin => "sin",
+            Math::Cos => "cos",
+            Math::Tan => "tan",
+            Math::Atan => "atan",
             Math::Copysign => "copysign",
         }
     }

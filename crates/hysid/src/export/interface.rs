@@ -175,8 +175,9 @@ pub fn comment(
          Step semantics: a step with the input at sample k returns the output at sample k (the\n\
          {}), then advances the state to k + 1.\n\
          Error flag: set once a step cannot be computed (the differential families' integration\n\
-         beyond its sub-step budget, a Preisach memory beyond its capacity); the outputs then\n\
-         hold their last values until the state is initialised again.\n\nParameters of the fit:\n",
+         beyond its sub-step budget, a Preisach memory beyond its capacity, a grey-box state\n\
+         that is not finite); the outputs then hold their last values until the state is\n\
+         initialised again.\n\nParameters of the fit:\n",
         interface.name,
         interface.description,
         model_name(file),

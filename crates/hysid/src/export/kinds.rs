@@ -8,19 +8,25 @@
 //! | `coleman_hodgdon` | the recursion (from 0: `initial_output: zero`) | the per-sample solve |
 //! | `ch_cascade` | the recursion from 0, then the linear block | none (as `hysid compensate`) |
 //!
+//! | grey-box, `equations` | the integration of the last interval, then h(x, u) ([`greybox`]) | none (not invertible) |
+//!
 //! Every step sets the error flag where the library's `simulate` errors on a non-finite
-//! output. Grey-box and equation-file models are not exported by this version.
+//! output.
 
 use super::code::{call, Expr};
 use super::program::{Ns, Program, ERROR_FIELD};
-use super::{coleman_hodgdon, families, linear};
+use super::{coleman_hodgdon, families, greybox, linear};
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::saved::FittedModel;
 use crate::{Error, Result};
 use std::ops::Not;
 
-/// The streaming program of `model`, or of its compensator when `inverse`.
-pub fn program(model: &FittedModel, inverse: bool) -> Result<Program> {
+/// The streaming program of `model`, or of its compensator when `inverse`, sampled every
+/// `ts` seconds (read by the grey-box models only).
+pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Program> {
+    if let Some(prog) = greybox::program(model, inverse, ts)? {
+        return Ok(prog);
+    }
     let mut prog = Program::new(1, 1);
     let (op, lin, ch) = (Ns::new("op_"), Ns::new("lin_"), Ns::new("ch_"));
     let kind = || model.to_file().kind().to_string();
@@ -84,9 +90,8 @@ pub fn program(model: &FittedModel, inverse: bool) -> Result<Program> {
         _ => {
             return Err(Error::UnsupportedKind {
                 kind: kind(),
-                operation: "export as code (this version exports operators, operator cascades \
-                            and Coleman–Hodgdon models; grey-box and equation-file models are \
-                            not yet exported)"
+                operation: "export as code (a model fitted to pre-filtered records or by \
+                            inverse dynamics needs the whole record; export the model itself)"
                     .into(),
             })
         }

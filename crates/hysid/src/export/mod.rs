@@ -30,20 +30,24 @@
 //! simulation would fail (an integration beyond its sub-step budget, a Preisach memory beyond
 //! its capacity, a non-finite output); the outputs then hold their last values until the
 //! state is initialised again. The compensator of an operator cascade with delay k takes the
-//! reference k samples ahead ([`linear`]). Grey-box and equation-file models are not exported
-//! by this version ([`Error::UnsupportedKind`]). See `docs/export.md`.
+//! reference k samples ahead ([`linear`]). Grey-box and equation-file models export forward
+//! with their saved integrator and input interpolation, one interval late as the library's
+//! stream ([`greybox`]); a `band_limited` or Newmark model is refused
+//! ([`Error::UnsupportedKind`]). See `docs/export.md`.
 //!
 //! How it is built: a language-neutral program ([`code`], [`program`]) that the renderers
 //! ([`render`]) print as C or Rust; each model kind ([`kinds`]) and each operator family,
 //! through the family registry ([`families`]), supplies its step once, transliterating the
 //! library's computation in its order of operations; the emitters know models, the renderers
 //! targets. Generated code is tested against the library sample by sample
-//! (`crates/hysid-tests/tests/export`): bit-identical as C, within 2e-14 of the range as Rust.
+//! (`crates/hysid-tests/tests/export`): bit-identical as C, within 2e-13 of the range as
+//! Rust (the `libm` crate's `pow` and `sin` differ from the platform's by an ulp).
 
 pub mod code;
 pub mod coleman_hodgdon;
 pub mod families;
 pub mod fmu;
+pub mod greybox;
 pub mod interface;
 pub mod kinds;
 pub mod linear;
@@ -209,7 +213,7 @@ fn prepare(
     check_name(name)?;
     let sample_time = SampleTime::of(file, options)?;
     let model = FittedModel::from_file(file)?;
-    let program = kinds::program(&model, options.inverse)?;
+    let program = kinds::program(&model, options.inverse, sample_time.seconds())?;
     program.check()?;
     let sizes = if options.inverse {
         (program.n_outputs, program.n_inputs)

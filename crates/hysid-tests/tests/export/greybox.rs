@@ -1,0 +1,198 @@
+//! The grey-box and equation-file cases: each built-in model and three equation files (one
+//! reading t, one discrete-time, the Bouc–Wen example with ν = 1.5 through `pow`), with
+//! zero-order hold and linear interpolation, RK4 with 4 sub-steps; and the adaptive
+//! integrator on two of them. Rigid body and actuators stick and slip on these inputs.
+
+use crate::cases::{signal, Case};
+use hysid::export::ExportOptions;
+use hysid::model::greybox::equation_model::EquationStateSpace;
+use hysid::model::greybox::models::GreyBoxKind;
+use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::saved::FittedModel;
+use hysid::model::ParameterSet;
+
+/// An equation file that reads the time t (and a `sin`, an `abs`).
+pub const TIMED: &str = r#"
+[model]
+name = "forced"
+states = ["x", "v"]
+inputs = ["u"]
+outputs = ["y"]
+
+[parameters]
+k = { value = 4.0 }
+c = { value = 0.3 }
+
+[equations]
+x = "v"
+v = "-k*x - c*v*abs(v) + u + 0.5*sin(20*t)"
+
+[output]
+y = "x + 0.1*u"
+"#;
+
+/// A discrete-time equation file (with an integer power and a `max`).
+pub const DISCRETE: &str = r#"
+[model]
+name = "recursion"
+states = ["x"]
+inputs = ["u"]
+outputs = ["y"]
+time = "discrete"
+
+[parameters]
+a = { value = 0.7 }
+
+[equations]
+x = "a*x + u - 0.1*x^3 + 0.01*max(u, x)"
+
+[output]
+y = "x"
+"#;
+
+const RK4: Integrator = Integrator::Rk4 { substeps: 4 };
+const ADAPTIVE: Integrator = Integrator::Adaptive {
+    rtol: 1e-6,
+    atol: 1e-9,
+};
+
+/// The case `label` of `model` on `input` sampled every `ts`.
+fn case(label: &str, model: &FittedModel, input: Vec<f64>, ts: f64) -> Case {
+    let expected = model
+        .simulate(&[&input], ts, None)
+        .unwrap_or_else(|e| panic!("{label}: the library's simulate failed: {e}"))[0]
+        .clone();
+    Case {
+        name: label.into(),
+        file: model.to_file(),
+        options: ExportOptions {
+            sample_time: Some(ts),
+            ..ExportOptions::default()
+        },
+        input,
+        expected,
+    }
+}
+
+fn no_std(n: usize) -> Vec<f64> {
+    vec![f64::NAN; n]
+}
+
+/// A built-in model with its defaults overridden by `values` (name, value).
+fn built_in(kind: GreyBoxKind, values: &[(&str, f64)], simulation: Simulation) -> FittedModel {
+    let model = kind.model();
+    let mut parameters: ParameterSet = model.parameters();
+    let mut theta = parameters.values();
+    for (name, v) in values {
+        let i = parameters
+            .names()
+            .iter()
+            .position(|n| n == name)
+            .expect("a parameter of the model");
+        theta[i] = *v;
+    }
+    parameters.set_values(&theta);
+    FittedModel::GreyBox {
+        kind: kind.name().into(),
+        std: no_std(parameters.len()),
+        parameters,
+        simulation,
+        initial_state: vec![0.0; model.states().len()],
+    }
+}
+
+/// An equation file with its own parameter values and initial state.
+pub fn equations(text: &str, simulation: Simulation) -> FittedModel {
+    let model = EquationStateSpace::parse(text, "test").expect("a valid equation file");
+    FittedModel::Equations {
+        equations: text.into(),
+        parameters: model.parameters(),
+        std: no_std(model.parameters().len()),
+        simulation,
+        initial_state: model.initial_values(),
+    }
+}
+
+fn scaled(u: &[f64], scale: f64) -> Vec<f64> {
+    u.iter().map(|v| scale * v).collect()
+}
+
+/// Every grey-box and equation-file case.
+pub fn cases() -> Vec<Case> {
+    let u = signal(3000, 41);
+    let bouc_wen = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/equations/bouc_wen.toml"
+    ))
+    .expect("the example")
+    .replace("nu         = { value = 1.0", "nu         = { value = 1.5");
+    let mut out = Vec::new();
+    for (tag, interpolation) in [
+        ("zoh", InputInterpolation::ZeroOrderHold),
+        ("linear", InputInterpolation::Linear),
+    ] {
+        let rk4 = Simulation {
+            integrator: RK4,
+            interpolation,
+        };
+        let bw = built_in(GreyBoxKind::BoucWen, &[], rk4);
+        out.push(case(
+            &format!("gb_bouc_wen_{tag}"),
+            &bw,
+            scaled(&u, 120.0),
+            1.0 / 750.0,
+        ));
+        let rigid = [("Fv", 0.5), ("Fc", 0.3), ("offset", 0.05)];
+        let rb = built_in(GreyBoxKind::RigidBody, &rigid, rk4);
+        out.push(case(
+            &format!("gb_rigid_body_{tag}"),
+            &rb,
+            scaled(&u, 0.6),
+            1e-3,
+        ));
+        let fixed = built_in(GreyBoxKind::ActuatorFixed, &[], rk4);
+        out.push(case(
+            &format!("gb_actuator_fixed_{tag}"),
+            &fixed,
+            scaled(&u, 0.5),
+            1e-3,
+        ));
+        let free = built_in(GreyBoxKind::ActuatorFree, &[], rk4);
+        out.push(case(
+            &format!("gb_actuator_free_{tag}"),
+            &free,
+            scaled(&u, 0.5),
+            1e-3,
+        ));
+        let timed = equations(TIMED, rk4);
+        out.push(case(&format!("eq_timed_{tag}"), &timed, u.clone(), 1e-2));
+        let discrete = equations(DISCRETE, rk4);
+        out.push(case(
+            &format!("eq_discrete_{tag}"),
+            &discrete,
+            scaled(&u, 0.5),
+            1e-2,
+        ));
+        let example = equations(&bouc_wen, rk4);
+        out.push(case(
+            &format!("eq_bouc_wen_{tag}"),
+            &example,
+            scaled(&u, 120.0),
+            1.0 / 750.0,
+        ));
+    }
+    let adaptive = Simulation {
+        integrator: ADAPTIVE,
+        interpolation: InputInterpolation::Linear,
+    };
+    let bw = built_in(GreyBoxKind::BoucWen, &[], adaptive);
+    out.push(case(
+        "gb_bouc_wen_adaptive",
+        &bw,
+        scaled(&u, 120.0),
+        1.0 / 750.0,
+    ));
+    let timed = equations(TIMED, adaptive);
+    out.push(case("eq_timed_adaptive", &timed, u.clone(), 1e-2));
+    out
+}
