@@ -17,5 +17,6 @@ mod inputs_sacred;
 mod operator_cascade_cli;
 mod outputs;
 mod report_schema;
+mod tutorial_cli;
 mod work_budget;
 mod zoo_cli;

@@ -28,7 +28,13 @@ impl Syntax for C<'_> {
         format!("{}_{name}", self.name)
     }
     fn math(&self, f: Math) -> String {
-        f.name().into()
+        match f {
+            // Inline helpers (see `MINMAX`): `fmax`/`fmin` are library calls at -O2 without
+            // -ffinite-math-only (three quarters of a PI step with 20 plays:
+            // `bench/export_steps.sh`).
+            Math::Fmax | Math::Fmin => format!("{}_math_{}", self.name, f.name()),
+            _ => f.name().into(),
+        }
     }
     fn call(&self, name: &str, args: &[String]) -> String {
         let mut all = vec!["state".to_string()];
@@ -77,6 +83,15 @@ pub fn render(program: &Program, name: &str, comment: &str, sample_time: f64) ->
         source(program, name, comment),
     )
 }
+
+/// `NAME_math_fmax` and `NAME_math_fmin`: C99's `fmax`/`fmin` (the non-NaN argument when
+/// one is NaN) as `static` functions the compiler inlines, with glibc's x86-64 choice between
+/// equal arguments (the second, so −0 and +0 come out as from `fmax`/`fmin` there). Each is
+/// written only when the code uses it (`-Wall -Werror` rejects an unused `static` function).
+const MINMAX: [(&str, &str); 2] = [
+    ("fmax", "return x > y ? x : y;"),
+    ("fmin", "return x < y ? x : y;"),
+];
 
 fn block_comment(text: &str) -> String {
     format!("/*\n{} */\n", comment_lines(text, " * "))
@@ -140,6 +155,7 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
     if !program.tables.is_empty() {
         c.push('\n');
     }
+    let tables_end = c.len();
     let signature = |f: &crate::export::code::Function| {
         let mut params = vec![format!("{name}_state *state")];
         params.extend(f.params.iter().map(|(n, t)| format!("{} {n}", c_type(*t))));
@@ -182,5 +198,16 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
     ));
     p.stmts(&program.step, 1, &mut c);
     c.push_str("}\n");
+    let mut helpers = String::new();
+    for (f, body) in MINMAX {
+        let helper = format!("{name}_math_{f}");
+        if c[tables_end..].contains(&format!("{helper}(")) {
+            helpers.push_str(&format!(
+                "static double {helper}(double x, double y) {{\n    \
+                 if (isnan(x)) return y;\n    if (isnan(y)) return x;\n    {body}\n}}\n\n"
+            ));
+        }
+    }
+    c.insert_str(tables_end, &helpers);
     c
 }
