@@ -208,6 +208,13 @@ COMMANDS = [
         "inputs": {"--data": "csv", "--model": "model"},
         "outputs": {"--csv": "file", "--json": "file", FLAG["plots"]: "dir"},
     },
+    {
+        "name": "export",
+        "base": ["export", "--model", "{op}", "--target", "c", "--name", "m", "--out", "exported"],
+        "numeric": ["--ts"],
+        "inputs": {"--model": "model"},
+        "outputs": {"--out": "dir"},
+    },
 ]
 
 # Input files: what a placeholder is copied from, by kind.
