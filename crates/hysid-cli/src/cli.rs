@@ -676,6 +676,11 @@ pub struct ExportArgs {
     /// With --target fmu: leave the binary out (a source-only FMU; no C compiler needed).
     #[arg(long = "no-binary")]
     pub no_binary: bool,
+    /// The measured initial output y(0) a Coleman–Hodgdon hysteresis saved with
+    /// "initial_output": "measured" starts from (required to export its forward step;
+    /// `hysid simulate` takes it from the record). Any finite number.
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::options::finite)]
+    pub y0: Option<f64>,
 }
 
 /// Export targets.

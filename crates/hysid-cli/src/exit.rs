@@ -96,7 +96,7 @@ pub fn classify(error: &anyhow::Error) -> ExitClass {
 
 /// The command-line flag of a library setting ([`Error::InvalidOption`]'s `option`), where
 /// the CLI has one.
-const FLAGS: [(&str, &str); 14] = [
+const FLAGS: [(&str, &str); 15] = [
     ("cutoff_hz", "--cutoff"),
     ("starts", "--starts"),
     ("start_factor", "--start-factor"),
@@ -110,6 +110,7 @@ const FLAGS: [(&str, &str); 14] = [
     ("substeps", "--substeps"),
     ("noise", "--noise"),
     ("ts", "--ts"),
+    ("y0", "--y0"),
     ("name", "--name"),
 ];
 

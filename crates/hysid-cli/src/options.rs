@@ -67,6 +67,11 @@ pub fn positive(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A finite number in [-1e300, 1e300]: a measured value of a signal.
+pub fn finite(text: &str) -> Result<f64, String> {
+    within(text, -1e300, 1e300)
+}
+
 /// A finite number in [0, 1e6]: a noise level or a play width.
 pub fn nonnegative(text: &str) -> Result<f64, String> {
     within(text, 0.0, 1e6)

@@ -22,7 +22,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// Exports the model file `model_json` to `target` (`c`, `rust`, `fmu`) under `name` into
 /// the directory `out` (created; refused when it holds any file); returns the paths written.
 #[pyfunction]
-#[pyo3(signature = (model_json, target, name, out, inverse, ts, binary))]
+#[pyo3(signature = (model_json, target, name, out, inverse, ts, binary, y0=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn export_model(
     py: Python<'_>,
@@ -33,6 +33,7 @@ fn export_model(
     inverse: bool,
     ts: Option<f64>,
     binary: bool,
+    y0: Option<f64>,
 ) -> PyResult<Vec<PathBuf>> {
     let model_json = model_json.to_string();
     let name = name.to_string();
@@ -63,6 +64,7 @@ fn export_model(
             inverse,
             sample_time: ts,
             binary,
+            initial_output: y0,
         };
         let files = export(&file, target, &name, &options)?;
         let paths = files.iter().map(|f| dir.path().join(&f.path)).collect();

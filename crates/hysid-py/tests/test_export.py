@@ -136,7 +136,7 @@ def manifest():
     rows = []
     for line in (FIXTURES / "manifest.txt").read_text().splitlines():
         model, record, inp, out = line.split()
-        rows.append((FIXTURES / model, FIXTURES / record, inp))
+        rows.append((FIXTURES / model, FIXTURES / record, inp, out))
     return rows
 
 
@@ -149,8 +149,8 @@ REFUSALS = ("does not support", "not invertible")
 
 
 @pytest.mark.skipif(not CLI, reason="set HYSID_CLI to a hysid binary to compare live")
-@pytest.mark.parametrize("model,record,inp", manifest(), ids=lambda p: getattr(p, "name", str(p)))
-def test_every_fixture_exported_by_the_cli_simulates_as_hysid_simulate(tmp_path, model, record, inp):
+@pytest.mark.parametrize("model,record,inp,outp", manifest(), ids=lambda p: getattr(p, "name", str(p)))
+def test_every_fixture_exported_by_the_cli_simulates_as_hysid_simulate(tmp_path, model, record, inp, outp):
     out = tmp_path / "out"
     # The record's own sample time (its time column; 1 s for the records without one): the
     # grey-box models integrate over it.
@@ -158,8 +158,14 @@ def test_every_fixture_exported_by_the_cli_simulates_as_hysid_simulate(tmp_path,
         header = next(csv.reader(f))
     time_column = next((c for c in header if c in ("t", "t_s", "time")), None)
     ts = float(np.diff(column(record, time_column)[:2])[0]) if time_column else 1.0
+    # A Coleman–Hodgdon hysteresis that starts from the measured output is given the record's
+    # first measured output at export (`--y0`), as `hysid simulate` takes it from the record.
+    saved = json.loads(model.read_text())
+    measured = saved.get("model", saved).get("initial_output") == "measured"
+    y0 = ["--y0", repr(float(column(record, outp)[0]))] if measured else []
     run = subprocess.run(
-        [CLI, "export", "--model", str(model), "--target", "fmu", "--name", "m", "--out", str(out), "--ts", repr(ts)],
+        [CLI, "export", "--model", str(model), "--target", "fmu", "--name", "m", "--out", str(out), "--ts", repr(ts)]
+        + y0,
         capture_output=True,
         text=True,
     )
@@ -172,6 +178,7 @@ def test_every_fixture_exported_by_the_cli_simulates_as_hysid_simulate(tmp_path,
     sim = tmp_path / "sim.csv"
     subprocess.run(
         [CLI, "simulate", "--model", str(model), "--data", str(record), "--input", inp, "--csv", str(sim)]
+        + (["--output", outp] if measured else [])
         + ([] if time_column else ["--ts", "1"]),
         check=True,
         capture_output=True,

@@ -27,6 +27,7 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         inverse: args.inverse,
         sample_time: args.ts,
         binary: !args.no_binary,
+        initial_output: args.y0,
     };
     let files = export(&file, target, &args.name, &options).with_context(|| {
         format!(

@@ -194,6 +194,13 @@ class Compensator:
 def model_stepper(model_json: str, ts: float, y0: Optional[float] = None) -> Stepper: ...
 def model_compensator(model_json: str, ts: float) -> Compensator: ...
 def export_model(
-    model_json: str, target: str, name: str, out: str, inverse: bool, ts: Optional[float], binary: bool
+    model_json: str,
+    target: str,
+    name: str,
+    out: str,
+    inverse: bool,
+    ts: Optional[float],
+    binary: bool,
+    y0: Optional[float] = None,
 ) -> List[str]: ...
 def fmu_of_c_code(header: str, source: str, interface_json: str, binary: bool) -> bytes: ...

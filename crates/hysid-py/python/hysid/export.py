@@ -24,6 +24,7 @@ def export(
     inverse: bool = False,
     ts: Optional[float] = None,
     binary: bool = True,
+    y0: Optional[float] = None,
 ) -> List[str]:
     """Writes the model as ``target`` (``"c"``: ``NAME.h`` and ``NAME.c``; ``"rust"``: the
     crate ``NAME/``; ``"fmu"``: ``NAME.fmu``) into the directory ``out``, created if missing
@@ -32,7 +33,9 @@ def export(
     ``inverse`` exports the compensator (input: the reference; output: the command).
     ``ts`` is the sample time in seconds, needed when the model file has none and equal to
     its own when it has one. ``binary=False`` leaves the FMU's compiled binary out (a
-    source-only FMU; the binary is built with ``$CC``, else ``cc``). Errors: ``ConfigError``
+    source-only FMU; the binary is built with ``$CC``, else ``cc``). ``y0`` is the measured
+    initial output a Coleman–Hodgdon hysteresis saved with ``initial_output: measured``
+    starts from (required to export its forward step). Errors: ``ConfigError``
     for a model or request that cannot be exported (a kind without an exporter, no inverse,
     a missing sample time, no C compiler), ``ModelFileError`` for an output directory that
     holds files.
@@ -52,5 +55,6 @@ def export(
         bool(inverse),
         None if ts is None else float(ts),
         bool(binary),
+        None if y0 is None else float(y0),
     )
     return [os.fspath(p) for p in paths]

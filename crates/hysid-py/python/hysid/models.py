@@ -133,10 +133,11 @@ class Model:
         inverse: bool = False,
         ts: Optional[float] = None,
         binary: bool = True,
+        y0: Optional[float] = None,
     ) -> List[str]:
         """The model as C99, a ``no_std`` Rust crate or an FMI 2.0 FMU (:mod:`hysid.export`,
         the command line's ``hysid export``); returns the paths written."""
-        return export(self, target, name, out, inverse=inverse, ts=ts, binary=binary)
+        return export(self, target, name, out, inverse=inverse, ts=ts, binary=binary, y0=y0)
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Model) and self.file == other.file

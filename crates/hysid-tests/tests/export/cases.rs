@@ -107,7 +107,7 @@ fn hysteresis() -> ColemanHodgdon {
 }
 
 /// The model kinds besides the operators: operator cascades (one per family), the
-/// Coleman–Hodgdon hysteresis (from 0, and from the measured output: compensator only) and
+/// Coleman–Hodgdon hysteresis (from 0, and from the measured output given at export) and
 /// its cascade.
 fn kinds(u: &[f64]) -> Vec<Case> {
     let mut out = Vec::new();
@@ -145,7 +145,11 @@ fn kinds(u: &[f64]) -> Vec<Case> {
         };
         let mut cases = cases_of(label, &model, u);
         if initial == InitialOutput::Measured {
-            cases.retain(|c| c.options.inverse);
+            // The forward step starts from the measured y(0) given at export (`--y0`), the
+            // value `simulate` was given (the record's first sample, in `cases_of`).
+            for case in cases.iter_mut().filter(|c| !c.options.inverse) {
+                case.options.initial_output = u.first().copied();
+            }
         }
         out.extend(cases);
     }

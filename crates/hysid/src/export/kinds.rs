@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | `operator` | the family's step | the family's inverse step |
 //! | `operator_cascade` | operator, then the linear block | the block's inverse (the reference k samples ahead), then the operator's inverse; refused unless B is minimum-phase |
-//! | `coleman_hodgdon` | the recursion (from 0: `initial_output: zero`) | the per-sample solve |
+//! | `coleman_hodgdon` | the recursion, from 0 (`initial_output: zero`) or from the measured y(0) given at export (`--y0`, `initial_output: measured`) | the per-sample solve |
 //! | `ch_cascade` | the recursion from 0, then the linear block | none (as `hysid compensate`) |
 //!
 //! | grey-box, `equations` | the integration of the last interval, then h(x, u) ([`greybox`]) | none (not invertible) |
@@ -15,7 +15,7 @@
 
 use super::code::{call, Expr};
 use super::program::{Ns, Program, ERROR_FIELD};
-use super::{coleman_hodgdon, families, greybox, linear};
+use super::{coleman_hodgdon, families, greybox, linear, ExportOptions};
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::saved::FittedModel;
 use crate::{Error, Result};
@@ -23,7 +23,8 @@ use std::ops::Not;
 
 /// The streaming program of `model`, or of its compensator when `inverse`, sampled every
 /// `ts` seconds (read by the grey-box models only).
-pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Program> {
+pub fn program(model: &FittedModel, options: &ExportOptions, ts: f64) -> Result<Program> {
+    let inverse = options.inverse;
     if let Some(prog) = greybox::program(model, inverse, ts)? {
         return Ok(prog);
     }
@@ -60,16 +61,23 @@ pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Program> {
             ]
         }
         (FittedModel::Hysteresis { model, initial, .. }, false) => {
-            if *initial == InitialOutput::Measured {
-                return Err(Error::UnsupportedKind {
-                    kind: kind(),
-                    operation: "a forward export starting from the measured output (a stream \
-                                has none); save the model with \"initial_output\": \"zero\", or \
-                                export its compensator with --inverse"
-                        .into(),
-                });
-            }
-            vec![coleman_hodgdon::forward(model, 0.0, &ch, &mut prog)?]
+            let v0 = match (initial, options.initial_output) {
+                (InitialOutput::Zero, _) => 0.0,
+                (InitialOutput::Measured, Some(y0)) if y0.is_finite() => y0,
+                (InitialOutput::Measured, _) => {
+                    return Err(Error::invalid_option(
+                        "y0",
+                        options
+                            .initial_output
+                            .map_or("none".into(), |v| v.to_string()),
+                        "this hysteresis starts from the measured output (initial_output: \
+                         measured): give the measured initial output y(0), a finite number, \
+                         or export its compensator"
+                            .into(),
+                    ))
+                }
+            };
+            vec![coleman_hodgdon::forward(model, v0, &ch, &mut prog)?]
         }
         (FittedModel::Hysteresis { model, initial, .. }, true) => {
             vec![coleman_hodgdon::inverse(model, *initial, &ch, &mut prog)?]

@@ -114,6 +114,10 @@ pub struct ExportOptions {
     pub sample_time: Option<f64>,
     /// Build the FMU's binary with the machine's C compiler (`--no-binary` turns it off).
     pub binary: bool,
+    /// The measured initial output y(0) (`--y0`) of a Coleman–Hodgdon hysteresis saved with
+    /// `initial_output: measured`, which its forward step starts from (as `hysid simulate`
+    /// starts from the record's first measured output); ignored by every other model.
+    pub initial_output: Option<f64>,
 }
 
 impl Default for ExportOptions {
@@ -122,6 +126,7 @@ impl Default for ExportOptions {
             inverse: false,
             sample_time: None,
             binary: true,
+            initial_output: None,
         }
     }
 }
@@ -213,7 +218,7 @@ fn prepare(
     check_name(name)?;
     let sample_time = SampleTime::of(file, options)?;
     let model = FittedModel::from_file(file)?;
-    let program = kinds::program(&model, options.inverse, sample_time.seconds())?;
+    let program = kinds::program(&model, options, sample_time.seconds())?;
     program.check()?;
     let sizes = if options.inverse {
         (program.n_outputs, program.n_inputs)
