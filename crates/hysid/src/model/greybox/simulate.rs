@@ -286,8 +286,10 @@ fn rate(
 
 /// Advances `x` over sample interval `sample` of a record (t_sample → t_sample+1) exactly as
 /// [`simulate`] does, the input read from `track`, a two-sample track [u_sample,
-/// u_sample+1]: the step of a streaming simulation (`crate::model::stream`). A discrete-time
-/// model takes its recursion's step (`next` is its scratch space, of the state's length).
+/// u_sample+1]: the step of a streaming simulation (`crate::model::stream`), which keeps the
+/// integrator's buffers in `work` ([`Workspace::new`] of the model's sizes) from sample to
+/// sample. A discrete-time model takes its recursion's step (`next` is its scratch space, of
+/// the state's length).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn advance_interval(
     model: &dyn StateSpaceModel,
@@ -297,17 +299,24 @@ pub(crate) fn advance_interval(
     integrator: Integrator,
     sample: usize,
     x: &mut [f64],
-    (u, next): (&mut [f64], &mut [f64]),
+    work: &mut Workspace,
+    next: &mut [f64],
 ) -> Result<()> {
     if model.discrete_time() {
-        track.at(0, 0.0, u);
-        model.rhs(sample as f64 * ts, x, u, theta, next);
+        track.at(0, 0.0, &mut work.u);
+        model.rhs(sample as f64 * ts, x, &work.u, theta, next);
         x.copy_from_slice(next);
         return Ok(());
     }
-    let mut stepper = Stepper::new(model, theta, track, ts, integrator)?;
+    // The caller's buffers for this interval, handed back after it (an empty workspace
+    // stands in meanwhile: no allocation).
+    let buffers = std::mem::replace(work, Workspace::new(0, 0));
+    let mut stepper = Stepper::with_workspace(model, theta, track, ts, integrator, buffers)
+        .inspect_err(|_| *work = Workspace::new(x.len(), track.n_channels()))?;
     stepper.first = sample;
-    stepper.advance(0, x)
+    let result = stepper.advance(0, x);
+    *work = stepper.work;
+    result
 }
 
 /// Refuses an integrator the model cannot be simulated with, as [`simulate`] does (Coulomb
@@ -357,9 +366,27 @@ struct Stepper<'a> {
     integrator: Integrator,
     /// The record's sample at the track's position 0 (the time origin of a streaming step).
     first: usize,
+    work: Workspace,
+}
+
+/// The working buffers of an integration: the input at a stage, RK4's with its stick–slip
+/// trial step, and the seven stage rates of Dormand–Prince (Newmark uses the first three).
+/// A streaming step keeps them from sample to sample ([`advance_interval`]).
+pub(crate) struct Workspace {
     u: Vec<f64>,
     rk4: StickSlip,
     k: [Vec<f64>; 7],
+}
+
+impl Workspace {
+    /// Buffers for `n` states and `n_inputs` inputs.
+    pub(crate) fn new(n: usize, n_inputs: usize) -> Self {
+        Self {
+            u: vec![0.0; n_inputs],
+            rk4: StickSlip::new(n),
+            k: std::array::from_fn(|_| vec![0.0; n]),
+        }
+    }
 }
 
 impl<'a> Stepper<'a> {
@@ -369,6 +396,19 @@ impl<'a> Stepper<'a> {
         input: &'a InputTrack,
         ts: f64,
         integrator: Integrator,
+    ) -> Result<Self> {
+        let work = Workspace::new(model.states().len(), input.n_channels());
+        Self::with_workspace(model, theta, input, ts, integrator, work)
+    }
+
+    /// [`Stepper::new`] with the buffers `work` (of the model's sizes).
+    fn with_workspace(
+        model: &'a dyn StateSpaceModel,
+        theta: &'a [f64],
+        input: &'a InputTrack,
+        ts: f64,
+        integrator: Integrator,
+        work: Workspace,
     ) -> Result<Self> {
         if model.stick_slip_velocity().is_some() && !matches!(integrator, Integrator::Rk4 { .. }) {
             return Err(Error::Unsupported(format!(
@@ -384,7 +424,6 @@ impl<'a> Stepper<'a> {
                 )));
             }
         }
-        let n = model.states().len();
         Ok(Self {
             model,
             theta,
@@ -392,9 +431,7 @@ impl<'a> Stepper<'a> {
             ts,
             integrator,
             first: 0,
-            u: vec![0.0; input.n_channels()],
-            rk4: StickSlip::new(n),
-            k: std::array::from_fn(|_| vec![0.0; n]),
+            work,
         })
     }
 
@@ -427,11 +464,11 @@ impl<'a> Stepper<'a> {
             self.theta,
             self.input,
             self.ts,
-            &mut self.u,
+            &mut self.work.u,
             (k, self.first + k),
             tau,
             x,
-            &mut self.k[slot],
+            &mut self.work.k[slot],
         );
     }
 
@@ -441,7 +478,7 @@ impl<'a> Stepper<'a> {
         let (model, theta, input, ts) = (self.model, self.theta, self.input, self.ts);
         let sample = self.first + k;
         let (tau, dtau) = (j as f64 / m as f64, 1.0 / m as f64);
-        let u = &mut self.u;
+        let u = &mut self.work.u;
         let mut f = |stage: Stage, x: &[f64], held: Option<f64>, out: &mut [f64]| {
             let tau = tau + stage.dt / ts;
             stage_input(input, m, k, j, stage, tau, u);
@@ -452,7 +489,7 @@ impl<'a> Stepper<'a> {
             }
         };
         let velocity = model.stick_slip_velocity();
-        self.rk4.step(&mut f, x, dtau * ts, velocity, None);
+        self.work.rk4.step(&mut f, x, dtau * ts, velocity, None);
     }
 
     /// One Newmark step (see the module docs) of fraction `dtau` from τ.
@@ -466,7 +503,7 @@ impl<'a> Stepper<'a> {
         // Rates at the start of the step.
         self.eval(k, tau, x, 0);
         let start = x.to_vec();
-        let rate0 = self.k[0].clone();
+        let rate0 = self.work.k[0].clone();
         // Unknowns: accelerations (dofs) and first-order rates (n − 2·dofs) at the end.
         let mut unknown = vec![0.0; n - dofs];
         let state_of = |unknown: &[f64], out: &mut [f64]| {
@@ -487,7 +524,7 @@ impl<'a> Stepper<'a> {
             state_of(&unknown, &mut trial);
             self.eval(k, tau + dtau, &trial, 1);
             for (r, (i, u)) in residual.iter_mut().zip(unknown.iter().enumerate()) {
-                *r = u - self.k[1][dofs + i];
+                *r = u - self.work.k[1][dofs + i];
             }
             let scale = unknown.iter().map(|v| v.abs()).fold(1.0, f64::max);
             if residual.iter().all(|r| r.abs() <= 1e-13 * scale) {
@@ -503,7 +540,7 @@ impl<'a> Stepper<'a> {
                 state_of(&bumped, &mut xb);
                 self.eval(k, tau + dtau, &xb, 2);
                 for r in 0..m {
-                    jac[(r, c)] -= (self.k[2][dofs + r] - self.k[1][dofs + r]) / step;
+                    jac[(r, c)] -= (self.work.k[2][dofs + r] - self.work.k[1][dofs + r]) / step;
                 }
             }
             let delta = jac
@@ -575,61 +612,13 @@ impl<'a> Stepper<'a> {
         y5: &mut [f64],
         err: &mut [f64],
     ) {
-        const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
-        const A: [[f64; 6]; 7] = [
-            [0.0; 6],
-            [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
-            [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-            [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-            [
-                19372.0 / 6561.0,
-                -25360.0 / 2187.0,
-                64448.0 / 6561.0,
-                -212.0 / 729.0,
-                0.0,
-                0.0,
-            ],
-            [
-                9017.0 / 3168.0,
-                -355.0 / 33.0,
-                46732.0 / 5247.0,
-                49.0 / 176.0,
-                -5103.0 / 18656.0,
-                0.0,
-            ],
-            [
-                35.0 / 384.0,
-                0.0,
-                500.0 / 1113.0,
-                125.0 / 192.0,
-                -2187.0 / 6784.0,
-                11.0 / 84.0,
-            ],
-        ];
-        const B5: [f64; 7] = [
-            35.0 / 384.0,
-            0.0,
-            500.0 / 1113.0,
-            125.0 / 192.0,
-            -2187.0 / 6784.0,
-            11.0 / 84.0,
-            0.0,
-        ];
-        const B4: [f64; 7] = [
-            5179.0 / 57600.0,
-            0.0,
-            7571.0 / 16695.0,
-            393.0 / 640.0,
-            -92097.0 / 339200.0,
-            187.0 / 2100.0,
-            1.0 / 40.0,
-        ];
+        use dormand_prince::{A, B4, B5, C};
         let h = dtau * self.ts;
         let n = x.len();
         for s in 0..7 {
             let mut stage = x.to_vec();
             for (j, a) in A[s].iter().enumerate().take(s) {
-                for (st, kj) in stage.iter_mut().zip(&self.k[j]) {
+                for (st, kj) in stage.iter_mut().zip(&self.work.k[j]) {
                     *st += h * a * kj;
                 }
             }
@@ -638,8 +627,8 @@ impl<'a> Stepper<'a> {
         for i in 0..n {
             let (mut s5, mut s4) = (0.0, 0.0);
             for s in 0..7 {
-                s5 += B5[s] * self.k[s][i];
-                s4 += B4[s] * self.k[s][i];
+                s5 += B5[s] * self.work.k[s][i];
+                s4 += B4[s] * self.work.k[s][i];
             }
             y5[i] = x[i] + h * s5;
             err[i] = h * (s5 - s4);
@@ -761,4 +750,63 @@ pub fn rk4_step(
     };
     let velocity = model.stick_slip_velocity();
     StickSlip::new(x.len()).step(&mut f, x, h, velocity, None);
+}
+
+/// The Dormand–Prince 5(4) tableau (Dormand & Prince 1980): nodes `C`, matrix `A` (the last
+/// row is the 5th-order weights, first same as last), and the weights of the 5th- and
+/// 4th-order solutions. Shared with the exported integrator (`crate::export::greybox`).
+pub(crate) mod dormand_prince {
+    /// The nodes c.
+    pub const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
+    /// The matrix A.
+    pub const A: [[f64; 6]; 7] = [
+        [0.0; 6],
+        [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+        [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+        [
+            19372.0 / 6561.0,
+            -25360.0 / 2187.0,
+            64448.0 / 6561.0,
+            -212.0 / 729.0,
+            0.0,
+            0.0,
+        ],
+        [
+            9017.0 / 3168.0,
+            -355.0 / 33.0,
+            46732.0 / 5247.0,
+            49.0 / 176.0,
+            -5103.0 / 18656.0,
+            0.0,
+        ],
+        [
+            35.0 / 384.0,
+            0.0,
+            500.0 / 1113.0,
+            125.0 / 192.0,
+            -2187.0 / 6784.0,
+            11.0 / 84.0,
+        ],
+    ];
+    /// The 5th-order weights.
+    pub const B5: [f64; 7] = [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+        0.0,
+    ];
+    /// The 4th-order weights (embedded error estimate).
+    pub const B4: [f64; 7] = [
+        5179.0 / 57600.0,
+        0.0,
+        7571.0 / 16695.0,
+        393.0 / 640.0,
+        -92097.0 / 339200.0,
+        187.0 / 2100.0,
+        1.0 / 40.0,
+    ];
 }

@@ -18,7 +18,7 @@
 //! says so.
 
 use super::Kernel;
-use crate::model::greybox::simulate::{advance_interval, check_integrator, InputTrack};
+use crate::model::greybox::simulate::{advance_interval, check_integrator, InputTrack, Workspace};
 use crate::model::greybox::{InputInterpolation, Simulation, StateSpaceModel};
 use crate::{Error, Result};
 
@@ -32,8 +32,9 @@ pub(super) struct GreyBoxStream {
     ts: f64,
     /// [u_{k−1}, u_k]: the interval the next step integrates.
     track: InputTrack,
-    /// Scratch space: an input sample and a state (the discrete-time recursion's).
-    u: Vec<f64>,
+    /// The integrator's buffers, kept from sample to sample (no allocation per step).
+    work: Workspace,
+    /// The discrete-time recursion's next state.
     next: Vec<f64>,
 }
 
@@ -81,7 +82,7 @@ impl GreyBoxStream {
         Ok(Self {
             x: x0.clone(),
             next: vec![0.0; x0.len()],
-            u: vec![0.0; n_inputs],
+            work: Workspace::new(x0.len(), n_inputs),
             x0,
             theta,
             simulation,
@@ -107,7 +108,8 @@ impl Kernel for GreyBoxStream {
                 self.simulation.integrator,
                 k - 1,
                 &mut self.x,
-                (&mut self.u, &mut self.next),
+                &mut self.work,
+                &mut self.next,
             )?;
         }
         if self.x.iter().any(|v| !v.is_finite()) {
