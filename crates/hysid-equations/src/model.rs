@@ -91,6 +91,88 @@ pub struct EquationModel {
     initial: Vec<InitialSpec>,
     tapes: Tapes,
     registers: usize,
+    /// h when its tape computes nothing (see [`DirectOutput`]).
+    direct_output: Option<DirectOutput>,
+}
+
+/// h of a model whose outputs are states, inputs, parameters or constants (y = x₀, say):
+/// its tape has no instruction, so y is read where it is and the Jacobians ∂h/∂x and
+/// ∂h/∂θ, derivatives of plain reads, are constants computed once — per sample, an output
+/// costs a few loads instead of a pass over a register file.
+#[derive(Clone, Debug)]
+struct DirectOutput {
+    /// The input slot (t, x, u, θ) or constant of each output.
+    y: Vec<Read>,
+    /// ∂h/∂x, ny×n row-major.
+    hx: Vec<f64>,
+    /// ∂h/∂θ, ny×p row-major.
+    htheta: Vec<f64>,
+}
+
+/// Where a direct output reads its value.
+#[derive(Clone, Copy, Debug)]
+enum Read {
+    State(usize),
+    Input(usize),
+    Parameter(usize),
+    Constant(f64),
+}
+
+impl DirectOutput {
+    /// The direct form of h (tape `h`, with its Jacobians `h_jac`), None when either tape
+    /// computes something.
+    fn of(h: &Tape, h_jac: &Tape, n: usize, m: usize, p: usize) -> Option<Self> {
+        let (inputs, consts, code) = h.parts();
+        let (jac_inputs, jac_consts, jac_code) = h_jac.parts();
+        if !code.is_empty() || !jac_code.is_empty() {
+            return None;
+        }
+        let read = |r: u32| -> Option<Read> {
+            let r = r as usize;
+            Some(match r {
+                // An output never reads t (the language refuses it in [output]).
+                0 => return None,
+                _ if r <= n => Read::State(r - 1),
+                _ if r <= n + m => Read::Input(r - 1 - n),
+                _ if r < inputs => Read::Parameter(r - 1 - n - m),
+                _ => Read::Constant(consts[r - inputs]),
+            })
+        };
+        let y = h
+            .outputs()
+            .iter()
+            .map(|&r| read(r))
+            .collect::<Option<Vec<_>>>()?;
+        // The Jacobian results: constants of the h_jac tape (a derivative of a plain read
+        // is 0 or 1), finite by convention.
+        let constant = |r: u32| -> Option<f64> {
+            let r = r as usize;
+            (r >= jac_inputs).then(|| finite_or_zero(jac_consts[r - jac_inputs]))
+        };
+        let ny = y.len();
+        let derivatives = h_jac.outputs()[ny..]
+            .iter()
+            .map(|&r| constant(r))
+            .collect::<Option<Vec<_>>>()?;
+        let (hx, htheta) = derivatives.split_at(ny * n);
+        (htheta.len() == ny * p).then(|| Self {
+            y,
+            hx: hx.to_vec(),
+            htheta: htheta.to_vec(),
+        })
+    }
+
+    #[inline]
+    fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
+        for (o, read) in y.iter_mut().zip(&self.y) {
+            *o = match *read {
+                Read::State(i) => x[i],
+                Read::Input(i) => u[i],
+                Read::Parameter(i) => theta[i],
+                Read::Constant(v) => v,
+            };
+        }
+    }
 }
 
 impl fmt::Debug for EquationModel {
@@ -446,6 +528,29 @@ impl EquationModel {
         }
     }
 
+    /// ∂h/∂x (ny×n) and ∂h/∂θ (ny×p), row-major, when they do not depend on (x, u, θ):
+    /// every output is a state, an input, a parameter or a constant (y = x₀, say). None
+    /// otherwise.
+    pub fn constant_output_jacobians(&self) -> Option<(&[f64], &[f64])> {
+        self.direct_output
+            .as_ref()
+            .map(|d| (d.hx.as_slice(), d.htheta.as_slice()))
+    }
+
+    /// The lengths `eval` asserts, for the paths that do not run a tape.
+    #[inline]
+    fn check_point(&self, x: &[f64], u: &[f64], theta: &[f64]) {
+        let (n, m, p) = (self.states.len(), self.inputs.len(), self.parameters.len());
+        assert!(
+            x.len() == n && u.len() == m && theta.len() == p,
+            "EquationModel '{}': expected {n} states, {m} inputs, {p} parameters, got {}, {}, {}",
+            self.name,
+            x.len(),
+            u.len(),
+            theta.len()
+        );
+    }
+
     fn with_thread_scratch<R>(&self, f: impl FnOnce(&mut Scratch) -> R) -> R {
         SCRATCH.with(|cell| match cell.try_borrow_mut() {
             Ok(mut s) => f(&mut s),
@@ -478,6 +583,10 @@ impl EquationModel {
     /// As [`Self::rhs_with`], with `y` of the length of [`Self::outputs`].
     pub fn output_with(&self, s: &mut Scratch, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
         check_len(y, self.outputs.len(), "y");
+        if let Some(direct) = &self.direct_output {
+            self.check_point(x, u, theta);
+            return direct.output(x, u, theta, y);
+        }
         self.eval(s, &self.tapes.h, 0.0, x, u, theta, &mut [y]);
     }
 
@@ -591,6 +700,13 @@ impl EquationModel {
         check_len(y, ny, "y");
         check_len(hx, ny * n, "hx");
         check_len(htheta, ny * p, "htheta");
+        if let Some(direct) = &self.direct_output {
+            self.check_point(x, u, theta);
+            direct.output(x, u, theta, y);
+            hx.copy_from_slice(&direct.hx);
+            htheta.copy_from_slice(&direct.htheta);
+            return;
+        }
         self.eval(s, &self.tapes.h_jac, 0.0, x, u, theta, &mut [y, hx, htheta]);
     }
 
@@ -633,6 +749,10 @@ impl EquationModel {
 
     /// [`Self::output_with`] with this thread's scratch.
     pub fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
+        if self.direct_output.is_some() {
+            // No register file needed.
+            return self.output_with(&mut Scratch::new(), x, u, theta, y);
+        }
         self.with_thread_scratch(|s| self.output_with(s, x, u, theta, y));
     }
 
@@ -641,6 +761,16 @@ impl EquationModel {
     /// compute f as this model does, to the bit ([`Listing`]).
     pub fn rhs_listing(&self) -> Listing {
         listing::of(&self.tapes.f, self.states.len(), self.inputs.len())
+    }
+
+    /// The operations of a [`ColumnTape`] in the order
+    /// [`Self::rhs_jacobian_columns_with`] performs them, with its results in that
+    /// method's layout: f (n), ∂f/∂x (n×n row-major), then ∂f/∂θ for the tape's columns
+    /// (n×k row-major). A printed listing computes what the tape computes, operation for
+    /// operation; the caller applies the finite-derivative convention (a derivative that is
+    /// not finite is reported as 0, see the crate docs) to every result after the first n.
+    pub fn columns_listing(&self, columns: &ColumnTape) -> Listing {
+        listing::of(&columns.tape, self.states.len(), self.inputs.len())
     }
 
     /// The operations that compute h, in the order [`Self::output`] performs them, one
@@ -674,6 +804,10 @@ impl EquationModel {
         hx: &mut [f64],
         htheta: &mut [f64],
     ) {
+        if self.direct_output.is_some() {
+            // No register file needed.
+            return self.output_jacobians_with(&mut Scratch::new(), x, u, theta, y, hx, htheta);
+        }
         self.with_thread_scratch(|s| self.output_jacobians_with(s, x, u, theta, y, hx, htheta));
     }
 
@@ -862,6 +996,7 @@ fn compile(text: &str, fm: FileModel) -> Result<EquationModel, EquationError> {
         units: fm.units,
         parameters: fm.parameters.into_iter().map(|(p, _)| p).collect(),
         initial: fm.initial,
+        direct_output: DirectOutput::of(&tapes.h, &tapes.h_jac, n, m, p),
         tapes,
         registers,
     })

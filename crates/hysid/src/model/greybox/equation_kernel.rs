@@ -17,10 +17,15 @@
 //! generic path (up to the sign of a zero), which `equation_path_equals_the_generic_path`
 //! in the tests of [`super::equation_model`] checks to the bit.
 //!
+//! The tape's results come from the bound tape itself or from its native code
+//! ([`super::native`]), which computes the same numbers (checked to the bit when it is
+//! built).
+//!
 //! Reference: forward sensitivities of ODEs, Hairer, Nørsett & Wanner, *Solving Ordinary
 //! Differential Equations I*, 2nd ed., §I.14.
 
 use super::fixed_rk4::{self, FixedSensitivityRhs, Rk4Sensitivities, SampleSink};
+use super::native::BoundNative;
 use crate::Result;
 use hysid_equations::BoundColumns;
 
@@ -33,12 +38,49 @@ const MAX_COLUMNS: usize = 10;
 const OUT: usize = 64;
 const _: () = assert!(MAX_STATES + MAX_STATES * MAX_STATES + MAX_STATES * MAX_COLUMNS <= OUT);
 
-/// f with its Jacobians from a bound tape, for N states and Q columns, the first k of
-/// them parameter columns.
+/// Where the results of one run are computed: the bound tape, or its native code
+/// ([`super::native`]), which writes the same numbers at the same positions.
+pub(super) enum Results {
+    /// The tape interpreter: writes the entries that depend on (x, u) (the others were
+    /// filled once, [`BoundColumns::fill_constants`]).
+    Tape(BoundColumns),
+    /// Native code, writing every entry at the positions of [`column_positions`] (of
+    /// `0..n` for f alone).
+    Native(BoundNative),
+}
+
+impl Results {
+    #[inline(always)]
+    fn eval<const N: usize>(&mut self, x: &[f64; N], u: &[f64], out: &mut [f64]) {
+        match self {
+            Results::Tape(tape) => tape.eval_fixed(0.0, x, u, out),
+            Results::Native(native) => native.eval(0.0, x, u, out),
+        }
+    }
+}
+
+/// Where the kernel keeps result k of a column tape of n states and k columns: f, ∂f/∂x,
+/// then the rows of ∂f/∂θ padded to the run's q columns.
+pub(super) fn column_positions(n: usize, k: usize, q: usize) -> Vec<usize> {
+    let direct = n + n * n;
+    (0..direct + n * k)
+        .map(|r| {
+            if r < direct {
+                r
+            } else {
+                let (i, c) = ((r - direct) / k, (r - direct) % k);
+                direct + i * q + c
+            }
+        })
+        .collect()
+}
+
+/// f with its Jacobians for N states and Q columns, the first k of them parameter
+/// columns.
 struct TapeKernel<const N: usize, const Q: usize> {
-    tape: BoundColumns,
+    results: Results,
     /// f, ∂f/∂x (N×N), ∂f/∂θ\[params\] (N×Q: the k columns of the tape, then the zero direct
-    /// terms of the initial-state columns), as the tape writes them: every index below is
+    /// terms of the initial-state columns), at [`column_positions`]: every index below is
     /// then known to be in bounds at compile time.
     out: [f64; OUT],
     /// Whether ∂fᵢ/∂xⱼ can be non-zero (false for an entry the bound tape knows is zero).
@@ -46,26 +88,28 @@ struct TapeKernel<const N: usize, const Q: usize> {
 }
 
 impl<const N: usize, const Q: usize> TapeKernel<N, Q> {
-    fn new(mut tape: BoundColumns, k: usize) -> Self {
+    /// `tape` bound to the run's θ (it tells which entries of ∂f/∂x are zero), and the
+    /// native code to run instead of it, if any.
+    fn new(mut tape: BoundColumns, k: usize, native: Option<BoundNative>) -> Self {
         let mut coupled = [[true; N]; N];
         for (i, row) in coupled.iter_mut().enumerate() {
             for (j, c) in row.iter_mut().enumerate() {
                 *c = tape.constant(N + i * N + j) != Some(0.0);
             }
         }
-        // ∂f/∂θ row i, column c (stride k in the tape's layout) goes to stride Q.
-        let direct = N + N * N;
-        tape.place(|r| {
-            if r < direct {
-                r
-            } else {
-                let (i, c) = ((r - direct) / k, (r - direct) % k);
-                direct + i * Q + c
-            }
-        });
+        let positions = column_positions(N, k, Q);
+        tape.place(|r| positions[r]);
         let mut out = [0.0; OUT];
         tape.fill_constants(&mut out);
-        Self { tape, out, coupled }
+        let results = match native {
+            Some(native) => Results::Native(native),
+            None => Results::Tape(tape),
+        };
+        Self {
+            results,
+            out,
+            coupled,
+        }
     }
 }
 
@@ -80,7 +124,7 @@ impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N,
         ds: &mut [[f64; Q]; N],
     ) {
         // Time-free tapes only (checked by `simulate`'s caller), so t is not needed.
-        self.tape.eval_fixed(0.0, x, u, &mut self.out);
+        self.results.eval(x, u, &mut self.out);
         let out = &self.out;
         for (i, d) in dx.iter_mut().enumerate() {
             *d = out[i];
@@ -103,9 +147,10 @@ impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N,
     }
 }
 
-/// ẋ alone from the bound tape of f, for a simulation without sensitivity columns (Q = 0).
+/// ẋ alone from the bound tape of f (or its native code), for a simulation without
+/// sensitivity columns (Q = 0).
 struct RateKernel<const N: usize> {
-    tape: BoundColumns,
+    results: Results,
     /// ẋ as the tape writes it.
     out: [f64; N],
 }
@@ -120,80 +165,96 @@ impl<const N: usize> FixedSensitivityRhs<N, 0> for RateKernel<N> {
         dx: &mut [f64; N],
         _ds: &mut [[f64; 0]; N],
     ) {
-        self.tape.eval_fixed(0.0, x, u, &mut self.out);
+        self.results.eval(x, u, &mut self.out);
         *dx = self.out;
     }
 }
 
-/// Runs the fixed-size path with the bound tape `tape` (which must not read t), None when
-/// the run's sizes have none (more than [`MAX_STATES`] states or [`MAX_COLUMNS`] columns,
-/// or no column: see [`simulate_rates`]).
+/// Runs the fixed-size path with the bound tape `tape` (which must not read t), or the
+/// `native` code of the same tape at [`column_positions`] when given; None when the run's
+/// sizes have none (more than [`MAX_STATES`] states or [`MAX_COLUMNS`] columns, or no
+/// column: see [`simulate_rates`]).
 pub(super) fn simulate(
     tape: BoundColumns,
+    native: Option<BoundNative>,
     run: &Rk4Sensitivities<'_>,
     on_sample: &mut SampleSink<'_>,
 ) -> Option<Result<()>> {
     fn with<const N: usize, const Q: usize>(
         tape: BoundColumns,
+        native: Option<BoundNative>,
         run: &Rk4Sensitivities<'_>,
         on_sample: &mut SampleSink<'_>,
     ) -> Option<Result<()>> {
-        let mut kernel = TapeKernel::<N, Q>::new(tape, run.params.len());
+        let mut kernel = TapeKernel::<N, Q>::new(tape, run.params.len(), native);
         Some(fixed_rk4::simulate::<_, N, Q>(&mut kernel, run, on_sample))
     }
     fn columns<const N: usize>(
         tape: BoundColumns,
+        native: Option<BoundNative>,
         run: &Rk4Sensitivities<'_>,
         on_sample: &mut SampleSink<'_>,
     ) -> Option<Result<()>> {
         const { assert!(MAX_COLUMNS == 10) };
         match run.columns() {
-            1 => with::<N, 1>(tape, run, on_sample),
-            2 => with::<N, 2>(tape, run, on_sample),
-            3 => with::<N, 3>(tape, run, on_sample),
-            4 => with::<N, 4>(tape, run, on_sample),
-            5 => with::<N, 5>(tape, run, on_sample),
-            6 => with::<N, 6>(tape, run, on_sample),
-            7 => with::<N, 7>(tape, run, on_sample),
-            8 => with::<N, 8>(tape, run, on_sample),
-            9 => with::<N, 9>(tape, run, on_sample),
-            10 => with::<N, 10>(tape, run, on_sample),
+            1 => with::<N, 1>(tape, native, run, on_sample),
+            2 => with::<N, 2>(tape, native, run, on_sample),
+            3 => with::<N, 3>(tape, native, run, on_sample),
+            4 => with::<N, 4>(tape, native, run, on_sample),
+            5 => with::<N, 5>(tape, native, run, on_sample),
+            6 => with::<N, 6>(tape, native, run, on_sample),
+            7 => with::<N, 7>(tape, native, run, on_sample),
+            8 => with::<N, 8>(tape, native, run, on_sample),
+            9 => with::<N, 9>(tape, native, run, on_sample),
+            10 => with::<N, 10>(tape, native, run, on_sample),
             _ => None,
         }
     }
     const { assert!(MAX_STATES == 4) };
     match run.x0.len() {
-        1 => columns::<1>(tape, run, on_sample),
-        2 => columns::<2>(tape, run, on_sample),
-        3 => columns::<3>(tape, run, on_sample),
-        4 => columns::<4>(tape, run, on_sample),
+        1 => columns::<1>(tape, native, run, on_sample),
+        2 => columns::<2>(tape, native, run, on_sample),
+        3 => columns::<3>(tape, native, run, on_sample),
+        4 => columns::<4>(tape, native, run, on_sample),
         _ => None,
     }
 }
 
+/// Whether the fixed-size path takes a run of `states` states and `columns` columns.
+pub(super) fn has_fixed_path(states: usize, columns: usize) -> bool {
+    (1..=MAX_STATES).contains(&states) && columns <= MAX_COLUMNS
+}
+
 /// Runs the fixed-size path without sensitivities (a plain simulation) with the bound tape
-/// of f `tape` (which must not read t), None for more than [`MAX_STATES`] states.
+/// of f `tape` (which must not read t), or its `native` code writing ẋ at 0..n; None for
+/// more than [`MAX_STATES`] states.
 pub(super) fn simulate_rates(
     tape: BoundColumns,
+    native: Option<BoundNative>,
     run: &Rk4Sensitivities<'_>,
     on_sample: &mut SampleSink<'_>,
 ) -> Option<Result<()>> {
     fn with<const N: usize>(
         tape: BoundColumns,
+        native: Option<BoundNative>,
         run: &Rk4Sensitivities<'_>,
         on_sample: &mut SampleSink<'_>,
     ) -> Option<Result<()>> {
         let mut out = [0.0; N];
         tape.fill_constants(&mut out);
         // `fill_constants` and `eval` write positions below N only (the layout of f).
-        let mut kernel = RateKernel::<N> { tape, out };
+        let results = match native {
+            Some(native) => Results::Native(native),
+            None => Results::Tape(tape),
+        };
+        let mut kernel = RateKernel::<N> { results, out };
         Some(fixed_rk4::simulate::<_, N, 0>(&mut kernel, run, on_sample))
     }
     match run.x0.len() {
-        1 => with::<1>(tape, run, on_sample),
-        2 => with::<2>(tape, run, on_sample),
-        3 => with::<3>(tape, run, on_sample),
-        4 => with::<4>(tape, run, on_sample),
+        1 => with::<1>(tape, native, run, on_sample),
+        2 => with::<2>(tape, native, run, on_sample),
+        3 => with::<3>(tape, native, run, on_sample),
+        4 => with::<4>(tape, native, run, on_sample),
         _ => None,
     }
 }

@@ -34,6 +34,7 @@
 //! interpolation do not apply to it.
 
 use super::fixed_rk4::{Rk4Sensitivities, SampleSink};
+use super::native::{Evaluator, NativeFunction, Shape};
 use super::{equation_kernel, sensitivity, JacobianScratch, StateSpaceModel};
 use crate::data::Channel;
 use crate::error::EquationFileError;
@@ -42,6 +43,7 @@ use crate::{Error, Result};
 use hysid_equations::{ColumnTape, EquationError, EquationModel, Scratch, TimeDomain};
 use std::cell::RefCell;
 use std::path::Path;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// The model kind of equation-file models in saved models and reports.
 pub const EQUATIONS_KIND: &str = "equations";
@@ -71,6 +73,26 @@ pub struct EquationStateSpace {
     /// The Jacobian tape restricted to the free parameters' ∂f/∂θ columns (what a fit
     /// asks sensitivities for).
     free_columns: Option<ColumnTape>,
+    /// Which code runs the tapes of a simulation.
+    evaluator: Evaluator,
+    /// The native functions built so far, shared by the clones of this model (a fit's
+    /// threads): one compilation (or cache load) per tape and layout, different ones
+    /// built side by side (the two halves of split sensitivity columns).
+    native: Arc<Mutex<NativeCells>>,
+}
+
+/// One native function, or why there is none, built once.
+type NativeCell = OnceLock<std::result::Result<Arc<NativeFunction>, String>>;
+
+/// The cells of the native functions asked for so far, by tape and layout.
+type NativeCells = Vec<(NativeKey, Arc<NativeCell>)>;
+
+/// Which tape and layout a native function computes: f alone, or the columns of the
+/// parameters `params` padded to `q` sensitivity columns.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum NativeKey {
+    Rates,
+    Columns { params: Vec<usize>, q: usize },
 }
 
 /// Per-thread registers and value buffers, so that the trait's Jacobian methods (which do
@@ -184,6 +206,8 @@ impl EquationStateSpace {
             .map_err(|e| Error::InvalidModel(format!("{origin}: {e}")))?;
         Ok(Self {
             free_columns: model.rhs_jacobian_columns(&parameters.free_indices()),
+            evaluator: Evaluator::from_env()?,
+            native: Arc::default(),
             states: model.states().iter().map(channel).collect(),
             inputs: model.inputs().iter().map(channel).collect(),
             outputs: model.outputs().iter().map(channel).collect(),
@@ -215,6 +239,116 @@ impl EquationStateSpace {
     /// Per state, whether `[initial]` asks for it to be estimated (`fixed = false`).
     pub fn initial_estimated(&self) -> Vec<bool> {
         self.model.initial().iter().map(|s| !s.fixed).collect()
+    }
+
+    /// The same model run by `evaluator` (the default is [`Evaluator::from_env`]).
+    pub fn with_evaluator(mut self, evaluator: Evaluator) -> Self {
+        self.evaluator = evaluator;
+        self.native = Arc::default();
+        self
+    }
+
+    /// Which code runs this model's simulations (see [`super::native`]).
+    pub fn evaluator(&self) -> Evaluator {
+        self.evaluator
+    }
+
+    /// The native code of the tape `key` names, built on first use (once for this model
+    /// and its clones); None when the evaluator is the tape, or `auto` and native code
+    /// cannot be built. With [`Evaluator::Native`] that is an error.
+    fn native(&self, key: NativeKey) -> Result<Option<Arc<NativeFunction>>> {
+        if self.evaluator == Evaluator::Tape {
+            return Ok(None);
+        }
+        let cell = {
+            let mut cells = self.native.lock().unwrap_or_else(|e| e.into_inner());
+            match cells.iter().find(|(k, _)| *k == key) {
+                Some((_, cell)) => Arc::clone(cell),
+                None => {
+                    let cell = Arc::new(NativeCell::new());
+                    cells.push((key.clone(), Arc::clone(&cell)));
+                    cell
+                }
+            }
+        };
+        let found = cell.get_or_init(|| self.build_native(&key)).clone();
+        match (found, self.evaluator) {
+            (Ok(f), _) => Ok(Some(f)),
+            (Err(why), Evaluator::Native) => Err(Error::Unsupported(format!(
+                "equation model '{}': no native code ({why}); unset HYSID_EVALUATOR (or set \
+                 it to auto) to run the tape interpreter",
+                self.name()
+            ))),
+            (Err(_), _) => Ok(None),
+        }
+    }
+
+    /// Builds the native code of `key` and checks it against the tape at sample points.
+    fn build_native(&self, key: &NativeKey) -> std::result::Result<Arc<NativeFunction>, String> {
+        let (n, m) = (self.states.len(), self.inputs.len());
+        let shape = Shape {
+            states: n,
+            inputs: m,
+            parameters: self.parameters.len(),
+        };
+        let theta = self.parameters.values();
+        match key {
+            NativeKey::Rates => {
+                let listing = self.model.rhs_listing();
+                let positions: Vec<usize> = (0..n).collect();
+                NativeFunction::build(&listing, n, &positions, shape, |native| {
+                    self.same_as_tape(native, &theta, n, |x, u, out| {
+                        self.model.rhs(0.0, x, u, &theta, out)
+                    })
+                })
+            }
+            NativeKey::Columns { params, q } => {
+                let columns = self
+                    .model
+                    .rhs_jacobian_columns(params)
+                    .ok_or("a parameter column out of range")?;
+                let listing = self.model.columns_listing(&columns);
+                let positions = equation_kernel::column_positions(n, params.len(), *q);
+                let len = positions.iter().max().map_or(0, |p| p + 1);
+                NativeFunction::build(&listing, n, &positions, shape, |native| {
+                    self.same_as_tape(native, &theta, len, |x, u, out| {
+                        let mut s = self.model.scratch();
+                        let (mut dx, mut fx) = (vec![0.0; n], vec![0.0; n * n]);
+                        let mut ft = vec![0.0; n * params.len()];
+                        self.model.rhs_jacobian_columns_with(
+                            &mut s, &columns, 0.0, x, u, &theta, &mut dx, &mut fx, &mut ft,
+                        );
+                        for (r, v) in dx.iter().chain(&fx).chain(&ft).enumerate() {
+                            out[positions[r]] = *v;
+                        }
+                    })
+                })
+            }
+        }
+    }
+
+    /// Whether `native` bound to θ writes, at a few seeded points (x, u), exactly the bits
+    /// `tape` writes into a buffer of `len` (NaN matching NaN).
+    fn same_as_tape(
+        &self,
+        native: &NativeFunction,
+        theta: &[f64],
+        len: usize,
+        tape: impl Fn(&[f64], &[f64], &mut [f64]),
+    ) -> bool {
+        let (n, m) = (self.states.len(), self.inputs.len());
+        let points = [0.37, -1.9, 2.6e-3, 41.0, -0.0, 7.5e-7];
+        (0..points.len()).all(|p| {
+            let pick = |i: usize| points[(p + 3 * i) % points.len()] * (1.0 + i as f64);
+            let x: Vec<f64> = (0..n).map(pick).collect();
+            let u: Vec<f64> = (0..m).map(|i| pick(n + i)).collect();
+            let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
+            native.eval_once(theta, 0.0, &x, &u, &mut a);
+            tape(&x, &u, &mut b);
+            a.iter()
+                .zip(&b)
+                .all(|(a, b)| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()))
+        })
     }
 }
 
@@ -320,8 +454,9 @@ impl StateSpaceModel for EquationStateSpace {
 
     /// The fixed-size path of the private `equation_kernel` module: the Jacobian tape of the
     /// run's columns (the tape of f for a run without columns, a plain simulation) bound to
-    /// its θ, for up to 4 states and 10 columns of a continuous-time file that does not read
-    /// t (otherwise None: the generic path runs).
+    /// its θ — run as native code unless the evaluator is the tape ([`super::native`]) —
+    /// for up to 4 states and 10 columns of a continuous-time file that does not read t
+    /// (otherwise None: the generic path runs).
     fn fixed_rk4_sensitivities(
         &self,
         run: &Rk4Sensitivities<'_>,
@@ -333,12 +468,19 @@ impl StateSpaceModel for EquationStateSpace {
         {
             return None;
         }
+        if !equation_kernel::has_fixed_path(run.x0.len(), run.columns()) {
+            return None;
+        }
         if run.columns() == 0 {
             let tape = self.model.bind_rhs(run.theta)?;
             if tape.uses_time() {
                 return None;
             }
-            return equation_kernel::simulate_rates(tape, run, on_sample);
+            let native = match self.native(NativeKey::Rates) {
+                Ok(native) => native.map(|f| f.bind(run.theta)),
+                Err(e) => return Some(Err(e)),
+            };
+            return equation_kernel::simulate_rates(tape, native, run, on_sample);
         }
         let fresh;
         let columns = match &self.free_columns {
@@ -352,10 +494,19 @@ impl StateSpaceModel for EquationStateSpace {
         if tape.uses_time() {
             return None;
         }
-        equation_kernel::simulate(tape, run, on_sample)
+        let key = NativeKey::Columns {
+            params: run.params.to_vec(),
+            q: run.columns(),
+        };
+        let native = match self.native(key) {
+            Ok(native) => native.map(|f| f.bind(run.theta)),
+            Err(e) => return Some(Err(e)),
+        };
+        equation_kernel::simulate(tape, native, run, on_sample)
     }
 
-    /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded).
+    /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded), or
+    /// copied when they are constants (outputs that are states, inputs or parameters).
     fn output_jacobians(
         &self,
         x: &[f64],
@@ -364,6 +515,11 @@ impl StateSpaceModel for EquationStateSpace {
         hx: &mut [f64],
         htheta: &mut [f64],
     ) -> bool {
+        if let Some((hx0, htheta0)) = self.model.constant_output_jacobians() {
+            hx.copy_from_slice(hx0);
+            htheta.copy_from_slice(htheta0);
+            return true;
+        }
         with_work(self.outputs.len(), |s, y| {
             self.model
                 .output_jacobians_with(s, x, u, theta, y, hx, htheta)

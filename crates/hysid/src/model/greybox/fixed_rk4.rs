@@ -115,7 +115,7 @@ impl<const N: usize, const Q: usize> Augmented<N, Q> {
 
 /// Simulates `run` with RK4 (its sub-steps per sample) from x0 with S(t₀) = s0 (row-major
 /// N × Q), calling `on_sample(k, x(t_k), S(t_k))` at every sample. The input is read at the
-/// half-step nodes of the track ([`InputTrack::at_node`]), which the caller has checked lie
+/// half-step nodes of the track ([`InputTrack::nodes`]), which the caller has checked lie
 /// on its grid (resolution 2·substeps).
 pub(crate) fn simulate<K, const N: usize, const Q: usize>(
     kernel: &mut K,
@@ -134,8 +134,11 @@ where
     let (half, sixth) = (0.5 * h, h / 6.0);
     let mut k = [Augmented::<N, Q>::ZERO; 4];
     let mut stage = Augmented::<N, Q>::ZERO;
-    // The input at the three nodes of a sub-step: start, middle, end.
-    let mut nodes: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; input.n_channels()]);
+    // The input at the 2m + 1 nodes of a sample interval, node-major: sub-step j reads
+    // nodes 2j (start), 2j + 1 (middle) and 2j + 2 (end).
+    let channels = input.n_channels();
+    let mut nodes = vec![0.0; (2 * m + 1) * channels];
+    let span = |i: usize| i * channels..(i + 1) * channels;
     let n_samples = input.len();
     for sample in 0..n_samples {
         if !z.is_finite() {
@@ -145,18 +148,21 @@ where
         if sample + 1 == n_samples {
             break;
         }
+        input.nodes(sample, &mut nodes);
         for j in 0..m {
-            for (n, node) in nodes.iter_mut().enumerate() {
-                input.at_node(sample, 2 * j + n, node);
-            }
+            let (start, middle, end) = (
+                &nodes[span(2 * j)],
+                &nodes[span(2 * j + 1)],
+                &nodes[span(2 * j + 2)],
+            );
             let [k1, k2, k3, k4] = &mut k;
-            kernel.eval(&z.x, &nodes[0], &z.s, &mut k1.x, &mut k1.s);
+            kernel.eval(&z.x, start, &z.s, &mut k1.x, &mut k1.s);
             stage.set_axpy(&z, half, k1);
-            kernel.eval(&stage.x, &nodes[1], &stage.s, &mut k2.x, &mut k2.s);
+            kernel.eval(&stage.x, middle, &stage.s, &mut k2.x, &mut k2.s);
             stage.set_axpy(&z, half, k2);
-            kernel.eval(&stage.x, &nodes[1], &stage.s, &mut k3.x, &mut k3.s);
+            kernel.eval(&stage.x, middle, &stage.s, &mut k3.x, &mut k3.s);
             stage.set_axpy(&z, h, k3);
-            kernel.eval(&stage.x, &nodes[2], &stage.s, &mut k4.x, &mut k4.s);
+            kernel.eval(&stage.x, end, &stage.s, &mut k4.x, &mut k4.s);
             z.add_rk4(sixth, &k);
         }
     }

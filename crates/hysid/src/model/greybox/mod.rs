@@ -18,6 +18,8 @@
 //! * [`fixed_rk4`]: RK4 with sensitivities on fixed-size arrays, for models that offer it.
 //! * [`stick_slip`]: RK4 steps that integrate Coulomb friction as stick–slip.
 //! * [`sensitivity`]: the right-hand side of the forward sensitivity equations.
+//! * [`native`]: equation-file models compiled to machine code (with the tape interpreter
+//!   as fallback and reference).
 //! * [`discrete`]: discrete-time models (x\[k+1\] = f(…), [`StateSpaceModel::discrete_time`]),
 //!   simulated by their recursion, with its exact sensitivities.
 //!
@@ -30,6 +32,7 @@ mod equation_kernel;
 pub mod equation_model;
 pub mod fixed_rk4;
 pub mod models;
+pub mod native;
 pub mod sensitivity;
 pub mod simulate;
 pub mod stick_slip;

@@ -184,6 +184,37 @@ impl InputTrack {
         }
     }
 
+    /// The input at every node 0, 1, …, [`resolution`](Self::resolution) of sample interval
+    /// k, node-major (`out[node · channels + c]`), each the value [`at_node`](Self::at_node)
+    /// gives: one call per sample for an integrator that reads several nodes.
+    ///
+    /// # Panics
+    /// If `out` is shorter than (resolution + 1) · channels.
+    #[inline]
+    pub fn nodes(&self, k: usize, out: &mut [f64]) {
+        let (channels, res) = (self.n_channels(), self.resolution);
+        let out = &mut out[..(res + 1) * channels];
+        for (c, s) in self.samples.iter().enumerate() {
+            let column = out.iter_mut().skip(c).step_by(channels);
+            match self.interpolation {
+                InputInterpolation::ZeroOrderHold => column.for_each(|o| *o = s[k]),
+                InputInterpolation::Linear => {
+                    let next = s.get(k + 1).copied().unwrap_or(s[k]);
+                    for (index, o) in column.enumerate() {
+                        let tau = index as f64 / res as f64;
+                        *o = s[k] + tau * (next - s[k]);
+                    }
+                }
+                InputInterpolation::BandLimited => {
+                    let f = &self.fine[c];
+                    for (index, o) in column.enumerate() {
+                        *o = f[(k * res + index).min(f.len() - 1)];
+                    }
+                }
+            }
+        }
+    }
+
     /// u(t_k + τ·ts) for τ ∈ [0, 1], written into `out`. With zero-order hold τ = 1 still
     /// gives u_k: the value held over the interval that ends there.
     #[inline]

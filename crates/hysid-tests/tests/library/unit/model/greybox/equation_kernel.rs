@@ -1,6 +1,7 @@
 //! Tests of `hysid::model::greybox::equation_kernel`.
 
 use hysid::model::greybox::equation_model::EquationStateSpace;
+use hysid::model::greybox::native::Evaluator;
 use hysid::model::greybox::simulate::{
     simulate, simulate_sensitivities, InputInterpolation, InputTrack, Integrator, Simulation,
 };
@@ -71,8 +72,8 @@ fn run(model: &dyn StateSpaceModel, case: &Case<'_>, sensitivities: bool) -> Vec
     out
 }
 
-/// The fixed-size path (bound tape, fixed arrays) gives the generic path's x and S to
-/// the bit (zeros compared by value): Bouc–Wen at ν = 1 and 1.3 with parameter and
+/// The fixed-size path (bound tape or its native code, fixed arrays) gives the generic
+/// path's x and S to the bit (zeros compared by value): Bouc–Wen at ν = 1 and 1.3 with parameter and
 /// initial-state columns, Duffing and the cascaded tanks (two states, estimated initial
 /// levels), every input interpolation, with and without sensitivities.
 #[test]
@@ -128,19 +129,23 @@ fn equation_path_equals_the_generic_path() {
     }
     for (model, case) in &cases {
         let generic = crate::unit::generic_path::GenericPath(*model);
-        for sensitivities in [true, false] {
-            let fixed = run(*model, case, sensitivities);
-            let reference = run(&generic, case, sensitivities);
-            assert_eq!(fixed.len(), reference.len());
-            for (i, (a, b)) in fixed.iter().zip(&reference).enumerate() {
-                assert!(
-                    a.to_bits() == b.to_bits() || (*a == 0.0 && *b == 0.0),
-                    "{} {:?} {:?}/{:?} sensitivities {sensitivities}, element {i}: {a} vs {b}",
-                    model.name(),
-                    case.interpolation,
-                    case.params,
-                    case.initial
-                );
+        for evaluator in [Evaluator::Tape, Evaluator::Native] {
+            let model = (*model).clone().with_evaluator(evaluator);
+            for sensitivities in [true, false] {
+                let fixed = run(&model, case, sensitivities);
+                let reference = run(&generic, case, sensitivities);
+                assert_eq!(fixed.len(), reference.len());
+                for (i, (a, b)) in fixed.iter().zip(&reference).enumerate() {
+                    assert!(
+                        a.to_bits() == b.to_bits() || (*a == 0.0 && *b == 0.0),
+                        "{} {evaluator:?} {:?} {:?}/{:?} sensitivities {sensitivities}, \
+                         element {i}: {a} vs {b}",
+                        model.name(),
+                        case.interpolation,
+                        case.params,
+                        case.initial
+                    );
+                }
             }
         }
     }

@@ -1,0 +1,193 @@
+//! Tests of `hysid::model::greybox::native`: the compiled form of an equation model's
+//! tapes gives the tape's numbers to the bit.
+
+use hysid::model::greybox::native::{Evaluator, NativeFunction, Provenance, Shape};
+use hysid_equations::EquationModel;
+
+/// Every operation of the language: the functions, integer and real powers (the exponent a
+/// parameter equal to 1, so pow's shortcut is taken), comparisons, and/or/not, if, and a
+/// literal constant.
+const EVERY_OPERATION: &str = r#"
+[model]
+states = ["a", "b"]
+inputs = ["u", "w"]
+outputs = ["y", "z"]
+
+[parameters]
+k = 1.5
+m = -0.75
+n = 3.0
+e = 1.0
+
+[let]
+q = "abs(a) + 0.5"
+
+[equations]
+a = "sin(a)*cos(b) + tan(u/7) - exp(-a^2) + ln(1 + b^2) + sqrt(abs(w) + 1) + sign(a - b)*tanh(k*u) + atan(m*w)"
+b = "pow(q, n) + pow(abs(b), e) + a^-3 + b^7 + min(a, k)*max(b, m) + if(a < b and not (u >= w) or a == b, k, -m) + if(a != u, a/(b + 2.5), 0.125)"
+
+[output]
+y = "a*k + b"
+z = "b"
+"#;
+
+/// A small xorshift generator: seeded, reproducible points.
+struct Points(u64);
+
+impl Points {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        // Mostly moderate values, some large, some exactly zero or negative zero.
+        match self.0 % 16 {
+            0 => 0.0,
+            1 => -0.0,
+            2 => (self.0 >> 11) as f64 * 1e-300,
+            3 => ((self.0 >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 1e6,
+            _ => ((self.0 >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 8.0,
+        }
+    }
+    fn vec(&mut self, n: usize) -> Vec<f64> {
+        (0..n).map(|_| self.next()).collect()
+    }
+}
+
+fn same(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+}
+
+fn shape(m: &EquationModel) -> Shape {
+    Shape {
+        states: m.states().len(),
+        inputs: m.inputs().len(),
+        parameters: m.parameters().len(),
+    }
+}
+
+/// Checks the native f and the native columns of `params` (padded to `q`, written in
+/// reverse order to exercise the positions) against the tape at 400 seeded points.
+fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
+    let (n, k) = (m.states().len(), params.len());
+    let mut points = Points(seed);
+    let theta = m.parameter_values();
+
+    // f alone.
+    let positions: Vec<usize> = (0..n).collect();
+    let f = NativeFunction::build(&m.rhs_listing(), n, &positions, shape(m), |_| true).unwrap();
+    // Columns: f, ∂f/∂x, ∂f/∂θ[params] into rows of q, the whole layout reversed.
+    let columns = m.rhs_jacobian_columns(params).unwrap();
+    let len = n + n * n + n * q;
+    let natural: Vec<usize> = (0..n + n * n)
+        .chain((0..n * k).map(|r| n + n * n + (r / k) * q + r % k))
+        .collect();
+    let reversed: Vec<usize> = natural.iter().map(|p| len - 1 - p).collect();
+    let jac = NativeFunction::build(&m.columns_listing(&columns), n, &reversed, shape(m), |_| {
+        true
+    })
+    .unwrap();
+
+    for point in 0..400 {
+        let x = points.vec(n);
+        let u = points.vec(m.inputs().len());
+        // Half of the points at the file's θ, half at another one.
+        let th: Vec<f64> = if point % 2 == 0 {
+            theta.clone()
+        } else {
+            theta
+                .iter()
+                .map(|v| v * (1.0 + 0.25 * points.next()))
+                .collect()
+        };
+        let (mut tape, mut native) = (vec![0.0; n], vec![0.0; n]);
+        m.rhs(0.0, &x, &u, &th, &mut tape);
+        f.bind(&th).eval(0.0, &x, &u, &mut native);
+        for i in 0..n {
+            assert!(
+                same(tape[i], native[i]),
+                "f{i} at x {x:?}, u {u:?}, θ {th:?}: tape {} native {}",
+                tape[i],
+                native[i]
+            );
+        }
+        let mut s = m.scratch();
+        let (mut dx, mut fx, mut ft) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * k]);
+        m.rhs_jacobian_columns_with(
+            &mut s, &columns, 0.0, &x, &u, &th, &mut dx, &mut fx, &mut ft,
+        );
+        let mut out = vec![f64::NAN; len];
+        jac.bind(&th).eval(0.0, &x, &u, &mut out);
+        for (r, v) in dx.iter().chain(&fx).chain(&ft).enumerate() {
+            let got = out[reversed[r]];
+            assert!(
+                same(*v, got),
+                "result {r} at x {x:?}, u {u:?}, θ {th:?}: tape {v} native {got}"
+            );
+        }
+    }
+}
+
+/// Every operation of the language, f and Jacobian columns, at seeded points that include
+/// zeros of both signs, tiny and large values, θ moved from the file's values.
+#[test]
+fn native_code_equals_the_tape_for_every_operation() {
+    let m = EquationModel::parse(EVERY_OPERATION).unwrap();
+    check_model(&m, &[0, 1, 2, 3], 4, 1);
+    check_model(&m, &[0, 1, 2, 3], 6, 2);
+    check_model(&m, &[3, 1], 3, 3);
+}
+
+/// The example files (Bouc–Wen, Duffing, cascaded tanks, the actuator with Coulomb
+/// friction, the discrete-time backlash) with their free parameters' columns.
+#[test]
+fn native_code_equals_the_tape_on_the_example_files() {
+    let dir = format!("{}/../../examples/equations", env!("CARGO_MANIFEST_DIR"));
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let m = EquationModel::parse(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let free: Vec<usize> = (0..m.parameters().len())
+            .filter(|&i| !m.parameters()[i].fixed)
+            .collect();
+        check_model(&m, &free, free.len() + m.states().len(), 7 + seen);
+        seen += 1;
+    }
+    assert!(seen >= 5, "{seen} example files");
+}
+
+/// A build compiles once; the next build of the same code loads the cached object; a
+/// check that fails refuses the code.
+#[test]
+fn the_compiled_code_is_cached_and_checked() {
+    // A literal no other test or run uses: the source is new to the cache.
+    let stamp = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos();
+    let text = format!(
+        "[model]\nstates = [\"x\"]\ninputs = [\"u\"]\noutputs = [\"y\"]\n[parameters]\na = 2.0\n\
+         [equations]\nx = \"-a*x + u + {stamp}e-40\"\n[output]\ny = \"x\"\n"
+    );
+    let m = EquationModel::parse(&text).unwrap();
+    let build = || NativeFunction::build(&m.rhs_listing(), 1, &[0], shape(&m), |_| true).unwrap();
+    assert!(matches!(build().provenance(), Provenance::Compiled(s) if s > 0.0));
+    assert_eq!(build().provenance(), Provenance::Cached);
+    let refused = NativeFunction::build(&m.rhs_listing(), 1, &[0], shape(&m), |_| false);
+    assert!(refused.unwrap_err().contains("does not reproduce the tape"));
+}
+
+#[test]
+fn evaluators_are_named_auto_native_and_tape() {
+    assert_eq!("auto".parse::<Evaluator>().unwrap(), Evaluator::Auto);
+    assert_eq!("".parse::<Evaluator>().unwrap(), Evaluator::Auto);
+    assert_eq!("native".parse::<Evaluator>().unwrap(), Evaluator::Native);
+    assert_eq!(" tape ".parse::<Evaluator>().unwrap(), Evaluator::Tape);
+    let e = "jit".parse::<Evaluator>().unwrap_err().to_string();
+    assert!(
+        e.contains("HYSID_EVALUATOR") && e.contains("auto, native or tape"),
+        "{e}"
+    );
+}
