@@ -72,6 +72,7 @@ fn case(label: &str, model: &FittedModel, input: Vec<f64>, ts: f64) -> Case {
         },
         input,
         expected,
+        clipped: None,
     }
 }
 
