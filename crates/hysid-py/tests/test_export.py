@@ -146,6 +146,8 @@ def column(path, name):
 
 
 REFUSALS = ("does not support", "not invertible")
+# Fixtures that must export (not be refused): the grey-box model integrated with Newmark.
+EXPORTED = ("bouc_wen_newmark.model.json",)
 
 
 @pytest.mark.skipif(not CLI, reason="set HYSID_CLI to a hysid binary to compare live")
@@ -170,6 +172,7 @@ def test_every_fixture_exported_by_the_cli_simulates_as_hysid_simulate(tmp_path,
         text=True,
     )
     if run.returncode != 0:
+        assert model.name not in EXPORTED, run.stderr
         assert run.returncode == 1 and any(r in run.stderr for r in REFUSALS), run.stderr
         assert len(run.stderr.splitlines()) == 1 and not out.exists()
         return
@@ -196,6 +199,11 @@ def test_every_fixture_exported_by_the_cli_simulates_as_hysid_simulate(tmp_path,
     # the Coleman–Hodgdon hysteresis) then shows y_k there — its state after u_k, evaluated
     # at u_k — and every other model (cascades: delay ≥ 1; grey-box: y = h(x)) y_{k+1}.
     close(got[:1], expected[:1], f"{model.name} simulate_fmu at t = 0")
+    # A grey-box model with linear input interpolation integrates [t_k, t_{k+1}] towards
+    # u_{k+1}, which simulate_fmu has not set when it records t_{k+1} (the interval is
+    # integrated with u_k held): its table is not simulate's, only the host above is exact.
+    if file.get("simulation", {}).get("interpolation") == "linear":
+        return
     if file["kind"] in ("operator", "coleman_hodgdon"):
         close(got[1:], expected[:-1], f"{model.name} simulate_fmu (input held one step)")
     else:

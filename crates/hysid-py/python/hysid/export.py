@@ -30,7 +30,10 @@ def export(
     crate ``NAME/``; ``"fmu"``: ``NAME.fmu``) into the directory ``out``, created if missing
     and refused if it holds any file; returns the paths written.
 
-    ``inverse`` exports the compensator (input: the reference; output: the command).
+    ``inverse`` exports the compensator (input: the reference; output: the command); its C
+    and Rust also count the steps whose reference was clipped to the reachable range
+    (``NAME_clipped`` / ``Model::clipped``, the length of ``Compensation.clipped`` for the
+    same references); the FMU does not expose the count.
     ``ts`` is the sample time in seconds, needed when the model file has none and equal to
     its own when it has one. ``binary=False`` leaves the FMU's compiled binary out (a
     source-only FMU; the binary is built with ``$CC``, else ``cc``). ``y0`` is the measured

@@ -17,7 +17,12 @@ const FLAGS: [&str; 6] = [
     "-O2",
 ];
 
-fn driver(name: &str) -> String {
+fn driver(name: &str, inverse: bool) -> String {
+    let clipped = if inverse {
+        format!("    printf(\"clipped %zu\\n\", {name}_clipped(&s));\n")
+    } else {
+        String::new()
+    };
     format!(
         "#include <stdio.h>\n#include \"{name}.h\"\n\
          int main(int argc, char **argv) {{\n\
@@ -27,18 +32,23 @@ fn driver(name: &str) -> String {
          \x20   {name}_init(&s);\n\
          \x20   while (fscanf(in, \"%lf\", &u[0]) == 1) {{\n\
          \x20       {name}_step(&s, u, y);\n        printf(\"%.17g\\n\", y[0]);\n    }}\n\
-         \x20   fclose(in);\n    if (s.error) {{\n        printf(\"error\\n\");\n    }}\n    return 0;\n}}\n"
+         \x20   fclose(in);\n    if (s.error) {{\n        printf(\"error\\n\");\n    }}\n{clipped}    return 0;\n}}\n"
     )
 }
 
-/// Compiles and runs the C of `case` in `dir`: the outputs and the error flag.
-fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool) {
+/// Compiles and runs the C of `case` in `dir`: the outputs, the error flag and, for a
+/// compensator, its clipped count.
+fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool, Option<usize>) {
     let name = &case.name;
     let code = c_code(&case.file, name, &case.options)
         .unwrap_or_else(|e| panic!("{name}: c_code failed: {e}"));
     std::fs::write(dir.join(format!("{name}.h")), &code.header).expect("write");
     std::fs::write(dir.join(format!("{name}.c")), &code.source).expect("write");
-    std::fs::write(dir.join(format!("{name}_driver.c")), driver(name)).expect("write");
+    std::fs::write(
+        dir.join(format!("{name}_driver.c")),
+        driver(name, case.options.inverse),
+    )
+    .expect("write");
     std::fs::write(
         dir.join(format!("{name}.in")),
         cases::input_text(&case.input),
@@ -64,17 +74,22 @@ fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool) {
         .output()
         .expect("run the driver");
     assert!(ran.status.success(), "{name}: the driver failed");
-    cases::parse_outputs(&String::from_utf8_lossy(&ran.stdout))
+    let text = String::from_utf8_lossy(&ran.stdout);
+    let (y, error) = cases::parse_outputs(&text);
+    (y, error, cases::parse_clipped(&text))
 }
 
 #[test]
 #[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
 fn generated_c_equals_the_library() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let results: Vec<(String, f64, bool)> = cases::all()
+    let all = cases::all();
+    let mut clipped = Vec::new();
+    let results: Vec<(String, f64, bool)> = all
         .iter()
         .map(|case| {
-            let (y, error) = run(case, dir.path());
+            let (y, error, count) = run(case, dir.path());
+            clipped.push(count);
             (
                 case.name.clone(),
                 cases::relative_difference(&y, &case.expected),
@@ -83,6 +98,7 @@ fn generated_c_equals_the_library() {
         })
         .collect();
     cases::check("C", &results);
+    cases::check_clipped("C", &all, &clipped);
 }
 
 #[test]
@@ -106,9 +122,10 @@ fn a_preisach_memory_beyond_its_capacity_sets_the_error_flag() {
         options: hysid::export::ExportOptions::default(),
         input,
         expected,
+        clipped: None,
     };
     let dir = tempfile::tempdir().expect("temp dir");
-    let (y, error) = run(&case, dir.path());
+    let (y, error, _) = run(&case, dir.path());
     assert!(
         error,
         "64 memory points were exceeded without the error flag"
@@ -146,9 +163,10 @@ fn a_diverging_grey_box_sets_the_error_flag_where_the_library_fails() {
         },
         input,
         expected: Vec::new(),
+        clipped: None,
     };
     let dir = tempfile::tempdir().expect("temp dir");
-    let (y, error) = run(&case, dir.path());
+    let (y, error, _) = run(&case, dir.path());
     assert!(error, "no error flag although the library failed: {failed}");
     assert!(
         y.iter().all(|v| v.is_finite()),

@@ -1,7 +1,8 @@
 //! The grey-box and equation-file cases: each built-in model and three equation files (one
 //! reading t, one discrete-time, the Bouc–Wen example with ν = 1.5 through `pow`), with
-//! zero-order hold and linear interpolation, RK4 with 4 sub-steps; and the adaptive
-//! integrator on two of them. Rigid body and actuators stick and slip on these inputs.
+//! zero-order hold and linear interpolation, RK4 with 4 sub-steps; the adaptive integrator
+//! on two of them; and Newmark on the models that accept it ([`newmark_cases`]). Rigid body
+//! and actuators stick and slip on these inputs.
 
 use crate::cases::{signal, Case};
 use hysid::export::ExportOptions;
@@ -71,6 +72,7 @@ fn case(label: &str, model: &FittedModel, input: Vec<f64>, ts: f64) -> Case {
         },
         input,
         expected,
+        clipped: None,
     }
 }
 
@@ -194,5 +196,54 @@ pub fn cases() -> Vec<Case> {
     ));
     let timed = equations(TIMED, adaptive);
     out.push(case("eq_timed_adaptive", &timed, u.clone(), 1e-2));
+    out.extend(newmark_cases(&u));
+    out
+}
+
+/// The Newmark cases: the built-in models the library integrates with Newmark (a
+/// second-order mechanical layout without Coulomb friction: Bouc–Wen only; equation files
+/// have no mechanical layout), with zero-order hold and linear interpolation, one and three
+/// sub-steps, and ν = 1.5 (|z|^ν by `pow`) at a longer sample time (larger Newton steps).
+fn newmark_cases(u: &[f64]) -> Vec<Case> {
+    let accepts = |kind: GreyBoxKind| {
+        let model = kind.model();
+        model.mechanical_dofs().is_some() && model.stick_slip_velocity().is_none()
+    };
+    assert_eq!(
+        GreyBoxKind::ALL
+            .into_iter()
+            .filter(|k| accepts(*k))
+            .collect::<Vec<_>>(),
+        [GreyBoxKind::BoucWen],
+        "a new built-in model accepts Newmark: add its cases"
+    );
+    let mut out = Vec::new();
+    for (tag, interpolation, substeps) in [
+        ("zoh1", InputInterpolation::ZeroOrderHold, 1),
+        ("linear3", InputInterpolation::Linear, 3),
+    ] {
+        let newmark = Simulation {
+            integrator: Integrator::Newmark { substeps },
+            interpolation,
+        };
+        let bw = built_in(GreyBoxKind::BoucWen, &[], newmark);
+        out.push(case(
+            &format!("gb_bouc_wen_newmark_{tag}"),
+            &bw,
+            scaled(u, 120.0),
+            1.0 / 750.0,
+        ));
+    }
+    let stiff = Simulation {
+        integrator: Integrator::Newmark { substeps: 2 },
+        interpolation: InputInterpolation::Linear,
+    };
+    let bw = built_in(GreyBoxKind::BoucWen, &[("nu", 1.5)], stiff);
+    out.push(case(
+        "gb_bouc_wen_newmark_nu",
+        &bw,
+        scaled(u, 150.0),
+        1.0 / 300.0,
+    ));
     out
 }

@@ -8,4 +8,5 @@ mod api;
 mod c_target;
 mod cases;
 mod greybox;
+mod newmark_lu;
 mod rust_target;

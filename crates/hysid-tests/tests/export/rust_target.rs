@@ -34,18 +34,24 @@ fn generated_rust_equals_the_library() {
          [workspace]\n\n[dependencies]\n",
     );
     let mut main = String::from(
-        "macro_rules! run {\n    ($k:ident, $name:expr) => {{\n\
+        "macro_rules! run {\n    ($k:ident, $name:expr $(, $clipped:ident)?) => {{\n\
          \x20       let text = std::fs::read_to_string(format!(\"{}.in\", $name)).unwrap();\n\
          \x20       let mut m = $k::Model::new();\n        let mut out = String::new();\n\
          \x20       for line in text.lines() {\n\
          \x20           let y = m.step(&[line.parse::<f64>().unwrap()]);\n\
          \x20           out.push_str(&format!(\"{:?}\\n\", y[0]));\n        }\n\
          \x20       if m.error() {\n            out.push_str(\"error\\n\");\n        }\n\
+         \x20       $(out.push_str(&format!(\"clipped {}\\n\", m.$clipped()));)?\n\
          \x20       std::fs::write(format!(\"{}.out\", $name), out).unwrap();\n    }};\n}\n\nfn main() {\n",
     );
     for case in &all {
         manifest.push_str(&write_crate(case, root));
-        main.push_str(&format!("    run!({0}, \"{0}\");\n", case.name));
+        let clipped = if case.options.inverse {
+            ", clipped"
+        } else {
+            ""
+        };
+        main.push_str(&format!("    run!({0}, \"{0}\"{clipped});\n", case.name));
     }
     main.push_str("}\n");
     std::fs::create_dir_all(root.join("src")).expect("mkdir");
@@ -77,11 +83,13 @@ fn generated_rust_equals_the_library() {
         "the check program failed: {}",
         String::from_utf8_lossy(&ran.stderr)
     );
+    let mut clipped = Vec::new();
     let results: Vec<(String, f64, bool)> = all
         .iter()
         .map(|case| {
             let text =
                 std::fs::read_to_string(root.join(format!("{}.out", case.name))).expect("read");
+            clipped.push(cases::parse_clipped(&text));
             let (y, error) = cases::parse_outputs(&text);
             (
                 case.name.clone(),
@@ -91,4 +99,5 @@ fn generated_rust_equals_the_library() {
         })
         .collect();
     cases::check("Rust", &results);
+    cases::check_clipped("Rust", &all, &clipped);
 }

@@ -9,7 +9,7 @@
 //! its compensator starts from the first reference, as `hysid compensate` does.
 
 use super::code::{call, local, select, Expr, Ty};
-use super::program::{Ns, Program, ERROR_FIELD};
+use super::program::{mark_clip, Ns, Program, ERROR_FIELD};
 use super::solve;
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::ColemanHodgdon;
@@ -157,6 +157,12 @@ pub fn inverse(
                         call(&rec.step, vec![y_s.clone(), x_s.clone(), xt.clone()]),
                     );
                     b.set_state(&rec.x, xt);
+                    // Clipped where the solve clipped, or where the new output missed r (the
+                    // recursion need not be monotone on every branch).
+                    let missed = (y_s.clone() - r.clone())
+                        .abs()
+                        .gt(1e-9 * (1.0 + r.clone().abs()));
+                    mark_clip(b, Expr::State(ns.sub("r").name("clipped")).or(missed));
                 },
                 |b| {
                     let y0 = match initial {
@@ -177,6 +183,11 @@ pub fn inverse(
                         select(x.clone().is_finite(), x, 0.0)
                     };
                     b.set_state(&rec.x, x0);
+                    // The first reference counts as clipped when the start misses it.
+                    let missed = (y0.clone() - r.clone())
+                        .abs()
+                        .gt(1e-12 * (1.0 + r.clone().abs()));
+                    mark_clip(b, missed);
                     b.set_state(&rec.y, y0);
                     b.set_state(&rec.started, Expr::Flag(true));
                 },

@@ -13,8 +13,8 @@
 //! Every step sets the error flag where the library's `simulate` errors on a non-finite
 //! output.
 
-use super::code::{call, Expr};
-use super::program::{Ns, Program, ERROR_FIELD};
+use super::code::{call, local, Expr};
+use super::program::{count_clip, Ns, Program, ERROR_FIELD};
 use super::{coleman_hodgdon, families, greybox, linear, ExportOptions};
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::saved::FittedModel;
@@ -29,6 +29,9 @@ pub fn program(model: &FittedModel, options: &ExportOptions, ts: f64) -> Result<
         return Ok(prog);
     }
     let mut prog = Program::new(1, 1);
+    if inverse {
+        prog.count_clipped()?;
+    }
     let (op, lin, ch) = (Ns::new("op_"), Ns::new("lin_"), Ns::new("ch_"));
     let kind = || model.to_file().kind().to_string();
     // The helpers applied in turn to the step's input.
@@ -104,12 +107,16 @@ pub fn program(model: &FittedModel, options: &ExportOptions, ts: f64) -> Result<
             })
         }
     };
+    let counting = prog.counts_clipped();
     prog.fallible_step(|b| {
-        let mut value = Expr::Input(0);
-        for (i, helper) in chain.iter().enumerate() {
-            value = b.let_(&format!("stage{i}"), call(helper, vec![value]));
-        }
-        let y = b.let_("y0", value);
+        count_clip(counting, b, |b| {
+            let mut value = Expr::Input(0);
+            for (i, helper) in chain.iter().enumerate() {
+                value = b.let_(&format!("stage{i}"), call(helper, vec![value]));
+            }
+            b.let_("y0", value);
+        });
+        let y = local("y0");
         b.if_(y.is_finite().not(), |b| {
             b.set_state(ERROR_FIELD, Expr::Flag(true))
         });

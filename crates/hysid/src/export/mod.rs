@@ -32,7 +32,8 @@
 //! state is initialised again. The compensator of an operator cascade with delay k takes the
 //! reference k samples ahead ([`linear`]). Grey-box and equation-file models export forward
 //! with their saved integrator and input interpolation, one interval late as the library's
-//! stream ([`greybox`]); a `band_limited` or Newmark model is refused
+//! stream ([`greybox`]), Newmark's Newton corrector with a fixed-size LU in nalgebra's order
+//! of operations ([`greybox::newmark`]); a `band_limited` model is refused
 //! ([`Error::UnsupportedKind`]). See `docs/export.md`.
 //!
 //! How it is built: a language-neutral program ([`code`], [`program`]) that the renderers

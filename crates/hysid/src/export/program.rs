@@ -4,6 +4,7 @@
 
 use super::code::{literals, Block, Expr, Function, Stmt, Ty};
 use crate::{Error, Result};
+use std::ops::Not;
 
 /// A field of the state struct: a scalar, or an array of fixed length.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,6 +33,13 @@ pub struct Table {
 pub const ERROR_FIELD: &str = "error";
 /// The name of the state's copy of the last outputs, held while the error flag is set.
 const HELD_FIELD: &str = "held";
+/// The name of a compensator's flag "this step clipped its reference" (see
+/// [`Program::count_clipped`]): the inverse emitters set it where the library's
+/// `CompensatorStep::clipped` is true.
+pub const CLIP_FIELD: &str = "clip";
+/// The name of a compensator's count of the steps that clipped since init (the library's
+/// `Compensator::clipped`), read by the generated `NAME_clipped` / `Model::clipped`.
+pub const CLIPPED_FIELD: &str = "clipped_steps";
 
 /// A streaming program: state, tables, helpers, initialisation and step.
 #[derive(Clone, Debug, PartialEq)]
@@ -86,6 +94,30 @@ impl Program {
             )));
         }
         Ok(())
+    }
+
+    /// Makes the program a compensator that counts its clipped steps: adds the flag
+    /// [`CLIP_FIELD`], which the inverse emitters set, and the count [`CLIPPED_FIELD`]; the
+    /// step ([`count_clip`]) clears the flag before and counts it after the solve.
+    pub fn count_clipped(&mut self) -> Result<()> {
+        self.field(
+            CLIP_FIELD,
+            Ty::Flag,
+            None,
+            "nonzero when this step clipped its reference to the reachable range",
+        )?;
+        self.field(
+            CLIPPED_FIELD,
+            Ty::Index,
+            None,
+            "the steps that clipped their reference since init",
+        )?;
+        Ok(())
+    }
+
+    /// True for a compensator that counts its clipped steps ([`Program::count_clipped`]).
+    pub fn counts_clipped(&self) -> bool {
+        self.fields.iter().any(|f| f.name == CLIPPED_FIELD)
     }
 
     /// Adds a state field; returns its name.
@@ -187,6 +219,32 @@ impl Program {
             None => Ok(()),
         }
     }
+}
+
+/// Emits into `b` the step `solve` of a program, and when `counting` (a compensator that counts
+/// its clipped steps, [`Program::counts_clipped`]) clears the clip flag before it and adds the
+/// flag to the count after it (a step that set the error flag is not counted: the library's
+/// step failed).
+pub fn count_clip(counting: bool, b: &mut Block, solve: impl FnOnce(&mut Block)) {
+    if !counting {
+        solve(b);
+        return;
+    }
+    b.set_state(CLIP_FIELD, Expr::Flag(false));
+    solve(b);
+    let counted = Expr::State(CLIP_FIELD.into()).and(Expr::State(ERROR_FIELD.into()).not());
+    b.if_(counted, |b| {
+        b.set_state(
+            CLIPPED_FIELD,
+            Expr::State(CLIPPED_FIELD.into()) + Expr::Index(1),
+        )
+    });
+}
+
+/// Emits into `b` "this step clipped its reference when `condition`" for a compensator's
+/// inverse emitter (the flag [`CLIP_FIELD`] of [`Program::count_clipped`]).
+pub fn mark_clip(b: &mut Block, condition: Expr) {
+    b.if_(condition, |b| b.set_state(CLIP_FIELD, Expr::Flag(true)));
 }
 
 /// The names of one component of a program (an operator, a linear block): every field,

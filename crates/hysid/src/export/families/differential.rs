@@ -12,7 +12,7 @@
 //! flag: the outputs then hold their last values until the next init.
 
 use crate::export::code::{call, idx, lit, local, select, Block, Expr, Ty};
-use crate::export::program::{Ns, Program, ERROR_FIELD};
+use crate::export::program::{mark_clip, Ns, Program, ERROR_FIELD};
 use crate::model::operators::differential::{InputOde, TOLERANCE};
 use crate::Result;
 use std::ops::Not;
@@ -429,6 +429,9 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
                     b.set("dd", dd.clone() * 2.0);
                 });
             });
+            // No bracket on either side: the closest output found, and the reference counts
+            // as clipped.
+            mark_clip(b, Expr::Flag(true));
             b.set_state(&sol_x, best_x);
             b.ret(best_v);
         },

@@ -12,7 +12,7 @@
 
 use super::Emit;
 use crate::export::code::{lit, local, Expr, Ty};
-use crate::export::program::{Ns, Program, ERROR_FIELD};
+use crate::export::program::{mark_clip, Ns, Program, ERROR_FIELD};
 use crate::model::operators::Orientation;
 use crate::Result;
 
@@ -54,13 +54,37 @@ impl<T: EmitCore> Emit for T {
 
     fn emit_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
         let o = self.orientation();
-        let helper = if o.inverse {
-            self.emit_core(ns, prog)?
-        } else {
-            self.emit_core_inverse(ns, prog)?.0
-        };
+        let s = o.sign();
+        if !o.inverse {
+            // Γ = ±G: u = G⁻¹[s·r], clipped where G⁻¹'s solve clips.
+            let (g_inv, clipped) = self.emit_core_inverse(ns, prog)?;
+            return prog.function(&ns.name("inverse"), &[("r", Ty::F64)], Some(Ty::F64), |b| {
+                let u = b.let_("u", Expr::Call(g_inv, vec![lit(s) * local("r")]));
+                if let Some(clipped) = clipped {
+                    mark_clip(b, Expr::State(clipped));
+                }
+                b.ret(u);
+            });
+        }
+        // Γ = ±G⁻¹: u = G[ρ], ρ = s·r; clipped when G⁻¹[u] (a second, checking state of G⁻¹)
+        // misses ρ by more than 1e-9 of the largest |ρ| so far (at least 1).
+        let g = self.emit_core(ns, prog)?;
+        let check = ns.sub("check");
+        let (g_inv, _) = self.emit_core_inverse(&check, prog)?;
+        let scale = prog.field(
+            &check.name("scale"),
+            Ty::F64,
+            None,
+            "the largest |reference| so far (at least 1)",
+        )?;
+        prog.init(|b| b.set_state(&scale, 1.0));
         prog.function(&ns.name("inverse"), &[("r", Ty::F64)], Some(Ty::F64), |b| {
-            b.ret(Expr::Call(helper, vec![lit(o.sign()) * local("r")]));
+            let rho = b.let_("rho", lit(s) * local("r"));
+            let u = b.let_("u", Expr::Call(g, vec![rho.clone()]));
+            let y = b.let_("y", Expr::Call(g_inv, vec![u.clone()]));
+            b.set_state(&scale, Expr::State(scale.clone()).max(rho.clone().abs()));
+            mark_clip(b, (y - rho).abs().gt(1e-9 * Expr::State(scale.clone())));
+            b.ret(u);
         })
     }
 }

@@ -12,15 +12,16 @@
 //! Each model supplies only its right-hand side f(t, x, u) and output h(x, u)
 //! ([`EmitStateSpace`]): the built-in models in [`models`], equation files from their
 //! compiled listing in [`equations`]. The integrator is emitted once ([`rk4`], with the
-//! stick–slip steps of models with Coulomb friction; [`dopri`]); a discrete-time model runs
-//! its recursion. Newmark integration is refused (its Newton corrector solves with a pivoted
-//! LU the generated code would have to reproduce to the bit), and so is a `band_limited`
-//! model, whose stream differs from its simulation
+//! stick–slip steps of models with Coulomb friction; [`dopri`]; [`newmark`], whose Newton
+//! corrector solves with a fixed-size LU with partial pivoting in nalgebra's order of
+//! operations, a singular Newton matrix setting the error flag); a discrete-time model runs
+//! its recursion. A `band_limited` model is refused: its stream differs from its simulation
 //! ([`FittedModel::streaming_differs`]).
 
 pub mod dopri;
 pub mod equations;
 pub mod models;
+pub mod newmark;
 pub mod rk4;
 
 use super::code::{idx, local, select, Block, Expr, Ty};
@@ -157,7 +158,7 @@ fn emitter(model: &FittedModel) -> Result<Option<Exported<'_>>> {
 
 /// The streaming program of a grey-box or equation model sampled every `ts` seconds, or
 /// None for another kind. Refused: the compensator (no grey-box model is invertible), a
-/// `band_limited` model, Newmark integration.
+/// `band_limited` model, and the integrators the library refuses for the model.
 pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Program>> {
     let Some(Exported {
         code,
@@ -203,14 +204,8 @@ pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Pro
             Integrator::Adaptive { rtol, atol } => {
                 dopri::emit(code.as_ref(), &d, (rtol, atol), &mut prog)?
             }
-            Integrator::Newmark { .. } => {
-                return Err(Error::UnsupportedKind {
-                    kind: kind(),
-                    operation: "export with the Newmark integrator (its Newton corrector is \
-                                not exported); refit it with --integrator rk4 (or save it \
-                                with the adaptive integrator) and export that"
-                        .into(),
-                })
+            Integrator::Newmark { substeps } => {
+                newmark::emit(code.as_ref(), &d, substeps, &mut prog)?
             }
         }
     };

@@ -5,7 +5,7 @@
 
 use super::{comment_lines, Printer, Syntax, ATOM, UNARY};
 use crate::export::code::{Math, Ty};
-use crate::export::program::Program;
+use crate::export::program::{Program, CLIPPED_FIELD};
 
 /// The C spelling, for the export `name`.
 struct C<'a> {
@@ -127,9 +127,16 @@ fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> Str
          void {name}_init({name}_state *s);\n\n\
          /* One sample: reads u[0 .. {name}_N_INPUTS), writes y[0 .. {name}_N_OUTPUTS) (the\n\
          \x20* output at this sample) and advances *s to the next sample. */\n\
-         void {name}_step({name}_state *s, const double *u, double *y);\n\n\
-         #endif /* {guard} */\n"
+         void {name}_step({name}_state *s, const double *u, double *y);\n\n"
     ));
+    if program.counts_clipped() {
+        h.push_str(&format!(
+            "/* The number of steps since {name}_init whose reference lay beyond the reachable\n\
+             \x20* range and was clipped (the library's Compensator::clipped). */\n\
+             size_t {name}_clipped(const {name}_state *s);\n\n"
+        ));
+    }
+    h.push_str(&format!("#endif /* {guard} */\n"));
     h
 }
 
@@ -198,6 +205,11 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
     ));
     p.stmts(&program.step, 1, &mut c);
     c.push_str("}\n");
+    if program.counts_clipped() {
+        c.push_str(&format!(
+            "\nsize_t {name}_clipped(const {name}_state *s) {{\n    return s->{CLIPPED_FIELD};\n}}\n"
+        ));
+    }
     let mut helpers = String::new();
     for (f, body) in MINMAX {
         let helper = format!("{name}_math_{f}");

@@ -5,7 +5,7 @@
 
 use super::{comment_lines, Printer, Syntax, ATOM};
 use crate::export::code::{Math, Ty};
-use crate::export::program::Program;
+use crate::export::program::{Program, CLIPPED_FIELD};
 
 /// The Rust spelling.
 struct Rust;
@@ -150,6 +150,13 @@ pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
         "    /// True once a step could not be computed; the outputs then hold their last\n\
          \x20   /// values until [`Model::reset`].\n    pub fn error(&self) -> bool {\n        self.error\n    }\n\n",
     );
+    if program.counts_clipped() {
+        r.push_str(&format!(
+            "    /// The number of steps since [`Model::reset`] whose reference lay beyond the\n\
+             \x20   /// reachable range and was clipped (the library's `Compensator::clipped`).\n\
+             \x20   pub fn clipped(&self) -> usize {{\n        self.{CLIPPED_FIELD}\n    }}\n\n"
+        ));
+    }
     r.push_str(
         "    /// One sample: the output at this sample for the input `u`; then the state\n\
          \x20   /// advances to the next sample.\n\
