@@ -101,3 +101,54 @@ fn a_bad_equation_file_is_one_line_with_its_place() {
         .unwrap()
         .contains("cannot be used with"));
 }
+
+/// The evaluator of equation files (`HYSID_EVALUATOR`): native code (compiled into the
+/// cache `HYSID_CACHE_DIR`), the tape interpreter, and `auto` without a compiler all give
+/// the same report figures to the bit; `native` without a compiler and an unknown
+/// evaluator are one-line errors.
+#[test]
+fn native_code_and_the_tape_fit_the_same() {
+    let dir = TempDir::new().unwrap();
+    let cache = dir.path().join("cache");
+    let fit = |evaluator: &str, cc: &str, name: &str| {
+        let report = dir.path().join(format!("{name}.json"));
+        let mut cmd = hysid();
+        cmd.env("HYSID_EVALUATOR", evaluator)
+            .env("HYSID_CACHE_DIR", &cache)
+            .env("CC", cc)
+            .args(["-q", "greybox", "fit", "--model-file"])
+            .arg(root().join("examples/equations/cascaded_tanks.toml"))
+            .arg("--data")
+            .arg(root().join("data/cascaded-tanks/estimation.csv"))
+            .args(["--input", "u_V", "--output", "y_V", "--starts", "1"])
+            .args(["--substeps", "2", "--json"])
+            .arg(&report);
+        (cmd, report)
+    };
+    let figures = |report: &Path| {
+        let r = json(report);
+        (r["model"]["parameters"].clone(), r["fit"].clone())
+    };
+    let (mut native, native_report) = fit("native", "cc", "native");
+    native.assert().success();
+    let compiled = fs::read_dir(cache.join("native")).unwrap().count();
+    assert!(compiled >= 2, "{compiled} files in the cache");
+    let (mut tape, tape_report) = fit("tape", "cc", "tape");
+    tape.assert().success();
+    let (mut fallback, fallback_report) = fit("auto", "/nonexistent/cc", "auto");
+    fallback.assert().success();
+    assert_eq!(figures(&native_report), figures(&tape_report));
+    assert_eq!(figures(&native_report), figures(&fallback_report));
+
+    let (mut refused, _) = fit("native", "/nonexistent/cc", "refused");
+    let fresh = dir.path().join("empty-cache");
+    refused.env("HYSID_CACHE_DIR", &fresh);
+    let err = one_line_error(&mut refused);
+    assert!(
+        err.contains("no native code") && err.contains("/nonexistent/cc"),
+        "{err}"
+    );
+    let (mut unknown, _) = fit("jit", "cc", "unknown");
+    let err = one_line_error(&mut unknown);
+    assert!(err.contains("HYSID_EVALUATOR is 'jit'"), "{err}");
+}

@@ -38,14 +38,13 @@ const MAX_COLUMNS: usize = 10;
 const OUT: usize = 64;
 const _: () = assert!(MAX_STATES + MAX_STATES * MAX_STATES + MAX_STATES * MAX_COLUMNS <= OUT);
 
-/// Where the results of one run are computed: the bound tape, or its native code
-/// ([`super::native`]), which writes the same numbers at the same positions.
-pub(super) enum Results {
+/// Where ẋ of a plain simulation is computed: the bound tape of f, or its native code
+/// ([`super::native`]), which writes the same numbers.
+enum Results {
     /// The tape interpreter: writes the entries that depend on (x, u) (the others were
     /// filled once, [`BoundColumns::fill_constants`]).
     Tape(BoundColumns),
-    /// Native code, writing every entry at the positions of [`column_positions`] (of
-    /// `0..n` for f alone).
+    /// Native code writing every entry.
     Native(BoundNative),
 }
 
@@ -59,9 +58,17 @@ impl Results {
     }
 }
 
+/// Per entry ∂fᵢ/∂xⱼ (row-major), whether it can be non-zero: false where the bound tape
+/// knows it is zero for its θ. A product by such an entry is left out of Ṡ.
+pub(super) fn coupling(tape: &BoundColumns, n: usize) -> Vec<bool> {
+    (0..n * n)
+        .map(|e| tape.constant(n + e) != Some(0.0))
+        .collect()
+}
+
 /// Where the kernel keeps result k of a column tape of n states and k columns: f, ∂f/∂x,
 /// then the rows of ∂f/∂θ padded to the run's q columns.
-pub(super) fn column_positions(n: usize, k: usize, q: usize) -> Vec<usize> {
+fn column_positions(n: usize, k: usize, q: usize) -> Vec<usize> {
     let direct = n + n * n;
     (0..direct + n * k)
         .map(|r| {
@@ -75,42 +82,33 @@ pub(super) fn column_positions(n: usize, k: usize, q: usize) -> Vec<usize> {
         .collect()
 }
 
-/// f with its Jacobians for N states and Q columns, the first k of them parameter
-/// columns.
+/// f with its Jacobians from the bound tape, for N states and Q columns, the first k of
+/// them parameter columns.
 struct TapeKernel<const N: usize, const Q: usize> {
-    results: Results,
+    tape: BoundColumns,
     /// f, ∂f/∂x (N×N), ∂f/∂θ\[params\] (N×Q: the k columns of the tape, then the zero direct
     /// terms of the initial-state columns), at [`column_positions`]: every index below is
     /// then known to be in bounds at compile time.
     out: [f64; OUT],
-    /// Whether ∂fᵢ/∂xⱼ can be non-zero (false for an entry the bound tape knows is zero).
+    /// Whether ∂fᵢ/∂xⱼ can be non-zero ([`coupling`]).
     coupled: [[bool; N]; N],
 }
 
 impl<const N: usize, const Q: usize> TapeKernel<N, Q> {
-    /// `tape` bound to the run's θ (it tells which entries of ∂f/∂x are zero), and the
-    /// native code to run instead of it, if any.
-    fn new(mut tape: BoundColumns, k: usize, native: Option<BoundNative>) -> Self {
-        let mut coupled = [[true; N]; N];
-        for (i, row) in coupled.iter_mut().enumerate() {
-            for (j, c) in row.iter_mut().enumerate() {
-                *c = tape.constant(N + i * N + j) != Some(0.0);
-            }
-        }
+    fn new(mut tape: BoundColumns, k: usize) -> Self {
+        let coupled = fixed_coupling(&tape);
         let positions = column_positions(N, k, Q);
         tape.place(|r| positions[r]);
         let mut out = [0.0; OUT];
         tape.fill_constants(&mut out);
-        let results = match native {
-            Some(native) => Results::Native(native),
-            None => Results::Tape(tape),
-        };
-        Self {
-            results,
-            out,
-            coupled,
-        }
+        Self { tape, out, coupled }
     }
+}
+
+/// [`coupling`] as a fixed-size array.
+fn fixed_coupling<const N: usize>(tape: &BoundColumns) -> [[bool; N]; N] {
+    let flat = coupling(tape, N);
+    std::array::from_fn(|i| std::array::from_fn(|j| flat[i * N + j]))
 }
 
 impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N, Q> {
@@ -124,7 +122,7 @@ impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N,
         ds: &mut [[f64; Q]; N],
     ) {
         // Time-free tapes only (checked by `simulate`'s caller), so t is not needed.
-        self.results.eval(x, u, &mut self.out);
+        self.tape.eval_fixed(0.0, x, u, &mut self.out);
         let out = &self.out;
         for (i, d) in dx.iter_mut().enumerate() {
             *d = out[i];
@@ -144,6 +142,35 @@ impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N,
                 }
             }
         }
+    }
+}
+
+/// ẋ and Ṡ from the native code of the column tape ([`super::native::Layout::Sensitivities`]),
+/// which sums Ṡ as [`TapeKernel`] does, with the same coupling flags.
+struct NativeKernel<const N: usize, const Q: usize> {
+    native: BoundNative,
+    coupled: [[bool; N]; N],
+}
+
+impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for NativeKernel<N, Q> {
+    #[inline(always)]
+    fn eval(
+        &mut self,
+        x: &[f64; N],
+        u: &[f64],
+        s: &[[f64; Q]; N],
+        dx: &mut [f64; N],
+        ds: &mut [[f64; Q]; N],
+    ) {
+        self.native.sensitivities(
+            0.0,
+            x,
+            u,
+            s.as_flattened(),
+            self.coupled.as_flattened(),
+            dx,
+            ds.as_flattened_mut(),
+        );
     }
 }
 
@@ -171,7 +198,7 @@ impl<const N: usize> FixedSensitivityRhs<N, 0> for RateKernel<N> {
 }
 
 /// Runs the fixed-size path with the bound tape `tape` (which must not read t), or the
-/// `native` code of the same tape at [`column_positions`] when given; None when the run's
+/// `native` sensitivity code of the same tape when given; None when the run's
 /// sizes have none (more than [`MAX_STATES`] states or [`MAX_COLUMNS`] columns, or no
 /// column: see [`simulate_rates`]).
 pub(super) fn simulate(
@@ -186,8 +213,17 @@ pub(super) fn simulate(
         run: &Rk4Sensitivities<'_>,
         on_sample: &mut SampleSink<'_>,
     ) -> Option<Result<()>> {
-        let mut kernel = TapeKernel::<N, Q>::new(tape, run.params.len(), native);
-        Some(fixed_rk4::simulate::<_, N, Q>(&mut kernel, run, on_sample))
+        Some(match native {
+            Some(native) => {
+                let coupled = fixed_coupling(&tape);
+                let mut kernel = NativeKernel::<N, Q> { native, coupled };
+                fixed_rk4::simulate::<_, N, Q>(&mut kernel, run, on_sample)
+            }
+            None => {
+                let mut kernel = TapeKernel::<N, Q>::new(tape, run.params.len());
+                fixed_rk4::simulate::<_, N, Q>(&mut kernel, run, on_sample)
+            }
+        })
     }
     fn columns<const N: usize>(
         tape: BoundColumns,

@@ -34,7 +34,7 @@
 //! interpolation do not apply to it.
 
 use super::fixed_rk4::{Rk4Sensitivities, SampleSink};
-use super::native::{Evaluator, NativeFunction, Shape};
+use super::native::{Evaluator, Layout, NativeFunction, Shape};
 use super::{equation_kernel, sensitivity, JacobianScratch, StateSpaceModel};
 use crate::data::Channel;
 use crate::error::EquationFileError;
@@ -294,11 +294,17 @@ impl EquationStateSpace {
         let theta = self.parameters.values();
         match key {
             NativeKey::Rates => {
-                let listing = self.model.rhs_listing();
-                let positions: Vec<usize> = (0..n).collect();
-                NativeFunction::build(&listing, n, &positions, shape, |native| {
-                    self.same_as_tape(native, &theta, n, |x, u, out| {
-                        self.model.rhs(0.0, x, u, &theta, out)
+                let layout = Layout::Results {
+                    values: n,
+                    positions: (0..n).collect(),
+                };
+                NativeFunction::build(&self.model.rhs_listing(), layout, shape, |native| {
+                    let native = native.bind(&theta);
+                    check_points(n, m, 0, |x, u, _| {
+                        let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+                        native.eval(0.0, x, u, &mut a);
+                        self.model.rhs(0.0, x, u, &theta, &mut b);
+                        same_bits(&a, &b)
                     })
                 })
             }
@@ -308,48 +314,72 @@ impl EquationStateSpace {
                     .rhs_jacobian_columns(params)
                     .ok_or("a parameter column out of range")?;
                 let listing = self.model.columns_listing(&columns);
-                let positions = equation_kernel::column_positions(n, params.len(), *q);
-                let len = positions.iter().max().map_or(0, |p| p + 1);
-                NativeFunction::build(&listing, n, &positions, shape, |native| {
-                    self.same_as_tape(native, &theta, len, |x, u, out| {
-                        let mut s = self.model.scratch();
-                        let (mut dx, mut fx) = (vec![0.0; n], vec![0.0; n * n]);
-                        let mut ft = vec![0.0; n * params.len()];
+                let (k, q) = (params.len(), *q);
+                let layout = Layout::Sensitivities { k, q };
+                NativeFunction::build(&listing, layout, shape, |native| {
+                    let Some(bound) = self.model.bind_columns(&columns, &theta) else {
+                        return false;
+                    };
+                    let coupled = equation_kernel::coupling(&bound, n);
+                    let native = native.bind(&theta);
+                    check_points(n, m, n * q, |x, u, s| {
+                        let (mut dx, mut ds) = (vec![0.0; n], vec![0.0; n * q]);
+                        native.sensitivities(0.0, x, u, s, &coupled, &mut dx, &mut ds);
+                        let mut scratch = self.model.scratch();
+                        let (mut f, mut fx, mut ft) =
+                            (vec![0.0; n], vec![0.0; n * n], vec![0.0; n * k]);
                         self.model.rhs_jacobian_columns_with(
-                            &mut s, &columns, 0.0, x, u, &theta, &mut dx, &mut fx, &mut ft,
+                            &mut scratch,
+                            &columns,
+                            0.0,
+                            x,
+                            u,
+                            &theta,
+                            &mut f,
+                            &mut fx,
+                            &mut ft,
                         );
-                        for (r, v) in dx.iter().chain(&fx).chain(&ft).enumerate() {
-                            out[positions[r]] = *v;
-                        }
+                        // The generic path's sums: they add the products the kernels
+                        // leave out (an entry zero for this θ), which changes at most the
+                        // sign of a zero.
+                        let mut want = vec![0.0; n * q];
+                        sensitivity_rates(n, &fx, &ft, s, &mut want);
+                        same_bits(&dx, &f)
+                            && ds
+                                .iter()
+                                .zip(&want)
+                                .all(|(a, b)| a == b || same_bits(&[*a], &[*b]))
                     })
                 })
             }
         }
     }
+}
 
-    /// Whether `native` bound to θ writes, at a few seeded points (x, u), exactly the bits
-    /// `tape` writes into a buffer of `len` (NaN matching NaN).
-    fn same_as_tape(
-        &self,
-        native: &NativeFunction,
-        theta: &[f64],
-        len: usize,
-        tape: impl Fn(&[f64], &[f64], &mut [f64]),
-    ) -> bool {
-        let (n, m) = (self.states.len(), self.inputs.len());
-        let points = [0.37, -1.9, 2.6e-3, 41.0, -0.0, 7.5e-7];
-        (0..points.len()).all(|p| {
-            let pick = |i: usize| points[(p + 3 * i) % points.len()] * (1.0 + i as f64);
-            let x: Vec<f64> = (0..n).map(pick).collect();
-            let u: Vec<f64> = (0..m).map(|i| pick(n + i)).collect();
-            let (mut a, mut b) = (vec![0.0; len], vec![0.0; len]);
-            native.eval_once(theta, 0.0, &x, &u, &mut a);
-            tape(&x, &u, &mut b);
-            a.iter()
-                .zip(&b)
-                .all(|(a, b)| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()))
-        })
-    }
+/// Whether `agrees(x, u, s)` holds at a few seeded points: n states, m inputs and `len`
+/// sensitivity entries, mixing signs, magnitudes and a negative zero.
+fn check_points(
+    n: usize,
+    m: usize,
+    len: usize,
+    mut agrees: impl FnMut(&[f64], &[f64], &[f64]) -> bool,
+) -> bool {
+    let points = [0.37, -1.9, 2.6e-3, 41.0, -0.0, 7.5e-7];
+    (0..points.len()).all(|p| {
+        let pick = |i: usize| points[(p + 3 * i) % points.len()] * (1.0 + i as f64);
+        let x: Vec<f64> = (0..n).map(pick).collect();
+        let u: Vec<f64> = (0..m).map(|i| pick(n + i)).collect();
+        let s: Vec<f64> = (0..len).map(|i| pick(n + m + i)).collect();
+        agrees(&x, &u, &s)
+    })
+}
+
+/// The same bits entry by entry (NaN matching NaN).
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(a, b)| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()))
 }
 
 impl StateSpaceModel for EquationStateSpace {

@@ -85,6 +85,54 @@ pub enum Provenance {
 
 type PrepareFn = unsafe extern "C" fn(*const f64, *mut f64);
 type EvalFn = unsafe extern "C" fn(f64, *const f64, *const f64, *const f64, *mut f64);
+type SensFn = unsafe extern "C" fn(
+    f64,
+    *const f64,
+    *const f64,
+    *const f64,
+    *const f64,
+    *const u8,
+    *mut f64,
+    *mut f64,
+);
+
+/// What a native function computes from a listing.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// The listing's results: the first `values` as computed, the others finite (a
+    /// non-finite derivative is 0), result k written at `positions[k]` of the output.
+    Results {
+        /// How many leading results are values (not derivatives).
+        values: usize,
+        /// Where each result goes.
+        positions: Vec<usize>,
+    },
+    /// For the listing of a column tape (f, ∂f/∂x, ∂f/∂θ for `k` parameter columns,
+    /// [`hysid_equations::EquationModel::columns_listing`]): ẋ = f and the forward
+    /// sensitivity rates of `q` ≥ k columns (row-major n × q; the last q − k, initial
+    /// states, have no direct term),
+    ///
+    /// ```text
+    /// Ṡᵢ꜀ = [f_θ]ᵢ꜀ + Σⱼ [f_x]ᵢⱼ · Sⱼ꜀
+    /// ```
+    ///
+    /// summed as the RK4 kernel of equation models sums them: the direct term, then the
+    /// products in the order of j, a product left out where its Jacobian entry is zero
+    /// for the bound θ ([`BoundNative::sensitivities`]'s `coupled`).
+    Sensitivities {
+        /// Parameter columns of the tape.
+        k: usize,
+        /// Sensitivity columns.
+        q: usize,
+    },
+}
+
+/// The entry point of a loaded function.
+#[derive(Clone, Copy)]
+enum Entry {
+    Results(EvalFn),
+    Sensitivities(SensFn),
+}
 
 /// The sizes a native function reads and writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,10 +150,12 @@ pub struct NativeFunction {
     #[cfg(target_os = "linux")]
     _library: object::Library,
     prepare: PrepareFn,
-    eval: EvalFn,
+    entry: Entry,
+    layout: Layout,
     /// Doubles of the prepared array.
     prepared: usize,
-    /// One more than the largest output position.
+    /// The length of the output a [`Layout::Results`] function writes (one more than its
+    /// largest position).
     out_len: usize,
     shape: Shape,
     provenance: Provenance,
@@ -115,68 +165,92 @@ impl std::fmt::Debug for NativeFunction {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("NativeFunction")
             .field("shape", &self.shape)
+            .field("layout", &self.layout)
             .field("prepared", &self.prepared)
-            .field("out_len", &self.out_len)
             .field("provenance", &self.provenance)
             .finish()
     }
 }
 
 impl NativeFunction {
-    /// The native form of `listing` over `shape`: its first `values` results as computed,
-    /// the others finite (a non-finite derivative is 0), result k written at
-    /// `positions[k]`. Before it is returned, `check` is called with it and must return
-    /// true (the caller compares it with the tape at sample points). Errors: one line,
-    /// why there is no native code (no C compiler, a compiler error, not Linux, a check
-    /// that failed).
+    /// The native form of `listing` over `shape`, computing what `layout` says. Before it
+    /// is returned, `check` is called with it and must return true (the caller compares it
+    /// with the tape at sample points). Errors: one line, why there is no native code (no
+    /// C compiler, a compiler error, not Linux, a layout that does not fit the listing, a
+    /// check that failed).
     pub fn build(
         listing: &Listing,
-        values: usize,
-        positions: &[usize],
+        layout: Layout,
         shape: Shape,
-        check: impl FnOnce(&NativeFunction) -> bool,
+        check: impl FnOnce(&Arc<NativeFunction>) -> bool,
     ) -> std::result::Result<Arc<Self>, String> {
-        if positions.len() != listing.results.len() {
-            return Err("one position per result is needed".into());
-        }
-        let source = source::c_source(listing, values, positions);
-        let native = Self::load(&source, shape, positions)?;
+        let n = shape.states;
+        let source = match &layout {
+            Layout::Results { values, positions } => {
+                if positions.len() != listing.results.len() || *values > positions.len() {
+                    return Err("one position per result is needed".into());
+                }
+                source::results_source(listing, *values, positions)
+            }
+            Layout::Sensitivities { k, q } => {
+                if listing.results.len() != n + n * n + n * k || q < k {
+                    return Err("the listing is not a column tape of this shape".into());
+                }
+                source::sensitivities_source(listing, n, *k, *q)
+            }
+        };
+        let native = Arc::new(Self::load(&source, layout, shape)?);
         if !check(&native) {
             return Err("the compiled code does not reproduce the tape's numbers".into());
         }
-        Ok(Arc::new(native))
+        Ok(native)
     }
 
     #[cfg(target_os = "linux")]
     fn load(
         source: &source::Source,
+        layout: Layout,
         shape: Shape,
-        positions: &[usize],
     ) -> std::result::Result<Self, String> {
         let (library, provenance) = object::load(&source.text)?;
         let prepare = library.symbol(c"hysid_prepare")?;
-        let eval = library.symbol(c"hysid_eval")?;
-        // SAFETY: the symbols are the functions `source::c_source` defines, with these
-        // C signatures.
-        let (prepare, eval) = unsafe {
+        // SAFETY: the symbols are the functions `source` defines, with these C signatures.
+        let (prepare, entry) = unsafe {
+            let entry = match layout {
+                Layout::Results { .. } => {
+                    Entry::Results(std::mem::transmute::<*mut std::ffi::c_void, EvalFn>(
+                        library.symbol(c"hysid_eval")?,
+                    ))
+                }
+                Layout::Sensitivities { .. } => {
+                    Entry::Sensitivities(std::mem::transmute::<*mut std::ffi::c_void, SensFn>(
+                        library.symbol(c"hysid_sens")?,
+                    ))
+                }
+            };
             (
                 std::mem::transmute::<*mut std::ffi::c_void, PrepareFn>(prepare),
-                std::mem::transmute::<*mut std::ffi::c_void, EvalFn>(eval),
+                entry,
             )
+        };
+        let out_len = match &layout {
+            Layout::Results { positions, .. } => positions.iter().max().map_or(0, |p| p + 1),
+            Layout::Sensitivities { .. } => 0,
         };
         Ok(Self {
             _library: library,
             prepare,
-            eval,
+            entry,
+            layout,
+            out_len,
             prepared: source.prepared,
-            out_len: positions.iter().max().map_or(0, |p| p + 1),
             shape,
             provenance,
         })
     }
 
     #[cfg(not(target_os = "linux"))]
-    fn load(_: &source::Source, _: Shape, _: &[usize]) -> std::result::Result<Self, String> {
+    fn load(_: &source::Source, _: Layout, _: Shape) -> std::result::Result<Self, String> {
         Err("native code is built on Linux only".into())
     }
 
@@ -185,57 +259,28 @@ impl NativeFunction {
         self.provenance
     }
 
+    /// What the function computes.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
     /// The function with the parameters θ prepared (what depends on θ alone computed once).
     ///
     /// # Panics
     /// If θ does not have the shape's length.
     pub fn bind(self: &Arc<Self>, theta: &[f64]) -> BoundNative {
+        BoundNative {
+            prepared: self.prepare(theta),
+            function: Arc::clone(self),
+        }
+    }
+
+    fn prepare(&self, theta: &[f64]) -> Vec<f64> {
         assert_eq!(theta.len(), self.shape.parameters, "parameters");
         let mut prepared = vec![0.0; self.prepared];
         // SAFETY: θ has the parameters the code reads; `prepared` the slots it writes.
         unsafe { (self.prepare)(theta.as_ptr(), prepared.as_mut_ptr()) };
-        BoundNative {
-            function: Arc::clone(self),
-            prepared,
-        }
-    }
-}
-
-impl NativeFunction {
-    /// One evaluation at θ and (t, x, u), θ prepared for it alone (a check; a simulation
-    /// prepares θ once, [`NativeFunction::bind`]).
-    ///
-    /// # Panics
-    /// As [`NativeFunction::bind`] and [`BoundNative::eval`].
-    pub fn eval_once(&self, theta: &[f64], t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
-        assert_eq!(theta.len(), self.shape.parameters, "parameters");
-        let mut prepared = vec![0.0; self.prepared];
-        // SAFETY: as in `bind`.
-        unsafe { (self.prepare)(theta.as_ptr(), prepared.as_mut_ptr()) };
-        self.eval_prepared(&prepared, t, x, u, out);
-    }
-
-    /// The results at (t, x, u) with the prepared slots `prepared`.
-    #[inline]
-    fn eval_prepared(&self, prepared: &[f64], t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
-        assert!(
-            x.len() >= self.shape.states
-                && u.len() >= self.shape.inputs
-                && out.len() >= self.out_len
-                && prepared.len() == self.prepared,
-            "native evaluation: buffers shorter than the model's"
-        );
-        // SAFETY: the code reads x[..states], u[..inputs] and the prepared slots, and
-        // writes out[..out_len]: all checked above.
-        unsafe {
-            (self.eval)(
-                t,
-                x.as_ptr(),
-                u.as_ptr(),
-                prepared.as_ptr(),
-                out.as_mut_ptr(),
-            )
-        }
+        prepared
     }
 }
 
@@ -246,13 +291,82 @@ pub struct BoundNative {
 }
 
 impl BoundNative {
-    /// The results at (t, x, u) into their positions in `out` (every position written each
-    /// call).
+    /// The results at (t, x, u) into their positions in `out`, every position written
+    /// ([`Layout::Results`]).
     ///
     /// # Panics
-    /// If x, u or `out` are shorter than the function reads or writes.
+    /// If the layout is another, or x, u or `out` are shorter than the function reads or
+    /// writes.
     #[inline]
     pub fn eval(&self, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
-        self.function.eval_prepared(&self.prepared, t, x, u, out);
+        let f = &*self.function;
+        let Entry::Results(eval) = f.entry else {
+            panic!("native evaluation: not a results layout");
+        };
+        assert!(
+            x.len() >= f.shape.states && u.len() >= f.shape.inputs && out.len() >= f.out_len,
+            "native evaluation: buffers shorter than the model's"
+        );
+        // SAFETY: the code reads x[..states], u[..inputs] and the prepared slots, and
+        // writes out[..out_len]: all checked above.
+        unsafe {
+            eval(
+                t,
+                x.as_ptr(),
+                u.as_ptr(),
+                self.prepared.as_ptr(),
+                out.as_mut_ptr(),
+            )
+        }
+    }
+
+    /// ẋ into `dx` and Ṡ (row-major n × q) into `ds` at (t, x, u) and sensitivities `s`
+    /// ([`Layout::Sensitivities`]); `coupled[i·n + j]` false leaves out the products of
+    /// an entry ∂fᵢ/∂xⱼ that depends on θ alone and is zero for the bound θ.
+    ///
+    /// # Panics
+    /// If the layout is another, or a buffer is shorter than the shape's.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn sensitivities(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        s: &[f64],
+        coupled: &[bool],
+        dx: &mut [f64],
+        ds: &mut [f64],
+    ) {
+        let f = &*self.function;
+        let (Entry::Sensitivities(sens), Layout::Sensitivities { q, .. }) = (f.entry, &f.layout)
+        else {
+            panic!("native evaluation: not a sensitivities layout");
+        };
+        let n = f.shape.states;
+        assert!(
+            x.len() >= n
+                && u.len() >= f.shape.inputs
+                && s.len() >= n * q
+                && coupled.len() >= n * n
+                && dx.len() >= n
+                && ds.len() >= n * q,
+            "native evaluation: buffers shorter than the model's"
+        );
+        // SAFETY: the code reads x[..n], u[..inputs], s[..n·q], coupled[..n²] (bool is one
+        // byte, 0 or 1) and the prepared slots, and writes dx[..n], ds[..n·q]: all
+        // checked above.
+        unsafe {
+            sens(
+                t,
+                x.as_ptr(),
+                u.as_ptr(),
+                s.as_ptr(),
+                self.prepared.as_ptr(),
+                coupled.as_ptr().cast::<u8>(),
+                dx.as_mut_ptr(),
+                ds.as_mut_ptr(),
+            )
+        }
     }
 }

@@ -1,15 +1,19 @@
-//! A listing ([`hysid_equations::Listing`]) printed as two C99 functions:
+//! A listing ([`hysid_equations::Listing`]) printed as C99 functions:
 //!
 //! ```c
 //! void hysid_prepare(const double *p, double *c);
+//! /* either the listing's results (results_source) */
 //! void hysid_eval(double t, const double *x, const double *u, const double *c, double *out);
+//! /* or, for a column tape, ẋ and the sensitivity rates (sensitivities_source) */
+//! void hysid_sens(double t, const double *x, const double *u, const double *s,
+//!                 const double *c, const unsigned char *coupled, double *dx, double *ds);
 //! ```
 //!
 //! `hysid_prepare` computes, once per parameter vector θ = `p`, every operation that reads
-//! neither t, x nor u, and stores in `c` what `hysid_eval` reads of them (the parameters
-//! themselves included); `hysid_eval` computes the rest at (t, x, u) and writes result k at
-//! `out[position k]`, the first `values` results as computed and the others (derivatives)
-//! finite by the language's convention (a non-finite derivative is 0).
+//! neither t, x nor u, and stores in `c` what the other function reads of them (the
+//! parameters themselves included); that function computes the rest at (t, x, u). Results
+//! that are derivatives are made finite by the language's convention (a non-finite
+//! derivative is 0). Every pointer is `restrict`: the caller's buffers never overlap.
 //!
 //! One C statement per operation, in the listing's order, with the tape's scalar semantics
 //! ([`hysid_equations::apply1`], [`hysid_equations::apply2`], [`hysid_equations::powi`]):
@@ -32,90 +36,235 @@ pub(super) struct Source {
     pub prepared: usize,
 }
 
-/// The C source of `listing` (see the module docs): `values` results as computed, the rest
-/// finite; result k written at `positions[k]`.
-pub(super) fn c_source(listing: &Listing, values: usize, positions: &[usize]) -> Source {
-    let varying = varying_operations(listing);
-    // The slots of `c`: every parameter and every θ-only value that the varying part or a
-    // result reads.
-    let mut slot_of_param: Vec<Option<usize>> = Vec::new();
-    let mut slot_of_value: Vec<Option<usize>> = vec![None; listing.operations.len()];
-    let mut slots = 0usize;
-    let mut need = |o: &Operand| match *o {
-        Operand::Parameter(i) => {
-            if slot_of_param.len() <= i {
-                slot_of_param.resize(i + 1, None);
-            }
-            if slot_of_param[i].is_none() {
-                slot_of_param[i] = Some(slots);
-                slots += 1;
+/// What a result (or operand) of the evaluation is, for the code that reads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Class {
+    /// A constant that reads as zero once made finite: a term it multiplies is left out.
+    Zero,
+    /// Another constant.
+    Constant,
+    /// Prepared from θ alone (constant within one simulation).
+    Prepared,
+    /// Computed from t, x or u at every evaluation.
+    Varying,
+}
+
+/// A listing split into what θ alone determines (`hysid_prepare`) and the rest.
+struct Split<'a> {
+    listing: &'a Listing,
+    varying: Vec<bool>,
+    slot_of_param: Vec<Option<usize>>,
+    slot_of_value: Vec<Option<usize>>,
+    slots: usize,
+    /// The body of `hysid_prepare`.
+    prepare: String,
+    /// The varying operations, one `const double vK = …;` each.
+    body: String,
+}
+
+impl<'a> Split<'a> {
+    fn new(listing: &'a Listing) -> Self {
+        let varying = varying_operations(listing);
+        let mut split = Split {
+            listing,
+            slot_of_param: Vec::new(),
+            slot_of_value: vec![None; listing.operations.len()],
+            slots: 0,
+            prepare: String::new(),
+            body: String::new(),
+            varying,
+        };
+        // The slots of `c`: every parameter and every θ-only value that the varying part
+        // or a result reads.
+        for (k, op) in listing.operations.iter().enumerate() {
+            if split.varying[k] {
+                for o in operands(op) {
+                    split.need(&o);
+                }
             }
         }
-        Operand::Value(k) if !varying[k] && slot_of_value[k].is_none() => {
-            slot_of_value[k] = Some(slots);
-            slots += 1;
+        for o in &listing.results {
+            split.need(o);
         }
-        _ => {}
-    };
-    for (k, op) in listing.operations.iter().enumerate() {
-        if varying[k] {
-            for o in operands(op) {
-                need(&o);
+        for (k, op) in listing.operations.iter().enumerate() {
+            let text = expression(op, &|o| {
+                if split.varying[k] {
+                    split.read(o)
+                } else {
+                    prepare_operand(o)
+                }
+            });
+            let to = if split.varying[k] {
+                &mut split.body
+            } else {
+                &mut split.prepare
+            };
+            let _ = writeln!(to, "    const double v{k} = {text};");
+        }
+        for (i, slot) in split.slot_of_param.iter().enumerate() {
+            if let Some(s) = slot {
+                let _ = writeln!(split.prepare, "    c[{s}] = p[{i}];");
             }
         }
-    }
-    for o in &listing.results {
-        need(o);
+        for (k, slot) in split.slot_of_value.iter().enumerate() {
+            if let Some(s) = slot {
+                let _ = writeln!(split.prepare, "    c[{s}] = v{k};");
+            }
+        }
+        split
     }
 
-    let mut prepare = String::new();
-    let mut eval = String::new();
-    for (k, op) in listing.operations.iter().enumerate() {
-        if varying[k] {
-            let read = |o: &Operand| eval_operand(o, &varying, &slot_of_param, &slot_of_value);
-            let _ = writeln!(eval, "    const double v{k} = {};", expression(op, &read));
+    fn need(&mut self, o: &Operand) {
+        match *o {
+            Operand::Parameter(i) => {
+                if self.slot_of_param.len() <= i {
+                    self.slot_of_param.resize(i + 1, None);
+                }
+                if self.slot_of_param[i].is_none() {
+                    self.slot_of_param[i] = Some(self.slots);
+                    self.slots += 1;
+                }
+            }
+            Operand::Value(k) if !self.varying[k] && self.slot_of_value[k].is_none() => {
+                self.slot_of_value[k] = Some(self.slots);
+                self.slots += 1;
+            }
+            _ => {}
+        }
+    }
+
+    /// An operand as the evaluating function reads it.
+    fn read(&self, o: &Operand) -> String {
+        match *o {
+            Operand::Time => "t".into(),
+            Operand::State(i) => format!("x[{i}]"),
+            Operand::Input(i) => format!("u[{i}]"),
+            Operand::Constant(v) => literal(v),
+            Operand::Parameter(i) => format!("c[{}]", self.slot_of_param[i].expect("slot")),
+            Operand::Value(k) if self.varying[k] => format!("v{k}"),
+            Operand::Value(k) => format!("c[{}]", self.slot_of_value[k].expect("slot")),
+        }
+    }
+
+    /// Result k as a derivative reads it: finite (by the convention), and its class.
+    fn derivative(&self, k: usize) -> (String, Class) {
+        let o = &self.listing.results[k];
+        let class = match *o {
+            Operand::Constant(v) if v.is_finite() && v != 0.0 => Class::Constant,
+            Operand::Constant(_) => Class::Zero,
+            Operand::Parameter(_) => Class::Prepared,
+            Operand::Value(j) if !self.varying[j] => Class::Prepared,
+            _ => Class::Varying,
+        };
+        (format!("hy_finite({})", self.read(o)), class)
+    }
+
+    /// The translation unit: the prelude, `hysid_prepare`, then `function` (whose body
+    /// follows the varying operations).
+    fn finish(self, signature: &str, tail: &str) -> Source {
+        let text = format!(
+            "/* Generated by hysid {version} from an equation file's tape; see \
+             model/greybox/native. */\n\
+             #include <math.h>\n\n\
+             {PRELUDE}\n\
+             /* {slots} prepared values. */\n\
+             void hysid_prepare(const double *restrict p, double *restrict c) {{\n    (void)p;\n    (void)c;\n\
+             {prepare}}}\n\n\
+             {signature} {{\n{body}{tail}}}\n",
+            version = env!("CARGO_PKG_VERSION"),
+            slots = self.slots,
+            prepare = self.prepare,
+            body = self.body,
+        );
+        Source {
+            text,
+            prepared: self.slots,
+        }
+    }
+}
+
+/// `hysid_eval(t, x, u, c, out)` for `listing` (see the module docs): `values` results as
+/// computed, the rest finite; result k written at `out[positions[k]]`.
+pub(super) fn results_source(listing: &Listing, values: usize, positions: &[usize]) -> Source {
+    let split = Split::new(listing);
+    let mut tail = String::from("    (void)t;\n    (void)x;\n    (void)u;\n    (void)c;\n");
+    for (k, &p) in positions.iter().enumerate().take(listing.results.len()) {
+        let v = if k < values {
+            split.read(&listing.results[k])
         } else {
-            let read = |o: &Operand| prepare_operand(o);
-            let _ = writeln!(
-                prepare,
-                "    const double v{k} = {};",
-                expression(op, &read)
-            );
+            split.derivative(k).0
+        };
+        let _ = writeln!(tail, "    out[{p}] = {v};");
+    }
+    split.finish(
+        "void hysid_eval(double t, const double *restrict x, const double *restrict u, \
+         const double *restrict c, double *restrict out)",
+        &tail,
+    )
+}
+
+/// `hysid_sens(x, u, s, c, coupled, dx, ds)` for the listing of a column tape of n states
+/// and k parameter columns (results f, ∂f/∂x, ∂f/∂θ as
+/// [`hysid_equations::EquationModel::columns_listing`] lays them out), for sensitivities of q ≥ k
+/// columns (row-major n × q, the last q − k initial-state columns without a direct term):
+///
+/// ```text
+/// ẋ = f        Ṡᵢ꜀ = [f_θ]ᵢ꜀ + Σⱼ [f_x]ᵢⱼ · Sⱼ꜀   (j in order)
+/// ```
+///
+/// summed in the order of the Rust kernel (`equation_kernel`): the direct term (0 in an
+/// initial-state column), then the products j = 0, 1, …; a product whose Jacobian entry is
+/// a constant zero is left out, and one whose entry depends on θ alone is added only where
+/// `coupled[i·n + j]` (the kernel's flags: false where the bound entry is zero), so every
+/// value is the kernel's.
+pub(super) fn sensitivities_source(listing: &Listing, n: usize, k: usize, q: usize) -> Source {
+    let split = Split::new(listing);
+    let mut tail = String::from("    (void)t;\n    (void)u;\n    (void)c;\n    (void)coupled;\n");
+    for i in 0..n {
+        let _ = writeln!(tail, "    dx[{i}] = {};", split.read(&listing.results[i]));
+    }
+    let entries: Vec<Vec<(String, Class)>> = (0..n)
+        .map(|i| (0..n).map(|j| split.derivative(n + i * n + j)).collect())
+        .collect();
+    for (i, row) in entries.iter().enumerate() {
+        for (j, (a, class)) in row.iter().enumerate() {
+            if *class != Class::Zero {
+                let _ = writeln!(tail, "    const double a{i}_{j} = {a};");
+            }
+            if *class == Class::Prepared {
+                let _ = writeln!(tail, "    const int on{i}_{j} = coupled[{}];", i * n + j);
+            }
         }
     }
-    for (i, slot) in slot_of_param.iter().enumerate() {
-        if let Some(s) = slot {
-            let _ = writeln!(prepare, "    c[{s}] = p[{i}];");
+    for (i, row) in entries.iter().enumerate() {
+        for col in 0..q {
+            let direct = if col < k {
+                split.derivative(n + n * n + i * k + col).0
+            } else {
+                "0.0".into()
+            };
+            let _ = writeln!(tail, "    {{\n        double d = {direct};");
+            for (j, (_, class)) in row.iter().enumerate() {
+                let term = format!("d += a{i}_{j} * s[{}];", j * q + col);
+                match class {
+                    Class::Zero => {}
+                    Class::Prepared => {
+                        let _ = writeln!(tail, "        if (on{i}_{j}) {{ {term} }}");
+                    }
+                    Class::Constant | Class::Varying => {
+                        let _ = writeln!(tail, "        {term}");
+                    }
+                }
+            }
+            let _ = writeln!(tail, "        ds[{}] = d;\n    }}", i * q + col);
         }
     }
-    for (k, slot) in slot_of_value.iter().enumerate() {
-        if let Some(s) = slot {
-            let _ = writeln!(prepare, "    c[{s}] = v{k};");
-        }
-    }
-    for (k, (o, &p)) in listing.results.iter().zip(positions).enumerate() {
-        let v = eval_operand(o, &varying, &slot_of_param, &slot_of_value);
-        if k < values {
-            let _ = writeln!(eval, "    out[{p}] = {v};");
-        } else {
-            let _ = writeln!(eval, "    out[{p}] = hy_finite({v});");
-        }
-    }
-    let text = format!(
-        "/* Generated by hysid {version} from an equation file's tape; see \
-         model/greybox/native. */\n\
-         #include <math.h>\n\n\
-         {PRELUDE}\n\
-         /* {slots} prepared values. */\n\
-         void hysid_prepare(const double *p, double *c) {{\n    (void)p;\n    (void)c;\n{prepare}}}\n\n\
-         void hysid_eval(double t, const double *x, const double *u, const double *c, \
-         double *out) {{\n    (void)t;\n    (void)x;\n    (void)u;\n    (void)c;\n{eval}}}\n",
-        version = env!("CARGO_PKG_VERSION"),
-    );
-    Source {
-        text,
-        prepared: slots,
-    }
+    split.finish(
+        "void hysid_sens(double t, const double *restrict x, const double *restrict u, \
+         const double *restrict s, const double *restrict c, \
+         const unsigned char *restrict coupled, double *restrict dx, double *restrict ds)",
+        &tail,
+    )
 }
 
 /// The helpers with the tape's scalar semantics.
@@ -177,24 +326,6 @@ fn prepare_operand(o: &Operand) -> String {
         Operand::Constant(v) => literal(v),
         // A θ-only operation reads none of these.
         Operand::Time | Operand::State(_) | Operand::Input(_) => unreachable!("varying operand"),
-    }
-}
-
-/// An operand as `hysid_eval` reads it.
-fn eval_operand(
-    o: &Operand,
-    varying: &[bool],
-    slot_of_param: &[Option<usize>],
-    slot_of_value: &[Option<usize>],
-) -> String {
-    match *o {
-        Operand::Time => "t".into(),
-        Operand::State(i) => format!("x[{i}]"),
-        Operand::Input(i) => format!("u[{i}]"),
-        Operand::Constant(v) => literal(v),
-        Operand::Parameter(i) => format!("c[{}]", slot_of_param[i].expect("slot assigned")),
-        Operand::Value(k) if varying[k] => format!("v{k}"),
-        Operand::Value(k) => format!("c[{}]", slot_of_value[k].expect("slot assigned")),
     }
 }
 

@@ -1,7 +1,7 @@
 //! Tests of `hysid::model::greybox::native`: the compiled form of an equation model's
 //! tapes gives the tape's numbers to the bit.
 
-use hysid::model::greybox::native::{Evaluator, NativeFunction, Provenance, Shape};
+use hysid::model::greybox::native::{Evaluator, Layout, NativeFunction, Provenance, Shape};
 use hysid_equations::EquationModel;
 
 /// Every operation of the language: the functions, integer and real powers (the exponent a
@@ -65,8 +65,13 @@ fn shape(m: &EquationModel) -> Shape {
     }
 }
 
-/// Checks the native f and the native columns of `params` (padded to `q`, written in
-/// reverse order to exercise the positions) against the tape at 400 seeded points.
+fn results(values: usize, positions: Vec<usize>) -> Layout {
+    Layout::Results { values, positions }
+}
+
+/// Checks the native f, the native columns of `params` (padded to `q`, written in reverse
+/// order to exercise the positions) and the native sensitivity rates of those columns
+/// against the tape at 400 seeded points.
 fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
     let (n, k) = (m.states().len(), params.len());
     let mut points = Points(seed);
@@ -74,7 +79,8 @@ fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
 
     // f alone.
     let positions: Vec<usize> = (0..n).collect();
-    let f = NativeFunction::build(&m.rhs_listing(), n, &positions, shape(m), |_| true).unwrap();
+    let f =
+        NativeFunction::build(&m.rhs_listing(), results(n, positions), shape(m), |_| true).unwrap();
     // Columns: f, ∂f/∂x, ∂f/∂θ[params] into rows of q, the whole layout reversed.
     let columns = m.rhs_jacobian_columns(params).unwrap();
     let len = n + n * n + n * q;
@@ -82,10 +88,12 @@ fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
         .chain((0..n * k).map(|r| n + n * n + (r / k) * q + r % k))
         .collect();
     let reversed: Vec<usize> = natural.iter().map(|p| len - 1 - p).collect();
-    let jac = NativeFunction::build(&m.columns_listing(&columns), n, &reversed, shape(m), |_| {
-        true
-    })
-    .unwrap();
+    let listing = m.columns_listing(&columns);
+    let jac =
+        NativeFunction::build(&listing, results(n, reversed.clone()), shape(m), |_| true).unwrap();
+    let sens = NativeFunction::build(&listing, Layout::Sensitivities { k, q }, shape(m), |_| true)
+        .unwrap();
+    let coupled = vec![true; n * n];
 
     for point in 0..400 {
         let x = points.vec(n);
@@ -124,6 +132,77 @@ fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
                 "result {r} at x {x:?}, u {u:?}, θ {th:?}: tape {v} native {got}"
             );
         }
+        // Ṡ = [f_θ, 0] + f_x·S, summed in the order of j; a constant-zero entry's product is
+        // left out by the native code, which changes at most the sign of a zero.
+        let s = points.vec(n * q);
+        let (mut ndx, mut nds) = (vec![0.0; n], vec![0.0; n * q]);
+        sens.bind(&th)
+            .sensitivities(0.0, &x, &u, &s, &coupled, &mut ndx, &mut nds);
+        assert!(
+            dx.iter().zip(&ndx).all(|(a, b)| same(*a, *b)),
+            "ẋ at x {x:?}"
+        );
+        for i in 0..n {
+            for c in 0..q {
+                let mut d = if c < k { ft[i * k + c] } else { 0.0 };
+                for j in 0..n {
+                    d += fx[i * n + j] * s[j * q + c];
+                }
+                let got = nds[i * q + c];
+                assert!(
+                    same(d, got) || d == got,
+                    "Ṡ[{i}][{c}] at x {x:?}, u {u:?}, S {s:?}: {d} native {got}"
+                );
+            }
+        }
+    }
+}
+
+/// An entry of ∂f/∂x that depends on θ alone is left out of Ṡ where the kernel says it is
+/// uncoupled (zero for the bound θ), and only there.
+#[test]
+fn uncoupled_entries_are_left_out_of_the_sensitivity_rates() {
+    let text = std::fs::read_to_string(format!(
+        "{}/../../examples/equations/bouc_wen.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let m = EquationModel::parse(&text).unwrap();
+    let theta = m.parameter_values();
+    let (k, q) = (6, 6);
+    let columns = m.rhs_jacobian_columns(&[0, 1, 2, 3, 4, 5]).unwrap();
+    let sens = NativeFunction::build(
+        &m.columns_listing(&columns),
+        Layout::Sensitivities { k, q },
+        shape(&m),
+        |_| true,
+    )
+    .unwrap()
+    .bind(&theta);
+    let (x, u) = ([1e-3, -2e-2, 3.0], [5.0]);
+    let s: Vec<f64> = (0..18).map(|i| 0.5 + i as f64).collect();
+    let run = |coupled: &[bool]| {
+        let (mut dx, mut ds) = ([0.0; 3], [0.0; 18]);
+        sens.sensitivities(0.0, &x, &u, &s, coupled, &mut dx, &mut ds);
+        ds
+    };
+    let all = run(&[true; 9]);
+    // ∂ẏ/∂y = −kL/mL (row 1, column 0) depends on θ alone.
+    let mut without = [true; 9];
+    without[3] = false;
+    let dropped = run(&without);
+    let fx10 = -theta[2] / theta[0];
+    for c in 0..q {
+        assert_ne!(all[q + c], dropped[q + c]);
+        let mut d = all[q + c];
+        d -= fx10 * s[c];
+        assert!(
+            (d - dropped[q + c]).abs() <= 1e-9 * all[q + c].abs(),
+            "column {c}"
+        );
+        // The other rows are unchanged.
+        assert_eq!(all[c].to_bits(), dropped[c].to_bits());
+        assert_eq!(all[2 * q + c].to_bits(), dropped[2 * q + c].to_bits());
     }
 }
 
@@ -172,10 +251,13 @@ fn the_compiled_code_is_cached_and_checked() {
          [equations]\nx = \"-a*x + u + {stamp}e-40\"\n[output]\ny = \"x\"\n"
     );
     let m = EquationModel::parse(&text).unwrap();
-    let build = || NativeFunction::build(&m.rhs_listing(), 1, &[0], shape(&m), |_| true).unwrap();
+    let build = || {
+        NativeFunction::build(&m.rhs_listing(), results(1, vec![0]), shape(&m), |_| true).unwrap()
+    };
     assert!(matches!(build().provenance(), Provenance::Compiled(s) if s > 0.0));
     assert_eq!(build().provenance(), Provenance::Cached);
-    let refused = NativeFunction::build(&m.rhs_listing(), 1, &[0], shape(&m), |_| false);
+    let refused =
+        NativeFunction::build(&m.rhs_listing(), results(1, vec![0]), shape(&m), |_| false);
     assert!(refused.unwrap_err().contains("does not reproduce the tape"));
 }
 
