@@ -6,7 +6,10 @@
 //!
 //! Equations and reference: see [`super::BoucWen`] (Noël & Schoukens 2016).
 
-use super::bouc_wen::{local_derivatives, LocalDerivatives, CL, KL, ML, NU, ZERO_SLOT};
+use super::bouc_wen::{
+    abs_pow, local_derivatives, LocalDerivatives, ALPHA, BD, BG, CL, KL, ML, NU, ZERO_SLOT,
+};
+use super::sign0;
 use crate::model::greybox::fixed_rk4::{self, FixedSensitivityRhs, Rk4Sensitivities, SampleSink};
 use crate::Result;
 
@@ -71,8 +74,33 @@ impl<const Q: usize> FixedSensitivityRhs<3, Q> for Kernel<Q> {
     }
 }
 
-/// Runs the fixed-size path for the run's column count, None when there is none (more
-/// columns than [`MAX_COLUMNS`], or a θ of another length).
+/// ẋ alone, for a plain simulation (no sensitivity column): the operations of
+/// [`BoucWen::rhs`](super::BoucWen) in its order, so the same bits as the generic path.
+struct Rates {
+    theta: [f64; 7],
+}
+
+impl FixedSensitivityRhs<3, 0> for Rates {
+    #[inline(always)]
+    fn eval(
+        &mut self,
+        x: &[f64; 3],
+        u: &[f64],
+        _s: &[[f64; 0]; 3],
+        dx: &mut [f64; 3],
+        _ds: &mut [[f64; 0]; 3],
+    ) {
+        let th = &self.theta;
+        let [y, v, z] = *x;
+        dx[0] = v;
+        dx[1] = (u[0] - th[CL] * v - th[KL] * y - z) / th[ML];
+        let a = abs_pow(z, th[NU]);
+        dx[2] = th[ALPHA] * v - th[BG] * v.abs() * sign0(z) * a - th[BD] * v * a;
+    }
+}
+
+/// Runs the fixed-size path for the run's column count (none: a plain simulation), None
+/// when there is none (more columns than [`MAX_COLUMNS`], or a θ of another length).
 pub(super) fn simulate(
     run: &Rk4Sensitivities<'_>,
     on_sample: &mut SampleSink<'_>,
@@ -86,6 +114,12 @@ pub(super) fn simulate(
     }
     const { assert!(MAX_COLUMNS == 10) };
     match run.columns() {
+        0 => {
+            let mut rates = Rates {
+                theta: run.theta.try_into().ok()?,
+            };
+            Some(fixed_rk4::simulate::<_, 3, 0>(&mut rates, run, on_sample))
+        }
         1 => with::<1>(run, on_sample),
         2 => with::<2>(run, on_sample),
         3 => with::<3>(run, on_sample),
