@@ -269,9 +269,18 @@ impl NativeFunction {
     /// # Panics
     /// If θ does not have the shape's length.
     pub fn bind(self: &Arc<Self>, theta: &[f64]) -> BoundNative {
+        let q = match self.layout {
+            Layout::Sensitivities { q, .. } => q,
+            Layout::Results { .. } => 0,
+        };
         BoundNative {
             prepared: self.prepare(theta),
-            function: Arc::clone(self),
+            entry: self.entry,
+            states: self.shape.states,
+            inputs: self.shape.inputs,
+            q,
+            out_len: self.out_len,
+            _function: Arc::clone(self),
         }
     }
 
@@ -286,8 +295,15 @@ impl NativeFunction {
 
 /// A [`NativeFunction`] with its parameters prepared ([`NativeFunction::bind`]).
 pub struct BoundNative {
-    function: Arc<NativeFunction>,
+    /// Keeps the code loaded.
+    _function: Arc<NativeFunction>,
     prepared: Vec<f64>,
+    // The function's entry point and sizes, read at every call.
+    entry: Entry,
+    states: usize,
+    inputs: usize,
+    q: usize,
+    out_len: usize,
 }
 
 impl BoundNative {
@@ -299,12 +315,11 @@ impl BoundNative {
     /// writes.
     #[inline]
     pub fn eval(&self, t: f64, x: &[f64], u: &[f64], out: &mut [f64]) {
-        let f = &*self.function;
-        let Entry::Results(eval) = f.entry else {
+        let Entry::Results(eval) = self.entry else {
             panic!("native evaluation: not a results layout");
         };
         assert!(
-            x.len() >= f.shape.states && u.len() >= f.shape.inputs && out.len() >= f.out_len,
+            x.len() >= self.states && u.len() >= self.inputs && out.len() >= self.out_len,
             "native evaluation: buffers shorter than the model's"
         );
         // SAFETY: the code reads x[..states], u[..inputs] and the prepared slots, and
@@ -338,15 +353,13 @@ impl BoundNative {
         dx: &mut [f64],
         ds: &mut [f64],
     ) {
-        let f = &*self.function;
-        let (Entry::Sensitivities(sens), Layout::Sensitivities { q, .. }) = (f.entry, &f.layout)
-        else {
+        let Entry::Sensitivities(sens) = self.entry else {
             panic!("native evaluation: not a sensitivities layout");
         };
-        let n = f.shape.states;
+        let (n, q) = (self.states, self.q);
         assert!(
             x.len() >= n
-                && u.len() >= f.shape.inputs
+                && u.len() >= self.inputs
                 && s.len() >= n * q
                 && coupled.len() >= n * n
                 && dx.len() >= n
