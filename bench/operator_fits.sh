@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Speed bar of the differential-operator fits: `hysid identify operator --family F` on the
 # 20 000-sample records of crates/hysid/examples/differential_records.rs (each family's own
-# operator, 40 dB output noise), whole process, for bouc-wen, duhem, dahl and jiles-atherton.
+# operator, 40 dB output noise), whole process, for bouc-wen, duhem, dahl and jiles-atherton
+# (and the asymmetric Bouc–Wen record), and — the "nothing else slower" check — PI and
+# Preisach fitted to the Bouc–Wen record.
 #
 #   bench/operator_fits.sh                 # this tree's binary
 #   bench/operator_fits.sh OLD_BINARY      # paired: OLD and NEW run back to back, in turn
@@ -22,8 +24,8 @@ trap 'rm -rf "$dir"' EXIT
 
 # Wall seconds of one run of binary $1 on family $2; the report in $dir/$3.json.
 once() {
-  /usr/bin/time -f "%e" -o "$dir/t" "$1" -q identify operator --family "$2" \
-    --data "$dir/$2.csv" --input u --output y --json "$dir/$3.json" >/dev/null
+  /usr/bin/time -f "%e" -o "$dir/t" "$1" -q identify operator --family "${2%%@*}" \
+    --data "$dir/${2##*@}.csv" --input u --output y --json "$dir/$3.json" >/dev/null
   cat "$dir/t"
 }
 
@@ -31,15 +33,17 @@ stats() { sort -n | awk '{v[NR]=$1} END {printf "median %.3f s (min %.3f, max %.
 
 fit() { python3 -c "import json,sys; print('%.4f' % json.load(open(sys.argv[1]))['fit']['fit_percent'])" "$1"; }
 
-for family in bouc-wen duhem dahl jiles-atherton; do
+# FAMILY@RECORD
+for family in bouc-wen@bouc-wen bouc-wen@bouc-wen-asym duhem@duhem dahl@dahl \
+  jiles-atherton@jiles-atherton pi@bouc-wen preisach@bouc-wen; do
   : >"$dir/new.t"
   : >"$dir/old.t"
   for _ in $(seq "$runs"); do
     once "$new" "$family" new >>"$dir/new.t"
     if [ -n "$old" ]; then once "$old" "$family" old >>"$dir/old.t"; fi
   done
-  printf '%-15s new: %s, fit %s %%\n' "$family" "$(stats <"$dir/new.t")" "$(fit "$dir/new.json")"
+  printf '%-26s new: %s, fit %s %%\n' "$family" "$(stats <"$dir/new.t")" "$(fit "$dir/new.json")"
   if [ -n "$old" ]; then
-    printf '%-15s old: %s, fit %s %%\n' "" "$(stats <"$dir/old.t")" "$(fit "$dir/old.json")"
+    printf '%-26s old: %s, fit %s %%\n' "" "$(stats <"$dir/old.t")" "$(fit "$dir/old.json")"
   fi
 done

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# The user-model route against the built-in model, whole process: the Bouc–Wen equation file
+# (examples/equations/bouc_wen.toml) and `--model bouc-wen` fitted to the benchmark's
+# training record from every free parameter at twice its nominal value, one start, RK4 × 4,
+# band-limited input — run back to back in turn, RUNS times each (default 9):
+#
+#   file, cached   the native code of the file's tapes loaded from the cache (every run
+#                  after a machine's first)
+#   file, cold     the cache emptied before each run: the compilation counted
+#   file, tape     HYSID_EVALUATOR=tape: the tape interpreter
+#   built-in       --model bouc-wen
+#
+# Prints per route the median, min and max wall seconds (/usr/bin/time) and the paired ratio
+# of medians to the built-in; checks once that the file's estimates equal the built-in's to
+# 1e-9 relative and the tape's to the bit.
+#
+#   bench/equation_fit.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+runs=${RUNS:-9}
+cargo build --release -q -p hysid-cli
+bin=./target/release/hysid
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+common=(--data data/bouc-wen/train_multisine_5periods.csv --input u_N --output y_m
+  --starts 1 --substeps 4 --interpolation band-limited
+  --init mL=4 --init cL=20 --init kL=1e5 --init alpha=1e5
+  --init beta_gamma=1600 --init beta_delta=-2200)
+file=(-q greybox fit --model-file examples/equations/bouc_wen.toml "${common[@]}")
+builtin=(-q greybox fit --model bouc-wen "${common[@]}")
+
+# Wall seconds of one run; the report in $dir/$1.json.
+once() {
+  local name=$1
+  shift
+  /usr/bin/time -f "%e" -o "$dir/t" "$@" --json "$dir/$name.json" >/dev/null
+  cat "$dir/t"
+}
+
+stats() { sort -n | awk '{v[NR]=$1} END {printf "median %.3f s (min %.3f, max %.3f)", v[int((NR+1)/2)], v[1], v[NR]}'; }
+median() { sort -n | awk '{v[NR]=$1} END {print v[int((NR+1)/2)]}'; }
+
+export HYSID_CACHE_DIR="$dir/cache"
+HYSID_EVALUATOR=native "$bin" "${file[@]}" >/dev/null # fill the cache
+for route in cached cold tape builtin; do : >"$dir/$route.t"; done
+for _ in $(seq "$runs"); do
+  once cached "$bin" "${file[@]}" >>"$dir/cached.t"
+  rm -rf "$dir/cache"
+  once cold "$bin" "${file[@]}" >>"$dir/cold.t"
+  HYSID_EVALUATOR=tape once tape "$bin" "${file[@]}" >>"$dir/tape.t"
+  once builtin "$bin" "${builtin[@]}" >>"$dir/builtin.t"
+done
+base=$(median <"$dir/builtin.t")
+for route in cached cold tape builtin; do
+  m=$(median <"$dir/$route.t")
+  printf '%-8s %s, %.2f× the built-in\n' "$route" "$(stats <"$dir/$route.t")" \
+    "$(python3 -c "print($m / $base)")"
+done
+python3 - "$dir" <<'EOF'
+import json, sys
+d = sys.argv[1]
+def values(name):
+    report = json.load(open(f"{d}/{name}.json"))
+    return {p["name"]: p["value"] for p in report["model"]["parameters"]}
+built, cached, tape = values("builtin"), values("cached"), values("tape")
+worst = max(abs(cached[k] - built[k]) / abs(built[k]) for k in built if built[k] != 0)
+print(f"estimates: file vs built-in max relative difference {worst:.1e}; "
+      f"native == tape to the bit: {cached == tape}")
+EOF
