@@ -125,6 +125,56 @@ pub(crate) fn simulate<K, const N: usize, const Q: usize>(
 where
     K: FixedSensitivityRhs<N, Q>,
 {
+    #[cfg(target_arch = "x86_64")]
+    if crate::numerics::cpu::has_avx() && !PORTABLE.with(std::cell::Cell::get) {
+        // SAFETY: the processor has AVX, the only requirement of `simulate_avx`.
+        return unsafe { simulate_avx::<K, N, Q>(kernel, run, on_sample) };
+    }
+    simulate_body::<K, N, Q>(kernel, run, on_sample)
+}
+
+thread_local! {
+    /// Set by [`with_portable_loop`]: this thread runs the portable loop even with AVX.
+    static PORTABLE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with this thread's fixed-size simulations on the portable loop, not its AVX
+/// twin: reached by the white-box tests, which compare the two to the bit.
+#[doc(hidden)]
+pub fn with_portable_loop<R>(f: impl FnOnce() -> R) -> R {
+    PORTABLE.with(|p| p.set(true));
+    let r = f();
+    PORTABLE.with(|p| p.set(false));
+    r
+}
+
+/// [`simulate_body`] compiled for AVX: element-wise stage updates and products, no sum that
+/// crosses lanes, no fused multiply–add, so the portable loop's bits (the rule of
+/// `docs/architecture.md`, "Vector instructions"; `avx_loop_equals_the_portable_loop` in the
+/// tests).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn simulate_avx<K, const N: usize, const Q: usize>(
+    kernel: &mut K,
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+) -> Result<()>
+where
+    K: FixedSensitivityRhs<N, Q>,
+{
+    simulate_body::<K, N, Q>(kernel, run, on_sample)
+}
+
+/// The loop of [`simulate`].
+#[inline(always)]
+fn simulate_body<K, const N: usize, const Q: usize>(
+    kernel: &mut K,
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+) -> Result<()>
+where
+    K: FixedSensitivityRhs<N, Q>,
+{
     let input = run.input;
     let mut z = Augmented::<N, Q>::ZERO;
     z.x.copy_from_slice(run.x0);

@@ -125,3 +125,34 @@ fn fixed_plain_simulation_equals_the_generic_path() {
         }
     }
 }
+
+/// The fixed-size loop compiled for AVX (where the processor has it) gives the portable
+/// loop's bits: Bouc–Wen with parameter and initial-state columns, and a plain simulation,
+/// every interpolation.
+#[test]
+fn avx_loop_equals_the_portable_loop() {
+    use hysid::model::greybox::fixed_rk4::with_portable_loop;
+    let theta = BoucWen.parameters().values();
+    for interpolation in [
+        InputInterpolation::ZeroOrderHold,
+        InputInterpolation::Linear,
+        InputInterpolation::BandLimited,
+    ] {
+        for (params, initial) in [
+            (&[0, 1, 2, 3, 4, 5][..], &[][..]),
+            (&[1, 3][..], &[0, 2][..]),
+        ] {
+            let avx = run(&BoucWen, &theta, interpolation, params, initial);
+            let portable =
+                with_portable_loop(|| run(&BoucWen, &theta, interpolation, params, initial));
+            assert_eq!(avx.len(), portable.len());
+            for (i, (a, b)) in avx.iter().zip(&portable).enumerate() {
+                assert_eq!(
+                    a.to_bits(),
+                    b.to_bits(),
+                    "{interpolation:?} {params:?} element {i}"
+                );
+            }
+        }
+    }
+}
