@@ -90,6 +90,18 @@ fn dl_error() -> String {
     }
 }
 
+/// [`FLAGS`], and `-mavx` where the processor has AVX (`numerics::cpu::has_avx`): wider
+/// registers for the same element-wise operations — no fused multiply–add, so the same
+/// numbers; the flags are part of the cache key, so a cache shared with a machine without
+/// AVX keeps an object of each kind.
+fn flags() -> Vec<&'static str> {
+    let mut flags = FLAGS.to_vec();
+    if crate::numerics::cpu::has_avx() {
+        flags.push("-mavx");
+    }
+    flags
+}
+
 /// The C compiler to run: `$CC`, else `cc`.
 fn compiler() -> String {
     std::env::var("CC")
@@ -144,7 +156,8 @@ fn unique() -> String {
 /// Errors are one line: no compiler, a compiler error, no loadable object.
 pub(super) fn load(source: &str) -> Result<(Library, Provenance), String> {
     let cc = compiler();
-    let key = format!("{:016x}", fnv1a(&[&cc, &FLAGS.join(" "), source]));
+    let flags = flags();
+    let key = format!("{:016x}", fnv1a(&[&cc, &flags.join(" "), source]));
     let cache = cache_dir();
     if let Some(dir) = &cache {
         let (so, c) = (dir.join(format!("{key}.so")), dir.join(format!("{key}.c")));
@@ -161,7 +174,7 @@ pub(super) fn load(source: &str) -> Result<(Library, Provenance), String> {
     let stem = dir.join(format!("{key}-{}", unique()));
     let (tmp_c, tmp_so) = (stem.with_extension("c"), stem.with_extension("so"));
     let started = Instant::now();
-    let result = compile(&cc, source, &tmp_c, &tmp_so);
+    let result = compile(&cc, &flags, source, &tmp_c, &tmp_so);
     let seconds = started.elapsed().as_secs_f64();
     let loaded = result.and_then(|()| match &cache {
         Some(dir) => {
@@ -208,10 +221,10 @@ fn remove_stale_temporaries(dir: &Path) {
 }
 
 /// Writes `source` to `c` and compiles it into the shared object `so`.
-fn compile(cc: &str, source: &str, c: &Path, so: &Path) -> Result<(), String> {
+fn compile(cc: &str, flags: &[&str], source: &str, c: &Path, so: &Path) -> Result<(), String> {
     std::fs::write(c, source).map_err(|e| format!("cannot write {}: {e}", c.display()))?;
     let output = Command::new(cc)
-        .args(FLAGS)
+        .args(flags)
         .arg("-o")
         .arg(so)
         .arg(c)
