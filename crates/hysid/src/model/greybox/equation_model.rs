@@ -260,18 +260,10 @@ impl EquationStateSpace {
         if self.evaluator == Evaluator::Tape {
             return Ok(None);
         }
-        let cell = {
-            let mut cells = self.native.lock().unwrap_or_else(|e| e.into_inner());
-            match cells.iter().find(|(k, _)| *k == key) {
-                Some((_, cell)) => Arc::clone(cell),
-                None => {
-                    let cell = Arc::new(NativeCell::new());
-                    cells.push((key.clone(), Arc::clone(&cell)));
-                    cell
-                }
-            }
-        };
-        let found = cell.get_or_init(|| self.build_native(&key)).clone();
+        let found = self
+            .native_cell(&key)
+            .get_or_init(|| self.build_native(&key))
+            .clone();
         match (found, self.evaluator) {
             (Ok(f), _) => Ok(Some(f)),
             (Err(why), Evaluator::Native) => Err(Error::Unsupported(format!(
@@ -283,7 +275,35 @@ impl EquationStateSpace {
         }
     }
 
-    /// Builds the native code of `key` and checks it against the tape at sample points.
+    /// The cell of `key`'s native function (made empty on first use).
+    fn native_cell(&self, key: &NativeKey) -> Arc<NativeCell> {
+        let mut cells = self.native.lock().unwrap_or_else(|e| e.into_inner());
+        match cells.iter().find(|(k, _)| k == key) {
+            Some((_, cell)) => Arc::clone(cell),
+            None => {
+                let cell = Arc::new(NativeCell::new());
+                cells.push((key.clone(), Arc::clone(&cell)));
+                cell
+            }
+        }
+    }
+
+    /// Whether the native ẋ `native` equals the tape of f at the check points.
+    fn rates_match(&self, native: &Arc<NativeFunction>) -> bool {
+        let (n, m) = (self.states.len(), self.inputs.len());
+        let theta = self.parameters.values();
+        let native = native.bind(&theta);
+        check_points(n, m, 0, |x, u, _| {
+            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+            native.eval(0.0, x, u, &mut a);
+            self.model.rhs(0.0, x, u, &theta, &mut b);
+            same_bits(&a, &b)
+        })
+    }
+
+    /// Builds the native code of `key` and checks it against the tape at sample points. The
+    /// code of a column tape carries ẋ alone as well: it becomes the plain simulations'
+    /// native function (checked likewise) unless they have one already.
     fn build_native(&self, key: &NativeKey) -> std::result::Result<Arc<NativeFunction>, String> {
         let (n, m) = (self.states.len(), self.inputs.len());
         let shape = Shape {
@@ -299,13 +319,7 @@ impl EquationStateSpace {
                     positions: (0..n).collect(),
                 };
                 NativeFunction::build(&self.model.rhs_listing(), layout, shape, |native| {
-                    let native = native.bind(&theta);
-                    check_points(n, m, 0, |x, u, _| {
-                        let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-                        native.eval(0.0, x, u, &mut a);
-                        self.model.rhs(0.0, x, u, &theta, &mut b);
-                        same_bits(&a, &b)
-                    })
+                    self.rates_match(native)
                 })
             }
             NativeKey::Columns { params, q } => {
@@ -316,7 +330,7 @@ impl EquationStateSpace {
                 let listing = self.model.columns_listing(&columns);
                 let (k, q) = (params.len(), *q);
                 let layout = Layout::Sensitivities { k, q };
-                NativeFunction::build(&listing, layout, shape, |native| {
+                let built = NativeFunction::build(&listing, layout, shape, |native| {
                     let Some(bound) = self.model.bind_columns(&columns, &theta) else {
                         return false;
                     };
@@ -350,7 +364,14 @@ impl EquationStateSpace {
                                 .zip(&want)
                                 .all(|(a, b)| a == b || same_bits(&[*a], &[*b]))
                     })
-                })
+                });
+                if let Some(rates) = built.as_ref().ok().and_then(|f| f.rates()) {
+                    if self.rates_match(&rates) {
+                        // Already set when the plain simulations built their own: kept.
+                        let _ = self.native_cell(&NativeKey::Rates).set(Ok(rates));
+                    }
+                }
+                built
             }
         }
     }

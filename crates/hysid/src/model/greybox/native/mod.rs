@@ -148,9 +148,12 @@ pub struct Shape {
 /// A listing compiled to machine code and loaded (see the module docs).
 pub struct NativeFunction {
     #[cfg(target_os = "linux")]
-    _library: object::Library,
+    library: Arc<object::Library>,
     prepare: PrepareFn,
     entry: Entry,
+    /// ẋ alone from the same code and prepared values (`hysid_rates`), for a
+    /// [`Layout::Sensitivities`] function.
+    rates: Option<EvalFn>,
     layout: Layout,
     /// Doubles of the prepared array.
     prepared: usize,
@@ -233,14 +236,24 @@ impl NativeFunction {
                 entry,
             )
         };
+        let rates = match layout {
+            // SAFETY: `hysid_rates` has the signature of `hysid_eval`.
+            Layout::Sensitivities { .. } => Some(unsafe {
+                std::mem::transmute::<*mut std::ffi::c_void, EvalFn>(
+                    library.symbol(c"hysid_rates")?,
+                )
+            }),
+            Layout::Results { .. } => None,
+        };
         let out_len = match &layout {
             Layout::Results { positions, .. } => positions.iter().max().map_or(0, |p| p + 1),
             Layout::Sensitivities { .. } => 0,
         };
         Ok(Self {
-            _library: library,
+            library: Arc::new(library),
             prepare,
             entry,
+            rates,
             layout,
             out_len,
             prepared: source.prepared,
@@ -257,6 +270,31 @@ impl NativeFunction {
     /// How the code was obtained.
     pub fn provenance(&self) -> Provenance {
         self.provenance
+    }
+
+    /// For a [`Layout::Sensitivities`] function, ẋ alone from the same compiled code: a
+    /// [`Layout::Results`] function of the first n results (f) at positions 0 … n − 1,
+    /// which a plain simulation runs (no second compilation). None for another layout.
+    /// Check it against the tape of f before use, as [`NativeFunction::build`]'s caller
+    /// checks the function itself.
+    pub fn rates(&self) -> Option<Arc<NativeFunction>> {
+        let rates = self.rates?;
+        let n = self.shape.states;
+        Some(Arc::new(NativeFunction {
+            #[cfg(target_os = "linux")]
+            library: Arc::clone(&self.library),
+            prepare: self.prepare,
+            entry: Entry::Results(rates),
+            rates: None,
+            layout: Layout::Results {
+                values: n,
+                positions: (0..n).collect(),
+            },
+            prepared: self.prepared,
+            out_len: n,
+            shape: self.shape,
+            provenance: self.provenance,
+        }))
     }
 
     /// What the function computes.

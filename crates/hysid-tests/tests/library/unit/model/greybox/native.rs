@@ -94,6 +94,10 @@ fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
     let sens = NativeFunction::build(&listing, Layout::Sensitivities { k, q }, shape(m), |_| true)
         .unwrap();
     let coupled = vec![true; n * n];
+    let rates = sens
+        .rates()
+        .expect("a sensitivity function carries ẋ alone");
+    assert!(f.rates().is_none());
 
     for point in 0..400 {
         let x = points.vec(n);
@@ -107,15 +111,18 @@ fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
                 .map(|v| v * (1.0 + 0.25 * points.next()))
                 .collect()
         };
-        let (mut tape, mut native) = (vec![0.0; n], vec![0.0; n]);
+        let (mut tape, mut native, mut carried) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         m.rhs(0.0, &x, &u, &th, &mut tape);
         f.bind(&th).eval(0.0, &x, &u, &mut native);
+        // ẋ alone from the sensitivity code's translation unit.
+        rates.bind(&th).eval(0.0, &x, &u, &mut carried);
         for i in 0..n {
             assert!(
-                same(tape[i], native[i]),
-                "f{i} at x {x:?}, u {u:?}, θ {th:?}: tape {} native {}",
+                same(tape[i], native[i]) && same(tape[i], carried[i]),
+                "f{i} at x {x:?}, u {u:?}, θ {th:?}: tape {} native {} carried {}",
                 tape[i],
-                native[i]
+                native[i],
+                carried[i]
             );
         }
         let mut s = m.scratch();
