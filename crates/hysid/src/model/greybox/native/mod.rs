@@ -1,7 +1,8 @@
-//! Equation-file models as machine code: the tape of f, ∂f/∂x and ∂f/∂θ printed as C
-//! (`source.rs`), compiled by the machine's C compiler into a cache keyed by its content and
-//! loaded (`object`), so that a fit of a model written as equations runs its right-hand
-//! side at the speed of a built-in model.
+//! Equation-file models as machine code: the tape of f, ∂f/∂x and ∂f/∂θ printed as C —
+//! for a fit, with the forward-sensitivity rates Ṡ = [f_θ, 0] + f_x·S and ẋ alone
+//! ([`Layout`]) — (`source.rs`), compiled by the machine's C compiler into a cache keyed by
+//! its content and loaded (`object.rs`), so that a fit of a model written as equations runs
+//! its right-hand side at the speed of a built-in model.
 //!
 //! When a fit (or a simulation) of an equation model starts, the model asks for the native
 //! form of the tape it is about to run ([`NativeFunction::build`]). The first time on a
@@ -13,7 +14,9 @@
 //! it is used, and refused unless every result has the tape's bits
 //! ([`NativeFunction::build`]'s `check`); the printed code performs the tape's operations in
 //! its order with its rounding (see `source.rs`), so the two agree to the bit and a fit gives
-//! the same estimates either way (`native_code_equals_the_tape` in the tests).
+//! the same estimates either way (`native_code_equals_the_tape_for_every_operation`,
+//! `native_code_equals_the_tape_on_the_example_files` and
+//! `bouc_wen_file_fit_from_twice_nominal_is_the_built_in_fit_native_or_taped` in the tests).
 //!
 //! Which evaluator runs is [`Evaluator`]: `auto` (native when it can be built, else the
 //! tape), `native` (an error when it cannot be built), `tape`; the default is read from the
@@ -23,7 +26,7 @@
 //! The technique — generating C for a model's residual and Jacobian and compiling it with
 //! the system compiler — is that of CasADi's code generation (J. A. E. Andersson et al.,
 //! "CasADi: a software framework for nonlinear optimization and optimal control",
-//! *Mathematical Programming Computation* 11, 2019, §5).
+//! *Mathematical Programming Computation* 11, 2019).
 
 #[cfg(target_os = "linux")]
 mod object;
