@@ -59,6 +59,9 @@ pub fn print_fit(title: &str, fit: &GreyBoxFit) {
         "  simulations: {} without sensitivities, {} with",
         oe.report.residual_evaluations, oe.report.sensitivity_evaluations
     );
+    if let Some(evaluation) = &fit.evaluation {
+        println!("  evaluated by: {evaluation}");
+    }
     if fit.starts.len() > 1 {
         let near = fit.starts_near_best(0.01);
         println!(

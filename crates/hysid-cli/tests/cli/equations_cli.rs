@@ -139,6 +139,23 @@ fn native_code_and_the_tape_fit_the_same() {
     fallback.assert().success();
     assert_eq!(figures(&native_report), figures(&tape_report));
     assert_eq!(figures(&native_report), figures(&fallback_report));
+    // The report says which code ran.
+    let evaluation = |report: &Path| {
+        json(report)["details"]["evaluation"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    assert!(evaluation(&native_report).starts_with("native code ("));
+    assert_eq!(
+        evaluation(&tape_report),
+        "tape interpreter (HYSID_EVALUATOR=tape)"
+    );
+    let fallback = evaluation(&fallback_report);
+    assert!(
+        fallback.starts_with("tape interpreter (no native code: no C compiler"),
+        "{fallback}"
+    );
 
     let (mut refused, _) = fit("native", "/nonexistent/cc", "refused");
     let fresh = dir.path().join("empty-cache");

@@ -47,6 +47,7 @@ pub fn greybox_report(
         "history": oe.report.history,
         "starts": fit.starts,
         "hold_check": fit.hold_check,
+        "evaluation": fit.evaluation,
     });
     let mut report = Report::of_output_error(
         command,

@@ -68,6 +68,9 @@ pub struct GreyBoxFit {
     /// have been interpolated band-limited ([`super::hold_check`](mod@super::hold_check)); None with another
     /// interpolation and for a discrete-time model.
     pub hold_check: Option<HoldCheck>,
+    /// How the model was evaluated ([`StateSpaceModel::evaluation`]): native code or the
+    /// tape of an equation model; None for a built-in model.
+    pub evaluation: Option<String>,
 }
 
 impl GreyBoxFit {
@@ -161,6 +164,7 @@ impl GreyBoxEstimation {
             starts,
             elapsed_s: clock.elapsed().as_secs_f64(),
             hold_check,
+            evaluation: model.evaluation(),
         })
     }
 

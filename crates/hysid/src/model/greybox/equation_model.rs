@@ -556,6 +556,35 @@ impl StateSpaceModel for EquationStateSpace {
         equation_kernel::simulate(tape, native, run, on_sample)
     }
 
+    /// "native code (…)" when every simulation that asked for native code got it (with the
+    /// compile time, or "loaded from the cache"), "tape interpreter (…)" with the reason
+    /// otherwise; None before any simulation.
+    fn evaluation(&self) -> Option<String> {
+        if self.evaluator == Evaluator::Tape {
+            return Some("tape interpreter (HYSID_EVALUATOR=tape)".into());
+        }
+        let cells = self.native.lock().unwrap_or_else(|e| e.into_inner());
+        let built: Vec<_> = cells.iter().filter_map(|(_, cell)| cell.get()).collect();
+        if built.is_empty() {
+            return (!cells.is_empty()).then(|| "native code (being built)".into());
+        }
+        if let Some(Err(why)) = built.iter().find(|b| b.is_err()) {
+            return Some(format!("tape interpreter (no native code: {why})"));
+        }
+        let compiled: f64 = built
+            .iter()
+            .filter_map(|b| match b.as_ref().ok()?.provenance() {
+                super::native::Provenance::Compiled(s) => Some(s),
+                super::native::Provenance::Cached => None,
+            })
+            .sum();
+        Some(if compiled > 0.0 {
+            format!("native code (compiled now: {compiled:.2} s of compiler time; cached for the next runs)")
+        } else {
+            "native code (loaded from the cache)".into()
+        })
+    }
+
     /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded), or
     /// copied when they are constants (outputs that are states, inputs or parameters).
     fn output_jacobians(

@@ -176,6 +176,14 @@ pub trait StateSpaceModel: Sync + Send {
         )
     }
 
+    /// How this model's simulations were evaluated, one line for a report: an equation
+    /// model says whether its native code ran (compiled now, or loaded from the cache) or
+    /// the tape interpreter, and why ([`native`]). None (the default) for a model whose
+    /// code is part of hysid.
+    fn evaluation(&self) -> Option<String> {
+        None
+    }
+
     /// RK4 with forward sensitivities through a path specialised to this model's sizes
     /// ([`fixed_rk4`]: fixed-size arrays, the parameters' constants computed once), giving
     /// the same numbers to the last bit as the generic path built on
