@@ -13,43 +13,10 @@ use hysid::model::saved::FittedModel;
 use hysid::model::ParameterSet;
 
 /// An equation file that reads the time t (and a `sin`, an `abs`).
-pub const TIMED: &str = r#"
-[model]
-name = "forced"
-states = ["x", "v"]
-inputs = ["u"]
-outputs = ["y"]
-
-[parameters]
-k = { value = 4.0 }
-c = { value = 0.3 }
-
-[equations]
-x = "v"
-v = "-k*x - c*v*abs(v) + u + 0.5*sin(20*t)"
-
-[output]
-y = "x + 0.1*u"
-"#;
+pub const TIMED: &str = include_str!("../fixtures/equations/forced.toml");
 
 /// A discrete-time equation file (with an integer power and a `max`).
-pub const DISCRETE: &str = r#"
-[model]
-name = "recursion"
-states = ["x"]
-inputs = ["u"]
-outputs = ["y"]
-time = "discrete"
-
-[parameters]
-a = { value = 0.7 }
-
-[equations]
-x = "a*x + u - 0.1*x^3 + 0.01*max(u, x)"
-
-[output]
-y = "x"
-"#;
+pub const DISCRETE: &str = include_str!("../fixtures/equations/recursion.toml");
 
 const RK4: Integrator = Integrator::Rk4 { substeps: 4 };
 const ADAPTIVE: Integrator = Integrator::Adaptive {

@@ -282,42 +282,10 @@ fn built_in_grey_box_models_stream_as_they_simulate() {
     }
 }
 
-/// An equation file that reads the time t, and a discrete-time one.
-const TIMED: &str = r#"
-[model]
-name = "forced"
-states = ["x", "v"]
-inputs = ["u"]
-outputs = ["y"]
-
-[parameters]
-k = { value = 4.0 }
-c = { value = 0.3 }
-
-[equations]
-x = "v"
-v = "-k*x - c*v*abs(v) + u + 0.5*sin(20*t)"
-
-[output]
-y = "x + 0.1*u"
-"#;
-const DISCRETE: &str = r#"
-[model]
-name = "recursion"
-states = ["x"]
-inputs = ["u"]
-outputs = ["y"]
-time = "discrete"
-
-[parameters]
-a = { value = 0.7 }
-
-[equations]
-x = "a*x + u - 0.1*x^3"
-
-[output]
-y = "x"
-"#;
+/// An equation file that reads the time t, and a discrete-time one (shared with the export
+/// tests).
+const TIMED: &str = include_str!("../fixtures/equations/forced.toml");
+const DISCRETE: &str = include_str!("../fixtures/equations/recursion.toml");
 
 #[test]
 fn equation_models_stream_as_they_simulate() {

@@ -62,9 +62,12 @@ static void say(const Instance *c, fmi2Status status, const char *category, cons
     }
 }
 
-static fmi2Status refuse(Instance *c, const char *message)
+/* An error, logged on the instance when there is one. */
+static fmi2Status refuse(fmi2Component c, const char *message)
 {
-    say(c, fmi2Error, "logStatusError", message);
+    if (c != NULL) {
+        say((const Instance *)c, fmi2Error, "logStatusError", message);
+    }
     return fmi2Error;
 }
 
@@ -302,7 +305,7 @@ static fmi2Status none(fmi2Component c, size_t nvr, const char *function)
         return fmi2OK;
     }
     snprintf(message, sizeof message, "%s: this FMU has Real variables only", function);
-    return refuse((Instance *)c, message);
+    return refuse(c, message);
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -458,11 +461,8 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
     (void)nKnown;
     (void)dvKnown;
     (void)dvUnknown;
-    if (c == NULL) {
-        return fmi2Error;
-    }
-    return refuse((Instance *)c, "fmi2GetDirectionalDerivative is not provided "
-                                 "(providesDirectionalDerivative=false)");
+    return refuse(c, "fmi2GetDirectionalDerivative is not provided "
+                     "(providesDirectionalDerivative=false)");
 }
 
 /* ---------------------------------------------------------------- co-simulation */
@@ -475,11 +475,8 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     (void)nvr;
     (void)order;
     (void)value;
-    if (c == NULL) {
-        return fmi2Error;
-    }
-    return refuse((Instance *)c, "fmi2SetRealInputDerivatives: the inputs are held over a "
-                                 "step, not interpolated (canInterpolateInputs=false)");
+    return refuse(c, "fmi2SetRealInputDerivatives: the inputs are held over a "
+                     "step, not interpolated (canInterpolateInputs=false)");
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
@@ -490,11 +487,8 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     (void)nvr;
     (void)order;
     (void)value;
-    if (c == NULL) {
-        return fmi2Error;
-    }
-    return refuse((Instance *)c, "fmi2GetRealOutputDerivatives is not provided "
-                                 "(maxOutputDerivativeOrder=0)");
+    return refuse(c, "fmi2GetRealOutputDerivatives is not provided "
+                     "(maxOutputDerivativeOrder=0)");
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
@@ -555,22 +549,16 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
 
 fmi2Status fmi2CancelStep(fmi2Component c)
 {
-    if (c == NULL) {
-        return fmi2Error;
-    }
-    return refuse((Instance *)c, "fmi2CancelStep: fmi2DoStep always completes (it never "
-                                 "returns fmi2Pending)");
+    return refuse(c, "fmi2CancelStep: fmi2DoStep always completes (it never "
+                     "returns fmi2Pending)");
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
 {
     (void)s;
     (void)value;
-    if (c == NULL) {
-        return fmi2Error;
-    }
-    return refuse((Instance *)c, "fmi2GetStatus: fmi2DoStep always completes (it never "
-                                 "returns fmi2Pending)");
+    return refuse(c, "fmi2GetStatus: fmi2DoStep always completes (it never "
+                     "returns fmi2Pending)");
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
@@ -590,10 +578,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 {
     (void)s;
     (void)value;
-    if (c == NULL) {
-        return fmi2Error;
-    }
-    return refuse((Instance *)c, "fmi2GetIntegerStatus: no integer status is provided");
+    return refuse(c, "fmi2GetIntegerStatus: no integer status is provided");
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
@@ -613,8 +598,5 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
 {
     (void)s;
     (void)value;
-    if (c == NULL) {
-        return fmi2Error;
-    }
-    return refuse((Instance *)c, "fmi2GetStringStatus: no string status is provided");
+    return refuse(c, "fmi2GetStringStatus: no string status is provided");
 }

@@ -97,6 +97,7 @@ impl StateSpaceModel for BoucWen {
         .expect("unique names")
     }
 
+    #[inline]
     fn rhs(&self, _t: f64, x: &[f64], u: &[f64], th: &[f64], dx: &mut [f64]) {
         let (y, v, z) = (x[0], x[1], x[2]);
         dx[0] = v;

@@ -6,11 +6,9 @@
 //!
 //! Equations and reference: see [`super::BoucWen`] (Noël & Schoukens 2016).
 
-use super::bouc_wen::{
-    abs_pow, local_derivatives, LocalDerivatives, ALPHA, BD, BG, CL, KL, ML, NU, ZERO_SLOT,
-};
-use super::sign0;
+use super::bouc_wen::{local_derivatives, LocalDerivatives, CL, KL, ML, NU, ZERO_SLOT};
 use crate::model::greybox::fixed_rk4::{self, FixedSensitivityRhs, Rk4Sensitivities, SampleSink};
+use crate::model::greybox::StateSpaceModel;
 use crate::Result;
 
 /// The largest number of sensitivity columns with a fixed-size path: the seven parameters and
@@ -74,8 +72,8 @@ impl<const Q: usize> FixedSensitivityRhs<3, Q> for Kernel<Q> {
     }
 }
 
-/// ẋ alone, for a plain simulation (no sensitivity column): the operations of
-/// [`BoucWen::rhs`](super::BoucWen) in its order, so the same bits as the generic path.
+/// ẋ alone, for a plain simulation (no sensitivity column): [`BoucWen::rhs`](super::BoucWen)
+/// itself, called statically, so the same bits as the generic path.
 struct Rates {
     theta: [f64; 7],
 }
@@ -90,12 +88,7 @@ impl FixedSensitivityRhs<3, 0> for Rates {
         dx: &mut [f64; 3],
         _ds: &mut [[f64; 0]; 3],
     ) {
-        let th = &self.theta;
-        let [y, v, z] = *x;
-        dx[0] = v;
-        dx[1] = (u[0] - th[CL] * v - th[KL] * y - z) / th[ML];
-        let a = abs_pow(z, th[NU]);
-        dx[2] = th[ALPHA] * v - th[BG] * v.abs() * sign0(z) * a - th[BD] * v * a;
+        super::BoucWen.rhs(0.0, x, u, &self.theta, dx);
     }
 }
 
