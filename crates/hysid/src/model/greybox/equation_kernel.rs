@@ -145,35 +145,6 @@ impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for TapeKernel<N,
     }
 }
 
-/// ẋ and Ṡ from the native code of the column tape ([`super::native::Layout::Sensitivities`]),
-/// which sums Ṡ as [`TapeKernel`] does, with the same coupling flags.
-struct NativeKernel<const N: usize, const Q: usize> {
-    native: BoundNative,
-    coupled: [[bool; N]; N],
-}
-
-impl<const N: usize, const Q: usize> FixedSensitivityRhs<N, Q> for NativeKernel<N, Q> {
-    #[inline(always)]
-    fn eval(
-        &mut self,
-        x: &[f64; N],
-        u: &[f64],
-        s: &[[f64; Q]; N],
-        dx: &mut [f64; N],
-        ds: &mut [[f64; Q]; N],
-    ) {
-        self.native.sensitivities(
-            0.0,
-            x,
-            u,
-            s.as_flattened(),
-            self.coupled.as_flattened(),
-            dx,
-            ds.as_flattened_mut(),
-        );
-    }
-}
-
 /// ẋ alone from the bound tape of f (or its native code), for a simulation without
 /// sensitivity columns (Q = 0).
 struct RateKernel<const N: usize> {
@@ -214,10 +185,14 @@ pub(super) fn simulate(
         on_sample: &mut SampleSink<'_>,
     ) -> Option<Result<()>> {
         Some(match native {
+            // The sub-steps of a sample in one call of the native code, which sums Ṡ as
+            // `TapeKernel` does, with the same coupling flags.
             Some(native) => {
-                let coupled = fixed_coupling(&tape);
-                let mut kernel = NativeKernel::<N, Q> { native, coupled };
-                fixed_rk4::simulate::<_, N, Q>(&mut kernel, run, on_sample)
+                let coupled = coupling(&tape, N);
+                let (m, h) = fixed_rk4::substep(run);
+                fixed_rk4::simulate_by_samples::<N, Q>(run, on_sample, |nodes, x, s| {
+                    native.substeps(nodes, &coupled, m, h, x, s)
+                })
             }
             None => {
                 let mut kernel = TapeKernel::<N, Q>::new(tape, run.params.len());

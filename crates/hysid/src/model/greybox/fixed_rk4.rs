@@ -165,7 +165,7 @@ where
     simulate_body::<K, N, Q>(kernel, run, on_sample)
 }
 
-/// The loop of [`simulate`].
+/// The loop of [`simulate`]: per sample, m RK4 sub-steps through the kernel's stages.
 #[inline(always)]
 fn simulate_body<K, const N: usize, const Q: usize>(
     kernel: &mut K,
@@ -175,20 +175,70 @@ fn simulate_body<K, const N: usize, const Q: usize>(
 where
     K: FixedSensitivityRhs<N, Q>,
 {
+    let (m, h) = substep(run);
+    let (half, sixth) = (0.5 * h, h / 6.0);
+    let mut k = [Augmented::<N, Q>::ZERO; 4];
+    let mut stage = Augmented::<N, Q>::ZERO;
+    let channels = run.input.n_channels();
+    let span = |i: usize| i * channels..(i + 1) * channels;
+    sample_loop(run, on_sample, |nodes, z: &mut Augmented<N, Q>| {
+        for j in 0..m {
+            let (start, middle, end) = (
+                &nodes[span(2 * j)],
+                &nodes[span(2 * j + 1)],
+                &nodes[span(2 * j + 2)],
+            );
+            let [k1, k2, k3, k4] = &mut k;
+            kernel.eval(&z.x, start, &z.s, &mut k1.x, &mut k1.s);
+            stage.set_axpy(z, half, k1);
+            kernel.eval(&stage.x, middle, &stage.s, &mut k2.x, &mut k2.s);
+            stage.set_axpy(z, half, k2);
+            kernel.eval(&stage.x, middle, &stage.s, &mut k3.x, &mut k3.s);
+            stage.set_axpy(z, h, k3);
+            kernel.eval(&stage.x, end, &stage.s, &mut k4.x, &mut k4.s);
+            z.add_rk4(sixth, &k);
+        }
+    })
+}
+
+/// The sub-steps per sample m (at least one) and the sub-step h = Ts/m of `run`.
+pub(crate) fn substep(run: &Rk4Sensitivities<'_>) -> (usize, f64) {
+    let m = run.substeps.max(1);
+    (m, run.ts / m as f64)
+}
+
+/// Simulates `run` as [`simulate`] does, with `advance(nodes, x, S)` moving x and S
+/// (row-major N × Q) over one sample interval from the input at its 2m + 1 half-step
+/// nodes: compiled code that runs the sub-steps of [`simulate`]'s kernel loop itself
+/// (equation files' native code, `hysid_substeps`), and must give its numbers.
+pub(crate) fn simulate_by_samples<const N: usize, const Q: usize>(
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+    mut advance: impl FnMut(&[f64], &mut [f64; N], &mut [f64]),
+) -> Result<()> {
+    sample_loop(run, on_sample, |nodes, z: &mut Augmented<N, Q>| {
+        advance(nodes, &mut z.x, z.s.as_flattened_mut())
+    })
+}
+
+/// The sample loop: from x0 and S(t₀) = s0, at every sample the divergence check and
+/// `on_sample(k, x(t_k), S(t_k))`, then `advance(nodes, z)` over the interval to the next
+/// sample, the input read at the interval's half-step nodes ([`InputTrack::nodes`], which
+/// the caller has checked lie on its grid: resolution 2·substeps).
+#[inline(always)]
+fn sample_loop<const N: usize, const Q: usize>(
+    run: &Rk4Sensitivities<'_>,
+    on_sample: &mut SampleSink<'_>,
+    mut advance: impl FnMut(&[f64], &mut Augmented<N, Q>),
+) -> Result<()> {
     let input = run.input;
     let mut z = Augmented::<N, Q>::ZERO;
     z.x.copy_from_slice(run.x0);
     z.s.as_flattened_mut().copy_from_slice(run.s0);
-    let m = run.substeps.max(1);
-    let h = run.ts / m as f64;
-    let (half, sixth) = (0.5 * h, h / 6.0);
-    let mut k = [Augmented::<N, Q>::ZERO; 4];
-    let mut stage = Augmented::<N, Q>::ZERO;
+    let (m, _) = substep(run);
     // The input at the 2m + 1 nodes of a sample interval, node-major: sub-step j reads
     // nodes 2j (start), 2j + 1 (middle) and 2j + 2 (end).
-    let channels = input.n_channels();
-    let mut nodes = vec![0.0; (2 * m + 1) * channels];
-    let span = |i: usize| i * channels..(i + 1) * channels;
+    let mut nodes = vec![0.0; (2 * m + 1) * input.n_channels()];
     let n_samples = input.len();
     for sample in 0..n_samples {
         if !z.is_finite() {
@@ -199,22 +249,7 @@ where
             break;
         }
         input.nodes(sample, &mut nodes);
-        for j in 0..m {
-            let (start, middle, end) = (
-                &nodes[span(2 * j)],
-                &nodes[span(2 * j + 1)],
-                &nodes[span(2 * j + 2)],
-            );
-            let [k1, k2, k3, k4] = &mut k;
-            kernel.eval(&z.x, start, &z.s, &mut k1.x, &mut k1.s);
-            stage.set_axpy(&z, half, k1);
-            kernel.eval(&stage.x, middle, &stage.s, &mut k2.x, &mut k2.s);
-            stage.set_axpy(&z, half, k2);
-            kernel.eval(&stage.x, middle, &stage.s, &mut k3.x, &mut k3.s);
-            stage.set_axpy(&z, h, k3);
-            kernel.eval(&stage.x, end, &stage.s, &mut k4.x, &mut k4.s);
-            z.add_rk4(sixth, &k);
-        }
+        advance(&nodes, &mut z);
     }
     Ok(())
 }

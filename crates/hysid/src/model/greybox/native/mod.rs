@@ -98,6 +98,8 @@ type SensFn = unsafe extern "C" fn(
     *mut f64,
     *mut f64,
 );
+type SubstepsFn =
+    unsafe extern "C" fn(*const f64, *const f64, *const u8, i32, f64, *mut f64, *mut f64);
 
 /// What a native function computes from a listing.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -130,11 +132,12 @@ pub enum Layout {
     },
 }
 
-/// The entry point of a loaded function.
+/// The entry points of a loaded function.
 #[derive(Clone, Copy)]
 enum Entry {
     Results(EvalFn),
-    Sensitivities(SensFn),
+    /// `hysid_sens` (one evaluation) and `hysid_substeps` (one sample interval's RK4).
+    Sensitivities(SensFn, SubstepsFn),
 }
 
 /// The sizes a native function reads and writes.
@@ -202,7 +205,7 @@ impl NativeFunction {
                 if listing.results.len() != n + n * n + n * k || q < k {
                     return Err("the listing is not a column tape of this shape".into());
                 }
-                source::sensitivities_source(listing, n, *k, *q)
+                source::sensitivities_source(listing, n, *k, *q, shape.inputs)
             }
         };
         let native = Arc::new(Self::load(&source, layout, shape)?);
@@ -228,11 +231,14 @@ impl NativeFunction {
                         library.symbol(c"hysid_eval")?,
                     ))
                 }
-                Layout::Sensitivities { .. } => {
-                    Entry::Sensitivities(std::mem::transmute::<*mut std::ffi::c_void, SensFn>(
+                Layout::Sensitivities { .. } => Entry::Sensitivities(
+                    std::mem::transmute::<*mut std::ffi::c_void, SensFn>(
                         library.symbol(c"hysid_sens")?,
-                    ))
-                }
+                    ),
+                    std::mem::transmute::<*mut std::ffi::c_void, SubstepsFn>(
+                        library.symbol(c"hysid_substeps")?,
+                    ),
+                ),
             };
             (
                 std::mem::transmute::<*mut std::ffi::c_void, PrepareFn>(prepare),
@@ -394,7 +400,7 @@ impl BoundNative {
         dx: &mut [f64],
         ds: &mut [f64],
     ) {
-        let Entry::Sensitivities(sens) = self.entry else {
+        let Entry::Sensitivities(sens, _) = self.entry else {
             panic!("native evaluation: not a sensitivities layout");
         };
         let (n, q) = (self.states, self.q);
@@ -420,6 +426,52 @@ impl BoundNative {
                 coupled.as_ptr().cast::<u8>(),
                 dx.as_mut_ptr(),
                 ds.as_mut_ptr(),
+            )
+        }
+    }
+
+    /// Advances x and S (row-major n × q) by one sample interval: `m` classical RK4
+    /// sub-steps of size `h`, the input read at the interval's 2m + 1 half-step nodes
+    /// (`nodes`, node-major) — the stages and updates of the fixed-size Rust loop
+    /// (`fixed_rk4`) with the rates of [`Self::sensitivities`], to the bit, in one call.
+    ///
+    /// # Panics
+    /// If the layout is not [`Layout::Sensitivities`], or a buffer is shorter than the
+    /// shape's, or m does not fit a C `int`.
+    #[inline]
+    pub fn substeps(
+        &self,
+        nodes: &[f64],
+        coupled: &[bool],
+        m: usize,
+        h: f64,
+        x: &mut [f64],
+        s: &mut [f64],
+    ) {
+        let Entry::Sensitivities(_, substeps) = self.entry else {
+            panic!("native evaluation: not a sensitivities layout");
+        };
+        let (n, q) = (self.states, self.q);
+        let steps = i32::try_from(m).expect("sub-steps per sample fit an int");
+        assert!(
+            nodes.len() >= (2 * m + 1) * self.inputs
+                && coupled.len() >= n * n
+                && x.len() >= n
+                && s.len() >= n * q,
+            "native evaluation: buffers shorter than the model's"
+        );
+        // SAFETY: the code reads nodes[..(2m + 1)·inputs], coupled[..n²] (bool is one byte,
+        // 0 or 1) and the prepared slots, and reads and writes x[..n], s[..n·q]: all
+        // checked above.
+        unsafe {
+            substeps(
+                nodes.as_ptr(),
+                self.prepared.as_ptr(),
+                coupled.as_ptr().cast::<u8>(),
+                steps,
+                h,
+                x.as_mut_ptr(),
+                s.as_mut_ptr(),
             )
         }
     }
