@@ -34,7 +34,7 @@
 //! interpolation do not apply to it.
 
 use super::fixed_rk4::{Rk4Sensitivities, SampleSink};
-use super::native::{Evaluator, Layout, NativeFunction, Shape};
+use super::native::{Backend, Evaluator, Layout, NativeFunction, Provenance, Shape};
 use super::{equation_kernel, sensitivity, JacobianScratch, StateSpaceModel};
 use crate::data::Channel;
 use crate::error::EquationFileError;
@@ -264,14 +264,14 @@ impl EquationStateSpace {
             .native_cell(&key)
             .get_or_init(|| self.build_native(&key))
             .clone();
-        match (found, self.evaluator) {
-            (Ok(f), _) => Ok(Some(f)),
-            (Err(why), Evaluator::Native) => Err(Error::Unsupported(format!(
+        match found {
+            Ok(f) => Ok(Some(f)),
+            Err(why) if self.evaluator.requires_native() => Err(Error::Unsupported(format!(
                 "equation model '{}': no native code ({why}); unset HYSID_EVALUATOR (or set \
                  it to auto) to run the tape interpreter",
                 self.name()
             ))),
-            (Err(_), _) => Ok(None),
+            Err(_) => Ok(None),
         }
     }
 
@@ -301,10 +301,31 @@ impl EquationStateSpace {
         })
     }
 
-    /// Builds the native code of `key` and checks it against the tape at sample points. The
-    /// code of a column tape carries ẋ alone as well: it becomes the plain simulations'
-    /// native function (checked likewise) unless they have one already.
+    /// The native code of `key` by the first of the evaluator's routes that builds it
+    /// ([`Evaluator::backends`]: in the process, else the C compiler), or why none did.
     fn build_native(&self, key: &NativeKey) -> std::result::Result<Arc<NativeFunction>, String> {
+        let mut why = Vec::new();
+        for &backend in self.evaluator.backends() {
+            match self.build_with(key, backend) {
+                Ok(native) => return Ok(native),
+                Err(e) => why.push(e),
+            }
+        }
+        Err(if why.is_empty() {
+            "no route to native code on this machine".into()
+        } else {
+            why.join("; ")
+        })
+    }
+
+    /// Builds the native code of `key` by `backend` and checks it against the tape at
+    /// sample points. The code of a column tape carries ẋ alone as well: it becomes the
+    /// plain simulations' native function (checked likewise) unless they have one already.
+    fn build_with(
+        &self,
+        key: &NativeKey,
+        backend: Backend,
+    ) -> std::result::Result<Arc<NativeFunction>, String> {
         let (n, m) = (self.states.len(), self.inputs.len());
         let shape = Shape {
             states: n,
@@ -318,9 +339,13 @@ impl EquationStateSpace {
                     values: n,
                     positions: (0..n).collect(),
                 };
-                NativeFunction::build(&self.model.rhs_listing(), layout, shape, |native| {
-                    self.rates_match(native)
-                })
+                NativeFunction::build(
+                    &self.model.rhs_listing(),
+                    layout,
+                    shape,
+                    backend,
+                    |native| self.rates_match(native),
+                )
             }
             NativeKey::Columns { params, q } => {
                 let columns = self
@@ -330,7 +355,7 @@ impl EquationStateSpace {
                 let listing = self.model.columns_listing(&columns);
                 let (k, q) = (params.len(), *q);
                 let layout = Layout::Sensitivities { k, q };
-                let built = NativeFunction::build(&listing, layout, shape, |native| {
+                let built = NativeFunction::build(&listing, layout, shape, backend, |native| {
                     let Some(bound) = self.model.bind_columns(&columns, &theta) else {
                         return false;
                     };
@@ -556,9 +581,10 @@ impl StateSpaceModel for EquationStateSpace {
         equation_kernel::simulate(tape, native, run, on_sample)
     }
 
-    /// "native code (…)" when every simulation that asked for native code got it (with the
-    /// compile time, or "loaded from the cache"), "tape interpreter (…)" with the reason
-    /// otherwise; None before any simulation.
+    /// "native code (…)" when every simulation that asked for native code got it (how:
+    /// generated in the process, compiled now with the compiler's time, or loaded from the
+    /// cache), "tape interpreter (…)" with the reason otherwise; None before any
+    /// simulation.
     fn evaluation(&self) -> Option<String> {
         if self.evaluator == Evaluator::Tape {
             return Some("tape interpreter (HYSID_EVALUATOR=tape)".into());
@@ -571,18 +597,27 @@ impl StateSpaceModel for EquationStateSpace {
         if let Some(Err(why)) = built.iter().find(|b| b.is_err()) {
             return Some(format!("tape interpreter (no native code: {why})"));
         }
-        let compiled: f64 = built
-            .iter()
-            .filter_map(|b| match b.as_ref().ok()?.provenance() {
-                super::native::Provenance::Compiled(s) => Some(s),
-                super::native::Provenance::Cached => None,
-            })
-            .sum();
-        Some(if compiled > 0.0 {
-            format!("native code (compiled now: {compiled:.2} s of compiler time; cached for the next runs)")
-        } else {
-            "native code (loaded from the cache)".into()
-        })
+        let (mut generated, mut compiled, mut cached) = (None::<f64>, None::<f64>, false);
+        for b in built.iter().filter_map(|b| b.as_ref().ok()) {
+            match b.provenance() {
+                Provenance::Generated(s) => *generated.get_or_insert(0.0) += s,
+                Provenance::Compiled(s) => *compiled.get_or_insert(0.0) += s,
+                Provenance::Cached => cached = true,
+            }
+        }
+        let mut how = Vec::new();
+        if let Some(s) = generated {
+            how.push(format!("generated in the process in {:.1} ms", 1e3 * s));
+        }
+        if let Some(s) = compiled {
+            how.push(format!(
+                "compiled now: {s:.2} s of compiler time; cached for the next runs"
+            ));
+        }
+        if cached {
+            how.push("loaded from the cache".into());
+        }
+        Some(format!("native code ({})", how.join("; ")))
     }
 
     /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded), or

@@ -28,6 +28,8 @@
 //! "CasADi: a software framework for nonlinear optimization and optimal control",
 //! *Mathematical Programming Computation* 11, 2019).
 
+#[cfg(all(target_os = "linux", target_arch = "x86_64"))]
+mod jit;
 #[cfg(target_os = "linux")]
 mod object;
 mod source;
@@ -39,22 +41,70 @@ use std::sync::Arc;
 /// Which code evaluates an equation model's tapes in a simulation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Evaluator {
-    /// Native code when it can be built (a C compiler, Linux), else the tape interpreter.
+    /// Native code when it can be built (emitted in the process, else by a C compiler),
+    /// else the tape interpreter.
     #[default]
     Auto,
-    /// Native code; a simulation fails with the reason when it cannot be built.
+    /// Native code by either route; a simulation fails with the reason when it cannot be
+    /// built.
     Native,
+    /// Native code emitted in the process only ([`Backend::Generated`]).
+    Jit,
+    /// Native code from the C compiler only ([`Backend::Compiled`]).
+    Cc,
     /// The tape interpreter.
     Tape,
 }
 
 impl Evaluator {
-    /// The evaluator the environment variable `HYSID_EVALUATOR` names (`auto`, `native` or
-    /// `tape`; unset or empty: `auto`).
+    /// The evaluator the environment variable `HYSID_EVALUATOR` names (`auto`, `native`,
+    /// `jit`, `cc` or `tape`; unset or empty: `auto`).
     pub fn from_env() -> Result<Self> {
         match std::env::var("HYSID_EVALUATOR") {
             Err(_) => Ok(Self::Auto),
             Ok(v) => v.parse(),
+        }
+    }
+
+    /// The routes to native code this evaluator tries, in order (none for the tape).
+    pub fn backends(self) -> &'static [Backend] {
+        match self {
+            Self::Auto | Self::Native if Backend::Generated.available() => {
+                &[Backend::Generated, Backend::Compiled]
+            }
+            Self::Auto | Self::Native | Self::Cc => &[Backend::Compiled],
+            Self::Jit => &[Backend::Generated],
+            Self::Tape => &[],
+        }
+    }
+
+    /// Whether a simulation fails when native code cannot be built.
+    pub fn requires_native(self) -> bool {
+        matches!(self, Self::Native | Self::Jit | Self::Cc)
+    }
+}
+
+/// How a listing becomes machine code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backend {
+    /// Emitted as x86-64 machine code in the process (`jit/`; Linux on x86-64 with AVX):
+    /// well under a millisecond.
+    Generated,
+    /// Printed as C (`source.rs`), compiled by the system's C compiler and cached
+    /// (`object.rs`; Linux): about 0.1 s the first time on a machine.
+    Compiled,
+}
+
+impl Backend {
+    /// Whether this build on this machine has the route (the C compiler's presence is
+    /// found out when it runs).
+    pub fn available(self) -> bool {
+        match self {
+            #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
+            Backend::Generated => jit::available(),
+            #[cfg(not(all(target_os = "linux", target_arch = "x86_64")))]
+            Backend::Generated => false,
+            Backend::Compiled => cfg!(target_os = "linux"),
         }
     }
 }
@@ -65,12 +115,15 @@ impl std::str::FromStr for Evaluator {
         match s.trim() {
             "" | "auto" => Ok(Self::Auto),
             "native" => Ok(Self::Native),
+            "jit" => Ok(Self::Jit),
+            "cc" => Ok(Self::Cc),
             "tape" => Ok(Self::Tape),
             other => Err(Error::invalid_option(
                 "HYSID_EVALUATOR",
                 other,
                 format!(
-                    "HYSID_EVALUATOR is '{other}'; the equation evaluator is auto, native or tape"
+                    "HYSID_EVALUATOR is '{other}'; the equation evaluator is auto, native, jit, cc \
+                     or tape"
                 ),
             )),
         }
@@ -80,6 +133,8 @@ impl std::str::FromStr for Evaluator {
 /// How a native function was obtained, for a report.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Provenance {
+    /// Emitted in the process ([`Backend::Generated`]), in this many seconds.
+    Generated(f64),
     /// Loaded from the cache of compiled models.
     Cached,
     /// Compiled now, in this many seconds.
@@ -153,8 +208,8 @@ pub struct Shape {
 
 /// A listing compiled to machine code and loaded (see the module docs).
 pub struct NativeFunction {
-    #[cfg(target_os = "linux")]
-    library: Arc<object::Library>,
+    /// Keeps the code mapped.
+    code: Arc<dyn Send + Sync>,
     prepare: PrepareFn,
     entry: Entry,
     /// ẋ alone from the same code and prepared values (`hysid_rates`), for a
@@ -170,6 +225,76 @@ pub struct NativeFunction {
     provenance: Provenance,
 }
 
+/// The entry points of a loaded or generated unit, by their C names.
+struct Found {
+    prepare: PrepareFn,
+    entry: Entry,
+    rates: Option<EvalFn>,
+}
+
+impl Found {
+    /// The functions `layout` needs, from `symbol` (a name to its address).
+    fn look_up(
+        symbol: impl Fn(&std::ffi::CStr) -> std::result::Result<*mut std::ffi::c_void, String>,
+        layout: &Layout,
+    ) -> std::result::Result<Self, String> {
+        type Address = *mut std::ffi::c_void;
+        // SAFETY: each name is a function of `source.rs` (or its generated twin) with the
+        // C signature it is transmuted to.
+        unsafe {
+            let prepare = std::mem::transmute::<Address, PrepareFn>(symbol(c"hysid_prepare")?);
+            let (entry, rates) = match layout {
+                Layout::Results { .. } => (
+                    Entry::Results(std::mem::transmute::<Address, EvalFn>(symbol(
+                        c"hysid_eval",
+                    )?)),
+                    None,
+                ),
+                Layout::Sensitivities { .. } => (
+                    Entry::Sensitivities(
+                        std::mem::transmute::<Address, SensFn>(symbol(c"hysid_sens")?),
+                        std::mem::transmute::<Address, SubstepsFn>(symbol(c"hysid_substeps")?),
+                    ),
+                    Some(std::mem::transmute::<Address, EvalFn>(symbol(
+                        c"hysid_rates",
+                    )?)),
+                ),
+            };
+            Ok(Self {
+                prepare,
+                entry,
+                rates,
+            })
+        }
+    }
+
+    /// The native function of these entry points, `code` kept alive with it.
+    fn function(
+        self,
+        code: Arc<dyn Send + Sync>,
+        layout: Layout,
+        shape: Shape,
+        prepared: usize,
+        provenance: Provenance,
+    ) -> NativeFunction {
+        let out_len = match &layout {
+            Layout::Results { positions, .. } => positions.iter().max().map_or(0, |p| p + 1),
+            Layout::Sensitivities { .. } => 0,
+        };
+        NativeFunction {
+            code,
+            prepare: self.prepare,
+            entry: self.entry,
+            rates: self.rates,
+            layout,
+            prepared,
+            out_len,
+            shape,
+            provenance,
+        }
+    }
+}
+
 impl std::fmt::Debug for NativeFunction {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("NativeFunction")
@@ -182,39 +307,57 @@ impl std::fmt::Debug for NativeFunction {
 }
 
 impl NativeFunction {
-    /// The native form of `listing` over `shape`, computing what `layout` says. Before it
-    /// is returned, `check` is called with it and must return true (the caller compares it
-    /// with the tape at sample points). Errors: one line, why there is no native code (no
-    /// C compiler, a compiler error, not Linux, a layout that does not fit the listing, a
-    /// check that failed).
+    /// The native form of `listing` over `shape`, computing what `layout` says, made by
+    /// `backend`. Before it is returned, `check` is called with it and must return true
+    /// (the caller compares it with the tape at sample points). Errors: one line, why
+    /// there is no native code (the route is not available here, no C compiler, a
+    /// compiler error, a layout that does not fit the listing, a check that failed).
     pub fn build(
         listing: &Listing,
         layout: Layout,
         shape: Shape,
+        backend: Backend,
         check: impl FnOnce(&Arc<NativeFunction>) -> bool,
     ) -> std::result::Result<Arc<Self>, String> {
         let n = shape.states;
-        let source = match &layout {
+        let fits = match &layout {
             Layout::Results { values, positions } => {
-                if positions.len() != listing.results.len() || *values > positions.len() {
-                    return Err("one position per result is needed".into());
-                }
-                source::results_source(listing, *values, positions)
+                positions.len() == listing.results.len() && *values <= positions.len()
             }
-            Layout::Sensitivities { k, q } => {
-                if listing.results.len() != n + n * n + n * k || q < k {
-                    return Err("the listing is not a column tape of this shape".into());
-                }
-                source::sensitivities_source(listing, n, *k, *q, shape.inputs)
-            }
+            Layout::Sensitivities { k, q } => listing.results.len() == n + n * n + n * k && q >= k,
         };
-        let native = Arc::new(Self::load(&source, layout, shape)?);
+        if !fits {
+            return Err(match layout {
+                Layout::Results { .. } => "one position per result is needed".into(),
+                Layout::Sensitivities { .. } => {
+                    "the listing is not a column tape of this shape".into()
+                }
+            });
+        }
+        if !backend.available() {
+            return Err(format!("{backend:?} native code is not available here"));
+        }
+        let native = Arc::new(match backend {
+            Backend::Generated => Self::generate(listing, layout, shape)?,
+            Backend::Compiled => {
+                let source = match &layout {
+                    Layout::Results { values, positions } => {
+                        source::results_source(listing, *values, positions)
+                    }
+                    Layout::Sensitivities { k, q } => {
+                        source::sensitivities_source(listing, n, *k, *q, shape.inputs)
+                    }
+                };
+                Self::load(&source, layout, shape)?
+            }
+        });
         if !check(&native) {
             return Err("the compiled code does not reproduce the tape's numbers".into());
         }
         Ok(native)
     }
 
+    /// The functions of `source` compiled by the C compiler (or loaded from the cache).
     #[cfg(target_os = "linux")]
     fn load(
         source: &source::Source,
@@ -222,58 +365,47 @@ impl NativeFunction {
         shape: Shape,
     ) -> std::result::Result<Self, String> {
         let (library, provenance) = object::load(&source.text)?;
-        let prepare = library.symbol(c"hysid_prepare")?;
-        // SAFETY: the symbols are the functions `source` defines, with these C signatures.
-        let (prepare, entry) = unsafe {
-            let entry = match layout {
-                Layout::Results { .. } => {
-                    Entry::Results(std::mem::transmute::<*mut std::ffi::c_void, EvalFn>(
-                        library.symbol(c"hysid_eval")?,
-                    ))
-                }
-                Layout::Sensitivities { .. } => Entry::Sensitivities(
-                    std::mem::transmute::<*mut std::ffi::c_void, SensFn>(
-                        library.symbol(c"hysid_sens")?,
-                    ),
-                    std::mem::transmute::<*mut std::ffi::c_void, SubstepsFn>(
-                        library.symbol(c"hysid_substeps")?,
-                    ),
-                ),
-            };
-            (
-                std::mem::transmute::<*mut std::ffi::c_void, PrepareFn>(prepare),
-                entry,
-            )
-        };
-        let rates = match layout {
-            // SAFETY: `hysid_rates` has the signature of `hysid_eval`.
-            Layout::Sensitivities { .. } => Some(unsafe {
-                std::mem::transmute::<*mut std::ffi::c_void, EvalFn>(
-                    library.symbol(c"hysid_rates")?,
-                )
-            }),
-            Layout::Results { .. } => None,
-        };
-        let out_len = match &layout {
-            Layout::Results { positions, .. } => positions.iter().max().map_or(0, |p| p + 1),
-            Layout::Sensitivities { .. } => 0,
-        };
-        Ok(Self {
-            library: Arc::new(library),
-            prepare,
-            entry,
-            rates,
-            layout,
-            out_len,
-            prepared: source.prepared,
-            shape,
-            provenance,
-        })
+        let library = Arc::new(library);
+        let symbol = |name: &std::ffi::CStr| library.symbol(name);
+        let found = Found::look_up(symbol, &layout)?;
+        Ok(found.function(library.clone(), layout, shape, source.prepared, provenance))
     }
 
     #[cfg(not(target_os = "linux"))]
     fn load(_: &source::Source, _: Layout, _: Shape) -> std::result::Result<Self, String> {
         Err("native code is built on Linux only".into())
+    }
+
+    /// The functions of `source.rs` emitted in the process.
+    #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
+    fn generate(
+        listing: &Listing,
+        layout: Layout,
+        shape: Shape,
+    ) -> std::result::Result<Self, String> {
+        let started = std::time::Instant::now();
+        let (code, entries, prepared) = jit::assemble(listing, &layout, shape)?;
+        let provenance = Provenance::Generated(started.elapsed().as_secs_f64());
+        let symbol = |name: &std::ffi::CStr| {
+            let offset = match (name.to_bytes(), entries.eval, entries.sens) {
+                (b"hysid_prepare", ..) => Some(entries.prepare),
+                (b"hysid_eval", Some(eval), _) => Some(eval),
+                (b"hysid_sens", _, Some((sens, _, _))) => Some(sens),
+                (b"hysid_substeps", _, Some((_, substeps, _))) => Some(substeps),
+                (b"hysid_rates", _, Some((_, _, rates))) => Some(rates),
+                _ => None,
+            };
+            offset
+                .map(|o| code.entry(o))
+                .ok_or_else(|| format!("no function {name:?} was generated"))
+        };
+        let found = Found::look_up(symbol, &layout)?;
+        Ok(found.function(Arc::new(code), layout, shape, prepared, provenance))
+    }
+
+    #[cfg(not(all(target_os = "linux", target_arch = "x86_64")))]
+    fn generate(_: &Listing, _: Layout, _: Shape) -> std::result::Result<Self, String> {
+        Err("native code is generated on x86-64 Linux only".into())
     }
 
     /// How the code was obtained.
@@ -290,8 +422,7 @@ impl NativeFunction {
         let rates = self.rates?;
         let n = self.shape.states;
         Some(Arc::new(NativeFunction {
-            #[cfg(target_os = "linux")]
-            library: Arc::clone(&self.library),
+            code: Arc::clone(&self.code),
             prepare: self.prepare,
             entry: Entry::Results(rates),
             rates: None,

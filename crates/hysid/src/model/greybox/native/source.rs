@@ -42,7 +42,7 @@ pub(super) struct Source {
 
 /// What a result (or operand) of the evaluation is, for the code that reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Class {
+pub(super) enum Class {
     /// A constant that reads as zero once made finite: a term it multiplies is left out.
     Zero,
     /// Another constant.
@@ -53,13 +53,18 @@ enum Class {
     Varying,
 }
 
-/// A listing split into what θ alone determines (`hysid_prepare`) and the rest.
-struct Split<'a> {
-    listing: &'a Listing,
-    varying: Vec<bool>,
-    slot_of_param: Vec<Option<usize>>,
-    slot_of_value: Vec<Option<usize>>,
-    slots: usize,
+/// A listing split into what θ alone determines (`hysid_prepare`) and the rest; the
+/// in-process code generator (`jit`) emits the same split.
+pub(super) struct Split<'a> {
+    pub listing: &'a Listing,
+    /// Per operation, whether it reads t, x or u (directly or through another).
+    pub varying: Vec<bool>,
+    /// Per parameter, its slot in `c` (when the evaluating code reads it).
+    pub slot_of_param: Vec<Option<usize>>,
+    /// Per θ-only operation, its slot in `c` (when the evaluating code reads it).
+    pub slot_of_value: Vec<Option<usize>>,
+    /// The length of `c`.
+    pub slots: usize,
     /// The body of `hysid_prepare`.
     prepare: String,
     /// The varying operations, one `const double vK = …;` each.
@@ -67,7 +72,7 @@ struct Split<'a> {
 }
 
 impl<'a> Split<'a> {
-    fn new(listing: &'a Listing) -> Self {
+    pub fn new(listing: &'a Listing) -> Self {
         let varying = varying_operations(listing);
         let mut split = Split {
             listing,
@@ -153,14 +158,18 @@ impl<'a> Split<'a> {
     /// Result k as a derivative reads it: finite (by the convention), and its class.
     fn derivative(&self, k: usize) -> (String, Class) {
         let o = &self.listing.results[k];
-        let class = match *o {
+        (format!("hy_finite({})", self.read(o)), self.class(o))
+    }
+
+    /// What an operand read as a derivative is (a constant reads as its finite value).
+    pub fn class(&self, o: &Operand) -> Class {
+        match *o {
             Operand::Constant(v) if v.is_finite() && v != 0.0 => Class::Constant,
             Operand::Constant(_) => Class::Zero,
             Operand::Parameter(_) => Class::Prepared,
             Operand::Value(j) if !self.varying[j] => Class::Prepared,
             _ => Class::Varying,
-        };
-        (format!("hy_finite({})", self.read(o)), class)
+        }
     }
 
     /// The translation unit: the prelude, `hysid_prepare`, then each function (signature
@@ -400,7 +409,8 @@ fn varying_operations(listing: &Listing) -> Vec<bool> {
     varying
 }
 
-fn operands(op: &Operation) -> Vec<Operand> {
+/// The operands an operation reads.
+pub(super) fn operands(op: &Operation) -> Vec<Operand> {
     match *op {
         Operation::Neg(a) | Operation::Unary(_, a) | Operation::Powi(a, _) | Operation::Not(a) => {
             vec![a]

@@ -1,7 +1,9 @@
 //! Tests of `hysid::model::greybox::native`: the compiled form of an equation model's
 //! tapes gives the tape's numbers to the bit.
 
-use hysid::model::greybox::native::{Evaluator, Layout, NativeFunction, Provenance, Shape};
+use hysid::model::greybox::native::{
+    Backend, Evaluator, Layout, NativeFunction, Provenance, Shape,
+};
 use hysid_equations::EquationModel;
 
 /// Every operation of the language: the functions, integer and real powers (the exponent a
@@ -69,18 +71,30 @@ fn results(values: usize, positions: Vec<usize>) -> Layout {
     Layout::Results { values, positions }
 }
 
+/// The routes to native code this machine has (the C compiler's on Linux; the in-process
+/// generator on x86-64 with AVX).
+fn backends() -> Vec<Backend> {
+    let all = [Backend::Generated, Backend::Compiled];
+    let here: Vec<Backend> = all.into_iter().filter(|b| b.available()).collect();
+    assert!(!here.is_empty(), "no route to native code on this machine");
+    here
+}
+
 /// Checks the native f, the native columns of `params` (padded to `q`, written in reverse
 /// order to exercise the positions) and the native sensitivity rates of those columns
-/// against the tape at 400 seeded points.
-fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
+/// against the tape at 400 seeded points, and the native RK4 sub-steps of a sample against
+/// the classical RK4 of those rates; the code made by `backend`.
+fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64, backend: Backend) {
     let (n, k) = (m.states().len(), params.len());
     let mut points = Points(seed);
     let theta = m.parameter_values();
 
     // f alone.
     let positions: Vec<usize> = (0..n).collect();
-    let f =
-        NativeFunction::build(&m.rhs_listing(), results(n, positions), shape(m), |_| true).unwrap();
+    let build = |listing: &hysid_equations::Listing, layout: Layout| {
+        NativeFunction::build(listing, layout, shape(m), backend, |_| true).unwrap()
+    };
+    let f = build(&m.rhs_listing(), results(n, positions));
     // Columns: f, ∂f/∂x, ∂f/∂θ[params] into rows of q, the whole layout reversed.
     let columns = m.rhs_jacobian_columns(params).unwrap();
     let len = n + n * n + n * q;
@@ -89,10 +103,8 @@ fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
         .collect();
     let reversed: Vec<usize> = natural.iter().map(|p| len - 1 - p).collect();
     let listing = m.columns_listing(&columns);
-    let jac =
-        NativeFunction::build(&listing, results(n, reversed.clone()), shape(m), |_| true).unwrap();
-    let sens = NativeFunction::build(&listing, Layout::Sensitivities { k, q }, shape(m), |_| true)
-        .unwrap();
+    let jac = build(&listing, results(n, reversed.clone()));
+    let sens = build(&listing, Layout::Sensitivities { k, q });
     let coupled = vec![true; n * n];
     let rates = sens
         .rates()
@@ -162,6 +174,54 @@ fn check_model(m: &EquationModel, params: &[usize], q: usize, seed: u64) {
                 );
             }
         }
+        if point % 8 == 0 {
+            check_substeps(&sens, &th, &x, &s, &coupled, m.inputs().len(), &mut points);
+        }
+    }
+}
+
+/// Three RK4 sub-steps of one sample interval by `substeps` equal to the bit the classical
+/// RK4 of the rates `sensitivities` gives, stage by stage in the fixed-size loop's order.
+fn check_substeps(
+    sens: &std::sync::Arc<NativeFunction>,
+    theta: &[f64],
+    x: &[f64],
+    s: &[f64],
+    coupled: &[bool],
+    inputs: usize,
+    points: &mut Points,
+) {
+    let (n, m, h) = (x.len(), 3, 1.0 / 3000.0);
+    let nodes: Vec<f64> = (0..(2 * m + 1) * inputs)
+        .map(|_| points.next() * 0.1)
+        .collect();
+    let bound = sens.bind(theta);
+    let (mut zx, mut zs) = (x.to_vec(), s.to_vec());
+    bound.substeps(&nodes, coupled, m, h, &mut zx, &mut zs);
+    let (half, sixth) = (0.5 * h, h / 6.0);
+    let mut z: Vec<f64> = x.iter().chain(s).copied().collect();
+    let rate = |z: &[f64], node: usize| {
+        let (mut dx, mut ds) = (vec![0.0; n], vec![0.0; s.len()]);
+        let u = &nodes[node * inputs..(node + 1) * inputs];
+        bound.sensitivities(0.0, &z[..n], u, &z[n..], coupled, &mut dx, &mut ds);
+        dx.extend(ds);
+        dx
+    };
+    let axpy = |z: &[f64], w: f64, k: &[f64]| -> Vec<f64> {
+        z.iter().zip(k).map(|(a, b)| a + w * b).collect()
+    };
+    for j in 0..m {
+        let k1 = rate(&z, 2 * j);
+        let k2 = rate(&axpy(&z, half, &k1), 2 * j + 1);
+        let k3 = rate(&axpy(&z, half, &k2), 2 * j + 1);
+        let k4 = rate(&axpy(&z, h, &k3), 2 * j + 2);
+        for (e, v) in z.iter_mut().enumerate() {
+            *v += sixth * (k1[e] + 2.0 * k2[e] + 2.0 * k3[e] + k4[e]);
+        }
+    }
+    let got: Vec<f64> = zx.iter().chain(&zs).copied().collect();
+    for (e, (a, b)) in z.iter().zip(&got).enumerate() {
+        assert!(same(*a, *b), "sub-steps, element {e}: RK4 {a} native {b}");
     }
 }
 
@@ -178,14 +238,28 @@ fn uncoupled_entries_are_left_out_of_the_sensitivity_rates() {
     let theta = m.parameter_values();
     let (k, q) = (6, 6);
     let columns = m.rhs_jacobian_columns(&[0, 1, 2, 3, 4, 5]).unwrap();
+    for backend in backends() {
+        uncoupled_entries_are_left_out(&m, &theta, &columns, k, q, backend);
+    }
+}
+
+fn uncoupled_entries_are_left_out(
+    m: &EquationModel,
+    theta: &[f64],
+    columns: &hysid_equations::ColumnTape,
+    k: usize,
+    q: usize,
+    backend: Backend,
+) {
     let sens = NativeFunction::build(
-        &m.columns_listing(&columns),
+        &m.columns_listing(columns),
         Layout::Sensitivities { k, q },
-        shape(&m),
+        shape(m),
+        backend,
         |_| true,
     )
     .unwrap()
-    .bind(&theta);
+    .bind(theta);
     let (x, u) = ([1e-3, -2e-2, 3.0], [5.0]);
     let s: Vec<f64> = (0..18).map(|i| 0.5 + i as f64).collect();
     let run = |coupled: &[bool]| {
@@ -218,9 +292,11 @@ fn uncoupled_entries_are_left_out_of_the_sensitivity_rates() {
 #[test]
 fn native_code_equals_the_tape_for_every_operation() {
     let m = EquationModel::parse(EVERY_OPERATION).unwrap();
-    check_model(&m, &[0, 1, 2, 3], 4, 1);
-    check_model(&m, &[0, 1, 2, 3], 6, 2);
-    check_model(&m, &[3, 1], 3, 3);
+    for backend in backends() {
+        check_model(&m, &[0, 1, 2, 3], 4, 1, backend);
+        check_model(&m, &[0, 1, 2, 3], 6, 2, backend);
+        check_model(&m, &[3, 1], 3, 3, backend);
+    }
 }
 
 /// The example files (Bouc–Wen, Duffing, cascaded tanks, the actuator with Coulomb
@@ -238,7 +314,9 @@ fn native_code_equals_the_tape_on_the_example_files() {
         let free: Vec<usize> = (0..m.parameters().len())
             .filter(|&i| !m.parameters()[i].fixed)
             .collect();
-        check_model(&m, &free, free.len() + m.states().len(), 7 + seen);
+        for backend in backends() {
+            check_model(&m, &free, free.len() + m.states().len(), 7 + seen, backend);
+        }
         seen += 1;
     }
     assert!(seen >= 5, "{seen} example files");
@@ -258,25 +336,52 @@ fn the_compiled_code_is_cached_and_checked() {
          [equations]\nx = \"-a*x + u + {stamp}e-40\"\n[output]\ny = \"x\"\n"
     );
     let m = EquationModel::parse(&text).unwrap();
-    let build = || {
-        NativeFunction::build(&m.rhs_listing(), results(1, vec![0]), shape(&m), |_| true).unwrap()
-    };
+    let (listing, backend) = (m.rhs_listing(), Backend::Compiled);
+    let build =
+        || NativeFunction::build(&listing, results(1, vec![0]), shape(&m), backend, |_| true);
+    let build = || build().unwrap();
     assert!(matches!(build().provenance(), Provenance::Compiled(s) if s > 0.0));
     assert_eq!(build().provenance(), Provenance::Cached);
-    let refused =
-        NativeFunction::build(&m.rhs_listing(), results(1, vec![0]), shape(&m), |_| false);
-    assert!(refused.unwrap_err().contains("does not reproduce the tape"));
+    for backend in backends() {
+        let refused =
+            NativeFunction::build(&listing, results(1, vec![0]), shape(&m), backend, |_| false);
+        assert!(refused.unwrap_err().contains("does not reproduce the tape"));
+    }
+}
+
+/// The in-process route emits code without a compiler or a cache: it says so, with the
+/// time it took.
+#[test]
+fn generated_code_needs_no_compiler() {
+    if !Backend::Generated.available() {
+        return;
+    }
+    let m = EquationModel::parse(EVERY_OPERATION).unwrap();
+    let f = NativeFunction::build(
+        &m.rhs_listing(),
+        results(2, vec![0, 1]),
+        shape(&m),
+        Backend::Generated,
+        |_| true,
+    )
+    .unwrap();
+    assert!(matches!(f.provenance(), Provenance::Generated(s) if (0.0..1.0).contains(&s)));
 }
 
 #[test]
-fn evaluators_are_named_auto_native_and_tape() {
+fn evaluators_are_named_auto_native_jit_cc_and_tape() {
     assert_eq!("auto".parse::<Evaluator>().unwrap(), Evaluator::Auto);
     assert_eq!("".parse::<Evaluator>().unwrap(), Evaluator::Auto);
     assert_eq!("native".parse::<Evaluator>().unwrap(), Evaluator::Native);
+    assert_eq!("jit".parse::<Evaluator>().unwrap(), Evaluator::Jit);
+    assert_eq!("cc".parse::<Evaluator>().unwrap(), Evaluator::Cc);
     assert_eq!(" tape ".parse::<Evaluator>().unwrap(), Evaluator::Tape);
-    let e = "jit".parse::<Evaluator>().unwrap_err().to_string();
+    let e = "fast".parse::<Evaluator>().unwrap_err().to_string();
     assert!(
-        e.contains("HYSID_EVALUATOR") && e.contains("auto, native or tape"),
+        e.contains("HYSID_EVALUATOR") && e.contains("auto, native, jit, cc or tape"),
         "{e}"
     );
+    assert_eq!(Evaluator::Cc.backends(), &[Backend::Compiled]);
+    assert_eq!(Evaluator::Jit.backends(), &[Backend::Generated]);
+    assert!(Evaluator::Tape.backends().is_empty());
 }

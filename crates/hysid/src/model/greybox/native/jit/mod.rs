@@ -1,0 +1,814 @@
+//! Native code without a C compiler: the functions of `source.rs` — `hysid_prepare`,
+//! `hysid_eval`, `hysid_sens`, `hysid_rates` and `hysid_substeps`, with the same
+//! signatures and the same numbers — emitted as x86-64 machine code in the process, in
+//! well under a millisecond, where the C compiler takes about a tenth of a second.
+//!
+//! The code is emitted from the same split of the listing (`source::Split`: what θ alone
+//! determines, prepared once per θ into `c`, and the rest), one block of straight-line
+//! double arithmetic per function or RK4 stage (`block.rs`: virtual registers allocated
+//! to the 16 xmm registers), in AVX encodings (`asm.rs`). Each operation is one scalar
+//! IEEE 754 instruction of the tape's operation, or a call of the function the tape calls
+//! (`sin`, `exp`, `pow`, … through [`hysid_equations::apply1`], [`hysid_equations::apply2`],
+//! [`hysid_equations::powi`]), in the listing's order; no product is fused with a sum, so
+//! every value has the tape's bits. Comparisons, `min`, `max`, `sign`, the finite-or-zero
+//! of derivatives and `if` are branch-free masks with the tape's semantics (ties and NaN
+//! included). The stages, stage states and update of `hysid_substeps` are those of the
+//! fixed-size Rust loop (`fixed_rk4`), element by element.
+//!
+//! Linux on x86-64 with AVX only (elsewhere the C compiler route runs). The code lives in
+//! pages mapped writable, filled, then made executable and read-only.
+
+mod asm;
+mod block;
+
+use super::source::{operands, Class, Split};
+use super::{Layout, Shape};
+use asm::{pred, Asm, Gpr, Logic, Mem, Scalar};
+use block::{Arg, Block, Ins, V};
+use hysid_equations::{Fn1, Fn2, Listing, Operand, Operation};
+use std::collections::HashMap;
+
+/// Whether this machine runs the generated code (x86-64 with AVX).
+pub(super) fn available() -> bool {
+    crate::numerics::cpu::has_avx()
+}
+
+/// Executable code and its constants (unmapped when dropped).
+pub(super) struct Code {
+    base: *mut u8,
+    len: usize,
+}
+
+// SAFETY: the mapping is read-only once built; the functions in it keep no state.
+unsafe impl Send for Code {}
+// SAFETY: as above.
+unsafe impl Sync for Code {}
+
+impl Drop for Code {
+    fn drop(&mut self) {
+        // SAFETY: the mapping of `new`, unmapped once.
+        unsafe {
+            libc::munmap(self.base.cast(), self.len);
+        }
+    }
+}
+
+impl Code {
+    /// `code` followed by the constants `pool` (at a 16-byte boundary), in new pages made
+    /// executable; each `mov rbx, imm64` at `pool_fixups` is given the constants' address.
+    fn new(mut code: Vec<u8>, pool: &[[u64; 2]], pool_fixups: &[usize]) -> Result<Self, String> {
+        let pool_at = code.len().next_multiple_of(16);
+        let len = pool_at + 16 * pool.len();
+        // SAFETY: a fresh anonymous private mapping; the result is checked.
+        let base = unsafe {
+            libc::mmap(
+                std::ptr::null_mut(),
+                len.max(1),
+                libc::PROT_READ | libc::PROT_WRITE,
+                libc::MAP_PRIVATE | libc::MAP_ANONYMOUS,
+                -1,
+                0,
+            )
+        };
+        if base == libc::MAP_FAILED {
+            return Err("no memory for generated code".into());
+        }
+        let code_len = code.len();
+        let pool_address = (base as u64) + pool_at as u64;
+        for &at in pool_fixups {
+            code[at..at + 8].copy_from_slice(&pool_address.to_le_bytes());
+        }
+        let bytes: Vec<u8> = pool
+            .iter()
+            .flat_map(|pair| pair.iter().flat_map(|w| w.to_le_bytes()))
+            .collect();
+        // SAFETY: both copies stay within the `len` bytes mapped writable above.
+        unsafe {
+            std::ptr::copy_nonoverlapping(code.as_ptr(), base.cast::<u8>(), code_len);
+            std::ptr::copy_nonoverlapping(
+                bytes.as_ptr(),
+                base.cast::<u8>().add(pool_at),
+                bytes.len(),
+            );
+        }
+        let code = Self {
+            base: base.cast(),
+            len: len.max(1),
+        };
+        // SAFETY: the mapping made above, now read-only and executable.
+        if unsafe { libc::mprotect(base, code.len, libc::PROT_READ | libc::PROT_EXEC) } != 0 {
+            return Err("the system refuses executable pages for generated code".into());
+        }
+        Ok(code)
+    }
+
+    /// The address of the function at `offset`.
+    pub fn entry(&self, offset: usize) -> *mut std::ffi::c_void {
+        debug_assert!(offset < self.len);
+        // SAFETY: within the mapping.
+        unsafe { self.base.add(offset).cast() }
+    }
+}
+
+/// Where each function starts in a [`Code`].
+pub(super) struct Entries {
+    pub prepare: usize,
+    /// `hysid_eval` of a results layout.
+    pub eval: Option<usize>,
+    /// `hysid_sens`, `hysid_substeps` and `hysid_rates` of a sensitivities layout.
+    pub sens: Option<(usize, usize, usize)>,
+}
+
+/// The machine code of `listing` for `layout` over `shape`, and the length of its
+/// prepared array: the functions `source.rs` would print, emitted here.
+pub(super) fn assemble(
+    listing: &Listing,
+    layout: &Layout,
+    shape: Shape,
+) -> Result<(Code, Entries, usize), String> {
+    let split = Split::new(listing);
+    let mut gen = Generator {
+        split: &split,
+        asm: Asm::default(),
+        pool: Pool::default(),
+        pool_fixups: Vec::new(),
+    };
+    let prepare = gen.prepare();
+    let mut entries = Entries {
+        prepare,
+        eval: None,
+        sens: None,
+    };
+    match layout {
+        Layout::Results { values, positions } => {
+            entries.eval = Some(gen.eval(*values, positions));
+        }
+        Layout::Sensitivities { k, q } => {
+            let n = shape.states;
+            let sens = gen.sens(n, *k, *q);
+            let substeps = gen.substeps(n, *k, *q, shape.inputs);
+            let rates = gen.eval(n, &(0..n).collect::<Vec<_>>());
+            entries.sens = Some((sens, substeps, rates));
+        }
+    }
+    let Generator {
+        asm,
+        pool,
+        pool_fixups,
+        ..
+    } = gen;
+    let code = Code::new(asm.finish(), &pool.entries, &pool_fixups)?;
+    Ok((code, entries, split.slots))
+}
+
+/// 16-byte constants (a double and a zero, or a mask), each stored once.
+#[derive(Default)]
+struct Pool {
+    entries: Vec<[u64; 2]>,
+    index: HashMap<[u64; 2], usize>,
+}
+
+impl Pool {
+    fn entry(&mut self, pair: [u64; 2]) -> Mem {
+        let n = self.entries.len();
+        let i = *self.index.entry(pair).or_insert(n);
+        if i == n {
+            self.entries.push(pair);
+        }
+        Mem::at(Gpr::Rbx, 16 * i)
+    }
+
+    fn double(&mut self, v: f64) -> Mem {
+        self.entry([v.to_bits(), 0])
+    }
+
+    /// |·|: every bit but the sign.
+    fn abs_mask(&mut self) -> Mem {
+        self.entry([!(1u64 << 63); 2])
+    }
+
+    /// −·: the sign bit.
+    fn sign_mask(&mut self) -> Mem {
+        self.entry([1u64 << 63, 0])
+    }
+}
+
+/// Where a block reads its operands and writes its results.
+#[derive(Clone, Copy)]
+struct Env {
+    t: Arg,
+    x: Mem,
+    u: Mem,
+    /// The prepared values.
+    c: Mem,
+}
+
+/// Where a stage reads S and the coupling flags and writes ẋ and Ṡ.
+#[derive(Clone, Copy)]
+struct StageIo {
+    s: Mem,
+    coupled: Mem,
+    dx: Mem,
+    ds: Mem,
+}
+
+struct Generator<'a> {
+    split: &'a Split<'a>,
+    asm: Asm,
+    pool: Pool,
+    /// Where `mov rbx, imm64` waits for the constants' address.
+    pool_fixups: Vec<usize>,
+}
+
+/// The callee-saved registers a function saves (with the return address, 56 bytes: the
+/// frame below is 8 mod 16 so that calls see an aligned stack).
+const SAVED: [Gpr; 6] = [Gpr::Rbx, Gpr::Rbp, Gpr::R12, Gpr::R13, Gpr::R14, Gpr::R15];
+
+/// A frame of doubles below the saved registers.
+struct Frame {
+    bytes: usize,
+}
+
+impl Frame {
+    /// A frame of `doubles` slots (plus 16 bytes: a 16-byte read of the last slot stays
+    /// inside), 8 mod 16 bytes long.
+    fn new(doubles: usize) -> Self {
+        let bytes = (8 * doubles + 16).next_multiple_of(16) + 8;
+        Self { bytes }
+    }
+
+    fn slot(&self, i: usize) -> Mem {
+        Mem::at(Gpr::Rsp, 8 * i)
+    }
+}
+
+impl Generator<'_> {
+    /// Saves the callee-saved registers, opens `frame` and points rbx at the constants;
+    /// returns where the function starts.
+    fn prologue(&mut self, frame: &Frame) -> usize {
+        let start = self.asm.code.len();
+        for r in SAVED {
+            self.asm.push(r);
+        }
+        self.asm
+            .add_imm(Gpr::Rsp, -i32::try_from(frame.bytes).expect("small frames"));
+        self.asm.mov_imm(Gpr::Rbx, 0);
+        self.pool_fixups.push(self.asm.code.len() - 8);
+        start
+    }
+
+    fn epilogue(&mut self, frame: &Frame) {
+        self.asm
+            .add_imm(Gpr::Rsp, i32::try_from(frame.bytes).expect("small frames"));
+        for r in SAVED.iter().rev() {
+            self.asm.pop(*r);
+        }
+        self.asm.ret();
+    }
+
+    /// `hysid_prepare(p, c)`: the θ-only operations the others read, and the parameters,
+    /// stored in their slots of c.
+    fn prepare(&mut self) -> usize {
+        let split = self.split;
+        let ops = &split.listing.operations;
+        let (p, c) = (Mem::at(Gpr::R12, 0), Mem::at(Gpr::R13, 0));
+        let mut roots: Vec<Operand> = Vec::new();
+        for (k, slot) in split.slot_of_value.iter().enumerate() {
+            if slot.is_some() {
+                roots.push(Operand::Value(k));
+            }
+        }
+        let needed = needed(split.listing, &roots, |k| !split.varying[k]);
+        let mut block = Block::default();
+        let mut values: Vec<Option<V>> = vec![None; ops.len()];
+        for (k, op) in ops.iter().enumerate() {
+            if needed[k] {
+                let read = |o: &Operand, pool: &mut Pool| match *o {
+                    Operand::Parameter(i) => Arg::Mem(p.offset(i)),
+                    Operand::Value(j) => Arg::V(values[j].expect("an earlier value")),
+                    Operand::Constant(v) => Arg::Mem(pool.double(v)),
+                    Operand::Time | Operand::State(_) | Operand::Input(_) => {
+                        unreachable!("a θ-only operation")
+                    }
+                };
+                values[k] = Some(lower(&mut block, &mut self.pool, op, read));
+            }
+        }
+        for (i, slot) in split.slot_of_param.iter().enumerate() {
+            if let Some(s) = slot {
+                let v = block.in_value(Arg::Mem(p.offset(i)));
+                block.push(Ins::Store {
+                    src: v,
+                    to: c.offset(*s),
+                });
+            }
+        }
+        for (k, slot) in split.slot_of_value.iter().enumerate() {
+            if let Some(s) = slot {
+                let src = values[k].expect("a prepared value is computed");
+                block.push(Ins::Store {
+                    src,
+                    to: c.offset(*s),
+                });
+            }
+        }
+        let frame = Frame::new(block.slots());
+        let start = self.prologue(&frame);
+        self.asm.mov(Gpr::R12, Gpr::Rdi);
+        self.asm.mov(Gpr::R13, Gpr::Rsi);
+        block.emit(&mut self.asm, frame.slot(0), &[]);
+        self.epilogue(&frame);
+        start
+    }
+
+    /// The varying operations that `roots` need, lowered into `block` reading `env`;
+    /// per operation its value.
+    fn varying(&mut self, block: &mut Block, env: Env, roots: &[Operand]) -> Vec<Option<V>> {
+        let split = self.split;
+        let needed = needed(split.listing, roots, |k| split.varying[k]);
+        let mut values: Vec<Option<V>> = vec![None; split.listing.operations.len()];
+        for (k, op) in split.listing.operations.iter().enumerate() {
+            if needed[k] {
+                let read = |o: &Operand, pool: &mut Pool| read(split, env, &values, o, pool);
+                values[k] = Some(lower(block, &mut self.pool, op, read));
+            }
+        }
+        values
+    }
+
+    /// `hysid_eval(t, x, u, c, out)`: results 0 … `values` − 1 as computed, the others
+    /// finite, result k at `out[positions[k]]`.
+    fn eval(&mut self, values: usize, positions: &[usize]) -> usize {
+        let split = self.split;
+        let results = &split.listing.results[..positions.len()];
+        let mut block = Block::default();
+        // Slot 0 of the frame holds t; the values spill after it.
+        let env = Env {
+            t: Arg::Mem(Mem::at(Gpr::Rsp, 0)),
+            x: Mem::at(Gpr::R12, 0),
+            u: Mem::at(Gpr::R13, 0),
+            c: Mem::at(Gpr::R14, 0),
+        };
+        let out = Mem::at(Gpr::R15, 0);
+        let computed = self.varying(&mut block, env, results);
+        for (k, (o, &position)) in results.iter().zip(positions).enumerate() {
+            let value = read(split, env, &computed, o, &mut self.pool);
+            let src = if k < values {
+                block.in_value(value)
+            } else {
+                finite(&mut block, &mut self.pool, value, o)
+            };
+            block.push(Ins::Store {
+                src,
+                to: out.offset(position),
+            });
+        }
+        let frame = Frame::new(1 + block.slots());
+        let start = self.prologue(&frame);
+        self.asm.store(Mem::at(Gpr::Rsp, 0), 0);
+        self.asm.mov(Gpr::R12, Gpr::Rdi);
+        self.asm.mov(Gpr::R13, Gpr::Rsi);
+        self.asm.mov(Gpr::R14, Gpr::Rdx);
+        self.asm.mov(Gpr::R15, Gpr::Rcx);
+        block.emit(&mut self.asm, frame.slot(1), &[]);
+        self.epilogue(&frame);
+        start
+    }
+
+    /// One evaluation of ẋ and Ṡ (`source::sensitivities_source`'s `hy_sens`) into a new
+    /// block: ẋ = f, then per row i and column c, d = [f_θ]ᵢ꜀ (0 for an initial-state
+    /// column) plus the products [f_x]ᵢⱼ·Sⱼ꜀ in the order of j — left out for a constant
+    /// zero entry, added only where `coupled[i·n + j]` for an entry prepared from θ.
+    fn stage(&mut self, env: Env, io: StageIo, n: usize, k: usize, q: usize) -> Block {
+        let split = self.split;
+        let results = &split.listing.results;
+        let entry = |i: usize, j: usize| n + i * n + j;
+        let direct = |i: usize, c: usize| n + n * n + i * k + c;
+        let mut roots: Vec<Operand> = results[..n].to_vec();
+        for i in 0..n {
+            roots.extend((0..n).map(|j| results[entry(i, j)]));
+            roots.extend((0..k).map(|c| results[direct(i, c)]));
+        }
+        let mut block = Block::default();
+        let computed = self.varying(&mut block, env, &roots);
+        let value = |o: &Operand, pool: &mut Pool| read(split, env, &computed, o, pool);
+        for (i, o) in results[..n].iter().enumerate() {
+            let v = value(o, &mut self.pool);
+            let src = block.in_value(v);
+            block.push(Ins::Store {
+                src,
+                to: io.dx.offset(i),
+            });
+        }
+        // The Jacobian entries that take part, finite.
+        let mut a: Vec<Vec<Option<(V, Class)>>> = vec![vec![None; n]; n];
+        for (i, row) in a.iter_mut().enumerate() {
+            for (j, cell) in row.iter_mut().enumerate() {
+                let o = &results[entry(i, j)];
+                let class = split.class(o);
+                if class != Class::Zero {
+                    let v = value(o, &mut self.pool);
+                    *cell = Some((finite(&mut block, &mut self.pool, v, o), class));
+                }
+            }
+        }
+        for (i, row) in a.iter().enumerate() {
+            for c in 0..q {
+                let d = if c < k {
+                    let o = &results[direct(i, c)];
+                    let v = value(o, &mut self.pool);
+                    finite(&mut block, &mut self.pool, v, o)
+                } else {
+                    let zero = self.pool.double(0.0);
+                    block.in_value(Arg::Mem(zero))
+                };
+                // d is a fresh value (a load or a mask's result): it accumulates alone.
+                for (j, cell) in row.iter().enumerate() {
+                    if let Some((aij, class)) = cell {
+                        let flag =
+                            (*class == Class::Prepared).then(|| io.coupled.offset_bytes(i * n + j));
+                        block.push(Ins::MulAdd {
+                            d,
+                            a: *aij,
+                            s: io.s.offset(j * q + c),
+                            flag,
+                        });
+                    }
+                }
+                block.push(Ins::Store {
+                    src: d,
+                    to: io.ds.offset(i * q + c),
+                });
+            }
+        }
+        block
+    }
+
+    /// `hysid_sens(t, x, u, s, c, coupled, dx, ds)`.
+    fn sens(&mut self, n: usize, k: usize, q: usize) -> usize {
+        // Frame: t, dx, ds, then the spill slots.
+        let env = Env {
+            t: Arg::Mem(Mem::at(Gpr::Rsp, 0)),
+            x: Mem::at(Gpr::R12, 0),
+            u: Mem::at(Gpr::R13, 0),
+            c: Mem::at(Gpr::R15, 0),
+        };
+        let io = StageIo {
+            s: Mem::at(Gpr::R14, 0),
+            coupled: Mem::at(Gpr::Rbp, 0),
+            dx: Mem::at(Gpr::R10, 0),
+            ds: Mem::at(Gpr::R11, 0),
+        };
+        let block = self.stage(env, io, n, k, q);
+        let frame = Frame::new(3 + block.slots());
+        let (dx_slot, ds_slot) = (frame.slot(1), frame.slot(2));
+        let start = self.prologue(&frame);
+        self.asm.store(frame.slot(0), 0);
+        self.asm.mov(Gpr::R12, Gpr::Rdi);
+        self.asm.mov(Gpr::R13, Gpr::Rsi);
+        self.asm.mov(Gpr::R14, Gpr::Rdx);
+        self.asm.mov(Gpr::R15, Gpr::Rcx);
+        self.asm.mov(Gpr::Rbp, Gpr::R8);
+        self.asm.mov(Gpr::R10, Gpr::R9);
+        // The eighth argument, above the return address, the saved registers and the frame.
+        let above = frame.bytes + 8 * SAVED.len() + 8;
+        self.asm.mov_load(Gpr::R11, Mem::at(Gpr::Rsp, above));
+        self.asm.mov_store(dx_slot, Gpr::R10);
+        self.asm.mov_store(ds_slot, Gpr::R11);
+        block.emit(
+            &mut self.asm,
+            frame.slot(3),
+            &[(Gpr::R10, dx_slot), (Gpr::R11, ds_slot)],
+        );
+        self.epilogue(&frame);
+        start
+    }
+
+    /// `hysid_substeps(nodes, c, coupled, m, h, x, s)`: m RK4 sub-steps of z = [x, S] (the
+    /// stages of [`Self::stage`], the stage states z + (h/2)·k₁, z + (h/2)·k₂, z + h·k₃ and
+    /// z ← z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), element by element as `fixed_rk4`).
+    fn substeps(&mut self, n: usize, k: usize, q: usize, inputs: usize) -> usize {
+        let len = n + n * q;
+        // Frame: h, h/2, h/6, the pointers x and s, z, k₁ … k₄, the stage state, spills.
+        let (h, half, sixth, x_ptr, s_ptr) = (0, 1, 2, 3, 4);
+        let z = 5;
+        let stage_k = |r: usize| z + len * (1 + r);
+        let state = z + 5 * len;
+        let spill = state + len;
+        let stage_base = |r: usize| if r == 0 { z } else { state };
+        // Stage r reads the input at node 0, 1, 1, 2 of the sub-step.
+        let mut blocks = Vec::new();
+        for (r, node) in [0, 1, 1, 2].into_iter().enumerate() {
+            let env = Env {
+                t: Arg::Mem(self.pool.double(0.0)),
+                x: Mem::at(Gpr::Rsp, 8 * stage_base(r)),
+                u: Mem::at(Gpr::R12, 8 * inputs * node),
+                c: Mem::at(Gpr::R13, 0),
+            };
+            let io = StageIo {
+                s: Mem::at(Gpr::Rsp, 8 * (stage_base(r) + n)),
+                coupled: Mem::at(Gpr::R14, 0),
+                dx: Mem::at(Gpr::Rsp, 8 * stage_k(r)),
+                ds: Mem::at(Gpr::Rsp, 8 * (stage_k(r) + n)),
+            };
+            blocks.push(self.stage(env, io, n, k, q));
+        }
+        let spills = blocks.iter().map(Block::slots).max().unwrap_or(0);
+        let frame = Frame::new(spill + spills);
+        let (two, one_half, six) = (
+            self.pool.double(2.0),
+            self.pool.double(0.5),
+            self.pool.double(6.0),
+        );
+        let slot = |i: usize| frame.slot(i);
+        let start = self.prologue(&frame);
+        let a = &mut self.asm;
+        a.mov(Gpr::R12, Gpr::Rdi);
+        a.mov(Gpr::R13, Gpr::Rsi);
+        a.mov(Gpr::R14, Gpr::Rdx);
+        a.movsxd(Gpr::R15, Gpr::Rcx);
+        a.mov_store(slot(x_ptr), Gpr::R8);
+        a.mov_store(slot(s_ptr), Gpr::R9);
+        a.store(slot(h), 0);
+        a.scalar(Scalar::Mul, 1, 0, asm::Rm::Mem(one_half));
+        a.store(slot(half), 1);
+        a.scalar(Scalar::Div, 1, 0, asm::Rm::Mem(six));
+        a.store(slot(sixth), 1);
+        for e in 0..len {
+            let from = if e < n {
+                Mem::at(Gpr::R8, 8 * e)
+            } else {
+                Mem::at(Gpr::R9, 8 * (e - n))
+            };
+            a.load(0, from);
+            a.store(slot(z + e), 0);
+        }
+        let (done, lp) = (a.label(), a.label());
+        a.test(Gpr::R15);
+        a.jump(Some(asm::cc::LESS_OR_EQUAL), done);
+        a.bind(lp);
+        for (r, block) in blocks.iter().enumerate() {
+            block.emit(&mut self.asm, frame.slot(spill), &[]);
+            let a = &mut self.asm;
+            if r < 3 {
+                // The next stage's state: z + w·k (w·k first, as base + c·k rounds).
+                a.load(0, slot([half, half, h][r]));
+                for e in 0..len {
+                    a.scalar(Scalar::Mul, 1, 0, asm::Rm::Mem(slot(stage_k(r) + e)));
+                    a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(slot(z + e)));
+                    a.store(slot(state + e), 1);
+                }
+            }
+        }
+        let a = &mut self.asm;
+        a.load(0, slot(sixth));
+        a.load(3, two);
+        for e in 0..len {
+            a.load(1, slot(stage_k(0) + e));
+            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(slot(stage_k(1) + e)));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
+            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(slot(stage_k(2) + e)));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(slot(stage_k(3) + e)));
+            a.scalar(Scalar::Mul, 1, 0, asm::Rm::Xmm(1));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(slot(z + e)));
+            a.store(slot(z + e), 1);
+        }
+        a.add_imm(Gpr::R12, i32::try_from(16 * inputs).expect("few inputs"));
+        a.dec(Gpr::R15);
+        a.jump(Some(asm::cc::NOT_ZERO), lp);
+        a.bind(done);
+        a.mov_load(Gpr::Rax, slot(x_ptr));
+        a.mov_load(Gpr::Rcx, slot(s_ptr));
+        for e in 0..len {
+            a.load(0, slot(z + e));
+            let to = if e < n {
+                Mem::at(Gpr::Rax, 8 * e)
+            } else {
+                Mem::at(Gpr::Rcx, 8 * (e - n))
+            };
+            a.store(to, 0);
+        }
+        self.epilogue(&frame);
+        start
+    }
+}
+
+/// An operand of a varying operation or result: in memory (x, u, c, a constant, t) or a
+/// value computed in the block.
+fn read(split: &Split<'_>, env: Env, values: &[Option<V>], o: &Operand, pool: &mut Pool) -> Arg {
+    match *o {
+        Operand::Time => env.t,
+        Operand::State(i) => Arg::Mem(env.x.offset(i)),
+        Operand::Input(i) => Arg::Mem(env.u.offset(i)),
+        Operand::Constant(v) => Arg::Mem(pool.double(v)),
+        Operand::Parameter(i) => Arg::Mem(
+            env.c
+                .offset(split.slot_of_param[i].expect("a read parameter has a slot")),
+        ),
+        Operand::Value(k) if split.varying[k] => Arg::V(values[k].expect("an earlier value")),
+        Operand::Value(k) => Arg::Mem(
+            env.c
+                .offset(split.slot_of_value[k].expect("a read value has a slot")),
+        ),
+    }
+}
+
+/// Per operation, whether `roots` need it (through operations that `keep` holds for).
+fn needed(listing: &Listing, roots: &[Operand], keep: impl Fn(usize) -> bool) -> Vec<bool> {
+    let mut needed = vec![false; listing.operations.len()];
+    for o in roots {
+        if let Operand::Value(k) = *o {
+            needed[k] = keep(k);
+        }
+    }
+    for k in (0..listing.operations.len()).rev() {
+        if needed[k] {
+            for o in operands(&listing.operations[k]) {
+                if let Operand::Value(j) = o {
+                    if keep(j) {
+                        needed[j] = true;
+                    }
+                }
+            }
+        }
+    }
+    needed
+}
+
+/// `value` (operand `o`) made finite: 0 where infinite or NaN. A constant is folded.
+fn finite(block: &mut Block, pool: &mut Pool, value: Arg, o: &Operand) -> V {
+    if let Operand::Constant(c) = *o {
+        return block.in_value(Arg::Mem(
+            pool.double(hysid_equations::apply1(Fn1::FiniteOr0, c)),
+        ));
+    }
+    let v = block.in_value(value);
+    finite_value(block, pool, v)
+}
+
+/// v where |v| < ∞, else +0.
+fn finite_value(block: &mut Block, pool: &mut Pool, v: V) -> V {
+    let abs = block.logic(Logic::And, Arg::V(v), Arg::Mem(pool.abs_mask()));
+    let infinity = pool.double(f64::INFINITY);
+    let is_finite = block.cmp(pred::LT_OQ, Arg::V(abs), Arg::Mem(infinity));
+    block.logic(Logic::And, Arg::V(is_finite), Arg::V(v))
+}
+
+/// `mask ? a : b` (a mask of all ones or zeros).
+fn select(block: &mut Block, mask: V, a: V, b: V) -> V {
+    let keep = block.logic(Logic::And, Arg::V(mask), Arg::V(a));
+    let other = block.logic(Logic::AndNot, Arg::V(mask), Arg::V(b));
+    block.logic(Logic::Or, Arg::V(keep), Arg::V(other))
+}
+
+/// 1 where `mask`, else 0.
+fn truth(block: &mut Block, pool: &mut Pool, mask: V) -> V {
+    block.logic(Logic::And, Arg::V(mask), Arg::Mem(pool.double(1.0)))
+}
+
+/// Operation `op` as instructions of `block`, its operands read by `read`.
+fn lower(
+    block: &mut Block,
+    pool: &mut Pool,
+    op: &Operation,
+    mut read: impl FnMut(&Operand, &mut Pool) -> Arg,
+) -> V {
+    let zero = |pool: &mut Pool| Arg::Mem(pool.double(0.0));
+    match *op {
+        Operation::Neg(a) => {
+            let a = read(&a, pool);
+            block.logic(Logic::Xor, a, Arg::Mem(pool.sign_mask()))
+        }
+        Operation::Unary(f, a) => {
+            let a = read(&a, pool);
+            match f {
+                Fn1::Abs => block.logic(Logic::And, a, Arg::Mem(pool.abs_mask())),
+                Fn1::Sqrt => {
+                    let a = block.in_value(a);
+                    block.scalar(Scalar::Sqrt, Arg::V(a), Arg::V(a))
+                }
+                Fn1::FiniteOr0 => {
+                    let a = block.in_value(a);
+                    finite_value(block, pool, a)
+                }
+                Fn1::Sign => {
+                    let a = block.in_value(a);
+                    let positive = block.cmp(pred::GT_OQ, Arg::V(a), zero(pool));
+                    let negative = block.cmp(pred::LT_OQ, Arg::V(a), zero(pool));
+                    let one = block.logic(Logic::And, Arg::V(positive), Arg::Mem(pool.double(1.0)));
+                    let minus =
+                        block.logic(Logic::And, Arg::V(negative), Arg::Mem(pool.double(-1.0)));
+                    block.logic(Logic::Or, Arg::V(one), Arg::V(minus))
+                }
+                Fn1::Sin | Fn1::Cos | Fn1::Tan | Fn1::Exp | Fn1::Ln | Fn1::Tanh | Fn1::Atan => {
+                    block.call(unary(f), a, a)
+                }
+            }
+        }
+        Operation::Binary(f, a, b) => {
+            let (a, b) = (read(&a, pool), read(&b, pool));
+            match f {
+                Fn2::Add => block.scalar(Scalar::Add, a, b),
+                Fn2::Sub => block.scalar(Scalar::Sub, a, b),
+                Fn2::Mul => block.scalar(Scalar::Mul, a, b),
+                Fn2::Div => block.scalar(Scalar::Div, a, b),
+                Fn2::Pow => {
+                    let (one, zero) = (pool.double(1.0), pool.double(0.0));
+                    block.pow(pow, a, b, one, zero)
+                }
+                Fn2::Min | Fn2::Max => {
+                    let (a, b) = (block.in_value(a), block.in_value(b));
+                    let p = if f == Fn2::Min {
+                        pred::LE_OQ
+                    } else {
+                        pred::GE_OQ
+                    };
+                    let first = block.cmp(p, Arg::V(a), Arg::V(b));
+                    select(block, first, a, b)
+                }
+                Fn2::Lt | Fn2::Le | Fn2::Eq | Fn2::Ne => {
+                    let p = match f {
+                        Fn2::Lt => pred::LT_OQ,
+                        Fn2::Le => pred::LE_OQ,
+                        Fn2::Eq => pred::EQ_OQ,
+                        _ => pred::NEQ_UQ,
+                    };
+                    let mask = block.cmp(p, a, b);
+                    truth(block, pool, mask)
+                }
+                Fn2::And | Fn2::Or => {
+                    let ma = block.cmp(pred::NEQ_UQ, a, zero(pool));
+                    let mb = block.cmp(pred::NEQ_UQ, b, zero(pool));
+                    let op = if f == Fn2::And { Logic::And } else { Logic::Or };
+                    let mask = block.logic(op, Arg::V(ma), Arg::V(mb));
+                    truth(block, pool, mask)
+                }
+            }
+        }
+        // The multiplications of `hysid_equations::powi` for n ≤ 4, else its loop.
+        Operation::Powi(a, n) => {
+            let a = read(&a, pool);
+            match n {
+                0 => block.in_value(Arg::Mem(pool.double(1.0))),
+                1 => block.in_value(a),
+                2 => block.scalar(Scalar::Mul, a, a),
+                3 => {
+                    let square = block.scalar(Scalar::Mul, a, a);
+                    block.scalar(Scalar::Mul, Arg::V(square), a)
+                }
+                4 => {
+                    let square = block.scalar(Scalar::Mul, a, a);
+                    block.scalar(Scalar::Mul, Arg::V(square), Arg::V(square))
+                }
+                _ => block.call(powi, a, Arg::Mem(pool.double(f64::from(n)))),
+            }
+        }
+        Operation::Not(a) => {
+            let a = read(&a, pool);
+            let mask = block.cmp(pred::EQ_OQ, a, zero(pool));
+            truth(block, pool, mask)
+        }
+        Operation::Select(c, a, b) => {
+            let (c, a, b) = (read(&c, pool), read(&a, pool), read(&b, pool));
+            let (a, b) = (block.in_value(a), block.in_value(b));
+            let mask = block.cmp(pred::NEQ_UQ, c, zero(pool));
+            select(block, mask, a, b)
+        }
+    }
+}
+
+/// The tape's aᵇ ([`hysid_equations::apply2`]) for generated code.
+extern "C" fn pow(a: f64, b: f64) -> f64 {
+    hysid_equations::apply2(Fn2::Pow, a, b)
+}
+
+/// The tape's aⁿ ([`hysid_equations::powi`]), n passed as a double.
+extern "C" fn powi(a: f64, n: f64) -> f64 {
+    hysid_equations::powi(a, n as i32)
+}
+
+/// The tape's f(a) ([`hysid_equations::apply1`]) for generated code (b unused).
+fn unary(f: Fn1) -> block::Helper {
+    macro_rules! helper {
+        ($f:expr) => {{
+            extern "C" fn helper(a: f64, _: f64) -> f64 {
+                hysid_equations::apply1($f, a)
+            }
+            helper
+        }};
+    }
+    match f {
+        Fn1::Sin => helper!(Fn1::Sin),
+        Fn1::Cos => helper!(Fn1::Cos),
+        Fn1::Tan => helper!(Fn1::Tan),
+        Fn1::Exp => helper!(Fn1::Exp),
+        Fn1::Ln => helper!(Fn1::Ln),
+        Fn1::Sqrt => helper!(Fn1::Sqrt),
+        Fn1::Abs => helper!(Fn1::Abs),
+        Fn1::Sign => helper!(Fn1::Sign),
+        Fn1::Tanh => helper!(Fn1::Tanh),
+        Fn1::Atan => helper!(Fn1::Atan),
+        Fn1::FiniteOr0 => helper!(Fn1::FiniteOr0),
+    }
+}
