@@ -4,15 +4,17 @@
 # training record from every free parameter at twice its nominal value, one start, RK4 × 4,
 # band-limited input — run back to back in turn, RUNS times each (default 9):
 #
-#   file, cached   the native code of the file's tapes loaded from the cache (every run
-#                  after a machine's first)
-#   file, cold     the cache emptied before each run: the compilation counted
-#   file, tape     HYSID_EVALUATOR=tape: the tape interpreter
-#   built-in       --model bouc-wen
+#   file     the default (HYSID_EVALUATOR=auto): machine code generated in the process
+#            (x86-64 with AVX), nothing cached
+#   cc       HYSID_EVALUATOR=cc: the C compiler's code loaded from the cache (every run
+#            after a machine's first)
+#   cold     HYSID_EVALUATOR=cc, the cache emptied before each run: the compilation counted
+#   tape     HYSID_EVALUATOR=tape: the tape interpreter
+#   builtin  --model bouc-wen
 #
 # Prints per route the median, min and max wall seconds (/usr/bin/time) and the paired ratio
 # of medians to the built-in; checks once that the file's estimates equal the built-in's to
-# 1e-9 relative and the tape's to the bit.
+# 1e-9 relative and that every route's equal the tape's to the bit.
 #
 #   bench/equation_fit.sh
 set -euo pipefail
@@ -41,17 +43,19 @@ stats() { sort -n | awk '{v[NR]=$1} END {printf "median %.3f s (min %.3f, max %.
 median() { sort -n | awk '{v[NR]=$1} END {print v[int((NR+1)/2)]}'; }
 
 export HYSID_CACHE_DIR="$dir/cache"
-HYSID_EVALUATOR=native "$bin" "${file[@]}" >/dev/null # fill the cache
-for route in cached cold tape builtin; do : >"$dir/$route.t"; done
+HYSID_EVALUATOR=cc "$bin" "${file[@]}" >/dev/null # fill the cache
+routes=(file cc cold tape builtin)
+for route in "${routes[@]}"; do : >"$dir/$route.t"; done
 for _ in $(seq "$runs"); do
-  once cached "$bin" "${file[@]}" >>"$dir/cached.t"
+  once file "$bin" "${file[@]}" >>"$dir/file.t"
+  HYSID_EVALUATOR=cc once cc "$bin" "${file[@]}" >>"$dir/cc.t"
   rm -rf "$dir/cache"
-  once cold "$bin" "${file[@]}" >>"$dir/cold.t"
+  HYSID_EVALUATOR=cc once cold "$bin" "${file[@]}" >>"$dir/cold.t"
   HYSID_EVALUATOR=tape once tape "$bin" "${file[@]}" >>"$dir/tape.t"
   once builtin "$bin" "${builtin[@]}" >>"$dir/builtin.t"
 done
 base=$(median <"$dir/builtin.t")
-for route in cached cold tape builtin; do
+for route in "${routes[@]}"; do
   m=$(median <"$dir/$route.t")
   printf '%-8s %s, %.2f× the built-in\n' "$route" "$(stats <"$dir/$route.t")" \
     "$(python3 -c "print($m / $base)")"
@@ -62,8 +66,9 @@ d = sys.argv[1]
 def values(name):
     report = json.load(open(f"{d}/{name}.json"))
     return {p["name"]: p["value"] for p in report["model"]["parameters"]}
-built, cached, tape = values("builtin"), values("cached"), values("tape")
-worst = max(abs(cached[k] - built[k]) / abs(built[k]) for k in built if built[k] != 0)
+built, tape = values("builtin"), values("tape")
+worst = max(abs(values("file")[k] - built[k]) / abs(built[k]) for k in built if built[k] != 0)
+same = all(values(route) == tape for route in ("file", "cc", "cold"))
 print(f"estimates: file vs built-in max relative difference {worst:.1e}; "
-      f"native == tape to the bit: {cached == tape}")
+      f"every route == tape to the bit: {same}")
 EOF

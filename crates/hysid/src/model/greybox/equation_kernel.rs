@@ -19,7 +19,9 @@
 //!
 //! The tape's results come from the bound tape itself or from its native code
 //! ([`super::native`]), which computes the same numbers (checked to the bit when it is
-//! built).
+//! built); with native code a whole sample interval's sub-steps run in one call of it
+//! (`hysid_substeps`, the stages and updates of [`super::fixed_rk4`] element by element),
+//! the sample loop being the fixed-size one ([`fixed_rk4::simulate_by_samples`]).
 //!
 //! Reference: forward sensitivities of ODEs, Hairer, Nørsett & Wanner, *Solving Ordinary
 //! Differential Equations I*, 2nd ed., §I.14.

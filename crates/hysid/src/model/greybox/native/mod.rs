@@ -1,32 +1,40 @@
-//! Equation-file models as machine code: the tape of f, ∂f/∂x and ∂f/∂θ printed as C —
-//! for a fit, with the forward-sensitivity rates Ṡ = [f_θ, 0] + f_x·S and ẋ alone
-//! ([`Layout`]) — (`source.rs`), compiled by the machine's C compiler into a cache keyed by
-//! its content and loaded (`object.rs`), so that a fit of a model written as equations runs
-//! its right-hand side at the speed of a built-in model.
+//! Equation-file models as machine code: the tape of f, ∂f/∂x and ∂f/∂θ — for a fit, with
+//! the forward-sensitivity rates Ṡ = [f_θ, 0] + f_x·S, ẋ alone and a sample interval's RK4
+//! sub-steps of x and S ([`Layout`]) — turned into machine code, so that a fit of a model
+//! written as equations runs at the speed of a built-in model. Two routes ([`Backend`]) make
+//! the same functions, with the same C signatures:
+//!
+//! * generated in the process (`jit/`, Linux on x86-64 with AVX): x86-64 code emitted from
+//!   the listing in well under a millisecond, without a compiler or a file;
+//! * compiled (`source.rs` prints C, `object.rs` compiles it with the machine's C compiler
+//!   into a cache keyed by its content and loads it): about 0.1 s the first time on a
+//!   machine, a cache load in well under a millisecond afterwards.
 //!
 //! When a fit (or a simulation) of an equation model starts, the model asks for the native
-//! form of the tape it is about to run ([`NativeFunction::build`]). The first time on a
-//! machine that costs one run of the C compiler (about 0.05–0.1 s for the Bouc–Wen file);
-//! afterwards the cached object is loaded in well under a millisecond. The tape interpreter
-//! stays: it is the fallback (no compiler, a compiler error, another operating system than
-//! Linux), it is what [`Evaluator::Tape`] selects, and it is the reference the native code
-//! is held to. Every native function is evaluated beside the tape at sample points before
-//! it is used, and refused unless every result has the tape's bits
-//! ([`NativeFunction::build`]'s `check`); the printed code performs the tape's operations in
-//! its order with its rounding (see `source.rs`), so the two agree to the bit and a fit gives
-//! the same estimates either way (`native_code_equals_the_tape_for_every_operation`,
-//! `native_code_equals_the_tape_on_the_example_files` and
-//! `bouc_wen_file_fit_from_twice_nominal_is_the_built_in_fit_native_or_taped` in the tests).
+//! form of the tape it is about to run ([`NativeFunction::build`]). The tape interpreter
+//! stays: it is the fallback (neither route available, a compiler error), it is what
+//! [`Evaluator::Tape`] selects, and it is the reference the native code is held to. Every
+//! native function is evaluated beside the tape at sample points before it is used, and
+//! refused unless every result has the tape's bits ([`NativeFunction::build`]'s `check`);
+//! both routes perform the tape's operations in its order with its rounding (no fused
+//! multiply–add, no reordering), so the two agree to the bit and a fit gives the same
+//! estimates either way (`native_code_equals_the_tape_for_every_operation`,
+//! `native_code_equals_the_tape_on_the_example_files`,
+//! `native_code_equals_the_tape_on_random_expressions` and
+//! `bouc_wen_file_fit_from_twice_nominal_is_the_built_in_fit_native_or_taped` in the tests,
+//! each for both routes).
 //!
-//! Which evaluator runs is [`Evaluator`]: `auto` (native when it can be built, else the
-//! tape), `native` (an error when it cannot be built), `tape`; the default is read from the
-//! environment variable `HYSID_EVALUATOR`. The compiler is `$CC`, else `cc`; the cache is
-//! `$HYSID_CACHE_DIR`, else `$XDG_CACHE_HOME/hysid`, else `~/.cache/hysid`.
+//! Which evaluator runs is [`Evaluator`]: `auto` (generated, else compiled, else the tape),
+//! `native` (an error when neither route builds), `jit` (generated only), `cc` (compiled
+//! only), `tape`; the default is read from the environment variable `HYSID_EVALUATOR`. The
+//! compiler is `$CC`, else `cc`; the cache is `$HYSID_CACHE_DIR`, else
+//! `$XDG_CACHE_HOME/hysid`, else `~/.cache/hysid`.
 //!
-//! The technique — generating C for a model's residual and Jacobian and compiling it with
-//! the system compiler — is that of CasADi's code generation (J. A. E. Andersson et al.,
-//! "CasADi: a software framework for nonlinear optimization and optimal control",
-//! *Mathematical Programming Computation* 11, 2019).
+//! The technique — generating code for a model's residual and Jacobian from its expression
+//! graph — is that of CasADi's code generation (J. A. E. Andersson et al., "CasADi: a
+//! software framework for nonlinear optimization and optimal control", *Mathematical
+//! Programming Computation* 11, 2019), which prints C for the system compiler; emitting the
+//! machine code directly is what a JIT compiler does.
 
 #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
 mod jit;
