@@ -176,35 +176,87 @@ where
     K: FixedSensitivityRhs<N, Q>,
 {
     let (m, h) = substep(run);
-    let (half, sixth) = (0.5 * h, h / 6.0);
-    let mut k = [Augmented::<N, Q>::ZERO; 4];
-    let mut stage = Augmented::<N, Q>::ZERO;
-    let channels = run.input.n_channels();
-    let span = |i: usize| i * channels..(i + 1) * channels;
-    sample_loop(run, on_sample, |nodes, z: &mut Augmented<N, Q>| {
-        for j in 0..m {
-            let (start, middle, end) = (
-                &nodes[span(2 * j)],
-                &nodes[span(2 * j + 1)],
-                &nodes[span(2 * j + 2)],
-            );
-            let [k1, k2, k3, k4] = &mut k;
-            kernel.eval(&z.x, start, &z.s, &mut k1.x, &mut k1.s);
-            stage.set_axpy(z, half, k1);
-            kernel.eval(&stage.x, middle, &stage.s, &mut k2.x, &mut k2.s);
-            stage.set_axpy(z, half, k2);
-            kernel.eval(&stage.x, middle, &stage.s, &mut k3.x, &mut k3.s);
-            stage.set_axpy(z, h, k3);
-            kernel.eval(&stage.x, end, &stage.s, &mut k4.x, &mut k4.s);
-            z.add_rk4(sixth, &k);
-        }
-    })
+    let mut substeps = Substeps {
+        kernel,
+        m,
+        h,
+        half: 0.5 * h,
+        sixth: h / 6.0,
+        channels: run.input.n_channels(),
+        k: [Augmented::<N, Q>::ZERO; 4],
+        stage: Augmented::<N, Q>::ZERO,
+    };
+    sample_loop(run, on_sample, &mut substeps)
 }
 
 /// The sub-steps per sample m (at least one) and the sub-step h = Ts/m of `run`.
 pub(crate) fn substep(run: &Rk4Sensitivities<'_>) -> (usize, f64) {
     let m = run.substeps.max(1);
     (m, run.ts / m as f64)
+}
+
+/// Moves z = [x, S] over one sample interval, the input given at its 2m + 1 half-step
+/// nodes (node-major).
+trait Advance<const N: usize, const Q: usize> {
+    fn advance(&mut self, nodes: &[f64], z: &mut Augmented<N, Q>);
+}
+
+/// The m classical RK4 sub-steps of a sample interval through a kernel's stages.
+struct Substeps<'k, K, const N: usize, const Q: usize> {
+    kernel: &'k mut K,
+    m: usize,
+    h: f64,
+    half: f64,
+    sixth: f64,
+    channels: usize,
+    k: [Augmented<N, Q>; 4],
+    stage: Augmented<N, Q>,
+}
+
+impl<K, const N: usize, const Q: usize> Advance<N, Q> for Substeps<'_, K, N, Q>
+where
+    K: FixedSensitivityRhs<N, Q>,
+{
+    // Inlined into the AVX twin, whose instructions it then uses.
+    #[inline(always)]
+    fn advance(&mut self, nodes: &[f64], z: &mut Augmented<N, Q>) {
+        let (h, half, sixth, channels) = (self.h, self.half, self.sixth, self.channels);
+        let span = |i: usize| i * channels..(i + 1) * channels;
+        let stage = &mut self.stage;
+        for j in 0..self.m {
+            // Sub-step j reads nodes 2j (start), 2j + 1 (middle) and 2j + 2 (end).
+            let (start, middle, end) = (
+                &nodes[span(2 * j)],
+                &nodes[span(2 * j + 1)],
+                &nodes[span(2 * j + 2)],
+            );
+            let [k1, k2, k3, k4] = &mut self.k;
+            self.kernel.eval(&z.x, start, &z.s, &mut k1.x, &mut k1.s);
+            stage.set_axpy(z, half, k1);
+            self.kernel
+                .eval(&stage.x, middle, &stage.s, &mut k2.x, &mut k2.s);
+            stage.set_axpy(z, half, k2);
+            self.kernel
+                .eval(&stage.x, middle, &stage.s, &mut k3.x, &mut k3.s);
+            stage.set_axpy(z, h, k3);
+            self.kernel
+                .eval(&stage.x, end, &stage.s, &mut k4.x, &mut k4.s);
+            z.add_rk4(sixth, &self.k);
+        }
+    }
+}
+
+/// A sample interval advanced by a function of (nodes, x, S row-major).
+struct BySample<F>(F);
+
+impl<F, const N: usize, const Q: usize> Advance<N, Q> for BySample<F>
+where
+    F: FnMut(&[f64], &mut [f64; N], &mut [f64]),
+{
+    #[inline(always)]
+    fn advance(&mut self, nodes: &[f64], z: &mut Augmented<N, Q>) {
+        (self.0)(nodes, &mut z.x, z.s.as_flattened_mut())
+    }
 }
 
 /// Simulates `run` as [`simulate`] does, with `advance(nodes, x, S)` moving x and S
@@ -214,30 +266,29 @@ pub(crate) fn substep(run: &Rk4Sensitivities<'_>) -> (usize, f64) {
 pub(crate) fn simulate_by_samples<const N: usize, const Q: usize>(
     run: &Rk4Sensitivities<'_>,
     on_sample: &mut SampleSink<'_>,
-    mut advance: impl FnMut(&[f64], &mut [f64; N], &mut [f64]),
+    advance: impl FnMut(&[f64], &mut [f64; N], &mut [f64]),
 ) -> Result<()> {
-    sample_loop(run, on_sample, |nodes, z: &mut Augmented<N, Q>| {
-        advance(nodes, &mut z.x, z.s.as_flattened_mut())
-    })
+    sample_loop::<_, N, Q>(run, on_sample, &mut BySample(advance))
 }
 
 /// The sample loop: from x0 and S(t₀) = s0, at every sample the divergence check and
-/// `on_sample(k, x(t_k), S(t_k))`, then `advance(nodes, z)` over the interval to the next
-/// sample, the input read at the interval's half-step nodes ([`InputTrack::nodes`], which
-/// the caller has checked lie on its grid: resolution 2·substeps).
+/// `on_sample(k, x(t_k), S(t_k))`, then `advance` over the interval to the next sample, the
+/// input read at the interval's half-step nodes ([`InputTrack::nodes`], which the caller
+/// has checked lie on its grid: resolution 2·substeps).
 #[inline(always)]
-fn sample_loop<const N: usize, const Q: usize>(
+fn sample_loop<A, const N: usize, const Q: usize>(
     run: &Rk4Sensitivities<'_>,
     on_sample: &mut SampleSink<'_>,
-    mut advance: impl FnMut(&[f64], &mut Augmented<N, Q>),
-) -> Result<()> {
+    advance: &mut A,
+) -> Result<()>
+where
+    A: Advance<N, Q>,
+{
     let input = run.input;
     let mut z = Augmented::<N, Q>::ZERO;
     z.x.copy_from_slice(run.x0);
     z.s.as_flattened_mut().copy_from_slice(run.s0);
     let (m, _) = substep(run);
-    // The input at the 2m + 1 nodes of a sample interval, node-major: sub-step j reads
-    // nodes 2j (start), 2j + 1 (middle) and 2j + 2 (end).
     let mut nodes = vec![0.0; (2 * m + 1) * input.n_channels()];
     let n_samples = input.len();
     for sample in 0..n_samples {
@@ -249,7 +300,7 @@ fn sample_loop<const N: usize, const Q: usize>(
             break;
         }
         input.nodes(sample, &mut nodes);
-        advance(&nodes, &mut z);
+        advance.advance(&nodes, &mut z);
     }
     Ok(())
 }

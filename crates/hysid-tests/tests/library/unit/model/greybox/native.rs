@@ -398,7 +398,7 @@ fn random_expression(points: &mut Points, depth: usize) -> String {
         return leaves[pick(leaves.len() as u64) as usize].to_string();
     }
     let op = pick(22);
-    let mut sub = |points: &mut Points| random_expression(points, depth - 1);
+    let sub = |points: &mut Points| random_expression(points, depth - 1);
     let (x, y) = (sub(points), sub(points));
     match op {
         0 => format!("({x} + {y})"),

@@ -203,13 +203,14 @@ struct Env {
     c: Mem,
 }
 
-/// Where a stage reads S and the coupling flags and writes ẋ and Ṡ.
+/// Where a stage reads S and the coupling flags and writes Ṡ: S and Ṡ in rows of `row`
+/// doubles (q, or q padded).
 #[derive(Clone, Copy)]
 struct StageIo {
     s: Mem,
     coupled: Mem,
-    dx: Mem,
     ds: Mem,
+    row: usize,
 }
 
 struct Generator<'a> {
@@ -376,10 +377,11 @@ impl Generator<'_> {
     }
 
     /// One evaluation of ẋ and Ṡ (`source::sensitivities_source`'s `hy_sens`) into a new
-    /// block: ẋ = f, then per row i and column c, d = [f_θ]ᵢ꜀ (0 for an initial-state
-    /// column) plus the products [f_x]ᵢⱼ·Sⱼ꜀ in the order of j — left out for a constant
-    /// zero entry, added only where `coupled[i·n + j]` for an entry prepared from θ.
-    fn stage(&mut self, env: Env, io: StageIo, n: usize, k: usize, q: usize) -> Block {
+    /// block: ẋ = f into `dx`, then per row i and column c, d = [f_θ]ᵢ꜀ (0 for an
+    /// initial-state column) plus the products [f_x]ᵢⱼ·Sⱼ꜀ in the order of j — left out for
+    /// a constant zero entry, added only where `coupled[i·n + j]` for an entry prepared from
+    /// θ.
+    fn stage(&mut self, env: Env, dx: Mem, n: usize, k: usize, q: usize, io: StageIo) -> Block {
         let split = self.split;
         let results = &split.listing.results;
         let entry = |i: usize, j: usize| n + i * n + j;
@@ -397,7 +399,7 @@ impl Generator<'_> {
             let src = block.in_value(v);
             block.push(Ins::Store {
                 src,
-                to: io.dx.offset(i),
+                to: dx.offset(i),
             });
         }
         // The Jacobian entries that take part, finite.
@@ -412,8 +414,15 @@ impl Generator<'_> {
                 }
             }
         }
-        for (i, row) in a.iter().enumerate() {
+        let StageIo {
+            s,
+            coupled,
+            ds,
+            row,
+        } = io;
+        for (i, cells) in a.iter().enumerate() {
             for c in 0..q {
+                // d is a fresh value (a load or a mask's result): it accumulates alone.
                 let d = if c < k {
                     let o = &results[direct(i, c)];
                     let v = value(o, &mut self.pool);
@@ -422,22 +431,21 @@ impl Generator<'_> {
                     let zero = self.pool.double(0.0);
                     block.in_value(Arg::Mem(zero))
                 };
-                // d is a fresh value (a load or a mask's result): it accumulates alone.
-                for (j, cell) in row.iter().enumerate() {
+                for (j, cell) in cells.iter().enumerate() {
                     if let Some((aij, class)) = cell {
                         let flag =
-                            (*class == Class::Prepared).then(|| io.coupled.offset_bytes(i * n + j));
+                            (*class == Class::Prepared).then(|| coupled.offset_bytes(i * n + j));
                         block.push(Ins::MulAdd {
                             d,
                             a: *aij,
-                            s: io.s.offset(j * q + c),
+                            s: s.offset(j * row + c),
                             flag,
                         });
                     }
                 }
                 block.push(Ins::Store {
                     src: d,
-                    to: io.ds.offset(i * q + c),
+                    to: ds.offset(i * row + c),
                 });
             }
         }
@@ -456,10 +464,10 @@ impl Generator<'_> {
         let io = StageIo {
             s: Mem::at(Gpr::R14, 0),
             coupled: Mem::at(Gpr::Rbp, 0),
-            dx: Mem::at(Gpr::R10, 0),
             ds: Mem::at(Gpr::R11, 0),
+            row: q,
         };
-        let block = self.stage(env, io, n, k, q);
+        let block = self.stage(env, Mem::at(Gpr::R10, 0), n, k, q, io);
         let frame = Frame::new(3 + block.slots());
         let (dx_slot, ds_slot) = (frame.slot(1), frame.slot(2));
         let start = self.prologue(&frame);
@@ -486,32 +494,40 @@ impl Generator<'_> {
 
     /// `hysid_substeps(nodes, c, coupled, m, h, x, s)`: m RK4 sub-steps of z = [x, S] (the
     /// stages of [`Self::stage`], the stage states z + (h/2)·k₁, z + (h/2)·k₂, z + h·k₃ and
-    /// z ← z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), element by element as `fixed_rk4`).
+    /// z ← z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), element by element as `fixed_rk4`). In the
+    /// frame z is padded to whole groups of four doubles (x, then each row of S), so that
+    /// the RK4 updates run four lanes at a time (each lane rounding as the scalar
+    /// operation); the padding lanes stay zero. (Ṡ four lanes at a time as well, from the
+    /// stage's terms stored for it, measured no faster: the stores of single doubles that a
+    /// four-lane load then reads stall it.)
     fn substeps(&mut self, n: usize, k: usize, q: usize, inputs: usize) -> usize {
-        let len = n + n * q;
-        // Frame: h, h/2, h/6, the pointers x and s, z, k₁ … k₄, the stage state, spills.
+        let (x4, row) = (n.next_multiple_of(4), q.next_multiple_of(4));
+        let len = x4 + n * row;
+        // Frame: h, h/2, h/6, the pointers x and s (a group of four), then z, k₁ … k₄, the
+        // stage state, the spill slots.
         let (h, half, sixth, x_ptr, s_ptr) = (0, 1, 2, 3, 4);
-        let z = 5;
+        let z = 8;
         let stage_k = |r: usize| z + len * (1 + r);
         let state = z + 5 * len;
         let spill = state + len;
         let stage_base = |r: usize| if r == 0 { z } else { state };
+        let at = |i: usize| Mem::at(Gpr::Rsp, 8 * i);
         // Stage r reads the input at node 0, 1, 1, 2 of the sub-step.
         let mut blocks = Vec::new();
         for (r, node) in [0, 1, 1, 2].into_iter().enumerate() {
             let env = Env {
                 t: Arg::Mem(self.pool.double(0.0)),
-                x: Mem::at(Gpr::Rsp, 8 * stage_base(r)),
+                x: at(stage_base(r)),
                 u: Mem::at(Gpr::R12, 8 * inputs * node),
                 c: Mem::at(Gpr::R13, 0),
             };
             let io = StageIo {
-                s: Mem::at(Gpr::Rsp, 8 * (stage_base(r) + n)),
+                s: at(stage_base(r) + x4),
                 coupled: Mem::at(Gpr::R14, 0),
-                dx: Mem::at(Gpr::Rsp, 8 * stage_k(r)),
-                ds: Mem::at(Gpr::Rsp, 8 * (stage_k(r) + n)),
+                ds: at(stage_k(r) + x4),
+                row,
             };
-            blocks.push(self.stage(env, io, n, k, q));
+            blocks.push(self.stage(env, at(stage_k(r)), n, k, q, io));
         }
         let spills = blocks.iter().map(Block::slots).max().unwrap_or(0);
         let frame = Frame::new(spill + spills);
@@ -520,28 +536,40 @@ impl Generator<'_> {
             self.pool.double(0.5),
             self.pool.double(6.0),
         );
-        let slot = |i: usize| frame.slot(i);
+        // Element e of z (x then S, row-major n × q) in the padded layout.
+        let padded = |e: usize| {
+            if e < n {
+                e
+            } else {
+                x4 + (e - n) / q * row + (e - n) % q
+            }
+        };
         let start = self.prologue(&frame);
         let a = &mut self.asm;
         a.mov(Gpr::R12, Gpr::Rdi);
         a.mov(Gpr::R13, Gpr::Rsi);
         a.mov(Gpr::R14, Gpr::Rdx);
         a.movsxd(Gpr::R15, Gpr::Rcx);
-        a.mov_store(slot(x_ptr), Gpr::R8);
-        a.mov_store(slot(s_ptr), Gpr::R9);
-        a.store(slot(h), 0);
+        a.mov_store(at(x_ptr), Gpr::R8);
+        a.mov_store(at(s_ptr), Gpr::R9);
+        a.store(at(h), 0);
         a.scalar(Scalar::Mul, 1, 0, asm::Rm::Mem(one_half));
-        a.store(slot(half), 1);
+        a.store(at(half), 1);
         a.scalar(Scalar::Div, 1, 0, asm::Rm::Mem(six));
-        a.store(slot(sixth), 1);
-        for e in 0..len {
+        a.store(at(sixth), 1);
+        // Zero lanes everywhere (the padding stays zero).
+        a.logic(Logic::Xor, 2, 2, asm::Rm::Xmm(2));
+        for group in (z..spill).step_by(4) {
+            a.store4(at(group), 2);
+        }
+        for e in 0..n + n * q {
             let from = if e < n {
                 Mem::at(Gpr::R8, 8 * e)
             } else {
                 Mem::at(Gpr::R9, 8 * (e - n))
             };
             a.load(0, from);
-            a.store(slot(z + e), 0);
+            a.store(at(z + padded(e)), 0);
         }
         let (done, lp) = (a.label(), a.label());
         a.test(Gpr::R15);
@@ -552,36 +580,39 @@ impl Generator<'_> {
             let a = &mut self.asm;
             if r < 3 {
                 // The next stage's state: z + w·k (w·k first, as base + c·k rounds).
-                a.load(0, slot([half, half, h][r]));
-                for e in 0..len {
-                    a.scalar(Scalar::Mul, 1, 0, asm::Rm::Mem(slot(stage_k(r) + e)));
-                    a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(slot(z + e)));
-                    a.store(slot(state + e), 1);
+                a.broadcast(0, at([half, half, h][r]));
+                for group in (0..len).step_by(4) {
+                    a.packed(Scalar::Mul, 1, 0, asm::Rm::Mem(at(stage_k(r) + group)));
+                    a.packed(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + group)));
+                    a.store4(at(state + group), 1);
                 }
             }
+            // Before the next block, whose calls may run legacy SSE code.
+            a.zero_upper();
         }
         let a = &mut self.asm;
-        a.load(0, slot(sixth));
-        a.load(3, two);
-        for e in 0..len {
-            a.load(1, slot(stage_k(0) + e));
-            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(slot(stage_k(1) + e)));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
-            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(slot(stage_k(2) + e)));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(slot(stage_k(3) + e)));
-            a.scalar(Scalar::Mul, 1, 0, asm::Rm::Xmm(1));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(slot(z + e)));
-            a.store(slot(z + e), 1);
+        a.broadcast(0, at(sixth));
+        a.broadcast(3, two);
+        for group in (0..len).step_by(4) {
+            a.load4(1, at(stage_k(0) + group));
+            a.packed(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(1) + group)));
+            a.packed(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
+            a.packed(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(2) + group)));
+            a.packed(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
+            a.packed(Scalar::Add, 1, 1, asm::Rm::Mem(at(stage_k(3) + group)));
+            a.packed(Scalar::Mul, 1, 0, asm::Rm::Xmm(1));
+            a.packed(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + group)));
+            a.store4(at(z + group), 1);
         }
+        a.zero_upper();
         a.add_imm(Gpr::R12, i32::try_from(16 * inputs).expect("few inputs"));
         a.dec(Gpr::R15);
         a.jump(Some(asm::cc::NOT_ZERO), lp);
         a.bind(done);
-        a.mov_load(Gpr::Rax, slot(x_ptr));
-        a.mov_load(Gpr::Rcx, slot(s_ptr));
-        for e in 0..len {
-            a.load(0, slot(z + e));
+        a.mov_load(Gpr::Rax, at(x_ptr));
+        a.mov_load(Gpr::Rcx, at(s_ptr));
+        for e in 0..n + n * q {
+            a.load(0, at(z + padded(e)));
             let to = if e < n {
                 Mem::at(Gpr::Rax, 8 * e)
             } else {
