@@ -132,6 +132,7 @@ pub(super) fn assemble(
         asm: Asm::default(),
         pool: Pool::default(),
         pool_fixups: Vec::new(),
+        largest_frame: 0,
     };
     let prepare = gen.prepare();
     let mut entries = Entries {
@@ -150,6 +151,13 @@ pub(super) fn assemble(
             let rates = gen.eval(n, &(0..n).collect::<Vec<_>>());
             entries.sens = Some((sens, substeps, rates));
         }
+    }
+    if gen.largest_frame > MAX_FRAME {
+        return Err(format!(
+            "the model needs a {} KiB stack frame, more than generated code takes ({} KiB)",
+            gen.largest_frame / 1024,
+            MAX_FRAME / 1024
+        ));
     }
     let Generator {
         asm,
@@ -219,7 +227,13 @@ struct Generator<'a> {
     pool: Pool,
     /// Where `mov rbx, imm64` waits for the constants' address.
     pool_fixups: Vec<usize>,
+    /// The largest stack frame of the functions so far (bytes).
+    largest_frame: usize,
 }
+
+/// The largest stack frame generated code may open: far below the stack of any thread
+/// that runs a simulation (a model this large runs compiled C, or the tape).
+const MAX_FRAME: usize = 256 * 1024;
 
 /// The callee-saved registers a function saves (with the return address, 56 bytes: the
 /// frame below is 8 mod 16 so that calls see an aligned stack).
@@ -248,6 +262,7 @@ impl Generator<'_> {
     /// returns where the function starts.
     fn prologue(&mut self, frame: &Frame) -> usize {
         let start = self.asm.code.len();
+        self.largest_frame = self.largest_frame.max(frame.bytes);
         for r in SAVED {
             self.asm.push(r);
         }
