@@ -511,10 +511,11 @@ impl Generator<'_> {
     /// stages of [`Self::stage`], the stage states z + (h/2)·k₁, z + (h/2)·k₂, z + h·k₃ and
     /// z ← z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), element by element as `fixed_rk4`). In the
     /// frame z is padded to whole groups of four doubles (x, then each row of S), so that
-    /// the RK4 updates run four lanes at a time (each lane rounding as the scalar
-    /// operation); the padding lanes stay zero. (Ṡ four lanes at a time as well, from the
-    /// stage's terms stored for it, measured no faster: the stores of single doubles that a
-    /// four-lane load then reads stall it.)
+    /// the RK4 updates of S run four lanes at a time (each lane rounding as the scalar
+    /// operation; x one double at a time, as the stages store and read it: a four-lane load
+    /// of doubles stored one by one waits for the stores); the padding lanes stay zero.
+    /// (Ṡ four lanes at a time as well, from the stage's terms stored for it, measured no
+    /// faster.)
     fn substeps(&mut self, n: usize, k: usize, q: usize, inputs: usize) -> usize {
         let (x4, row) = (n.next_multiple_of(4), q.next_multiple_of(4));
         let len = x4 + n * row;
@@ -596,7 +597,12 @@ impl Generator<'_> {
             if r < 3 {
                 // The next stage's state: z + w·k (w·k first, as base + c·k rounds).
                 a.broadcast(0, at([half, half, h][r]));
-                for group in (0..len).step_by(4) {
+                for e in 0..n {
+                    a.scalar(Scalar::Mul, 1, 0, asm::Rm::Mem(at(stage_k(r) + e)));
+                    a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + e)));
+                    a.store(at(state + e), 1);
+                }
+                for group in (x4..len).step_by(4) {
                     a.packed(Scalar::Mul, 1, 0, asm::Rm::Mem(at(stage_k(r) + group)));
                     a.packed(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + group)));
                     a.store4(at(state + group), 1);
@@ -608,7 +614,18 @@ impl Generator<'_> {
         let a = &mut self.asm;
         a.broadcast(0, at(sixth));
         a.broadcast(3, two);
-        for group in (0..len).step_by(4) {
+        for e in 0..n {
+            a.load(1, at(stage_k(0) + e));
+            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(1) + e)));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
+            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(2) + e)));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(at(stage_k(3) + e)));
+            a.scalar(Scalar::Mul, 1, 0, asm::Rm::Xmm(1));
+            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + e)));
+            a.store(at(z + e), 1);
+        }
+        for group in (x4..len).step_by(4) {
             a.load4(1, at(stage_k(0) + group));
             a.packed(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(1) + group)));
             a.packed(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
