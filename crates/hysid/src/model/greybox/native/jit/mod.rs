@@ -210,6 +210,9 @@ struct Generator<'a> {
 /// that runs a simulation (a model this large runs compiled C, or the tape).
 const MAX_FRAME: usize = 256 * 1024;
 
+/// The page size the stack probes step by.
+const PAGE: usize = 4096;
+
 /// The callee-saved registers a function saves (with the return address, 56 bytes: the
 /// frame below is 8 mod 16 so that calls see an aligned stack).
 const SAVED: [Gpr; 6] = [Gpr::Rbx, Gpr::Rbp, Gpr::R12, Gpr::R13, Gpr::R14, Gpr::R15];
@@ -241,8 +244,19 @@ impl Generator<'_> {
         for r in SAVED {
             self.asm.push(r);
         }
-        self.asm
-            .add_imm(Gpr::Rsp, -i32::try_from(frame.bytes).expect("small frames"));
+        // A frame beyond i32 is refused before the code could run (MAX_FRAME).
+        let bytes = i32::try_from(frame.bytes).unwrap_or(i32::MAX);
+        self.asm.add_imm(Gpr::Rsp, -bytes);
+        // Stack probes: each page of a large frame read from the top down, so that a
+        // thread's guard page faults rather than being stepped over.
+        if frame.bytes > PAGE {
+            let mut below_top = frame.bytes;
+            while below_top > PAGE {
+                below_top -= PAGE;
+                self.asm.mov_load(Gpr::Rax, Mem::at(Gpr::Rsp, below_top));
+            }
+            self.asm.mov_load(Gpr::Rax, Mem::at(Gpr::Rsp, 0));
+        }
         self.asm.mov_imm(Gpr::Rbx, 0);
         self.pool_fixups.push(self.asm.code.len() - 8);
         start
@@ -250,7 +264,7 @@ impl Generator<'_> {
 
     fn epilogue(&mut self, frame: &Frame) {
         self.asm
-            .add_imm(Gpr::Rsp, i32::try_from(frame.bytes).expect("small frames"));
+            .add_imm(Gpr::Rsp, i32::try_from(frame.bytes).unwrap_or(i32::MAX));
         for r in SAVED.iter().rev() {
             self.asm.pop(*r);
         }
