@@ -8,7 +8,7 @@
 //! prefix; the instruction pages of `VADDSD`, `VCMPSD`, `VANDPD`, `VMOVSD`, `MOV`, `CALL`).
 
 /// A general-purpose register, numbered as the encoding numbers it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[allow(dead_code)] // the full register file, named as the manual names it
 pub(super) enum Gpr {
     Rax = 0,
@@ -30,7 +30,7 @@ pub(super) enum Gpr {
 }
 
 /// `[base + disp]`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(super) struct Mem {
     pub base: Gpr,
     pub disp: i32,

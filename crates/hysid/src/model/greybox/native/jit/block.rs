@@ -48,8 +48,9 @@ pub(super) enum Ins {
         one: Mem,
         zero: Mem,
     },
-    /// `dst = a` (a load).
-    Load { dst: V, a: Mem },
+    /// `dst = a` (a load); `reread` when the memory holds the value for the whole block,
+    /// so that an eviction need not store it (it is read again from `a`).
+    Load { dst: V, a: Mem, reread: bool },
     /// `[to] = src`.
     Store { src: V, to: Mem },
     /// `d = d + a·[s]`, only where the byte at `flag` is non-zero when given.
@@ -86,6 +87,9 @@ impl Ins {
 pub(super) struct Block {
     ins: Vec<Ins>,
     values: usize,
+    /// The value each memory operand was loaded into (the block's memory is read-only
+    /// to it but for its stores of results, which it never reads back).
+    loaded: std::collections::HashMap<Mem, V>,
 }
 
 impl Block {
@@ -101,6 +105,7 @@ impl Block {
 
     /// `op(a, b)` into a new value.
     pub fn scalar(&mut self, op: Scalar, a: Arg, b: Arg) -> V {
+        let a = Arg::V(self.in_value(a));
         let dst = self.value();
         self.push(Ins::Scalar { op, dst, a, b });
         dst
@@ -108,6 +113,7 @@ impl Block {
 
     /// The mask of `a pred b` into a new value.
     pub fn cmp(&mut self, pred: u8, a: Arg, b: Arg) -> V {
+        let a = Arg::V(self.in_value(a));
         let dst = self.value();
         self.push(Ins::Cmp { pred, dst, a, b });
         dst
@@ -145,15 +151,35 @@ impl Block {
     }
 
     /// `a` as a value (loaded when in memory).
+    /// `a` as a value to read (memory loaded once per block).
     pub fn in_value(&mut self, a: Arg) -> V {
         match a {
             Arg::V(v) => v,
             Arg::Mem(m) => {
+                if let Some(&v) = self.loaded.get(&m) {
+                    return v;
+                }
                 let dst = self.value();
-                self.push(Ins::Load { dst, a: m });
+                self.push(Ins::Load {
+                    dst,
+                    a: m,
+                    reread: true,
+                });
+                self.loaded.insert(m, dst);
                 dst
             }
         }
+    }
+
+    /// A new value loaded from `m`, of its own: an accumulator ([`Ins::MulAdd`]) starts so.
+    pub fn fresh(&mut self, m: Mem) -> V {
+        let dst = self.value();
+        self.push(Ins::Load {
+            dst,
+            a: m,
+            reread: false,
+        });
+        dst
     }
 
     /// How many frame slots (doubles) the block's values may need.
@@ -178,6 +204,7 @@ impl Block {
             cursor: vec![0; self.values],
             home: vec![None; self.values],
             saved: vec![false; self.values],
+            origin: vec![None; self.values],
             holder: [None; 16],
         };
         for (p, ins) in self.ins.iter().enumerate() {
@@ -198,13 +225,16 @@ struct State<'a> {
     home: Vec<Option<Xmm>>,
     /// Per value, whether its slot holds its current value.
     saved: Vec<bool>,
+    /// Per value loaded from memory that holds it for the whole block: that memory, its
+    /// slot.
+    origin: Vec<Option<Mem>>,
     /// Per register, the value it holds.
     holder: [Option<V>; 16],
 }
 
 impl State<'_> {
     fn slot(&self, v: V) -> Mem {
-        self.spill.offset(v.0)
+        self.origin[v.0].unwrap_or(self.spill.offset(v.0))
     }
 
     /// The next instruction at or after `p` reading v (usize::MAX: none).
@@ -374,8 +404,11 @@ impl State<'_> {
                     .filter_map(|r| self.holder[r as usize].map(|v| (r, v)))
                     .collect();
                 for &(r, v) in &held {
-                    let slot = self.slot(v);
-                    self.asm.store(slot, r);
+                    // A value read from memory of the block's is read from there again.
+                    if self.origin[v.0].is_none() {
+                        let slot = self.slot(v);
+                        self.asm.store(slot, r);
+                    }
                 }
                 let (slot_a, slot_b) = (self.slot(a), self.slot(b));
                 self.asm.load(0, slot_a);
@@ -397,9 +430,13 @@ impl State<'_> {
                 self.bind(dst, rd);
                 self.saved[dst.0] = false;
             }
-            Ins::Load { dst, a } => {
+            Ins::Load { dst, a, reread } => {
                 let rd = self.define(dst, p);
                 self.asm.load(rd, a);
+                if reread {
+                    self.origin[dst.0] = Some(a);
+                    self.saved[dst.0] = true;
+                }
             }
             Ins::Store { src, to } => {
                 let r = self.reg(src, p, &[]);

@@ -48,9 +48,8 @@ impl Pool {
 /// `value` (operand `o`) made finite: 0 where infinite or NaN. A constant is folded.
 pub(super) fn finite(block: &mut Block, pool: &mut Pool, value: Arg, o: &Operand) -> V {
     if let Operand::Constant(c) = *o {
-        return block.in_value(Arg::Mem(
-            pool.double(hysid_equations::apply1(Fn1::FiniteOr0, c)),
-        ));
+        // A value of its own: the caller may accumulate into it.
+        return block.fresh(pool.double(hysid_equations::apply1(Fn1::FiniteOr0, c)));
     }
     let v = block.in_value(value);
     finite_value(block, pool, v)

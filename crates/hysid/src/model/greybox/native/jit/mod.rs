@@ -433,7 +433,7 @@ impl Generator<'_> {
                     finite(&mut block, &mut self.pool, v, o)
                 } else {
                     let zero = self.pool.double(0.0);
-                    block.in_value(Arg::Mem(zero))
+                    block.fresh(zero)
                 };
                 for (j, cell) in cells.iter().enumerate() {
                     if let Some((aij, class)) = cell {
