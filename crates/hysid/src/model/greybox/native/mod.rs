@@ -395,16 +395,10 @@ impl NativeFunction {
         let (code, entries, prepared) = jit::assemble(listing, &layout, shape)?;
         let provenance = Provenance::Generated(started.elapsed().as_secs_f64());
         let symbol = |name: &std::ffi::CStr| {
-            let offset = match (name.to_bytes(), entries.eval, entries.sens) {
-                (b"hysid_prepare", ..) => Some(entries.prepare),
-                (b"hysid_eval", Some(eval), _) => Some(eval),
-                (b"hysid_sens", _, Some((sens, _, _))) => Some(sens),
-                (b"hysid_substeps", _, Some((_, substeps, _))) => Some(substeps),
-                (b"hysid_rates", _, Some((_, _, rates))) => Some(rates),
-                _ => None,
-            };
-            offset
-                .map(|o| code.entry(o))
+            entries
+                .iter()
+                .find(|(entry, _)| *entry == name)
+                .map(|&(_, offset)| code.entry(offset))
                 .ok_or_else(|| format!("no function {name:?} was generated"))
         };
         let found = Found::look_up(symbol, &layout)?;
@@ -427,22 +421,23 @@ impl NativeFunction {
     /// Check it against the tape of f before use, as [`NativeFunction::build`]'s caller
     /// checks the function itself.
     pub fn rates(&self) -> Option<Arc<NativeFunction>> {
-        let rates = self.rates?;
-        let n = self.shape.states;
-        Some(Arc::new(NativeFunction {
-            code: Arc::clone(&self.code),
+        let found = Found {
             prepare: self.prepare,
-            entry: Entry::Results(rates),
+            entry: Entry::Results(self.rates?),
             rates: None,
-            layout: Layout::Results {
-                values: n,
-                positions: (0..n).collect(),
-            },
-            prepared: self.prepared,
-            out_len: n,
-            shape: self.shape,
-            provenance: self.provenance,
-        }))
+        };
+        let n = self.shape.states;
+        let layout = Layout::Results {
+            values: n,
+            positions: (0..n).collect(),
+        };
+        Some(Arc::new(found.function(
+            Arc::clone(&self.code),
+            layout,
+            self.shape,
+            self.prepared,
+            self.provenance,
+        )))
     }
 
     /// What the function computes.

@@ -216,7 +216,7 @@ fn check_substeps(
         let k3 = rate(&axpy(&z, half, &k2), 2 * j + 1);
         let k4 = rate(&axpy(&z, h, &k3), 2 * j + 2);
         for (e, v) in z.iter_mut().enumerate() {
-            *v += sixth * (k1[e] + 2.0 * k2[e] + 2.0 * k3[e] + k4[e]);
+            *v += hysid::numerics::integrate::rk4::increment(sixth, k1[e], k2[e], k3[e], k4[e]);
         }
     }
     let got: Vec<f64> = zx.iter().chain(&zs).copied().collect();

@@ -100,6 +100,14 @@ pub(super) mod pred {
     pub const GT_OQ: u8 = 0x1E;
 }
 
+/// How many doubles an element-wise instruction works on: one (the scalar form) or four
+/// (the 256-bit packed form; each lane rounds as the scalar operation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Lanes {
+    One,
+    Four,
+}
+
 /// A position in the code a jump goes to, bound once.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Label(usize);
@@ -206,6 +214,30 @@ impl Asm {
     pub fn packed(&mut self, op: Scalar, dst: Xmm, a: Xmm, b: Rm) {
         debug_assert!(matches!(op, Scalar::Add | Scalar::Mul));
         self.vex_in(MAP_0F, true, PP_66, op as u8, dst, a, b);
+    }
+
+    /// `dst = a op b` (`Add` or `Mul`) on `lanes` doubles.
+    pub fn arith(&mut self, lanes: Lanes, op: Scalar, dst: Xmm, a: Xmm, b: Rm) {
+        match lanes {
+            Lanes::One => self.scalar(op, dst, a, b),
+            Lanes::Four => self.packed(op, dst, a, b),
+        }
+    }
+
+    /// `dst = [m]`, `lanes` doubles.
+    pub fn load_lanes(&mut self, lanes: Lanes, dst: Xmm, m: Mem) {
+        match lanes {
+            Lanes::One => self.load(dst, m),
+            Lanes::Four => self.load4(dst, m),
+        }
+    }
+
+    /// `[m] = src`, `lanes` doubles.
+    pub fn store_lanes(&mut self, lanes: Lanes, m: Mem, src: Xmm) {
+        match lanes {
+            Lanes::One => self.store(m, src),
+            Lanes::Four => self.store4(m, src),
+        }
     }
 
     /// `dst = [m]`, four doubles (`VMOVUPD` ymm).

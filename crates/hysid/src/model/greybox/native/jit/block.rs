@@ -31,9 +31,9 @@ pub(super) enum Arg {
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Ins {
     /// `dst = a op b`.
-    Scalar { op: Scalar, dst: V, a: Arg, b: Arg },
+    Scalar { op: Scalar, dst: V, a: V, b: Arg },
     /// `dst = mask(a pred b)`.
-    Cmp { pred: u8, dst: V, a: Arg, b: Arg },
+    Cmp { pred: u8, dst: V, a: V, b: Arg },
     /// `dst = a op b` bitwise; `b` a value or a 16-byte constant.
     Logic { op: Logic, dst: V, a: V, b: Arg },
     /// `dst = f(a, b)`.
@@ -70,10 +70,10 @@ impl Ins {
             Arg::Mem(_) => None,
         };
         match self {
-            Ins::Scalar { a, b, .. } | Ins::Cmp { a, b, .. } | Ins::Call { a, b, .. } => {
-                [v(a), v(b)]
+            Ins::Call { a, b, .. } => [v(a), v(b)],
+            Ins::Scalar { a, b, .. } | Ins::Cmp { a, b, .. } | Ins::Logic { a, b, .. } => {
+                [Some(*a), v(b)]
             }
-            Ins::Logic { a, b, .. } => [Some(*a), v(b)],
             Ins::Pow { a, b, .. } => [Some(*a), Some(*b)],
             Ins::Load { .. } => [None, None],
             Ins::Store { src, .. } => [Some(*src), None],
@@ -105,7 +105,7 @@ impl Block {
 
     /// `op(a, b)` into a new value.
     pub fn scalar(&mut self, op: Scalar, a: Arg, b: Arg) -> V {
-        let a = Arg::V(self.in_value(a));
+        let a = self.in_value(a);
         let dst = self.value();
         self.push(Ins::Scalar { op, dst, a, b });
         dst
@@ -113,7 +113,7 @@ impl Block {
 
     /// The mask of `a pred b` into a new value.
     pub fn cmp(&mut self, pred: u8, a: Arg, b: Arg) -> V {
-        let a = Arg::V(self.in_value(a));
+        let a = self.in_value(a);
         let dst = self.value();
         self.push(Ins::Cmp { pred, dst, a, b });
         dst
@@ -329,35 +329,24 @@ impl State<'_> {
         r
     }
 
-    /// `a` in a register for the first source: its own, or a free one it is loaded into
-    /// (held by no value: the destination may take it).
-    fn first(&mut self, a: Arg, p: usize) -> Xmm {
-        match a {
-            Arg::V(v) => self.reg(v, p, &[]),
-            Arg::Mem(m) => {
-                let r = self.free_register(p, &[]);
-                self.asm.load(r, m);
-                r
-            }
-        }
+    /// The registers of a two-source instruction `ins` (`a` a value, `b` in a register or
+    /// memory) and of its destination, which may take a source's register (the instruction
+    /// reads its sources before it writes), even one whose value is evicted to make room.
+    fn binary(&mut self, ins: &Ins, dst: V, a: V, b: Arg, p: usize) -> (Xmm, Xmm, Rm) {
+        let ra = self.reg(a, p, &[]);
+        let rb = self.rm(b);
+        self.retire(ins);
+        (self.define(dst, p), ra, rb)
     }
 
     fn emit(&mut self, p: usize, ins: &Ins, restore: &[(Gpr, Mem)]) {
         match *ins {
-            // The destination may take an operand's register (the instruction reads its
-            // sources before it writes), even one whose value is evicted to make room.
             Ins::Scalar { op, dst, a, b } => {
-                let ra = self.first(a, p);
-                let rb = self.rm(b);
-                self.retire(ins);
-                let rd = self.define(dst, p);
+                let (rd, ra, rb) = self.binary(ins, dst, a, b, p);
                 self.asm.scalar(op, rd, ra, rb);
             }
             Ins::Cmp { pred, dst, a, b } => {
-                let ra = self.first(a, p);
-                let rb = self.rm(b);
-                self.retire(ins);
-                let rd = self.define(dst, p);
+                let (rd, ra, rb) = self.binary(ins, dst, a, b, p);
                 self.asm.cmp(pred, rd, ra, rb);
             }
             Ins::Logic { op, dst, a, b } => {

@@ -30,10 +30,11 @@ mod lower;
 
 use super::source::{operands, Class, Split};
 use super::{Layout, Shape};
-use asm::{Asm, Gpr, Logic, Mem, Scalar};
+use asm::{Asm, Gpr, Lanes, Logic, Mem, Rm, Scalar};
 use block::{Arg, Block, Ins, V};
 use hysid_equations::{Listing, Operand};
 use lower::{finite, lower, Pool};
+use std::ffi::CStr;
 
 /// Whether this machine runs the generated code (x86-64 with AVX).
 pub(super) fn available() -> bool {
@@ -117,14 +118,8 @@ impl Code {
     }
 }
 
-/// Where each function starts in a [`Code`].
-pub(super) struct Entries {
-    pub prepare: usize,
-    /// `hysid_eval` of a results layout.
-    pub eval: Option<usize>,
-    /// `hysid_sens`, `hysid_substeps` and `hysid_rates` of a sensitivities layout.
-    pub sens: Option<(usize, usize, usize)>,
-}
+/// Where each function starts in a [`Code`], by its C name.
+pub(super) type Entries = Vec<(&'static CStr, usize)>;
 
 /// The machine code of `listing` for `layout` over `shape`, and the length of its
 /// prepared array: the functions `source.rs` would print, emitted here.
@@ -141,22 +136,17 @@ pub(super) fn assemble(
         pool_fixups: Vec::new(),
         largest_frame: 0,
     };
-    let prepare = gen.prepare();
-    let mut entries = Entries {
-        prepare,
-        eval: None,
-        sens: None,
-    };
+    let mut entries: Entries = vec![(c"hysid_prepare", gen.prepare())];
     match layout {
         Layout::Results { values, positions } => {
-            entries.eval = Some(gen.eval(*values, positions));
+            entries.push((c"hysid_eval", gen.eval(*values, positions)));
         }
         Layout::Sensitivities { k, q } => {
             let n = shape.states;
-            let sens = gen.sens(n, *k, *q);
-            let substeps = gen.substeps(n, *k, *q, shape.inputs);
+            entries.push((c"hysid_sens", gen.sens(n, *k, *q)));
+            entries.push((c"hysid_substeps", gen.substeps(n, *k, *q, shape.inputs)));
             let rates = gen.eval(n, &(0..n).collect::<Vec<_>>());
-            entries.sens = Some((sens, substeps, rates));
+            entries.push((c"hysid_rates", rates));
         }
     }
     if gen.largest_frame > MAX_FRAME {
@@ -558,12 +548,12 @@ impl Generator<'_> {
         a.mov_store(at(x_ptr), Gpr::R8);
         a.mov_store(at(s_ptr), Gpr::R9);
         a.store(at(h), 0);
-        a.scalar(Scalar::Mul, 1, 0, asm::Rm::Mem(one_half));
+        a.scalar(Scalar::Mul, 1, 0, Rm::Mem(one_half));
         a.store(at(half), 1);
-        a.scalar(Scalar::Div, 1, 0, asm::Rm::Mem(six));
+        a.scalar(Scalar::Div, 1, 0, Rm::Mem(six));
         a.store(at(sixth), 1);
         // Zero lanes everywhere (the padding stays zero).
-        a.logic(Logic::Xor, 2, 2, asm::Rm::Xmm(2));
+        a.logic(Logic::Xor, 2, 2, Rm::Xmm(2));
         for group in (z..spill).step_by(4) {
             a.store4(at(group), 2);
         }
@@ -580,50 +570,43 @@ impl Generator<'_> {
         a.test(Gpr::R15);
         a.jump(Some(asm::cc::LESS_OR_EQUAL), done);
         a.bind(lp);
+        // The updates run over x one double at a time (as the stages store and read it: a
+        // four-lane load of doubles stored one by one waits for the stores), over S four
+        // lanes at a time.
+        let chunks: Vec<(usize, Lanes)> = (0..n)
+            .map(|e| (e, Lanes::One))
+            .chain((x4..len).step_by(4).map(|g| (g, Lanes::Four)))
+            .collect();
         for (r, block) in blocks.iter().enumerate() {
             block.emit(&mut self.asm, frame.slot(spill), &[]);
             let a = &mut self.asm;
             if r < 3 {
                 // The next stage's state: z + w·k (w·k first, as base + c·k rounds).
                 a.broadcast(0, at([half, half, h][r]));
-                for e in 0..n {
-                    a.scalar(Scalar::Mul, 1, 0, asm::Rm::Mem(at(stage_k(r) + e)));
-                    a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + e)));
-                    a.store(at(state + e), 1);
-                }
-                for group in (x4..len).step_by(4) {
-                    a.packed(Scalar::Mul, 1, 0, asm::Rm::Mem(at(stage_k(r) + group)));
-                    a.packed(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + group)));
-                    a.store4(at(state + group), 1);
+                for &(e, lanes) in &chunks {
+                    a.arith(lanes, Scalar::Mul, 1, 0, Rm::Mem(at(stage_k(r) + e)));
+                    a.arith(lanes, Scalar::Add, 1, 1, Rm::Mem(at(z + e)));
+                    a.store_lanes(lanes, at(state + e), 1);
                 }
             }
             // Before the next block, whose calls may run legacy SSE code.
             a.zero_upper();
         }
+        // z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), in that order.
         let a = &mut self.asm;
         a.broadcast(0, at(sixth));
         a.broadcast(3, two);
-        for e in 0..n {
-            a.load(1, at(stage_k(0) + e));
-            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(1) + e)));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
-            a.scalar(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(2) + e)));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(at(stage_k(3) + e)));
-            a.scalar(Scalar::Mul, 1, 0, asm::Rm::Xmm(1));
-            a.scalar(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + e)));
-            a.store(at(z + e), 1);
-        }
-        for group in (x4..len).step_by(4) {
-            a.load4(1, at(stage_k(0) + group));
-            a.packed(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(1) + group)));
-            a.packed(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
-            a.packed(Scalar::Mul, 2, 3, asm::Rm::Mem(at(stage_k(2) + group)));
-            a.packed(Scalar::Add, 1, 1, asm::Rm::Xmm(2));
-            a.packed(Scalar::Add, 1, 1, asm::Rm::Mem(at(stage_k(3) + group)));
-            a.packed(Scalar::Mul, 1, 0, asm::Rm::Xmm(1));
-            a.packed(Scalar::Add, 1, 1, asm::Rm::Mem(at(z + group)));
-            a.store4(at(z + group), 1);
+        for &(e, lanes) in &chunks {
+            let k = |r: usize| Rm::Mem(at(stage_k(r) + e));
+            a.load_lanes(lanes, 1, at(stage_k(0) + e));
+            a.arith(lanes, Scalar::Mul, 2, 3, k(1));
+            a.arith(lanes, Scalar::Add, 1, 1, Rm::Xmm(2));
+            a.arith(lanes, Scalar::Mul, 2, 3, k(2));
+            a.arith(lanes, Scalar::Add, 1, 1, Rm::Xmm(2));
+            a.arith(lanes, Scalar::Add, 1, 1, k(3));
+            a.arith(lanes, Scalar::Mul, 1, 0, Rm::Xmm(1));
+            a.arith(lanes, Scalar::Add, 1, 1, Rm::Mem(at(z + e)));
+            a.store_lanes(lanes, at(z + e), 1);
         }
         a.zero_upper();
         a.add_imm(Gpr::R12, i32::try_from(16 * inputs).expect("few inputs"));
