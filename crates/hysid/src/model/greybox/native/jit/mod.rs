@@ -28,7 +28,7 @@ mod asm;
 mod block;
 mod lower;
 
-use super::source::{operands, Class, Split};
+use super::source::{needed, Class, Split};
 use super::{Layout, Shape};
 use asm::{Asm, Gpr, Lanes, Logic, Mem, Rm, Scalar};
 use block::{Arg, Block, Ins, V};
@@ -647,26 +647,4 @@ fn read(split: &Split<'_>, env: Env, values: &[Option<V>], o: &Operand, pool: &m
                 .offset(split.slot_of_value[k].expect("a read value has a slot")),
         ),
     }
-}
-
-/// Per operation, whether `roots` need it (through operations that `keep` holds for).
-fn needed(listing: &Listing, roots: &[Operand], keep: impl Fn(usize) -> bool) -> Vec<bool> {
-    let mut needed = vec![false; listing.operations.len()];
-    for o in roots {
-        if let Operand::Value(k) = *o {
-            needed[k] = keep(k);
-        }
-    }
-    for k in (0..listing.operations.len()).rev() {
-        if needed[k] {
-            for o in operands(&listing.operations[k]) {
-                if let Operand::Value(j) = o {
-                    if keep(j) {
-                        needed[j] = true;
-                    }
-                }
-            }
-        }
-    }
-    needed
 }
