@@ -299,6 +299,37 @@ fn native_code_equals_the_tape_for_every_operation() {
     }
 }
 
+/// A Jacobian entry that depends on θ alone and is not finite (∂ẋ/∂w = ln p at p = 0)
+/// counts as zero in Ṡ, in the sensitivity rates and in the sub-steps (whose generated code
+/// makes such entries finite once per call).
+#[test]
+fn jacobian_entries_of_theta_alone_are_made_finite() {
+    let m = EquationModel::parse(
+        r#"
+[model]
+name = "infinite_gain"
+states = ["x", "w"]
+inputs = ["u"]
+outputs = ["x"]
+
+[parameters]
+p = { value = 0.0 }
+g = { value = 0.5 }
+
+[equations]
+x = "w * ln(p) + g * u"
+w = "-x"
+
+[output]
+x = "x"
+"#,
+    )
+    .unwrap();
+    for backend in backends() {
+        check_model(&m, &[0, 1], 2, 11, backend);
+    }
+}
+
 /// The example files (Bouc–Wen, Duffing, cascaded tanks, the actuator with Coulomb
 /// friction, the discrete-time backlash) with their free parameters' columns.
 #[test]

@@ -100,14 +100,6 @@ pub(super) mod pred {
     pub const GT_OQ: u8 = 0x1E;
 }
 
-/// How many doubles an element-wise instruction works on: one (the scalar form) or four
-/// (the 256-bit packed form; each lane rounds as the scalar operation).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Lanes {
-    One,
-    Four,
-}
-
 /// A position in the code a jump goes to, bound once.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Label(usize);
@@ -124,7 +116,6 @@ pub(super) struct Asm {
 const PP_66: u8 = 1;
 const PP_F2: u8 = 3;
 const MAP_0F: u8 = 1;
-const MAP_0F38: u8 = 2;
 
 impl Asm {
     fn bytes(&mut self, b: &[u8]) {
@@ -149,13 +140,6 @@ impl Asm {
     /// A three-byte VEX instruction of map 0F, 128-bit, W0: `reg` the ModRM.reg operand,
     /// `v` the extra source (vvvv), `rm` the ModRM.rm operand.
     fn vex(&mut self, pp: u8, opcode: u8, reg: u8, v: u8, rm: Rm) {
-        self.vex_in(MAP_0F, false, pp, opcode, reg, v, rm);
-    }
-
-    /// A three-byte VEX instruction of opcode map `map` (1: 0F, 2: 0F38), 256-bit when
-    /// `wide`, W0.
-    #[allow(clippy::too_many_arguments)]
-    fn vex_in(&mut self, map: u8, wide: bool, pp: u8, opcode: u8, reg: u8, v: u8, rm: Rm) {
         let b = match rm {
             Rm::Xmm(r) => r >> 3,
             Rm::Mem(m) => (m.base as u8) >> 3,
@@ -163,8 +147,8 @@ impl Asm {
         let r = reg >> 3;
         self.bytes(&[
             0xC4,
-            (r ^ 1) << 7 | 1 << 6 | (b ^ 1) << 5 | map,
-            ((!v) & 15) << 3 | u8::from(wide) << 2 | pp,
+            (r ^ 1) << 7 | 1 << 6 | (b ^ 1) << 5 | MAP_0F,
+            ((!v) & 15) << 3 | pp,
             opcode,
         ]);
         self.modrm(reg, rm);
@@ -207,58 +191,6 @@ impl Asm {
         if dst != src {
             self.vex(PP_66, 0x28, dst, 0, Rm::Xmm(src));
         }
-    }
-
-    /// `dst = a op b` on four doubles (`VADDPD`/`VMULPD` ymm; a memory `b` is read as 32
-    /// bytes): each lane rounds as the scalar operation does.
-    pub fn packed(&mut self, op: Scalar, dst: Xmm, a: Xmm, b: Rm) {
-        debug_assert!(matches!(op, Scalar::Add | Scalar::Mul));
-        self.vex_in(MAP_0F, true, PP_66, op as u8, dst, a, b);
-    }
-
-    /// `dst = a op b` (`Add` or `Mul`) on `lanes` doubles.
-    pub fn arith(&mut self, lanes: Lanes, op: Scalar, dst: Xmm, a: Xmm, b: Rm) {
-        match lanes {
-            Lanes::One => self.scalar(op, dst, a, b),
-            Lanes::Four => self.packed(op, dst, a, b),
-        }
-    }
-
-    /// `dst = [m]`, `lanes` doubles.
-    pub fn load_lanes(&mut self, lanes: Lanes, dst: Xmm, m: Mem) {
-        match lanes {
-            Lanes::One => self.load(dst, m),
-            Lanes::Four => self.load4(dst, m),
-        }
-    }
-
-    /// `[m] = src`, `lanes` doubles.
-    pub fn store_lanes(&mut self, lanes: Lanes, m: Mem, src: Xmm) {
-        match lanes {
-            Lanes::One => self.store(m, src),
-            Lanes::Four => self.store4(m, src),
-        }
-    }
-
-    /// `dst = [m]`, four doubles (`VMOVUPD` ymm).
-    pub fn load4(&mut self, dst: Xmm, m: Mem) {
-        self.vex_in(MAP_0F, true, PP_66, 0x10, dst, 0, Rm::Mem(m));
-    }
-
-    /// `[m] = src`, four doubles (`VMOVUPD` ymm).
-    pub fn store4(&mut self, m: Mem, src: Xmm) {
-        self.vex_in(MAP_0F, true, PP_66, 0x11, src, 0, Rm::Mem(m));
-    }
-
-    /// `dst = [m]` in each of four lanes (`VBROADCASTSD` ymm, m64).
-    pub fn broadcast(&mut self, dst: Xmm, m: Mem) {
-        self.vex_in(MAP_0F38, true, PP_66, 0x19, dst, 0, Rm::Mem(m));
-    }
-
-    /// Clears the upper halves of the ymm registers (`VZEROUPPER`): after 256-bit code,
-    /// before code that may use the legacy SSE encodings.
-    pub fn zero_upper(&mut self) {
-        self.bytes(&[0xC5, 0xF8, 0x77]);
     }
 
     fn rex_w(&mut self, reg: u8, rm: u8) {

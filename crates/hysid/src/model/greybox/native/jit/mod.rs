@@ -30,7 +30,7 @@ mod lower;
 
 use super::source::{needed, Class, Split};
 use super::{Layout, Shape};
-use asm::{Asm, Gpr, Lanes, Logic, Mem, Rm, Scalar};
+use asm::{Asm, Gpr, Mem, Rm, Scalar};
 use block::{Arg, Block, Ins, V};
 use hysid_equations::{Listing, Operand};
 use lower::{finite, lower, Pool};
@@ -176,14 +176,36 @@ struct Env {
     c: Mem,
 }
 
-/// Where a stage reads S and the coupling flags and writes Ṡ: S and Ṡ in rows of `row`
-/// doubles (q, or q padded).
+/// Where a stage reads S (row-major, rows of q doubles) and the coupling flags, and what it
+/// does with each rate it computes.
 #[derive(Clone, Copy)]
 struct StageIo {
     s: Mem,
     coupled: Mem,
-    ds: Mem,
-    row: usize,
+    /// Where the Jacobian entries prepared from θ wait made finite (entry (i, j) at
+    /// i·n + j), when the caller made them so once per call.
+    finite: Option<Mem>,
+    then: Then,
+}
+
+/// What a stage does with each rate k it computes, element e of z = [x, S] (ẋᵢ at e = i,
+/// Ṡᵢ꜀ at e = n + i·q + c).
+#[derive(Clone, Copy)]
+enum Then {
+    /// Stores ẋ at `dx` and Ṡ at `ds` (`hysid_sens`).
+    Store { dx: Mem, ds: Mem },
+    /// Stores k at `k` and the next stage's state z + w·k at `out`, both in z's layout
+    /// (`out` none of the memory the stage reads), w in memory: stages 1–3 of
+    /// `hysid_substeps`.
+    Next { k: Mem, z: Mem, w: Mem, out: Mem },
+    /// z ← z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄) (`rk4::increment`, in that order), k₁ … k₃ at
+    /// `k` in z's layout, k itself not stored: stage 4 of `hysid_substeps`.
+    Update {
+        z: Mem,
+        k: [Mem; 3],
+        sixth: Mem,
+        two: Mem,
+    },
 }
 
 struct Generator<'a> {
@@ -375,7 +397,7 @@ impl Generator<'_> {
     /// initial-state column) plus the products [f_x]ᵢⱼ·Sⱼ꜀ in the order of j — left out for
     /// a constant zero entry, added only where `coupled[i·n + j]` for an entry prepared from
     /// θ.
-    fn stage(&mut self, env: Env, dx: Mem, n: usize, k: usize, q: usize, io: StageIo) -> Block {
+    fn stage(&mut self, env: Env, n: usize, k: usize, q: usize, io: StageIo) -> Block {
         let split = self.split;
         let results = &split.listing.results;
         let entry = |i: usize, j: usize| n + i * n + j;
@@ -388,13 +410,59 @@ impl Generator<'_> {
         let mut block = Block::default();
         let computed = self.varying(&mut block, env, &roots);
         let value = |o: &Operand, pool: &mut Pool| read(split, env, &computed, o, pool);
+        let StageIo {
+            s,
+            coupled,
+            finite: prepared,
+            then,
+        } = io;
+        let rate = |block: &mut Block, k: V, e: usize| match then {
+            Then::Store { dx, ds } => {
+                let to = if e < n {
+                    dx.offset(e)
+                } else {
+                    ds.offset(e - n)
+                };
+                block.push(Ins::Store { src: k, to });
+            }
+            Then::Next { k: at, z, w, out } => {
+                block.push(Ins::Store {
+                    src: k,
+                    to: at.offset(e),
+                });
+                // w·k first, as base + c·k rounds.
+                let wk = block.scalar(Scalar::Mul, Arg::V(k), Arg::Mem(w));
+                let state = block.scalar(Scalar::Add, Arg::V(wk), Arg::Mem(z.offset(e)));
+                block.push(Ins::Store {
+                    src: state,
+                    to: out.offset(e),
+                });
+            }
+            Then::Update {
+                z,
+                k: [k1, k2, k3],
+                sixth,
+                two,
+            } => {
+                let mut sum = block.in_value(Arg::Mem(k1.offset(e)));
+                for kr in [k2, k3] {
+                    let twice = block.scalar(Scalar::Mul, Arg::Mem(two), Arg::Mem(kr.offset(e)));
+                    sum = block.scalar(Scalar::Add, Arg::V(sum), Arg::V(twice));
+                }
+                let sum = block.scalar(Scalar::Add, Arg::V(sum), Arg::V(k));
+                let step = block.scalar(Scalar::Mul, Arg::Mem(sixth), Arg::V(sum));
+                // z[e] is read by this instruction, before the store that replaces it.
+                let updated = block.scalar(Scalar::Add, Arg::V(step), Arg::Mem(z.offset(e)));
+                block.push(Ins::Store {
+                    src: updated,
+                    to: z.offset(e),
+                });
+            }
+        };
         for (i, o) in results[..n].iter().enumerate() {
             let v = value(o, &mut self.pool);
             let src = block.in_value(v);
-            block.push(Ins::Store {
-                src,
-                to: dx.offset(i),
-            });
+            rate(&mut block, src, i);
         }
         // The Jacobian entries that take part, finite.
         let mut a: Vec<Vec<Option<(V, Class)>>> = vec![vec![None; n]; n];
@@ -402,18 +470,17 @@ impl Generator<'_> {
             for (j, cell) in row.iter_mut().enumerate() {
                 let o = &results[entry(i, j)];
                 let class = split.class(o);
-                if class != Class::Zero {
-                    let v = value(o, &mut self.pool);
-                    *cell = Some((finite(&mut block, &mut self.pool, v, o), class));
-                }
+                let made_finite = match (class, prepared) {
+                    (Class::Zero, _) => continue,
+                    (Class::Prepared, Some(at)) => block.in_value(Arg::Mem(at.offset(i * n + j))),
+                    _ => {
+                        let v = value(o, &mut self.pool);
+                        finite(&mut block, &mut self.pool, v, o)
+                    }
+                };
+                *cell = Some((made_finite, class));
             }
         }
-        let StageIo {
-            s,
-            coupled,
-            ds,
-            row,
-        } = io;
         for (i, cells) in a.iter().enumerate() {
             for c in 0..q {
                 // d is a fresh value (a load or a mask's result): it accumulates alone.
@@ -432,15 +499,12 @@ impl Generator<'_> {
                         block.push(Ins::MulAdd {
                             d,
                             a: *aij,
-                            s: s.offset(j * row + c),
+                            s: s.offset(j * q + c),
                             flag,
                         });
                     }
                 }
-                block.push(Ins::Store {
-                    src: d,
-                    to: ds.offset(i * row + c),
-                });
+                rate(&mut block, d, n + i * q + c);
             }
         }
         block
@@ -458,10 +522,13 @@ impl Generator<'_> {
         let io = StageIo {
             s: Mem::at(Gpr::R14, 0),
             coupled: Mem::at(Gpr::Rbp, 0),
-            ds: Mem::at(Gpr::R11, 0),
-            row: q,
+            finite: None,
+            then: Then::Store {
+                dx: Mem::at(Gpr::R10, 0),
+                ds: Mem::at(Gpr::R11, 0),
+            },
         };
-        let block = self.stage(env, Mem::at(Gpr::R10, 0), n, k, q, io);
+        let block = self.stage(env, n, k, q, io);
         let frame = Frame::new(3 + block.slots());
         let (dx_slot, ds_slot) = (frame.slot(1), frame.slot(2));
         let start = self.prologue(&frame);
@@ -488,25 +555,28 @@ impl Generator<'_> {
 
     /// `hysid_substeps(nodes, c, coupled, m, h, x, s)`: m RK4 sub-steps of z = [x, S] (the
     /// stages of [`Self::stage`], the stage states z + (h/2)·k₁, z + (h/2)·k₂, z + h·k₃ and
-    /// z ← z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), element by element as `fixed_rk4`). In the
-    /// frame z is padded to whole groups of four doubles (x, then each row of S), so that
-    /// the RK4 updates of S run four lanes at a time (each lane rounding as the scalar
-    /// operation; x one double at a time, as the stages store and read it: a four-lane load
-    /// of doubles stored one by one waits for the stores); the padding lanes stay zero.
-    /// (Ṡ four lanes at a time as well, from the stage's terms stored for it, measured no
-    /// faster.)
+    /// z ← z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), element by element as `fixed_rk4`). Each stage
+    /// forms the next stage's state (the last one z's update) element by element as it
+    /// computes the rates, so every value is read back as it was stored, one double at a
+    /// time. (Measured slower or no faster, paired: the updates of S four lanes at a time
+    /// after each stage, from rates stored one double at a time, whose four-lane loads wait
+    /// for the stores; Ṡ four lanes at a time from the stage's terms stored for it.)
     fn substeps(&mut self, n: usize, k: usize, q: usize, inputs: usize) -> usize {
-        let (x4, row) = (n.next_multiple_of(4), q.next_multiple_of(4));
-        let len = x4 + n * row;
-        // Frame: h, h/2, h/6, the pointers x and s (a group of four), then z, k₁ … k₄, the
-        // stage state, the spill slots.
+        let len = n + n * q;
+        // Frame: h, h/2, h/6, the pointers x and s, then z, k₁, k₂, k₃ and two stage states
+        // (a stage reads one and writes the next stage's into the other), each in z's
+        // layout, the n × n Jacobian entries prepared from θ made finite, then the spill
+        // slots.
         let (h, half, sixth, x_ptr, s_ptr) = (0, 1, 2, 3, 4);
-        let z = 8;
+        let z = 5;
         let stage_k = |r: usize| z + len * (1 + r);
-        let state = z + 5 * len;
-        let spill = state + len;
-        let stage_base = |r: usize| if r == 0 { z } else { state };
+        let states = [z + 4 * len, z + 5 * len];
+        let finite_at = z + 6 * len;
+        let spill = finite_at + n * n;
+        // Stage r reads z (r = 0) or the state stage r − 1 wrote.
+        let stage_base = |r: usize| if r == 0 { z } else { states[(r - 1) % 2] };
         let at = |i: usize| Mem::at(Gpr::Rsp, 8 * i);
+        let two = self.pool.double(2.0);
         // Stage r reads the input at node 0, 1, 1, 2 of the sub-step.
         let mut blocks = Vec::new();
         for (r, node) in [0, 1, 1, 2].into_iter().enumerate() {
@@ -516,27 +586,65 @@ impl Generator<'_> {
                 u: Mem::at(Gpr::R12, 8 * inputs * node),
                 c: Mem::at(Gpr::R13, 0),
             };
-            let io = StageIo {
-                s: at(stage_base(r) + x4),
-                coupled: Mem::at(Gpr::R14, 0),
-                ds: at(stage_k(r) + x4),
-                row,
-            };
-            blocks.push(self.stage(env, at(stage_k(r)), n, k, q, io));
-        }
-        let spills = blocks.iter().map(Block::slots).max().unwrap_or(0);
-        let frame = Frame::new(spill + spills);
-        let (two, one_half, six) = (
-            self.pool.double(2.0),
-            self.pool.double(0.5),
-            self.pool.double(6.0),
-        );
-        // Element e of z (x then S, row-major n × q) in the padded layout.
-        let padded = |e: usize| {
-            if e < n {
-                e
+            // Stages 2, 3 and 4 start from z + (h/2)·k₁, z + (h/2)·k₂ and z + h·k₃; stage 4
+            // updates z.
+            let then = if r < 3 {
+                Then::Next {
+                    k: at(stage_k(r)),
+                    z: at(z),
+                    w: at([half, half, h][r]),
+                    out: at(states[r % 2]),
+                }
             } else {
-                x4 + (e - n) / q * row + (e - n) % q
+                Then::Update {
+                    z: at(z),
+                    k: [at(stage_k(0)), at(stage_k(1)), at(stage_k(2))],
+                    sixth: at(sixth),
+                    two,
+                }
+            };
+            let io = StageIo {
+                s: at(stage_base(r) + n),
+                coupled: Mem::at(Gpr::R14, 0),
+                finite: Some(at(finite_at)),
+                then,
+            };
+            blocks.push(self.stage(env, n, k, q, io));
+        }
+        // Before the loop: the Jacobian entries prepared from θ made finite, once.
+        let mut prepare = Block::default();
+        let results = &self.split.listing.results;
+        for e in 0..n * n {
+            let o = &results[n + e];
+            if self.split.class(o) == Class::Prepared {
+                let env = Env {
+                    t: Arg::Mem(self.pool.double(0.0)),
+                    x: at(z),
+                    u: Mem::at(Gpr::R12, 0),
+                    c: Mem::at(Gpr::R13, 0),
+                };
+                let v = read(self.split, env, &[], o, &mut self.pool);
+                let src = finite(&mut prepare, &mut self.pool, v, o);
+                prepare.push(Ins::Store {
+                    src,
+                    to: at(finite_at + e),
+                });
+            }
+        }
+        let spills = blocks
+            .iter()
+            .chain([&prepare])
+            .map(Block::slots)
+            .max()
+            .unwrap_or(0);
+        let frame = Frame::new(spill + spills);
+        let (one_half, six) = (self.pool.double(0.5), self.pool.double(6.0));
+        // Element e of z in the caller's buffers: x, then S row-major.
+        let caller = |e: usize, x: Gpr, s: Gpr| {
+            if e < n {
+                Mem::at(x, 8 * e)
+            } else {
+                Mem::at(s, 8 * (e - n))
             }
         };
         let start = self.prologue(&frame);
@@ -552,77 +660,29 @@ impl Generator<'_> {
         a.store(at(half), 1);
         a.scalar(Scalar::Div, 1, 0, Rm::Mem(six));
         a.store(at(sixth), 1);
-        // Zero lanes everywhere (the padding stays zero).
-        a.logic(Logic::Xor, 2, 2, Rm::Xmm(2));
-        for group in (z..spill).step_by(4) {
-            a.store4(at(group), 2);
+        for e in 0..len {
+            a.load(0, caller(e, Gpr::R8, Gpr::R9));
+            a.store(at(z + e), 0);
         }
-        for e in 0..n + n * q {
-            let from = if e < n {
-                Mem::at(Gpr::R8, 8 * e)
-            } else {
-                Mem::at(Gpr::R9, 8 * (e - n))
-            };
-            a.load(0, from);
-            a.store(at(z + padded(e)), 0);
-        }
+        prepare.emit(&mut self.asm, frame.slot(spill), &[]);
+        let a = &mut self.asm;
         let (done, lp) = (a.label(), a.label());
         a.test(Gpr::R15);
         a.jump(Some(asm::cc::LESS_OR_EQUAL), done);
         a.bind(lp);
-        // The updates run over x one double at a time (as the stages store and read it: a
-        // four-lane load of doubles stored one by one waits for the stores), over S four
-        // lanes at a time.
-        let chunks: Vec<(usize, Lanes)> = (0..n)
-            .map(|e| (e, Lanes::One))
-            .chain((x4..len).step_by(4).map(|g| (g, Lanes::Four)))
-            .collect();
-        for (r, block) in blocks.iter().enumerate() {
+        for block in &blocks {
             block.emit(&mut self.asm, frame.slot(spill), &[]);
-            let a = &mut self.asm;
-            if r < 3 {
-                // The next stage's state: z + w·k (w·k first, as base + c·k rounds).
-                a.broadcast(0, at([half, half, h][r]));
-                for &(e, lanes) in &chunks {
-                    a.arith(lanes, Scalar::Mul, 1, 0, Rm::Mem(at(stage_k(r) + e)));
-                    a.arith(lanes, Scalar::Add, 1, 1, Rm::Mem(at(z + e)));
-                    a.store_lanes(lanes, at(state + e), 1);
-                }
-            }
-            // Before the next block, whose calls may run legacy SSE code.
-            a.zero_upper();
         }
-        // z + (h/6)·(k₁ + 2k₂ + 2k₃ + k₄), in that order.
         let a = &mut self.asm;
-        a.broadcast(0, at(sixth));
-        a.broadcast(3, two);
-        for &(e, lanes) in &chunks {
-            let k = |r: usize| Rm::Mem(at(stage_k(r) + e));
-            a.load_lanes(lanes, 1, at(stage_k(0) + e));
-            a.arith(lanes, Scalar::Mul, 2, 3, k(1));
-            a.arith(lanes, Scalar::Add, 1, 1, Rm::Xmm(2));
-            a.arith(lanes, Scalar::Mul, 2, 3, k(2));
-            a.arith(lanes, Scalar::Add, 1, 1, Rm::Xmm(2));
-            a.arith(lanes, Scalar::Add, 1, 1, k(3));
-            a.arith(lanes, Scalar::Mul, 1, 0, Rm::Xmm(1));
-            a.arith(lanes, Scalar::Add, 1, 1, Rm::Mem(at(z + e)));
-            a.store_lanes(lanes, at(z + e), 1);
-        }
-        a.zero_upper();
         a.add_imm(Gpr::R12, i32::try_from(16 * inputs).expect("few inputs"));
         a.dec(Gpr::R15);
         a.jump(Some(asm::cc::NOT_ZERO), lp);
         a.bind(done);
         a.mov_load(Gpr::Rax, at(x_ptr));
         a.mov_load(Gpr::Rcx, at(s_ptr));
-        for e in 0..n + n * q {
-            a.load(0, at(z + padded(e)));
-            let to = if e < n {
-                Mem::at(Gpr::Rax, 8 * e)
-            } else {
-                Mem::at(Gpr::Rcx, 8 * (e - n))
-            };
-            a.store(to, 0);
+        for e in 0..len {
+            a.load(0, at(z + e));
+            a.store(caller(e, Gpr::Rax, Gpr::Rcx), 0);
         }
         self.epilogue(&frame);
         start
