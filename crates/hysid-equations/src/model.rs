@@ -537,6 +537,14 @@ impl EquationModel {
             .map(|d| (d.hx.as_slice(), d.htheta.as_slice()))
     }
 
+    /// Whether y = h(x, u, θ) may read an input: false only when every output is a state, a
+    /// parameter or a constant (the outputs computed by the tape count as reading).
+    pub fn output_reads_inputs(&self) -> bool {
+        self.direct_output
+            .as_ref()
+            .is_none_or(|d| d.y.iter().any(|r| matches!(r, Read::Input(_))))
+    }
+
     /// The lengths `eval` asserts, for the paths that do not run a tape.
     #[inline]
     fn check_point(&self, x: &[f64], u: &[f64], theta: &[f64]) {

@@ -448,3 +448,42 @@ fn column_tapes_equal_the_full_jacobian_columns() {
     let six = m.rhs_jacobian_columns(&[0, 1, 2, 3, 4, 5]).unwrap();
     assert!(six.len() < m.tape_lengths()[1]);
 }
+
+/// An output reads the input when it is the input or when the tape computes it (which may
+/// read anything); an output that is a state, a parameter or a constant does not.
+#[test]
+fn outputs_that_read_the_input_are_told_apart() {
+    let model = |output: &str| {
+        EquationModel::parse(&format!(
+            r#"
+[model]
+name = "first_order"
+states = ["x"]
+inputs = ["u"]
+outputs = ["y"]
+
+[parameters]
+a = {{ value = 2.0 }}
+
+[equations]
+x = "-a*x + u"
+
+[output]
+y = "{output}"
+"#
+        ))
+        .unwrap()
+    };
+    for (output, reads) in [
+        ("x", false),
+        ("a", false),
+        ("1.5", false),
+        ("u", true),
+        ("x + u", true),
+        ("2*x", true),
+    ] {
+        assert_eq!(model(output).output_reads_inputs(), reads, "y = {output}");
+    }
+    assert!(model("x").constant_output_jacobians().is_some());
+    assert!(model("2*x").constant_output_jacobians().is_none());
+}

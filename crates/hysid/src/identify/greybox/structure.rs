@@ -259,7 +259,13 @@ impl OutputErrorModel for GreyBox {
         let (mut y, mut hx, mut ht) = (vec![0.0; ny], vec![0.0; ny * nx], vec![0.0; ny * p]);
         let mut row = vec![0.0; ny * free.len()];
         let model = self.model.as_ref();
-        let mut has_output_jacobian = true;
+        // What does not change from sample to sample is asked for once: the output's
+        // Jacobians when the model says they are constant (at x(t₀), the input unread), the
+        // input when the output does not read it.
+        let constant_jacobians = model.output_jacobians_are_constant();
+        let reads_input = model.output_reads_input();
+        let mut has_output_jacobian =
+            !constant_jacobians || model.output_jacobians(x0, &u, model_theta, &mut hx, &mut ht);
         let outcome = simulate_sensitivities(
             model,
             model_theta,
@@ -270,9 +276,14 @@ impl OutputErrorModel for GreyBox {
             &params,
             &initial,
             |k, x, s| {
-                track.at(k, 0.0, &mut u);
+                if reads_input {
+                    track.at(k, 0.0, &mut u);
+                }
                 model.output(x, &u, model_theta, &mut y);
-                has_output_jacobian &= model.output_jacobians(x, &u, model_theta, &mut hx, &mut ht);
+                if !constant_jacobians {
+                    has_output_jacobian &=
+                        model.output_jacobians(x, &u, model_theta, &mut hx, &mut ht);
+                }
                 // ∂y/∂p = h_x S + h_θ (the direct term only for model parameters).
                 for o in 0..ny {
                     for (f, col) in column.iter().enumerate() {

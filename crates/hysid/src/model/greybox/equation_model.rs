@@ -622,6 +622,14 @@ impl StateSpaceModel for EquationStateSpace {
 
     /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded), or
     /// copied when they are constants (outputs that are states, inputs or parameters).
+    fn output_jacobians_are_constant(&self) -> bool {
+        self.model.constant_output_jacobians().is_some()
+    }
+
+    fn output_reads_input(&self) -> bool {
+        self.model.output_reads_inputs()
+    }
+
     fn output_jacobians(
         &self,
         x: &[f64],

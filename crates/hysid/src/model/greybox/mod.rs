@@ -92,6 +92,21 @@ pub trait StateSpaceModel: Sync + Send {
         false
     }
 
+    /// Whether ∂h/∂x and ∂h/∂θ ([`output_jacobians`](Self::output_jacobians)) are the same
+    /// at every state and input, for a given θ (an output that is a state, say): a fit's
+    /// sensitivity pass then asks for them once instead of at every sample. False (the
+    /// default) unless the model says so.
+    fn output_jacobians_are_constant(&self) -> bool {
+        false
+    }
+
+    /// Whether y = h(x, u, θ) reads the input u: when it does not, a fit's sensitivity pass
+    /// does not interpolate the input at the samples for the output. True (the default)
+    /// unless the model says otherwise.
+    fn output_reads_input(&self) -> bool {
+        true
+    }
+
     /// True for a discrete-time model: [`rhs`](Self::rhs) then gives the next state
     /// x\[k+1\] = f(t_k, x\[k\], u\[k\], θ) instead of ẋ, its Jacobians are those of this
     /// map, and simulation runs the recursion whatever the integrator ([`discrete`]).

@@ -7,6 +7,7 @@ mod budget;
 mod cascade;
 mod cascade_pass;
 mod global;
+mod greybox;
 mod grid_regression;
 mod multistart;
 mod operator_cascade;

@@ -171,6 +171,14 @@ impl StateSpaceModel for BoucWen {
         true
     }
 
+    fn output_jacobians_are_constant(&self) -> bool {
+        true
+    }
+
+    fn output_reads_input(&self) -> bool {
+        false
+    }
+
     fn mechanical_dofs(&self) -> Option<usize> {
         Some(1)
     }

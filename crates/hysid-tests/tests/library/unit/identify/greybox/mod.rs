@@ -1,0 +1,3 @@
+//! Tests of `hysid::identify::greybox`.
+
+mod structure;
