@@ -620,16 +620,18 @@ impl StateSpaceModel for EquationStateSpace {
         Some(format!("native code ({})", how.join("; ")))
     }
 
-    /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded), or
-    /// copied when they are constants (outputs that are states, inputs or parameters).
+    /// Constant when every output is a state, an input, a parameter or a constant.
     fn output_jacobians_are_constant(&self) -> bool {
         self.model.constant_output_jacobians().is_some()
     }
 
+    /// Read unless every output is a state, a parameter or a constant.
     fn output_reads_input(&self) -> bool {
         self.model.output_reads_inputs()
     }
 
+    /// From the tape that computes h, ∂h/∂x and ∂h/∂θ in one pass (h is discarded), or
+    /// copied when they are constants (outputs that are states, inputs or parameters).
     fn output_jacobians(
         &self,
         x: &[f64],

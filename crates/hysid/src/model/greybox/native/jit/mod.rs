@@ -393,10 +393,10 @@ impl Generator<'_> {
     }
 
     /// One evaluation of ẋ and Ṡ (`source::sensitivities_source`'s `hy_sens`) into a new
-    /// block: ẋ = f into `dx`, then per row i and column c, d = [f_θ]ᵢ꜀ (0 for an
-    /// initial-state column) plus the products [f_x]ᵢⱼ·Sⱼ꜀ in the order of j — left out for
-    /// a constant zero entry, added only where `coupled[i·n + j]` for an entry prepared from
-    /// θ.
+    /// block: ẋ = f, then per row i and column c, d = [f_θ]ᵢ꜀ (0 for an initial-state
+    /// column) plus the products [f_x]ᵢⱼ·Sⱼ꜀ in the order of j — left out for a constant
+    /// zero entry, added only where `coupled[i·n + j]` for an entry prepared from θ — each
+    /// rate handed to `io.then` as it is computed.
     fn stage(&mut self, env: Env, n: usize, k: usize, q: usize, io: StageIo) -> Block {
         let split = self.split;
         let results = &split.listing.results;
@@ -611,18 +611,19 @@ impl Generator<'_> {
             };
             blocks.push(self.stage(env, n, k, q, io));
         }
-        // Before the loop: the Jacobian entries prepared from θ made finite, once.
+        // Before the loop: the Jacobian entries prepared from θ made finite, once (they
+        // read c alone).
         let mut prepare = Block::default();
+        let env = Env {
+            t: Arg::Mem(self.pool.double(0.0)),
+            x: at(z),
+            u: Mem::at(Gpr::R12, 0),
+            c: Mem::at(Gpr::R13, 0),
+        };
         let results = &self.split.listing.results;
         for e in 0..n * n {
             let o = &results[n + e];
             if self.split.class(o) == Class::Prepared {
-                let env = Env {
-                    t: Arg::Mem(self.pool.double(0.0)),
-                    x: at(z),
-                    u: Mem::at(Gpr::R12, 0),
-                    c: Mem::at(Gpr::R13, 0),
-                };
                 let v = read(self.split, env, &[], o, &mut self.pool);
                 let src = finite(&mut prepare, &mut self.pool, v, o);
                 prepare.push(Ins::Store {
