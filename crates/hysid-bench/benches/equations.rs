@@ -60,6 +60,7 @@ fn sensitivities(c: &mut Criterion) {
                 let mut last = 0.0;
                 gb.simulate_sensitivities(black_box(&theta), &data, 0, &free, &mut |_, y, s| {
                     last += y[0] + s[0];
+                    std::ops::ControlFlow::Continue(())
                 })
                 .unwrap()
                 .unwrap();
@@ -95,6 +96,7 @@ fn discrete(c: &mut Criterion) {
             let mut last = 0.0;
             gb.simulate_sensitivities(black_box(&theta), &data, 0, &free, &mut |_, y, s| {
                 last += y[0] + s[0];
+                std::ops::ControlFlow::Continue(())
             })
             .unwrap()
             .unwrap();

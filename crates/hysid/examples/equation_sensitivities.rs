@@ -53,6 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "sens" => gb
                 .simulate_sensitivities(&theta, &data, 0, &free, &mut |_, y, s| {
                     check += y[0] + s[0];
+                    std::ops::ControlFlow::Continue(())
                 })
                 .ok_or("no sensitivities")??,
             "plain" => {

@@ -56,6 +56,7 @@ fn sensitivities(
     gb.simulate_sensitivities(theta, data, 0, free, &mut |k, yk, dy| {
         y[k] = yk[0];
         s[k].copy_from_slice(dy);
+        std::ops::ControlFlow::Continue(())
     })
     .expect("analytic sensitivities")
     .unwrap();

@@ -134,7 +134,8 @@ fn sensitivities_match_finite_differences() {
         let mut y = vec![0.0; 512];
         gb.simulate_sensitivities(&theta, &data, 0, &free, &mut |t, yt, dy| {
             y[t] = yt[0];
-            analytic[t].copy_from_slice(dy)
+            analytic[t].copy_from_slice(dy);
+            std::ops::ControlFlow::Continue(())
         })
         .expect("analytic sensitivities")
         .unwrap();

@@ -115,7 +115,8 @@ impl OutputErrorModel for HysteresisStructure {
             for (r, &i) in row.iter_mut().zip(free) {
                 *r = s[i];
             }
-            sink(t, &[v], &row);
+            // The recursion runs to the end: the sink ignores what follows a Break.
+            let _ = sink(t, &[v], &row);
         });
         Some(match failed {
             None => Ok(()),

@@ -23,12 +23,13 @@ use crate::data::IdData;
 use crate::model::ParameterSet;
 use crate::numerics::levenberg_marquardt::{
     minimize, Control, Covariance, IterationRecord, LeastSquaresProblem, LmConfig, LmReport,
-    NormalEquations,
+    NormalEquations, Trial,
 };
 use crate::numerics::{levenberg_marquardt, metrics};
 use crate::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
+use std::ops::ControlFlow;
 use std::sync::atomic::AtomicUsize;
 use std::sync::atomic::Ordering::Relaxed;
 use std::sync::{Mutex, OnceLock};
@@ -37,9 +38,14 @@ use std::sync::{Mutex, OnceLock};
 pub mod gram;
 use gram::Accumulator;
 
+pub mod ceiling;
+use ceiling::Ceiling;
+
 /// Receives one sample of simulated outputs and their sensitivities:
-/// `(t, ŷ(t) [n_y], ∂ŷ(t)/∂θ_free [n_y × n_free, row-major])`.
-pub type SensitivitySink<'a> = dyn FnMut(usize, &[f64], &[f64]) + 'a;
+/// `(t, ŷ(t) [n_y], ∂ŷ(t)/∂θ_free [n_y × n_free, row-major])`. `Break` says the rest of the
+/// pass is not needed (a trial point certain to be rejected, see [`ceiling`]): the model may
+/// stop there, or go on, the sink then ignoring what follows.
+pub type SensitivitySink<'a> = dyn FnMut(usize, &[f64], &[f64]) -> ControlFlow<()> + 'a;
 
 /// Consecutive samples of a single-output model's simulation with its sensitivities: the
 /// same rows a [`SensitivitySink`] would see one at a time, handed over in blocks so that the
@@ -568,6 +574,17 @@ impl Speculation {
 /// Simulated outputs `[experiment][output][t]`.
 type Simulations = Vec<Vec<Vec<f64>>>;
 
+/// What a speculative pass knows of S at its point.
+enum PassCost {
+    /// S, summed row by row in the engine's order (no split columns).
+    Summed(f64),
+    /// To be summed from the residuals the pass wrote (split columns).
+    InResiduals,
+    /// A lower bound of S above the trial's ceiling: the pass stopped there (see
+    /// [`ceiling`]), and the residuals are only partly written.
+    Above(f64),
+}
+
 impl<'a> OutputErrorProblem<'a> {
     /// Checks that the data suit the model and precomputes the residual layout.
     pub fn new(
@@ -683,13 +700,16 @@ impl<'a> OutputErrorProblem<'a> {
     }
 
     /// Residuals and normal equations of every experiment in one pass per experiment; None
-    /// when the model has no analytic sensitivities.
+    /// when the model has no analytic sensitivities. Split passes stop once they pass
+    /// `ceiling` when given: the normal equations are then zero, for the caller to discard
+    /// (it asks the ceiling).
     fn residuals_with_normal_equations(
         &self,
         theta: &[f64],
         free: &[usize],
         split: bool,
         r: Option<&mut [f64]>,
+        ceiling: Option<&Ceiling>,
     ) -> Option<Result<NormalEquations>> {
         // Without split columns the pass's outputs are the simulation's (the only way here,
         // see `overlap`): they are kept as the last simulation, which the fit statistics at
@@ -723,7 +743,7 @@ impl<'a> OutputErrorProblem<'a> {
         let parts: Vec<Option<Result<NormalEquations>>> = chunks
             .into_par_iter()
             .map(|(e, chunk, outputs)| match (outputs, chunk) {
-                (None, Some(chunk)) => self.experiment_split(theta, free, e, chunk),
+                (None, Some(chunk)) => self.experiment_split(theta, free, e, chunk, ceiling),
                 (outputs, chunk) => {
                     self.experiment_normal_equations(theta, free, e, chunk, outputs)
                 }
@@ -768,23 +788,34 @@ impl<'a> OutputErrorProblem<'a> {
     }
 
     /// One experiment's residuals and normal equations with the sensitivity columns split
-    /// between two threads (the Jacobian block is stored, JᵀJ formed by one product).
+    /// between two threads (the Jacobian block is stored, JᵀJ formed by one product). Both
+    /// threads stop once the residuals pass `ceiling` when given; the normal equations are
+    /// then zero.
     fn experiment_split(
         &self,
         theta: &[f64],
         free: &[usize],
         e: usize,
         r: &mut [f64],
+        ceiling: Option<&Ceiling>,
     ) -> Option<Result<NormalEquations>> {
         let (first, second) = free.split_at(free.len() / 2);
         let (a, b) = rayon::join(
-            || self.experiment_columns(theta, first, e, Some(&mut *r)),
-            || self.experiment_columns(theta, second, e, None),
+            || self.experiment_columns(theta, first, e, Some(&mut *r), ceiling),
+            || self.experiment_columns(theta, second, e, None, ceiling),
         );
         let (mut a, b) = match (a?, b?) {
             (Ok(a), Ok(b)) => (a, b),
             (Err(err), _) | (_, Err(err)) => return Some(Err(err)),
         };
+        if ceiling.is_some_and(Ceiling::passed) {
+            let p = free.len();
+            return Some(Ok(NormalEquations {
+                jtj: DMatrix::zeros(p, p),
+                jtr: DVector::zeros(p),
+                cost: 0.0,
+            }));
+        }
         a.extend_from_slice(&b);
         let jac = DMatrix::from_vec(r.len(), free.len(), a);
         let res = DVector::from_column_slice(r);
@@ -796,13 +827,15 @@ impl<'a> OutputErrorProblem<'a> {
     }
 
     /// The Jacobian columns of one experiment's residuals for the parameters `free`,
-    /// column-major, and its residuals into `r` when given.
+    /// column-major, and its residuals into `r` when given (counted into `ceiling`, whose
+    /// passing stops the pass, when given too).
     fn experiment_columns(
         &self,
         theta: &[f64],
         free: &[usize],
         e: usize,
         mut r: Option<&mut [f64]>,
+        ceiling: Option<&Ceiling>,
     ) -> Option<Result<Vec<f64>>> {
         let p = free.len();
         let exp = self.data.experiment(e);
@@ -811,19 +844,27 @@ impl<'a> OutputErrorProblem<'a> {
         let n_rows = rows * self.weights.len();
         let skip = self.skip;
         let weights = &self.weights;
+        let mut tally = ceiling.map(Ceiling::tally);
         let mut sink = |t: usize, yhat: &[f64], dyhat: &[f64]| {
             if t < skip {
-                return;
+                return ControlFlow::Continue(());
+            }
+            if tally.as_ref().is_some_and(|tally| tally.passed()) {
+                return ControlFlow::Break(());
             }
             for (o, w) in weights.iter().enumerate() {
                 let row = o * rows + t - skip;
                 if let Some(r) = r.as_deref_mut() {
                     r[row] = w * (exp.output(o)[t] - yhat[o]);
+                    if let Some(tally) = &mut tally {
+                        tally.add(r[row]);
+                    }
                 }
                 for k in 0..p {
                     jac[k * n_rows + row] = -w * dyhat[o * p + k];
                 }
             }
+            ControlFlow::Continue(())
         };
         let outcome = self
             .model
@@ -919,7 +960,7 @@ impl<'a> OutputErrorProblem<'a> {
                 }
             }
             if t < skip {
-                return;
+                return ControlFlow::Continue(());
             }
             for (o, w) in weights.iter().enumerate() {
                 let r = w * (exp.output(o)[t] - yhat[o]);
@@ -928,6 +969,7 @@ impl<'a> OutputErrorProblem<'a> {
                 }
                 acc.add_scaled(-w, &dyhat[o * p..(o + 1) * p], r);
             }
+            ControlFlow::Continue(())
         };
         let outcome = self
             .model
@@ -999,34 +1041,21 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
     }
 
     fn residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<()> {
-        self.speculative_residuals(theta, r).map(|_| ())
+        self.speculative_residuals(theta, r, None).map(|_| ())
     }
 
     fn trial_cost(&self, theta: &[f64], r: &mut Vec<f64>) -> Result<f64> {
-        // A long record's trial point is one pipelined pass (see `overlap`); its S, summed as
-        // the engine sums, is all the engine reads, so the residuals are not written out.
-        if self.pipelines() && self.data.n_experiments() == 1 {
-            if let Some(pass) = self.speculative_pass(theta, None) {
-                return match pass? {
-                    Some(cost) if cost.is_finite() => Ok(cost),
-                    _ => Err(Error::Diverged {
-                        index: 0,
-                        reason: "the criterion is not finite".into(),
-                    }),
-                };
-            }
-        }
-        r.resize(self.n_residuals, 0.0);
-        self.residuals_and_cost(theta, r)
+        self.trial_cost_under(theta, r, None)
     }
 
-    fn trial_cost_predicted(&self, theta: &[f64], r: &mut Vec<f64>, predicted: f64) -> Result<f64> {
+    fn trial_cost_with(&self, theta: &[f64], r: &mut Vec<f64>, trial: Trial) -> Result<f64> {
+        let ceiling = Ceiling::new(trial.ceiling);
         match self.companion {
-            Some(companion) if predicted < NEAR_MINIMUM && self.pipelines() => {
+            Some(companion) if trial.predicted < NEAR_MINIMUM && self.pipelines() => {
                 self.pass_threads.store(1, Relaxed);
                 let cost = std::thread::scope(|scope| {
                     let beside = scope.spawn(|| companion(theta, 1));
-                    let cost = self.trial_cost(theta, r);
+                    let cost = self.trial_cost_under(theta, r, Some(&ceiling));
                     // A panic of the companion is the caller's: it surfaces here.
                     if let Err(panic) = beside.join() {
                         std::panic::resume_unwind(panic);
@@ -1036,17 +1065,12 @@ impl LeastSquaresProblem for OutputErrorProblem<'_> {
                 self.pass_threads.store(PASS_THREADS, Relaxed);
                 cost
             }
-            _ => self.trial_cost(theta, r),
+            _ => self.trial_cost_under(theta, r, Some(&ceiling)),
         }
     }
 
     fn residuals_and_cost(&self, theta: &[f64], r: &mut [f64]) -> Result<f64> {
-        // The pass's S is Σ r² summed row by row, the engine's order, when the residuals are
-        // one experiment's (several are summed experiment by experiment).
-        match self.speculative_residuals(theta, r)? {
-            Some(cost) if self.data.n_experiments() == 1 && cost.is_finite() => Ok(cost),
-            _ => levenberg_marquardt::sum_of_squares(r),
-        }
+        self.residuals_and_cost_under(theta, r, None)
     }
 
     fn normal_equations(&self, theta: &[f64], free: &[usize]) -> Option<Result<NormalEquations>> {
@@ -1104,11 +1128,61 @@ impl OutputErrorProblem<'_> {
         total
     }
 
+    /// [`LeastSquaresProblem::trial_cost`], its pass stopped once it passes `ceiling` when
+    /// given (the lower bound of S it reached is then returned; see [`ceiling`]).
+    fn trial_cost_under(
+        &self,
+        theta: &[f64],
+        r: &mut Vec<f64>,
+        ceiling: Option<&Ceiling>,
+    ) -> Result<f64> {
+        // A long record's trial point is one pipelined pass (see `overlap`); its S, summed as
+        // the engine sums, is all the engine reads, so the residuals are not written out.
+        if self.pipelines() && self.data.n_experiments() == 1 {
+            if let Some(pass) = self.speculative_pass(theta, None, None) {
+                return match pass? {
+                    PassCost::Summed(cost) if cost.is_finite() => Ok(cost),
+                    _ => Err(Error::Diverged {
+                        index: 0,
+                        reason: "the criterion is not finite".into(),
+                    }),
+                };
+            }
+        }
+        r.resize(self.n_residuals, 0.0);
+        self.residuals_and_cost_under(theta, r, ceiling)
+    }
+
+    /// [`LeastSquaresProblem::residuals_and_cost`], the pass stopped at `ceiling` as in
+    /// [`trial_cost_under`](Self::trial_cost_under) (`r` is then partly written).
+    fn residuals_and_cost_under(
+        &self,
+        theta: &[f64],
+        r: &mut [f64],
+        ceiling: Option<&Ceiling>,
+    ) -> Result<f64> {
+        // The pass's S is Σ r² summed row by row, the engine's order, when the residuals are
+        // one experiment's (several are summed experiment by experiment).
+        match self.speculative_residuals(theta, r, ceiling)? {
+            Some(PassCost::Above(bound)) => Ok(bound),
+            Some(PassCost::Summed(cost)) if self.data.n_experiments() == 1 && cost.is_finite() => {
+                Ok(cost)
+            }
+            _ => levenberg_marquardt::sum_of_squares(r),
+        }
+    }
+
     /// The residuals at θ into `r`, from a sensitivity pass when speculating (see
-    /// [`speculative_pass`](Self::speculative_pass)), else from a simulation (returns None).
-    fn speculative_residuals(&self, theta: &[f64], r: &mut [f64]) -> Result<Option<f64>> {
-        if let Some(pass) = self.speculative_pass(theta, Some(&mut *r)) {
-            return pass;
+    /// [`speculative_pass`](Self::speculative_pass), which may stop at `ceiling`), else from
+    /// a simulation (returns None).
+    fn speculative_residuals(
+        &self,
+        theta: &[f64],
+        r: &mut [f64],
+        ceiling: Option<&Ceiling>,
+    ) -> Result<Option<PassCost>> {
+        if let Some(pass) = self.speculative_pass(theta, Some(&mut *r), ceiling) {
+            return pass.map(Some);
         }
         if let Some(spec) = &self.speculation {
             spec.without.fetch_add(1, Relaxed);
@@ -1117,27 +1191,36 @@ impl OutputErrorProblem<'_> {
     }
 
     /// One speculative pass at θ, its residuals into `r` when given: its normal equations
-    /// are kept for the engine's request that follows, and it returns its S when that was
-    /// accumulated row by row (no split columns; the split columns' product sums otherwise).
-    /// None when not speculating, or when the model turns out to have no pass.
+    /// are kept for the engine's request that follows, and it says what it knows of S (see
+    /// [`PassCost`]). A pass with split columns stops once it passes `ceiling` when given;
+    /// its normal equations are then not kept. None when not speculating, or when the model
+    /// turns out to have no pass.
     fn speculative_pass(
         &self,
         theta: &[f64],
         r: Option<&mut [f64]>,
-    ) -> Option<Result<Option<f64>>> {
+        ceiling: Option<&Ceiling>,
+    ) -> Option<Result<PassCost>> {
         let spec = self
             .speculation
             .as_ref()
             .filter(|s| !s.disabled.load(Relaxed))?;
+        let ceiling = ceiling.filter(|_| spec.split);
         let Some(system) =
-            self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, r)
+            self.residuals_with_normal_equations(theta, &spec.kept.free, spec.split, r, ceiling)
         else {
             spec.disabled.store(true, Relaxed);
             return None;
         };
         spec.with_sensitivities.fetch_add(1, Relaxed);
         Some(system.map(|system| {
-            let cost = (!spec.split).then_some(system.cost);
+            if let Some(bound) = ceiling.and_then(Ceiling::lower_bound) {
+                return PassCost::Above(bound);
+            }
+            let cost = match spec.split {
+                true => PassCost::InResiduals,
+                false => PassCost::Summed(system.cost),
+            };
             spec.kept.keep(theta, system);
             cost
         }))
@@ -1207,7 +1290,7 @@ impl OutputErrorProblem<'_> {
                 spec.with_sensitivities.fetch_add(1, Relaxed);
                 if spec.split && spec.kept.free == free {
                     // The start: the engine asks for the normal equations first.
-                    return self.residuals_with_normal_equations(theta, free, true, None);
+                    return self.residuals_with_normal_equations(theta, free, true, None, None);
                 }
             }
         }

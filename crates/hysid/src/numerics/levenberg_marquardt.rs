@@ -48,6 +48,16 @@ pub struct NormalEquations {
     pub cost: f64,
 }
 
+/// What the engine knows of a trial point before its S is computed
+/// ([`LeastSquaresProblem::trial_cost_with`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Trial {
+    /// The relative decrease of S the step's quadratic model predicts.
+    pub predicted: f64,
+    /// The current S: a trial point is accepted only if its S is below this.
+    pub ceiling: f64,
+}
+
 /// A nonlinear least-squares problem min Σ rᵢ(θ)².
 pub trait LeastSquaresProblem: Sync {
     /// Length of the full parameter vector θ (fixed parameters included).
@@ -79,17 +89,14 @@ pub trait LeastSquaresProblem: Sync {
         self.residuals_and_cost(theta, r)
     }
 
-    /// [`trial_cost`](Self::trial_cost) for a step whose quadratic model predicts S to fall
-    /// by the fraction `predicted` of its current value. An engine near a minimum converges
-    /// quadratically, so a small `predicted` says this trial point is likely the fit's last:
-    /// a problem may start work that only the fit's end needs beside it (the default does
-    /// nothing more). The value returned must be `trial_cost`'s.
-    fn trial_cost_predicted(
-        &self,
-        theta: &[f64],
-        r: &mut Vec<f64>,
-        _predicted: f64,
-    ) -> Result<f64> {
+    /// [`trial_cost`](Self::trial_cost) with what the engine knows of the trial point (see
+    /// [`Trial`]). A small `trial.predicted` says the point is likely the fit's last (an
+    /// engine near a minimum converges quadratically): a problem may start work that only the
+    /// fit's end needs beside it. The value returned must be `trial_cost`'s, except that once
+    /// S(θ) is known to exceed `trial.ceiling` a problem may stop and return any lower bound
+    /// of S(θ) above the ceiling: the point is rejected whatever its S. The default does
+    /// neither.
+    fn trial_cost_with(&self, theta: &[f64], r: &mut Vec<f64>, _trial: Trial) -> Result<f64> {
         self.trial_cost(theta, r)
     }
 
@@ -534,10 +541,13 @@ impl<'a> State<'a> {
             self.fevals += 1;
             self.plain_evals += 1;
             let evaluated = match self.analytic {
-                true => self.problem.trial_cost_predicted(
+                true => self.problem.trial_cost_with(
                     &candidate,
                     trial,
-                    predicted / self.system.cost,
+                    Trial {
+                        predicted: predicted / self.system.cost,
+                        ceiling: self.system.cost,
+                    },
                 ),
                 false => {
                     trial.resize(self.problem.n_residuals(), 0.0);

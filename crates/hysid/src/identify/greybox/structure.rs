@@ -300,7 +300,7 @@ impl OutputErrorModel for GreyBox {
                         };
                     }
                 }
-                sink(k, &y, &row);
+                sink(k, &y, &row)
             },
         );
         match outcome {

@@ -27,6 +27,7 @@
 use super::simulate::InputTrack;
 use super::{JacobianScratch, StateSpaceModel};
 use crate::{Error, Result};
+use std::ops::ControlFlow;
 
 fn diverged(k: usize) -> Error {
     Error::Diverged {
@@ -65,8 +66,8 @@ pub(crate) fn simulate(
 
 /// The recursion with its sensitivities (see the module docs) for the parameters `params`
 /// (indices into θ) and the initial states `initial` (indices into x); calls
-/// `on_sample(k, x[k], S[k])` with S row-major n × q. Ok(false) without simulating when the
-/// model has no analytic Jacobians.
+/// `on_sample(k, x[k], S[k])` with S row-major n × q (`Break` ends the recursion there).
+/// Ok(false) without simulating when the model has no analytic Jacobians.
 #[allow(clippy::too_many_arguments)]
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub fn simulate_sensitivities(
@@ -77,7 +78,7 @@ pub fn simulate_sensitivities(
     ts: f64,
     params: &[usize],
     initial: &[usize],
-    mut on_sample: impl FnMut(usize, &[f64], &[f64]),
+    mut on_sample: impl FnMut(usize, &[f64], &[f64]) -> ControlFlow<()>,
 ) -> Result<bool> {
     let (n, n_samples) = (x0.len(), input.len());
     let q = params.len() + initial.len();
@@ -93,7 +94,7 @@ pub fn simulate_sensitivities(
             return Err(diverged(k));
         }
         if k + 1 == n_samples {
-            on_sample(k, &x, &s);
+            let _ = on_sample(k, &x, &s);
             break;
         }
         input.at(k, 0.0, &mut u);
@@ -113,7 +114,9 @@ pub fn simulate_sensitivities(
         ) {
             return Ok(false);
         }
-        on_sample(k, &x, &s);
+        if on_sample(k, &x, &s).is_break() {
+            break;
+        }
         std::mem::swap(&mut x, &mut x_next);
         std::mem::swap(&mut s, &mut s_next);
     }

@@ -20,9 +20,11 @@
 
 use super::simulate::{diverged, InputTrack};
 use crate::Result;
+use std::ops::ControlFlow;
 
-/// Receives each sample k with x(t_k) and S(t_k) (row-major n × q).
-pub type SampleSink<'a> = dyn FnMut(usize, &[f64], &[f64]) + 'a;
+/// Receives each sample k with x(t_k) and S(t_k) (row-major n × q); `Break` ends the
+/// simulation there (its caller, which said so, knows the rest was not simulated).
+pub type SampleSink<'a> = dyn FnMut(usize, &[f64], &[f64]) -> ControlFlow<()> + 'a;
 
 /// One simulation with forward sensitivities, as [`super::simulate::simulate_sensitivities`]
 /// asks a model's own fixed-size path for it
@@ -272,7 +274,8 @@ pub(crate) fn simulate_by_samples<const N: usize, const Q: usize>(
 }
 
 /// The sample loop: from x0 and S(t₀) = s0, at every sample the divergence check and
-/// `on_sample(k, x(t_k), S(t_k))`, then `advance` over the interval to the next sample, the
+/// `on_sample(k, x(t_k), S(t_k))` (which may end the loop), then `advance` over the interval
+/// to the next sample, the
 /// input read at the interval's half-step nodes ([`InputTrack::nodes`], which the caller
 /// has checked lie on its grid: resolution 2·substeps).
 #[inline(always)]
@@ -295,8 +298,7 @@ where
         if !z.is_finite() {
             return Err(diverged(sample));
         }
-        on_sample(sample, &z.x, z.s.as_flattened());
-        if sample + 1 == n_samples {
+        if on_sample(sample, &z.x, z.s.as_flattened()).is_break() || sample + 1 == n_samples {
             break;
         }
         input.nodes(sample, &mut nodes);

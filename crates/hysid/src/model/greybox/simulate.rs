@@ -35,6 +35,7 @@ use super::stick_slip::{Sensitivities, StickSlip};
 use super::{JacobianScratch, StateSpaceModel};
 use crate::numerics::integrate::Stage;
 use crate::{Error, Result};
+use std::ops::ControlFlow;
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -194,6 +195,14 @@ impl InputTrack {
     pub fn nodes(&self, k: usize, out: &mut [f64]) {
         let (channels, res) = (self.n_channels(), self.resolution);
         let out = &mut out[..(res + 1) * channels];
+        // One band-limited channel away from the record's end: the nodes are one run of the
+        // fine table (the values of the general loop below, copied at once).
+        if let (InputInterpolation::BandLimited, [f]) = (self.interpolation, &self.fine[..]) {
+            if let Some(run) = f.get(k * res..k * res + res + 1) {
+                out.copy_from_slice(run);
+                return;
+            }
+        }
         for (c, s) in self.samples.iter().enumerate() {
             let column = out.iter_mut().skip(c).step_by(channels);
             match self.interpolation {
@@ -275,7 +284,10 @@ pub fn simulate(
                 params: &[],
                 initial: &[],
             };
-            let mut states_only = |k: usize, x: &[f64], _: &[f64]| on_sample(k, x);
+            let mut states_only = |k: usize, x: &[f64], _: &[f64]| {
+                on_sample(k, x);
+                ControlFlow::Continue(())
+            };
             if let Some(done) = model.fixed_rk4_sensitivities(&run, &mut states_only) {
                 return done;
             }
@@ -669,7 +681,8 @@ impl<'a> Stepper<'a> {
 
 /// Simulates with RK4 and the forward sensitivities S = ∂x/∂p for the parameters listed in
 /// `params` (indices into θ) followed by the initial states listed in `initial` (indices into
-/// x). Calls `on_sample(k, x(t_k), S(t_k))` with S row-major n × q. Needs the model's
+/// x). Calls `on_sample(k, x(t_k), S(t_k))` with S row-major n × q; `Break` ends the
+/// simulation there (Ok(true): the caller that said so knows the rest is missing). Needs the model's
 /// analytic Jacobians; returns Ok(false) without simulating when it has none. A
 /// discrete-time model runs its recursion and its chain rule instead, `substeps` unused
 /// ([`super::discrete`]).
@@ -683,7 +696,7 @@ pub fn simulate_sensitivities(
     substeps: usize,
     params: &[usize],
     initial: &[usize],
-    mut on_sample: impl FnMut(usize, &[f64], &[f64]),
+    mut on_sample: impl FnMut(usize, &[f64], &[f64]) -> ControlFlow<()>,
 ) -> Result<bool> {
     if model.discrete_time() {
         return super::discrete::simulate_sensitivities(
@@ -744,8 +757,7 @@ pub fn simulate_sensitivities(
         if z.iter().any(|v| !v.is_finite()) {
             return Err(diverged(k));
         }
-        on_sample(k, &z[..n], &z[n..]);
-        if k + 1 == n_samples {
+        if on_sample(k, &z[..n], &z[n..]).is_break() || k + 1 == n_samples {
             break;
         }
         for j in 0..m {

@@ -142,6 +142,7 @@ fn sensitivities_match_finite_differences() {
             .simulate_sensitivities(&theta, &data, 0, &free, &mut |t, y, dy| {
                 yhat[t] = y[0];
                 analytic[t].copy_from_slice(dy);
+                std::ops::ControlFlow::Continue(())
             })
             .unwrap()
             .unwrap();

@@ -124,7 +124,10 @@ fn divergence_is_reported() {
         let expected = recursion(&ex.truth, &x, None, &[0, 1], |_, _, _| {});
         assert_eq!(expected, Some(at + 1));
         let mut count = 0;
-        let err = stream_sensitivities(&ex.truth, &x, None, &[0, 1], &mut |_, _, _| count += 1);
+        let err = stream_sensitivities(&ex.truth, &x, None, &[0, 1], &mut |_, _, _| {
+            count += 1;
+            std::ops::ControlFlow::Continue(())
+        });
         assert!(matches!(err, Err(Error::Diverged { index, .. }) if Some(index) == expected));
         assert_eq!(count, x.len());
     }

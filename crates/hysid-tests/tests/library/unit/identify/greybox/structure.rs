@@ -29,6 +29,7 @@ fn pass(model: Arc<dyn StateSpaceModel>, data: &IdData) -> Vec<f64> {
     gb.simulate_sensitivities(&theta, data, 0, &free, &mut |_, y, dy| {
         rows.extend_from_slice(y);
         rows.extend_from_slice(dy);
+        std::ops::ControlFlow::Continue(())
     })
     .expect("analytic sensitivities")
     .unwrap();

@@ -1,5 +1,6 @@
 //! Tests of `hysid::identify::output_error`.
 
+mod ceiling;
 mod gram;
 
 use hysid::experiments::voros::CascadeExample;

@@ -44,6 +44,7 @@ fn recursion_and_sensitivities_equal_the_closed_form() {
                 );
             }
             checked += 1;
+            std::ops::ControlFlow::Continue(())
         },
     )
     .unwrap();

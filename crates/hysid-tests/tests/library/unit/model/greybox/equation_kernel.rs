@@ -53,6 +53,7 @@ fn run(model: &dyn StateSpaceModel, case: &Case<'_>, sensitivities: bool) -> Vec
             |_, x, s| {
                 out.extend_from_slice(x);
                 out.extend_from_slice(s);
+                std::ops::ControlFlow::Continue(())
             },
         )
         .unwrap();

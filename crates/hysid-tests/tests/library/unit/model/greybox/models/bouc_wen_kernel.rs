@@ -34,6 +34,7 @@ fn run(
         |_, x, s| {
             out.extend_from_slice(x);
             out.extend_from_slice(s);
+            std::ops::ControlFlow::Continue(())
         },
     )
     .unwrap();
