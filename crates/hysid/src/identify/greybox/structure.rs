@@ -150,6 +150,37 @@ impl GreyBox {
     }
 }
 
+/// Where one entry ∂y_o/∂p of the sensitivity pass comes from, p a free parameter.
+#[derive(Clone, Copy, Debug)]
+enum Entry {
+    /// An initial state of another experiment: no effect here.
+    Zero,
+    /// Column `c` of S, plus the direct term ∂h/∂θ of model parameter `direct`.
+    Column { c: usize, direct: Option<usize> },
+}
+
+impl Entry {
+    /// The entry for the output's Jacobian rows `hx` = ∂h_o/∂x and `ht` = ∂h_o/∂θ and
+    /// S (row-major n × q): Σ_j hx_j·S_jc in the order of j, from −0 as `Iterator::sum`
+    /// starts, then + ht of the direct term.
+    #[inline]
+    fn derivative(self, hx: &[f64], ht: &[f64], s: &[f64], q: usize) -> f64 {
+        match self {
+            Entry::Zero => 0.0,
+            Entry::Column { c, direct } => {
+                let mut acc = -0.0;
+                for (j, h) in hx.iter().enumerate() {
+                    acc += h * s[j * q + c];
+                }
+                if let Some(i) = direct {
+                    acc += ht[i];
+                }
+                acc
+            }
+        }
+    }
+}
+
 impl OutputErrorModel for GreyBox {
     fn parameters(&self) -> ParameterSet {
         self.parameter_set(&self.model.parameters())
@@ -237,12 +268,11 @@ impl OutputErrorModel for GreyBox {
             .map(|&i| i - own.start)
             .collect();
         let q = params.len() + initial.len();
-        // Where each free index's sensitivity comes from: a column of S (None: it belongs to
-        // another experiment's initial state and has no effect here).
-        let column: Vec<Option<usize>> = free
+        // Where each free index's sensitivity comes from.
+        let entries: Vec<Entry> = free
             .iter()
             .map(|&i| {
-                if i < p {
+                let column = if i < p {
                     params.iter().position(|&j| j == i)
                 } else if own.contains(&i) {
                     initial
@@ -251,6 +281,13 @@ impl OutputErrorModel for GreyBox {
                         .map(|c| params.len() + c)
                 } else {
                     None
+                };
+                match column {
+                    Some(c) => Entry::Column {
+                        c,
+                        direct: (i < p).then_some(i),
+                    },
+                    None => Entry::Zero,
                 }
             })
             .collect();
@@ -285,19 +322,11 @@ impl OutputErrorModel for GreyBox {
                         model.output_jacobians(x, &u, model_theta, &mut hx, &mut ht);
                 }
                 // ∂y/∂p = h_x S + h_θ (the direct term only for model parameters).
+                let nf = entries.len();
                 for o in 0..ny {
-                    for (f, col) in column.iter().enumerate() {
-                        row[o * free.len() + f] = match col {
-                            None => 0.0,
-                            Some(c) => {
-                                let mut acc: f64 =
-                                    (0..nx).map(|j| hx[o * nx + j] * s[j * q + c]).sum();
-                                if *c < params.len() {
-                                    acc += ht[o * p + params[*c]];
-                                }
-                                acc
-                            }
-                        };
+                    let (hx, ht) = (&hx[o * nx..][..nx], &ht[o * p..][..p]);
+                    for (value, entry) in row[o * nf..][..nf].iter_mut().zip(&entries) {
+                        *value = entry.derivative(hx, ht, s, q);
                     }
                 }
                 sink(k, &y, &row)
