@@ -755,11 +755,13 @@ impl EquationModel {
         self.with_thread_scratch(|s| self.rhs_with(s, t, x, u, theta, dx));
     }
 
-    /// [`Self::output_with`] with this thread's scratch.
+    /// [`Self::output_with`] with this thread's scratch (none when every output is a state,
+    /// an input, a parameter or a constant: they are read, no tape runs).
     pub fn output(&self, x: &[f64], u: &[f64], theta: &[f64], y: &mut [f64]) {
-        if self.direct_output.is_some() {
-            // No register file needed.
-            return self.output_with(&mut Scratch::new(), x, u, theta, y);
+        if let Some(direct) = &self.direct_output {
+            check_len(y, self.outputs.len(), "y");
+            self.check_point(x, u, theta);
+            return direct.output(x, u, theta, y);
         }
         self.with_thread_scratch(|s| self.output_with(s, x, u, theta, y));
     }
