@@ -173,7 +173,8 @@ impl<const N: usize> FixedSensitivityRhs<N, 0> for RateKernel<N> {
 /// Runs the fixed-size path with the bound tape `tape` (which must not read t), or the
 /// `native` sensitivity code of the same tape when given; None when the run's
 /// sizes have none (more than [`MAX_STATES`] states or [`MAX_COLUMNS`] columns, or no
-/// column: see [`simulate_rates`]).
+/// column and no native code: see [`simulate_rates`]). Without columns, the native
+/// sub-steps of x alone run: one call per sample, not one per stage.
 pub(super) fn simulate(
     tape: BoundColumns,
     native: Option<BoundNative>,
@@ -210,6 +211,8 @@ pub(super) fn simulate(
     ) -> Option<Result<()>> {
         const { assert!(MAX_COLUMNS == 10) };
         match run.columns() {
+            // A plain simulation: the native sub-steps alone (the tape's is `simulate_rates`).
+            0 if native.is_some() => with::<N, 0>(tape, native, run, on_sample),
             1 => with::<N, 1>(tape, native, run, on_sample),
             2 => with::<N, 2>(tape, native, run, on_sample),
             3 => with::<N, 3>(tape, native, run, on_sample),

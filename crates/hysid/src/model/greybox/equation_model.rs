@@ -552,6 +552,22 @@ impl StateSpaceModel for EquationStateSpace {
             if tape.uses_time() {
                 return None;
             }
+            // Native code: the sub-steps of x alone, one call per sample (a stage's values
+            // stay in registers), when the column code's ẋ is the tape of f's to the bit;
+            // else ẋ called per stage.
+            match self.native(NativeKey::Columns {
+                params: Vec::new(),
+                q: 0,
+            }) {
+                Err(e) => return Some(Err(e)),
+                Ok(Some(code)) if code.rates().is_some_and(|r| self.rates_match(&r)) => {
+                    let columns = self.model.rhs_jacobian_columns(&[])?;
+                    let bound = self.model.bind_columns(&columns, run.theta)?;
+                    let native = Some(code.bind(run.theta));
+                    return equation_kernel::simulate(bound, native, run, on_sample);
+                }
+                Ok(_) => {}
+            }
             let native = match self.native(NativeKey::Rates) {
                 Ok(native) => native.map(|f| f.bind(run.theta)),
                 Err(e) => return Some(Err(e)),

@@ -275,9 +275,9 @@ pub(crate) fn simulate_by_samples<const N: usize, const Q: usize>(
 
 /// The sample loop: from x0 and S(t₀) = s0, at every sample the divergence check and
 /// `on_sample(k, x(t_k), S(t_k))` (which may end the loop), then `advance` over the interval
-/// to the next sample, the
-/// input read at the interval's half-step nodes ([`InputTrack::nodes`], which the caller
-/// has checked lie on its grid: resolution 2·substeps).
+/// to the next sample, the input read at the interval's half-step nodes
+/// ([`InputTrack::nodes`], which the caller has checked lie on its grid: resolution
+/// 2·substeps).
 #[inline(always)]
 fn sample_loop<A, const N: usize, const Q: usize>(
     run: &Rk4Sensitivities<'_>,

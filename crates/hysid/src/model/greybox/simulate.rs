@@ -682,8 +682,8 @@ impl<'a> Stepper<'a> {
 /// Simulates with RK4 and the forward sensitivities S = ∂x/∂p for the parameters listed in
 /// `params` (indices into θ) followed by the initial states listed in `initial` (indices into
 /// x). Calls `on_sample(k, x(t_k), S(t_k))` with S row-major n × q; `Break` ends the
-/// simulation there (Ok(true): the caller that said so knows the rest is missing). Needs the model's
-/// analytic Jacobians; returns Ok(false) without simulating when it has none. A
+/// simulation there (Ok(true): the caller that said so knows the rest is missing). Needs
+/// the model's analytic Jacobians; returns Ok(false) without simulating when it has none. A
 /// discrete-time model runs its recursion and its chain rule instead, `substeps` unused
 /// ([`super::discrete`]).
 #[allow(clippy::too_many_arguments)]
