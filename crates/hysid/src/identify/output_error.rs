@@ -804,7 +804,7 @@ impl<'a> OutputErrorProblem<'a> {
             || self.experiment_columns(theta, first, e, Some(&mut *r), ceiling),
             || self.experiment_columns(theta, second, e, None, ceiling),
         );
-        let (mut a, b) = match (a?, b?) {
+        let (a, b) = match (a?, b?) {
             (Ok(a), Ok(b)) => (a, b),
             (Err(err), _) | (_, Err(err)) => return Some(Err(err)),
         };
@@ -816,14 +816,9 @@ impl<'a> OutputErrorProblem<'a> {
                 cost: 0.0,
             }));
         }
-        a.extend_from_slice(&b);
-        let jac = DMatrix::from_vec(r.len(), free.len(), a);
-        let res = DVector::from_column_slice(r);
-        Some(Ok(NormalEquations {
-            jtj: jac.tr_mul(&jac),
-            jtr: jac.tr_mul(&res),
-            cost: res.norm_squared(),
-        }))
+        let rows = r.len();
+        let columns: Vec<&[f64]> = a.chunks_exact(rows).chain(b.chunks_exact(rows)).collect();
+        Some(Ok(gram::of_columns(&columns, r)))
     }
 
     /// The Jacobian columns of one experiment's residuals for the parameters `free`,

@@ -18,10 +18,53 @@
 
 use crate::numerics::cpu::has_avx;
 use crate::numerics::levenberg_marquardt::NormalEquations;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, DVectorView};
+use rayon::prelude::*;
 
 #[cfg(target_arch = "x86_64")]
 mod tiles;
+
+/// The normal equations of a Jacobian stored by columns (each as long as `r`) and the
+/// residuals r, as nalgebra's `J.tr_mul(&J)`, `J.tr_mul(&r)` and `r.norm_squared()` form them
+/// from the stored block: entry (i, j) of JᵀJ is `dot` of columns i and j, (Jᵀr)ᵢ `dot` of
+/// column i and r (so the same bits), here without copying the columns into one block,
+/// each entry of the symmetric JᵀJ computed once (a·b and b·a are the same products summed
+/// in the same order), and the dot products shared out over the rayon threads.
+pub fn of_columns(columns: &[&[f64]], r: &[f64]) -> NormalEquations {
+    fn view(c: &[f64]) -> DVectorView<'_, f64> {
+        DVectorView::from_slice(c, c.len())
+    }
+    let p = columns.len();
+    let res = view(r);
+    // The upper triangle of JᵀJ row by row, then Jᵀr.
+    let pairs: Vec<(usize, Option<usize>)> = (0..p)
+        .flat_map(|i| (i..p).map(move |j| (i, Some(j))))
+        .chain((0..p).map(|i| (i, None)))
+        .collect();
+    let dots: Vec<f64> = pairs
+        .par_iter()
+        .map(|&(i, j)| match j {
+            Some(j) => view(columns[i]).dot(&view(columns[j])),
+            None => view(columns[i]).dot(&res),
+        })
+        .collect();
+    let mut jtj = DMatrix::zeros(p, p);
+    let mut jtr = DVector::zeros(p);
+    for (&(i, j), &d) in pairs.iter().zip(&dots) {
+        match j {
+            Some(j) => {
+                jtj[(i, j)] = d;
+                jtj[(j, i)] = d;
+            }
+            None => jtr[i] = d,
+        }
+    }
+    NormalEquations {
+        jtj,
+        jtr,
+        cost: res.norm_squared(),
+    }
+}
 
 /// The AVX tiles' buffers (nothing on other architectures, which have no tiles).
 #[cfg(target_arch = "x86_64")]

@@ -150,3 +150,32 @@ fn avx_tiles_equal_portable_kernel() {
         assert_eq!(a.cost, b.cost, "p = {p}");
     }
 }
+
+/// The normal equations of a Jacobian given by its columns are nalgebra's products of the
+/// stored block, bit for bit: `J.tr_mul(&J)`, `J.tr_mul(&r)` and `r.norm_squared()`, for
+/// column counts and lengths on either side of the dot product's eight-way unrolling.
+#[test]
+fn columns_give_the_block_products() {
+    for (p, n) in [(1, 5), (2, 8), (3, 9), (6, 40_960), (7, 1_003)] {
+        let (rows, res) = random_rows(29 + p as u64, p, n);
+        let block = DMatrix::from_fn(n, p, |t, k| rows[t][k]);
+        let stored: Vec<Vec<f64>> = (0..p)
+            .map(|k| block.column(k).iter().copied().collect())
+            .collect();
+        let columns: Vec<&[f64]> = stored.iter().map(Vec::as_slice).collect();
+        let got = of_columns(&columns, &res);
+        let r = DVector::from_column_slice(&res);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(got.jtj.as_slice()),
+            bits(block.tr_mul(&block).as_slice()),
+            "p {p}, n {n}"
+        );
+        assert_eq!(
+            bits(got.jtr.as_slice()),
+            bits(block.tr_mul(&r).as_slice()),
+            "p {p}, n {n}"
+        );
+        assert_eq!(got.cost.to_bits(), r.norm_squared().to_bits());
+    }
+}
