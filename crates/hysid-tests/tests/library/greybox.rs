@@ -14,7 +14,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 /// The benchmark's settings as the fits use them: RK4 at 4 sub-steps, band-limited input.
-fn benchmark_simulation() -> Simulation {
+pub(crate) fn benchmark_simulation() -> Simulation {
     Simulation {
         integrator: Integrator::Rk4 { substeps: 4 },
         interpolation: InputInterpolation::BandLimited,
@@ -23,7 +23,7 @@ fn benchmark_simulation() -> Simulation {
 
 /// A benchmark-like record: `periods` periods of 4096 samples of a 5–150 Hz multisine, RMS
 /// 50 N at 750 Hz, simulated with the true parameters.
-fn synthetic_record(periods: usize, seed: u64) -> IdData {
+pub(crate) fn synthetic_record(periods: usize, seed: u64) -> IdData {
     let u = multisine(4096, periods, 750.0, 5.0, 150.0, 50.0, seed).unwrap();
     let input = IdData::input_only(1.0 / 750.0, "u", u.clone()).unwrap();
     let gb = GreyBox::new(
@@ -41,7 +41,8 @@ fn synthetic_record(periods: usize, seed: u64) -> IdData {
     with_output(&input, y.remove(0))
 }
 
-fn with_output(input: &IdData, y: Vec<f64>) -> IdData {
+/// `input`'s record with the output `y`.
+pub(crate) fn with_output(input: &IdData, y: Vec<f64>) -> IdData {
     IdData::siso(
         input.ts(),
         "u",

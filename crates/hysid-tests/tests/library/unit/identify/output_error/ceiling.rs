@@ -1,46 +1,30 @@
 //! Tests of `hysid::identify::output_error::ceiling`: trial passes that stop once their
 //! point is certain to be rejected.
 
+use crate::greybox::{benchmark_simulation, synthetic_record, with_output};
 use hysid::data::IdData;
 use hysid::identify::greybox::{GreyBox, InitialStates};
 use hysid::identify::output_error::OutputErrorProblem;
 use hysid::identify::OutputErrorModel;
 use hysid::model::greybox::models::BoucWen;
-use hysid::model::greybox::{InputInterpolation, Integrator, Simulation};
 use hysid::numerics::levenberg_marquardt::{
     minimize, LeastSquaresProblem, LmConfig, LmReport, NormalEquations, Trial,
 };
-use hysid::numerics::signal::multisine;
 use hysid::numerics::Control;
 use hysid::Result;
 use std::sync::Arc;
 
 /// The Bouc–Wen model (RK4, 4 sub-steps, band-limited input, at rest) and a record of 4 096
-/// samples it simulated at its nominal parameters, with a deterministic error of a few µm
-/// added (the benchmark's noise level).
+/// samples it simulated at its nominal parameters (`synthetic_record`), with a deterministic
+/// error of a few µm added (the benchmark's noise level).
 fn bouc_wen_record() -> (GreyBox, IdData) {
-    let n = 4096;
-    let u = multisine(n, 1, 750.0, 5.0, 150.0, 50.0, 3).unwrap();
-    let sim = Simulation {
-        integrator: Integrator::Rk4 { substeps: 4 },
-        interpolation: InputInterpolation::BandLimited,
-    };
-    let silent = IdData::siso(1.0 / 750.0, "u", u.clone(), "y", vec![0.0; n]).unwrap();
-    let gb = GreyBox::new(
-        Arc::new(BoucWen),
-        &silent,
-        sim,
-        InitialStates::at_rest(3, 1),
-    )
-    .unwrap();
-    let theta = gb.parameters().values();
-    let mut y = vec![vec![0.0; n]];
-    gb.simulate(&theta, &silent, 0, &mut y).unwrap();
-    let y: Vec<f64> = (y.remove(0).iter().enumerate())
+    let clean = synthetic_record(1, 3);
+    let y: Vec<f64> = (clean.experiment(0).output(0).iter().enumerate())
         .map(|(k, v)| v + 7e-6 * ((k as f64 * 0.618_034).fract() - 0.5))
         .collect();
-    let data = IdData::siso(1.0 / 750.0, "u", u, "y", y).unwrap();
-    let gb = GreyBox::new(Arc::new(BoucWen), &data, sim, InitialStates::at_rest(3, 1)).unwrap();
+    let data = with_output(&clean, y);
+    let at_rest = InitialStates::at_rest(3, 1);
+    let gb = GreyBox::new(Arc::new(BoucWen), &data, benchmark_simulation(), at_rest).unwrap();
     (gb, data)
 }
 
