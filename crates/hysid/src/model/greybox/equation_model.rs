@@ -95,6 +95,16 @@ enum NativeKey {
     Columns { params: Vec<usize>, q: usize },
 }
 
+impl NativeKey {
+    /// The column code without columns: a plain simulation's sub-steps of x alone.
+    fn plain_substeps() -> Self {
+        Self::Columns {
+            params: Vec::new(),
+            q: 0,
+        }
+    }
+}
+
 /// Per-thread registers and value buffers, so that the trait's Jacobian methods (which do
 /// not return f or h) never allocate after their first call on a thread.
 #[derive(Default)]
@@ -390,11 +400,17 @@ impl EquationStateSpace {
                                 .all(|(a, b)| a == b || same_bits(&[*a], &[*b]))
                     })
                 });
-                if let Some(rates) = built.as_ref().ok().and_then(|f| f.rates()) {
-                    if self.rates_match(&rates) {
-                        // Already set when the plain simulations built their own: kept.
-                        let _ = self.native_cell(&NativeKey::Rates).set(Ok(rates));
-                    }
+                let rates = built.as_ref().ok().and_then(|f| f.rates());
+                let matched = rates.filter(|rates| self.rates_match(rates));
+                if let Some(rates) = &matched {
+                    // Already set when the plain simulations built their own: kept.
+                    let _ = self
+                        .native_cell(&NativeKey::Rates)
+                        .set(Ok(Arc::clone(rates)));
+                }
+                // A plain simulation's sub-steps must give its ẋ: the tape of f's.
+                if *key == NativeKey::plain_substeps() && matched.is_none() {
+                    return Err("the column code's ẋ is not the tape of f's".into());
                 }
                 built
             }
@@ -553,20 +569,13 @@ impl StateSpaceModel for EquationStateSpace {
                 return None;
             }
             // Native code: the sub-steps of x alone, one call per sample (a stage's values
-            // stay in registers), when the column code's ẋ is the tape of f's to the bit;
-            // else ẋ called per stage.
-            match self.native(NativeKey::Columns {
-                params: Vec::new(),
-                q: 0,
-            }) {
-                Err(e) => return Some(Err(e)),
-                Ok(Some(code)) if code.rates().is_some_and(|r| self.rates_match(&r)) => {
-                    let columns = self.model.rhs_jacobian_columns(&[])?;
-                    let bound = self.model.bind_columns(&columns, run.theta)?;
-                    let native = Some(code.bind(run.theta));
-                    return equation_kernel::simulate(bound, native, run, on_sample);
-                }
-                Ok(_) => {}
+            // stay in registers; built only when its ẋ is the tape of f's to the bit), else
+            // the native ẋ called per stage, else the tape.
+            if let Ok(Some(code)) = self.native(NativeKey::plain_substeps()) {
+                let columns = self.model.rhs_jacobian_columns(&[])?;
+                let bound = self.model.bind_columns(&columns, run.theta)?;
+                let native = Some(code.bind(run.theta));
+                return equation_kernel::simulate(bound, native, run, on_sample);
             }
             let native = match self.native(NativeKey::Rates) {
                 Ok(native) => native.map(|f| f.bind(run.theta)),

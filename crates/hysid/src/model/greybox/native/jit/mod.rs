@@ -403,8 +403,9 @@ impl Generator<'_> {
         let entry = |i: usize, j: usize| n + i * n + j;
         let direct = |i: usize, c: usize| n + n * n + i * k + c;
         // Without columns (a plain simulation's sub-steps) the Jacobian takes no part.
+        let jacobian_rows = if q > 0 { n } else { 0 };
         let mut roots: Vec<Operand> = results[..n].to_vec();
-        for i in (0..n).filter(|_| q > 0) {
+        for i in 0..jacobian_rows {
             roots.extend((0..n).map(|j| results[entry(i, j)]));
             roots.extend((0..k).map(|c| results[direct(i, c)]));
         }
@@ -467,7 +468,7 @@ impl Generator<'_> {
         }
         // The Jacobian entries that take part, finite.
         let mut a: Vec<Vec<Option<(V, Class)>>> = vec![vec![None; n]; n];
-        for (i, row) in a.iter_mut().enumerate().filter(|_| q > 0) {
+        for (i, row) in a.iter_mut().enumerate().take(jacobian_rows) {
             for (j, cell) in row.iter_mut().enumerate() {
                 let o = &results[entry(i, j)];
                 let class = split.class(o);
@@ -622,7 +623,9 @@ impl Generator<'_> {
             c: Mem::at(Gpr::R13, 0),
         };
         let results = &self.split.listing.results;
-        for e in (0..n * n).filter(|_| q > 0) {
+        // None without columns: the Jacobian takes no part.
+        let entries = if q > 0 { n * n } else { 0 };
+        for e in 0..entries {
             let o = &results[n + e];
             if self.split.class(o) == Class::Prepared {
                 let v = read(self.split, env, &[], o, &mut self.pool);
