@@ -272,23 +272,15 @@ impl OutputErrorModel for GreyBox {
         let entries: Vec<Entry> = free
             .iter()
             .map(|&i| {
-                let column = if i < p {
-                    params.iter().position(|&j| j == i)
+                let (column, direct) = if i < p {
+                    (params.iter().position(|&j| j == i), Some(i))
                 } else if own.contains(&i) {
-                    initial
-                        .iter()
-                        .position(|&j| j == i - own.start)
-                        .map(|c| params.len() + c)
+                    let state = initial.iter().position(|&j| j == i - own.start);
+                    (state.map(|c| params.len() + c), None)
                 } else {
-                    None
+                    (None, None)
                 };
-                match column {
-                    Some(c) => Entry::Column {
-                        c,
-                        direct: (i < p).then_some(i),
-                    },
-                    None => Entry::Zero,
-                }
+                column.map_or(Entry::Zero, |c| Entry::Column { c, direct })
             })
             .collect();
         let track = &self.tracks[exp];
