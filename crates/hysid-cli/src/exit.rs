@@ -7,6 +7,7 @@
 //! | 2 | usage: the command line itself is wrong (unknown option, missing or unparsable value, an output path that is an input or another output of the run) |
 //! | 3 | numerical failure: a singular regression, a diverged simulation, a non-finite result |
 //! | 4 | I/O: a file could not be opened, read or written |
+//! | 130 | interrupted (SIGINT, SIGTERM, SIGHUP): the run's partial outputs removed (`main`'s handler) |
 //! | 101 | an internal fault (a panic) — a bug to report |
 //!
 //! Every error is one line on stderr: what is wrong, where, and what to do. Usage errors

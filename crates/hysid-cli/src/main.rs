@@ -22,6 +22,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     exit::one_line_panics();
+    remove_partial_outputs_on_interrupt();
     let args: Vec<std::ffi::OsString> = std::env::args_os().collect();
     exit::remember_args(&args);
     let cli = match cli::Cli::try_parse_from(args) {
@@ -42,6 +43,18 @@ fn main() -> ExitCode {
             exit::classify(&e).exit_code()
         }
     }
+}
+
+/// On SIGINT, SIGTERM or SIGHUP: the temporaries of the run's outputs are removed (the
+/// previous outputs stay as they were) and the process exits with status 130. The program
+/// installs this handler, not the library (signals belong to the program).
+fn remove_partial_outputs_on_interrupt() {
+    // Without a handler (one could not be installed) the default action still ends the
+    // run; its temporaries are hidden files that a later run of the same output ignores.
+    let _ = ctrlc::set_handler(|| {
+        hysid::io::atomic::remove_live_temporaries();
+        std::process::exit(130);
+    });
 }
 
 /// `--help` and `--version` print as usual (exit 0); every other parser error is one line

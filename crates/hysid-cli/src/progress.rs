@@ -13,7 +13,7 @@
 //! succeeds (exit 0) with one warning line on stderr.
 
 use hysid::numerics::{Control, IterationRecord, Observer, Progress};
-use hysid::report::{Report, TerminationSummary};
+use hysid::report::Report;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -105,14 +105,10 @@ pub fn mark_report(report: &Report) -> Report {
             .get_or_insert_with(hysid::identify::budget::counted);
         search.estimated_model_steps = crate::budget::estimated();
     }
-    if let (true, Some(limit), Some(search)) = (time_limit_hit(), limit_s(), &mut report.search) {
-        search.termination = TerminationSummary {
-            code: "time_limit".into(),
-            message: format!("time limit of {limit} s reached; the best result so far"),
-            converged: false,
-        };
+    match (time_limit_hit(), limit_s()) {
+        (true, Some(limit)) => report.stopped_by_time_limit(limit),
+        _ => report,
     }
-    report
 }
 
 /// Where progress goes: a live bar, throttled plain lines, or nowhere.

@@ -12,6 +12,7 @@
 use crate::errors::run;
 use crate::pool::run_on;
 use crate::recipes::{id_data, samples};
+use crate::watch::watching;
 use hysid::experiments::actuator_rig::Rig;
 use hysid::identify::actuator::{read_data_sets, Record, ThreeSteps, PARAMETERS};
 use hysid::numerics::LmConfig;
@@ -122,7 +123,7 @@ fn records(sets: Vec<(Vec<f64>, Vec<f64>, f64)>) -> Result<BTreeMap<usize, Recor
 /// The three steps on data sets 1–8; returns the report's JSON (`details.steps`: one report
 /// per step; `details.elapsed_s`: wall time; `model`: m67, the CLI's `--model-out`).
 #[pyfunction]
-#[pyo3(signature = (sets, source, truth, gear_ratio, saddle_mass, cutoff_hz, remove_mean, reversal_margin, unfiltered_step3, max_iterations, tolerance, threads=0))]
+#[pyo3(signature = (sets, source, truth, gear_ratio, saddle_mass, cutoff_hz, remove_mean, reversal_margin, unfiltered_step3, max_iterations, tolerance, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn actuator_three_steps(
     py: Python<'_>,
@@ -138,6 +139,8 @@ fn actuator_three_steps(
     max_iterations: usize,
     tolerance: f64,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let sets: Vec<(Vec<f64>, Vec<f64>, f64)> = sets
         .iter()
@@ -153,30 +156,39 @@ fn actuator_three_steps(
         max_iterations,
         tolerance,
     };
-    run_on(py, threads, move || {
-        if let Some(t) = &truth {
-            if t.len() != PARAMETERS.len() || t.iter().any(|v| !v.is_finite()) {
-                return Err(Error::invalid_option(
-                    "truth",
-                    format!("{t:?}"),
-                    format!(
-                        "truth: give {} finite values ({})",
-                        PARAMETERS.len(),
-                        PARAMETERS.join(", ")
-                    ),
-                ));
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            if let Some(t) = &truth {
+                if t.len() != PARAMETERS.len() || t.iter().any(|v| !v.is_finite()) {
+                    return Err(Error::invalid_option(
+                        "truth",
+                        format!("{t:?}"),
+                        format!(
+                            "truth: give {} finite values ({})",
+                            PARAMETERS.len(),
+                            PARAMETERS.join(", ")
+                        ),
+                    ));
+                }
             }
-        }
-        let clock = std::time::Instant::now();
-        let records = records(sets)?;
-        let steps = settings.three_steps();
-        let id = steps.run(&records)?;
-        let mut report = three_steps_report(&id, truth.as_deref(), vec![source], steps.simulation)?;
-        if let Some(obj) = report.details.as_object_mut() {
-            obj.insert("elapsed_s".into(), json!(clock.elapsed().as_secs_f64()));
-        }
-        report.to_json()
-    })
+            let clock = std::time::Instant::now();
+            let records = records(sets)?;
+            let steps = ThreeSteps {
+                observer: watch.observer(),
+                ..settings.three_steps()
+            };
+            let id = steps.run(&records)?;
+            let mut report =
+                three_steps_report(&id, truth.as_deref(), vec![source], steps.simulation)?;
+            if let Some(obj) = report.details.as_object_mut() {
+                obj.insert("elapsed_s".into(), json!(clock.elapsed().as_secs_f64()));
+            }
+            watch.finish(report).to_json()
+        },
+    )
 }
 
 /// The eight data sets of the virtual rig: [(set, saddle_free, ts, torque, angle)].

@@ -11,9 +11,8 @@
 
 use crate::errors::guard;
 use crate::pool::run_on;
-use crate::recipes::{
-    estimation, id_data, parameter_set, quiet, samples, simulation, source, ParamTuple,
-};
+use crate::recipes::{estimation, id_data, parameter_set, samples, simulation, source, ParamTuple};
+use crate::watch::watching;
 use hysid::identify::greybox::InitialStates;
 use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::StateSpaceModel;
@@ -135,7 +134,7 @@ fn checked_parameters(
 /// state is `[initial]` of the file (states with `fixed = false` estimated). Returns the
 /// report's JSON (the CLI's `greybox fit --model-file`).
 #[pyfunction]
-#[pyo3(signature = (text, u, y, ts, params, starts, seed, integrator, substeps, interpolation, threads=0))]
+#[pyo3(signature = (text, u, y, ts, params, starts, seed, integrator, substeps, interpolation, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn greybox_fit_equations(
     py: Python<'_>,
@@ -150,6 +149,8 @@ fn greybox_fit_equations(
     substeps: usize,
     interpolation: &str,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let u: Vec<Vec<f64>> = u.iter().map(samples).collect();
     let y: Vec<Vec<f64>> = y.iter().map(samples).collect();
@@ -158,32 +159,37 @@ fn greybox_fit_equations(
         integrator.to_string(),
         interpolation.to_string(),
     );
-    run_on(py, threads, move || {
-        let eq = Arc::new(EquationStateSpace::parse(&text, "equation model")?);
-        let model: Arc<dyn StateSpaceModel> = eq.clone();
-        let sim = simulation(&integrator, substeps, &interpolation)?;
-        let data = id_data(ts, u, y)?;
-        let params = checked_parameters(&eq, &params)?;
-        let initial = InitialStates::of_equations(&eq, data.n_experiments(), &[]);
-        let fit = estimation(sim, starts, seed).estimate(
-            model.clone(),
-            &data,
-            &params,
-            initial,
-            &mut quiet(),
-        )?;
-        let fitted = fit
-            .fitted_model(model.as_ref(), sim)
-            .with_equations(eq.source());
-        let extra = json!({"residual_analysis": hysid::report::greybox_residuals(&fit, &data), "sensitivity": null});
-        hysid::report::greybox_report(
-            "greybox fit",
-            &fit,
-            &data,
-            source(),
-            fitted.to_file(),
-            extra,
-        )?
-        .to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let eq = Arc::new(EquationStateSpace::parse(&text, "equation model")?);
+            let model: Arc<dyn StateSpaceModel> = eq.clone();
+            let sim = simulation(&integrator, substeps, &interpolation)?;
+            let data = id_data(ts, u, y)?;
+            let params = checked_parameters(&eq, &params)?;
+            let initial = InitialStates::of_equations(&eq, data.n_experiments(), &[]);
+            let fit = estimation(sim, starts, seed, watch).estimate(
+                model.clone(),
+                &data,
+                &params,
+                initial,
+                &mut watch.callback(),
+            )?;
+            let fitted = fit
+                .fitted_model(model.as_ref(), sim)
+                .with_equations(eq.source());
+            let extra = json!({"residual_analysis": hysid::report::greybox_residuals(&fit, &data), "sensitivity": null});
+            let report = hysid::report::greybox_report(
+                "greybox fit",
+                &fit,
+                &data,
+                source(),
+                fitted.to_file(),
+                extra,
+            )?;
+            watch.finish(report).to_json()
+        },
+    )
 }

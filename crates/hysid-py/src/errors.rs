@@ -108,9 +108,12 @@ pub fn run<T: Send>(py: Python<'_>, f: impl FnOnce() -> hysid::Result<T> + Send)
     convert(py, outcome)
 }
 
-type Caught<T> = std::thread::Result<hysid::Result<T>>;
+/// A recipe's outcome: its result or error, or the panic caught.
+pub type Caught<T> = std::thread::Result<hysid::Result<T>>;
 
-fn convert<T>(py: Python<'_>, outcome: Caught<T>) -> PyResult<T> {
+/// The Python form of a recipe's outcome: the value, the library error's exception, or
+/// `InternalError` for a caught panic.
+pub fn convert<T>(py: Python<'_>, outcome: Caught<T>) -> PyResult<T> {
     match outcome {
         Ok(Ok(value)) => Ok(value),
         Ok(Err(e)) => Err(to_py(py, e)),

@@ -7,6 +7,10 @@
 //! JSON makes pickling exact (serde_json writes the shortest round-tripping decimal of
 //! every f64, and Python's `json` reads it back bit for bit).
 //!
+//! Long calls run on a worker thread while the calling thread checks Python's signals, so
+//! Ctrl-C raises `KeyboardInterrupt` within a fraction of a second ([`watch`]); the
+//! library installs no signal handler of its own.
+//!
 //! Errors: every [`hysid::Error`] becomes a subclass of `hysid.HysidError` carrying the
 //! library's one-line message ([`errors`]); a panic inside the library is caught with
 //! [`std::panic::catch_unwind`] and raised as `hysid.InternalError`, never as a Rust panic.
@@ -27,6 +31,7 @@ pub mod pool;
 pub mod recipes;
 pub mod stream;
 pub mod user_model;
+pub mod watch;
 pub mod zoo;
 
 /// The module `hysid._hysid`.

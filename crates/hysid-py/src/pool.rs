@@ -12,7 +12,8 @@
 //! `threads = 0` means the process default, set by `hysid.set_num_threads(n)` (0 at start:
 //! rayon's global pool, one worker per core).
 
-use crate::errors::{run, InternalError};
+use crate::errors::{convert, InternalError};
+use crate::watch::{run_watched, Watch, Watching};
 use pyo3::prelude::*;
 use rayon::{ThreadPool, ThreadPoolBuilder};
 use std::cell::RefCell;
@@ -71,14 +72,19 @@ pub fn pool(n: usize) -> PyResult<Option<Arc<ThreadPool>>> {
     Ok(Some(p))
 }
 
-/// [`run`] (GIL released, errors mapped) with the parallel work of `f` on `threads` workers.
-pub fn run_on<T: Send>(
+/// A long call: `f` watched from the calling thread, so that Ctrl-C stops it, with the time
+/// limit and progress callable of `watching` ([`crate::watch`]), its parallel work on
+/// `threads` workers, its errors mapped.
+pub fn run_on<T: Send + 'static>(
     py: Python<'_>,
     threads: usize,
-    f: impl FnOnce() -> hysid::Result<T> + Send,
+    watching: Watching,
+    f: impl FnOnce(&Watch) -> hysid::Result<T> + Send + 'static,
 ) -> PyResult<T> {
-    match pool(threads)? {
-        None => run(py, f),
-        Some(p) => run(py, || p.install(f)),
-    }
+    let pool = pool(threads)?;
+    let outcome = run_watched(py, watching, move |watch| match pool {
+        None => f(watch),
+        Some(p) => p.install(|| f(watch)),
+    })?;
+    convert(py, outcome)
 }

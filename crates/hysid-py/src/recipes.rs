@@ -9,6 +9,7 @@
 
 use crate::errors::{guard, run};
 use crate::pool::run_on;
+use crate::watch::{watching, Watch};
 use hysid::data::{Channel, Experiment, IdData};
 use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::greybox::{GreyBoxEstimation, InitialStates};
@@ -81,7 +82,7 @@ pub fn source() -> Vec<String> {
 
 /// Identifies a Coleman–Hodgdon hysteresis + linear-block cascade (Vörös 2015).
 #[pyfunction]
-#[pyo3(signature = (x, y, hysteresis, na, nb, delay, ts, uncertainty, replicates, seed, threads=0))]
+#[pyo3(signature = (x, y, hysteresis, na, nb, delay, ts, uncertainty, replicates, seed, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn identify_cascade(
     py: Python<'_>,
@@ -96,6 +97,8 @@ fn identify_cascade(
     replicates: usize,
     seed: u64,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (x, y) = (samples(&x), samples(&y));
     let hysteresis = hysteresis.to_string();
@@ -110,21 +113,36 @@ fn identify_cascade(
             ))
         }
     };
-    run_on(py, threads, move || {
-        let form = ChForm::parse(&hysteresis)?;
-        let data = id_data(ts, vec![x], vec![y])?;
-        let mut id = CascadeIdentification::new(form, na, nb, delay);
-        id.uncertainty = uncertainty;
-        id.bootstrap_seed = seed;
-        let fit = id.estimate(&data, &mut quiet())?;
-        let extra = json!({"input": ["x"], "output": ["y"]});
-        report::cascade_report("identify cascade", &fit, &data, source(), extra)?.to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let form = ChForm::parse(&hysteresis)?;
+            let data = id_data(ts, vec![x], vec![y])?;
+            let mut id = CascadeIdentification::new(form, na, nb, delay);
+            id.uncertainty = uncertainty;
+            id.bootstrap_seed = seed;
+            id.observer = watch.observer();
+            let fit = id.estimate(&data, &mut watch.callback())?;
+            let extra = json!({"input": ["x"], "output": ["y"]});
+            watch
+                .finish(report::cascade_report(
+                    "identify cascade",
+                    &fit,
+                    &data,
+                    source(),
+                    extra,
+                )?)
+                .to_json()
+        },
+    )
 }
 
 /// Identifies a Coleman–Hodgdon hysteresis alone (separated regression, then output error).
 #[pyfunction]
-#[pyo3(signature = (x, y, hysteresis, ts, initial_output, threads=0))]
+#[pyo3(signature = (x, y, hysteresis, ts, initial_output, threads=0, time_limit=None, progress=None))]
+#[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn identify_hysteresis(
     py: Python<'_>,
     x: PyReadonlyArray1<'_, f64>,
@@ -133,6 +151,8 @@ fn identify_hysteresis(
     ts: f64,
     initial_output: &str,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (x, y) = (samples(&x), samples(&y));
     let hysteresis = hysteresis.to_string();
@@ -147,14 +167,21 @@ fn identify_hysteresis(
             ))
         }
     };
-    run_on(py, threads, move || {
-        let form = ChForm::parse(&hysteresis)?;
-        let data = id_data(ts, vec![x], vec![y])?;
-        let mut id = HysteresisIdentification::new(form);
-        id.initial = initial;
-        let fit = id.estimate(&data, &mut quiet())?;
-        report::hysteresis_report(&fit, &data, source(), initial)?.to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let form = ChForm::parse(&hysteresis)?;
+            let data = id_data(ts, vec![x], vec![y])?;
+            let mut id = HysteresisIdentification::new(form);
+            id.initial = initial;
+            let fit = id.estimate(&data, &mut watch.callback())?;
+            watch
+                .finish(report::hysteresis_report(&fit, &data, source(), initial)?)
+                .to_json()
+        },
+    )
 }
 
 /// The default parameters of a built-in grey-box model:
@@ -231,18 +258,19 @@ pub fn simulation(integrator: &str, substeps: usize, interpolation: &str) -> Res
 }
 
 /// The grey-box estimation settings.
-pub fn estimation(sim: Simulation, starts: usize, seed: u64) -> GreyBoxEstimation {
+pub fn estimation(sim: Simulation, starts: usize, seed: u64, watch: &Watch) -> GreyBoxEstimation {
     GreyBoxEstimation {
         simulation: sim,
         starts: starts.max(1),
         seed,
+        observer: watch.observer(),
         ..GreyBoxEstimation::default()
     }
 }
 
 /// Output-error fit of a built-in grey-box model (`bouc-wen`, `rigid-body`, …).
 #[pyfunction]
-#[pyo3(signature = (kind, u, y, ts, params, starts, seed, integrator, substeps, interpolation, threads=0))]
+#[pyo3(signature = (kind, u, y, ts, params, starts, seed, integrator, substeps, interpolation, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn greybox_fit(
     py: Python<'_>,
@@ -257,6 +285,8 @@ fn greybox_fit(
     substeps: usize,
     interpolation: &str,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let u: Vec<Vec<f64>> = u.iter().map(samples).collect();
     let y: Vec<Vec<f64>> = y.iter().map(samples).collect();
@@ -265,37 +295,42 @@ fn greybox_fit(
         integrator.to_string(),
         interpolation.to_string(),
     );
-    run_on(py, threads, move || {
-        let model: Arc<dyn StateSpaceModel> = Arc::from(models::by_kind(&kind)?);
-        let sim = simulation(&integrator, substeps, &interpolation)?;
-        let data = id_data(ts, u, y)?;
-        let params = parameter_set(&params)?;
-        let n_states = model.states().len();
-        let fit = estimation(sim, starts, seed).estimate(
-            model.clone(),
-            &data,
-            &params,
-            InitialStates::at_rest(n_states, 1),
-            &mut quiet(),
-        )?;
-        let fitted = fit.fitted_model(model.as_ref(), sim);
-        let extra = json!({"residual_analysis": report::greybox_residuals(&fit, &data), "sensitivity": null});
-        report::greybox_report(
-            "greybox fit",
-            &fit,
-            &data,
-            source(),
-            fitted.to_file(),
-            extra,
-        )?
-        .to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let model: Arc<dyn StateSpaceModel> = Arc::from(models::by_kind(&kind)?);
+            let sim = simulation(&integrator, substeps, &interpolation)?;
+            let data = id_data(ts, u, y)?;
+            let params = parameter_set(&params)?;
+            let n_states = model.states().len();
+            let fit = estimation(sim, starts, seed, watch).estimate(
+                model.clone(),
+                &data,
+                &params,
+                InitialStates::at_rest(n_states, 1),
+                &mut watch.callback(),
+            )?;
+            let fitted = fit.fitted_model(model.as_ref(), sim);
+            let extra = json!({"residual_analysis": report::greybox_residuals(&fit, &data), "sensitivity": null});
+            let report = report::greybox_report(
+                "greybox fit",
+                &fit,
+                &data,
+                source(),
+                fitted.to_file(),
+                extra,
+            )?;
+            watch.finish(report).to_json()
+        },
+    )
 }
 
 /// The Bouc–Wen benchmark of Noël & Schoukens (2016): fit on the training record, e_RMS
 /// (the RMS simulation error) on each test record.
 #[pyfunction]
-#[pyo3(signature = (u, y, ts, params, tests, steady_state, starts, seed, substeps, threads=0))]
+#[pyo3(signature = (u, y, ts, params, tests, steady_state, starts, seed, substeps, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn benchmark_bouc_wen(
     py: Python<'_>,
@@ -309,44 +344,51 @@ fn benchmark_bouc_wen(
     seed: u64,
     substeps: usize,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (u, y) = (samples(&u), samples(&y));
     let tests: Vec<(Vec<f64>, Vec<f64>, f64, String)> = tests
         .iter()
         .map(|(u, y, ts, name)| (samples(u), samples(y), *ts, name.clone()))
         .collect();
-    run_on(py, threads, move || {
-        let sim = Simulation {
-            integrator: Integrator::Rk4 {
-                substeps: substeps.max(1),
-            },
-            interpolation: InputInterpolation::BandLimited,
-        };
-        let data = id_data(ts, vec![u], vec![y])?;
-        let params = parameter_set(&params)?;
-        let model = models::BoucWen;
-        let fit = estimation(sim, starts, seed).estimate(
-            Arc::new(model),
-            &data,
-            &params,
-            InitialStates::at_rest(3, 1),
-            &mut quiet(),
-        )?;
-        let fitted = fit.fitted_model(&model, sim);
-        let validation = tests
-            .iter()
-            .map(|(u, y, ts, name)| score(&fitted, u, y, *ts, name, steady_state))
-            .collect::<Result<Vec<_>>>()?;
-        report::bouc_wen_benchmark_report(
-            &fit,
-            &data,
-            source(),
-            fitted.to_file(),
-            validation,
-            steady_state,
-        )?
-        .to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let sim = Simulation {
+                integrator: Integrator::Rk4 {
+                    substeps: substeps.max(1),
+                },
+                interpolation: InputInterpolation::BandLimited,
+            };
+            let data = id_data(ts, vec![u], vec![y])?;
+            let params = parameter_set(&params)?;
+            let model = models::BoucWen;
+            let fit = estimation(sim, starts, seed, watch).estimate(
+                Arc::new(model),
+                &data,
+                &params,
+                InitialStates::at_rest(3, 1),
+                &mut watch.callback(),
+            )?;
+            let fitted = fit.fitted_model(&model, sim);
+            let validation = tests
+                .iter()
+                .map(|(u, y, ts, name)| score(&fitted, u, y, *ts, name, steady_state))
+                .collect::<Result<Vec<_>>>()?;
+            let report = report::bouc_wen_benchmark_report(
+                &fit,
+                &data,
+                source(),
+                fitted.to_file(),
+                validation,
+                steady_state,
+            )?;
+            watch.finish(report).to_json()
+        },
+    )
 }
 
 /// e_RMS of `model` on one test record, from rest or in the periodic steady state (the
@@ -379,7 +421,7 @@ fn score(
 /// Rigid-body least squares (the paper's step 1): filtered position, velocity and
 /// acceleration, force = g·u regressed on inertia, viscous and Coulomb friction.
 #[pyfunction]
-#[pyo3(signature = (q, u, ts, gain, offset, cutoff_hz, order, decimation, border, inertia_name, threads=0))]
+#[pyo3(signature = (q, u, ts, gain, offset, cutoff_hz, order, decimation, border, inertia_name, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn rigid_body_ls(
     py: Python<'_>,
@@ -394,33 +436,40 @@ fn rigid_body_ls(
     border: usize,
     inertia_name: String,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (q, u) = (samples(&q), samples(&u));
-    run_on(py, threads, move || {
-        let clock = std::time::Instant::now();
-        // Checks the record (finite, equal lengths, enough samples) as for every recipe.
-        id_data(ts, vec![u.clone()], vec![q.clone()])?;
-        let ls = RigidBodyLs {
-            inertia_name,
-            gain,
-            offset,
-            cutoff_hz,
-            filter_order: order,
-            decimation,
-            border,
-        };
-        let e = ls.estimate(&q, &u, ts)?;
-        let settings = json!({"position": "q", "input": "u"});
-        let elapsed = clock.elapsed().as_secs_f64();
-        let source = source().remove(0);
-        let record = report::RigidBodyRecord {
-            source: &source,
-            q: &q,
-            u: &u,
-            ts,
-        };
-        report::rigid_body_report(&e, &ls, record, &[], elapsed, settings)?.to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |_| {
+            let clock = std::time::Instant::now();
+            // Checks the record (finite, equal lengths, enough samples) as for every recipe.
+            id_data(ts, vec![u.clone()], vec![q.clone()])?;
+            let ls = RigidBodyLs {
+                inertia_name,
+                gain,
+                offset,
+                cutoff_hz,
+                filter_order: order,
+                decimation,
+                border,
+            };
+            let e = ls.estimate(&q, &u, ts)?;
+            let settings = json!({"position": "q", "input": "u"});
+            let elapsed = clock.elapsed().as_secs_f64();
+            let source = source().remove(0);
+            let record = report::RigidBodyRecord {
+                source: &source,
+                q: &q,
+                u: &u,
+                ts,
+            };
+            report::rigid_body_report(&e, &ls, record, &[], elapsed, settings)?.to_json()
+        },
+    )
 }
 
 /// Simulates a saved model (`hysid.model/1` JSON) for the input channels `inputs`.

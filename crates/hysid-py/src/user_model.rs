@@ -260,7 +260,7 @@ fn greybox_fit_user(
             values: vec![x0],
             estimated: vec![false; n],
         };
-        let fit = estimation(sim, starts, seed).estimate(
+        let fit = estimation(sim, starts, seed, &Default::default()).estimate(
             m.clone(),
             &data,
             &m.params,

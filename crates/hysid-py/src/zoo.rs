@@ -6,7 +6,8 @@
 
 use crate::errors::guard;
 use crate::pool::run_on;
-use crate::recipes::{id_data, parse_model, quiet, samples, source};
+use crate::recipes::{id_data, parse_model, samples, source};
+use crate::watch::watching;
 use hysid::data::IdData;
 use hysid::identify::operator_cascade::OperatorCascadeIdentification;
 use hysid::identify::operators::{
@@ -62,7 +63,7 @@ fn family_options(
 /// identify operator` as JSON text. `threshold_grid` empty: the uniform grid of
 /// `thresholds`.
 #[pyfunction]
-#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0))]
+#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn identify_operator(
     py: Python<'_>,
@@ -76,14 +77,27 @@ fn identify_operator(
     lambda_: f64,
     dead_zones: usize,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (u, y) = (samples(&u), samples(&y));
     let family = guard(py, || Family::parse(family))?;
     let options = family_options(thresholds, threshold_grid, grid, lambda_, dead_zones);
-    run_on(py, threads, move || {
-        let data = id_data(ts, vec![u], vec![y])?;
-        operator_report(family, &data, &options)?.to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let data = id_data(ts, vec![u], vec![y])?;
+            let options = FamilyOptions {
+                observer: watch.observer(),
+                ..options
+            };
+            watch
+                .finish(operator_report(family, &data, &options)?)
+                .to_json()
+        },
+    )
 }
 
 /// `family` fitted to the first experiment of `data`, and its `identify operator` report.
@@ -102,7 +116,7 @@ fn operator_report(
 /// `nb` coefficients and delay `delay`: the report of `hysid identify cascade --hysteresis
 /// FAMILY` as JSON text.
 #[pyfunction]
-#[pyo3(signature = (x, y, family, na, nb, delay, ts, thresholds, grid, threads=0))]
+#[pyo3(signature = (x, y, family, na, nb, delay, ts, thresholds, grid, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn identify_operator_cascade(
     py: Python<'_>,
@@ -116,21 +130,31 @@ fn identify_operator_cascade(
     thresholds: usize,
     grid: usize,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (x, y) = (samples(&x), samples(&y));
     let family = guard(py, || Family::parse_operator(family))?;
-    run_on(py, threads, move || {
-        let data = id_data(ts, vec![x], vec![y])?;
-        let mut id = OperatorCascadeIdentification::new(family, na, nb, delay);
-        id.options = FamilyOptions {
-            thresholds,
-            grid,
-            ..FamilyOptions::default()
-        };
-        let fit = id.estimate(&data, &mut quiet())?;
-        let extra = json!({"input": ["x"], "output": ["y"]});
-        report::operator_cascade_report(family.name(), &fit, &data, source(), extra)?.to_json()
-    })
+    run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let data = id_data(ts, vec![x], vec![y])?;
+            let mut id = OperatorCascadeIdentification::new(family, na, nb, delay);
+            id.options = FamilyOptions {
+                thresholds,
+                grid,
+                observer: watch.observer(),
+                ..FamilyOptions::default()
+            };
+            let fit = id.estimate(&data, &mut watch.callback())?;
+            let extra = json!({"input": ["x"], "output": ["y"]});
+            let report =
+                report::operator_cascade_report(family.name(), &fit, &data, source(), extra)?;
+            watch.finish(report).to_json()
+        },
+    )
 }
 
 /// What `compare` returns: the `hysid compare` report; per family in the ranked order,
@@ -147,7 +171,7 @@ type Compared<'py> = (
 /// Fits `families` to (u, y) and ranks them by validation fit % on (u_val, y_val), or on
 /// the last 40 % of (u, y) when those are None (`hysid compare`).
 #[pyfunction]
-#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0))]
+#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn compare<'py>(
     py: Python<'py>,
@@ -163,6 +187,8 @@ fn compare<'py>(
     lambda_: f64,
     dead_zones: usize,
     threads: usize,
+    time_limit: Option<f64>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Compared<'py>> {
     let (u, y) = (samples(&u), samples(&y));
     let validation = u_val.zip(y_val).map(|(a, b)| (samples(&a), samples(&b)));
@@ -172,40 +198,50 @@ fn compare<'py>(
         family: family_options(thresholds, threshold_grid, grid, lambda_, dead_zones),
         ..CompareOptions::default()
     };
-    let (text, results, comparison) = run_on(py, threads, move || {
-        let data = id_data(ts, vec![u.clone()], vec![y.clone()])?;
-        let held_out = validation
-            .as_ref()
-            .map(|(a, b)| (a.as_slice(), b.as_slice()));
-        let comparison = compare_families(&u, &y, held_out, &options)?;
-        let what = if held_out.is_some() {
-            "validation record"
-        } else {
-            "validation samples"
-        };
-        let text = report::compare_report(&data, &comparison, source(), what)?.to_json()?;
-        let train = match comparison.split {
-            Split::Fraction { train, .. } => train,
-            Split::Record { train, .. } => train,
-        };
-        let train_data = id_data(ts, vec![u[..train].to_vec()], vec![y[..train].to_vec()])?;
-        let results = comparison
-            .rows
-            .iter()
-            .map(|row| {
-                let text = match &row.fitted {
-                    Some(fitted) => {
-                        let simulated = report::operator_simulation(fitted, &train_data)?;
-                        let r = report::operator_report(fitted, &train_data, &simulated, source())?;
-                        Some(r.to_json()?)
-                    }
-                    None => None,
-                };
-                Ok((row.family.to_string(), text))
-            })
-            .collect::<hysid::Result<Vec<_>>>()?;
-        Ok((text, results, comparison))
-    })?;
+    let (text, results, comparison) = run_on(
+        py,
+        threads,
+        watching(py, time_limit, progress)?,
+        move |watch| {
+            let data = id_data(ts, vec![u.clone()], vec![y.clone()])?;
+            let held_out = validation
+                .as_ref()
+                .map(|(a, b)| (a.as_slice(), b.as_slice()));
+            let mut options = options;
+            options.family.observer = watch.observer();
+            let comparison = compare_families(&u, &y, held_out, &options)?;
+            let what = if held_out.is_some() {
+                "validation record"
+            } else {
+                "validation samples"
+            };
+            let text = watch
+                .finish(report::compare_report(&data, &comparison, source(), what)?)
+                .to_json()?;
+            let train = match comparison.split {
+                Split::Fraction { train, .. } => train,
+                Split::Record { train, .. } => train,
+            };
+            let train_data = id_data(ts, vec![u[..train].to_vec()], vec![y[..train].to_vec()])?;
+            let results = comparison
+                .rows
+                .iter()
+                .map(|row| {
+                    let text = match &row.fitted {
+                        Some(fitted) => {
+                            let simulated = report::operator_simulation(fitted, &train_data)?;
+                            let r =
+                                report::operator_report(fitted, &train_data, &simulated, source())?;
+                            Some(r.to_json()?)
+                        }
+                        None => None,
+                    };
+                    Ok((row.family.to_string(), text))
+                })
+                .collect::<hysid::Result<Vec<_>>>()?;
+            Ok((text, results, comparison))
+        },
+    )?;
     let simulated = comparison
         .rows
         .iter()

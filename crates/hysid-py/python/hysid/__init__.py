@@ -62,6 +62,7 @@ from .compensation import Compensation
 from .greybox import GreyBoxModel
 from .models import Model, load_model
 from .parameters import Parameter
+from .progress import HysidWarning, Progress, ProgressArg
 from .recipes import (
     BOUC_WEN_FS,
     benchmark_bouc_wen,
@@ -114,6 +115,9 @@ __all__ = [
     "ModelFileError",
     "CallbackError",
     "InternalError",
+    "HysidWarning",
+    "Progress",
+    "ProgressArg",
     "fleet",
     "plot",
     "stream",

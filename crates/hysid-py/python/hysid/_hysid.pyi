@@ -1,7 +1,7 @@
 """Type stubs of the extension module hysid._hysid (the low-level layer; use the functions
 of the hysid package). Every fit returns the hysid.report/1 report as JSON text."""
 
-from typing import List, Optional, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 import numpy.typing as npt
@@ -18,6 +18,8 @@ class ConfigError(HysidError, ValueError): ...
 
 _Array = npt.NDArray[np.float64]
 _Param = Tuple[str, float, float, float, bool, str]
+#: (stage, done, total, iteration, cost, elapsed_s), called on the calling thread.
+_Progress = Callable[[str, int, int, Optional[int], Optional[float], float], None]
 _Spec = Tuple[object, object, List[str], int, int, List[_Param], List[float]]
 
 def identify_cascade(
@@ -32,6 +34,8 @@ def identify_cascade(
     replicates: int,
     seed: int,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def families() -> List[Tuple[str, str]]: ...
 def identify_operator(
@@ -45,6 +49,8 @@ def identify_operator(
     lambda_: float,
     dead_zones: int,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def identify_operator_cascade(
     x: _Array,
@@ -57,6 +63,8 @@ def identify_operator_cascade(
     thresholds: int,
     grid: int,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def compare(
     u: _Array,
@@ -71,11 +79,20 @@ def compare(
     lambda_: float,
     dead_zones: int,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> Tuple[str, List[Tuple[str, Optional[str]]], _Array, _Array, List[_Array]]: ...
 def compensate(model_json: str, reference: _Array, ts: float, model_source: str) -> Tuple[str, _Array, _Array]: ...
 def residual_analysis(u: _Array, y: _Array, yhat: _Array, ts: float, max_lag: int) -> str: ...
 def identify_hysteresis(
-    x: _Array, y: _Array, hysteresis: str, ts: float, initial_output: str, threads: int = 0
+    x: _Array,
+    y: _Array,
+    hysteresis: str,
+    ts: float,
+    initial_output: str,
+    threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def model_parameters(kind: str) -> Tuple[List[_Param], List[str], int]: ...
 def greybox_fit(
@@ -90,6 +107,8 @@ def greybox_fit(
     substeps: int,
     interpolation: str,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def greybox_fit_user(
     spec: _Spec,
@@ -113,6 +132,8 @@ def benchmark_bouc_wen(
     seed: int,
     substeps: int,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def rigid_body_ls(
     q: _Array,
@@ -126,6 +147,8 @@ def rigid_body_ls(
     border: int,
     inertia_name: str,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def simulate_model(
     model_json: str, inputs: Sequence[_Array], ts: float, y0: Optional[float] = None
@@ -155,6 +178,8 @@ def greybox_fit_equations(
     substeps: int,
     interpolation: str,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 def actuator_parameter_names() -> List[str]: ...
 def actuator_rig_truth() -> List[float]: ...
@@ -175,6 +200,8 @@ def actuator_three_steps(
     max_iterations: int,
     tolerance: float,
     threads: int = 0,
+    time_limit: Optional[float] = None,
+    progress: Optional[_Progress] = None,
 ) -> str: ...
 
 class Stepper:

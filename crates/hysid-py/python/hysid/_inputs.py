@@ -26,6 +26,15 @@ def array(a: Any, name: str, *, ndim: Tuple[int, ...] = (1,)) -> FloatArray:
     if isinstance(a, (str, bytes, dict)) or a is None:
         raise TypeError(f"{name}: expected a numeric array, got {type(a).__name__}")
     try:
+        kind = np.asarray(a).dtype.kind
+    except (TypeError, ValueError) as e:
+        raise TypeError(f"{name}: expected a numeric array, got {type(a).__name__} ({e})") from None
+    if kind not in "iuf":
+        # Strings ("1.5"), objects, booleans, complex numbers and dates are not samples:
+        # numpy would parse or cast some of them silently.
+        what = {"U": "strings", "S": "bytes", "O": "Python objects", "b": "booleans", "c": "complex numbers"}
+        raise TypeError(f"{name}: expected a numeric array of real numbers, got an array of {what.get(kind, kind)}")
+    try:
         arr: FloatArray = np.ascontiguousarray(np.asarray(a, dtype=np.float64))
     except (TypeError, ValueError) as e:
         raise TypeError(f"{name}: expected a numeric array, got {type(a).__name__} ({e})") from None

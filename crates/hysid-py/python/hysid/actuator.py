@@ -14,6 +14,7 @@ from . import _hysid
 from . import _inputs as check
 from ._hysid import ConfigError, DataError, ModelFileError
 from ._inputs import FloatArray
+from .progress import ProgressArg, warn_if_stopped, watching
 from .results import Result
 
 #: Gear ratio r [m/rad] and saddle mass m [kg] of the actuator of Gunnar et al. (2006).
@@ -81,6 +82,8 @@ def actuator_three_steps(
     max_iterations: int = 30,
     tolerance: float = 1e-4,
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Result:
     """The three-step identification of a linear actuator with hysteresis (J. Gunnar,
     E. Wernholt, G. Hovland, T. Brogårdh, "Nonlinear Grey-Box Identification of Linear
@@ -113,6 +116,7 @@ def actuator_three_steps(
     known (``truth`` dict or ``rig.json``). The GIL is released; ``threads`` as for
     :func:`identify_cascade`.
     """
+    limit, tell = watching(time_limit, progress)
     sets, source, rig_truth = _actuator_sets(records, ts)
     names = _hysid.actuator_parameter_names()
     truth = truth if truth is not None else rig_truth
@@ -138,8 +142,12 @@ def actuator_three_steps(
         check.count(max_iterations, "max_iterations"),
         float(tolerance),
         check.threads(threads),
+        limit,
+        tell,
     )
-    return Result(json.loads(text))
+    result = Result(json.loads(text))
+    warn_if_stopped(result.termination_code, limit, "actuator_three_steps")
+    return result
 
 
 class ActuatorRecord:

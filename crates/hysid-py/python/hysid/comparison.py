@@ -7,6 +7,8 @@ import copy
 import json
 from typing import Any, Dict, List, Optional, Sequence, Tuple, TypedDict
 
+import numpy as np
+
 from ._fields import Fields, ReportError
 from ._inputs import FloatArray
 from .models import Model, model_in
@@ -58,7 +60,8 @@ class Comparison:
     family → the one-line error of those that failed; ``model``: the best family's
     :class:`Model`; ``split``: how the data were split, in words; ``validation``: the
     scored validation samples (:class:`Record`) and ``simulated``: family → its output on
-    them. ``to_dataframe()`` (pandas), ``plot()`` (matplotlib), ``report()``.
+    them; ``termination_code``: ``"time_limit"`` when the call's ``time_limit`` stopped the
+    families' searches (the best results so far), else None. ``to_dataframe()`` (pandas), ``plot()`` (matplotlib), ``report()``.
     """
 
     best: Optional[str]
@@ -69,6 +72,7 @@ class Comparison:
     split: str
     validation: Record
     simulated: Dict[str, FloatArray]
+    termination_code: Optional[str]
 
     def __init__(
         self,
@@ -86,6 +90,8 @@ class Comparison:
             raise ReportError("report.details is null; a comparison lists its families there")
         self.best = details.optional("best", str)
         self.split = details.get("split_text", str)
+        stopped = details.absent_or("stopped_by_time_limit_s", float)
+        self.termination_code = None if stopped is None else "time_limit"
         split = details.object("split")
         kind = None if split is None else split.get("kind", str)
         train = split.get("train", int) if split is not None and kind == "fraction" else len(training.u)
@@ -145,9 +151,36 @@ class Comparison:
         failed = f", {len(self.errors)} failed" if self.errors else ""
         return f"Comparison({len(self.table)} families{failed}: {ranked}{', …' if len(self.table) > 3 else ''})"
 
+    def __eq__(self, other: object) -> bool:
+        """The same ranking, figures and fitted models (the wall-clock times are not
+        compared), on the same validation samples."""
+        if not isinstance(other, Comparison):
+            return NotImplemented
+        return (
+            _timeless(self._report) == _timeless(other._report)
+            and self.results == other.results
+            and np.array_equal(self.validation.u, other.validation.u)
+            and np.array_equal(self.validation.y, other.validation.y)
+        )
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, compared by value
+
     def __reduce__(self) -> Tuple[Any, ...]:
         simulated = [self.simulated.get(r["family"], self.validation.u[:0]) for r in self.table]
         return (
             Comparison.from_extension,
             (json.dumps(self._report), self._texts, self.validation, simulated, self._training),
         )
+
+
+def _timeless(report: Dict[str, Any]) -> Dict[str, Any]:
+    """A compare report without its wall-clock figures (each family's fit time)."""
+    rep = copy.deepcopy(report)
+    details = rep.get("details")
+    if isinstance(details, dict):
+        for row in details.get("families", []) or []:
+            if isinstance(row, dict):
+                row.pop("fit_time_s", None)
+    if isinstance(rep.get("search"), dict):
+        rep["search"].pop("elapsed_s", None)
+    return rep

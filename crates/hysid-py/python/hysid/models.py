@@ -8,6 +8,7 @@ module and one method here each (see "Deployment" in :class:`Model`).
 from __future__ import annotations
 
 import copy
+import errno
 import json
 import math
 import os
@@ -184,4 +185,7 @@ def load_model(path: Union[str, "os.PathLike[str]"]) -> Model:
     """Reads a model file written by the CLI (``--model``) or by :meth:`Model.save`."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path: expected a str or path, got {type(path).__name__}")
-    return Model(json.loads(_hysid.load_model(os.fspath(path))))
+    where = os.fspath(path)
+    if not os.path.exists(where):
+        raise FileNotFoundError(errno.ENOENT, "no model file there; check the path", where)
+    return Model(json.loads(_hysid.load_model(where)))

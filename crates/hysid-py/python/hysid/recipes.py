@@ -17,6 +17,7 @@ from ._families import FAMILIES, FamilyName
 from ._hysid import ConfigError, DataError
 from .greybox import GreyBoxModel, Integrator, Interpolation
 from .parameters import Parameter
+from .progress import ProgressArg, warn_if_stopped, watching
 from .results import Record, Result
 
 
@@ -65,6 +66,8 @@ def identify_cascade(
     thresholds: Optional[int] = None,
     grid: Optional[int] = None,
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Result:
     """Identifies a hysteresis + linear-block cascade: v(k) = H[x](k), A(q⁻¹) y(k) =
     q⁻ᵈᵉˡᵃʸ B(q⁻¹) v(k) with ``na`` denominator and ``nb`` numerator coefficients.
@@ -84,6 +87,7 @@ def identify_cascade(
     """
     x, y, given_ts = check.pair(x, y, ("x", "y"), ts)
     step = check.sample_time(given_ts, 1.0)
+    limit, tell = watching(time_limit, progress)
     name = check.choice(hysteresis, "hysteresis", FAMILIES)
     method = check.choice(uncertainty, "uncertainty", typing.get_args(UncertaintyMethod))
     orders = (check.count(na, "na"), check.count(nb, "nb"), check.count(delay, "delay"))
@@ -101,6 +105,8 @@ def identify_cascade(
             check.count(replicates, "replicates"),
             check.count(seed, "seed"),
             check.threads(threads),
+            limit,
+            tell,
         )
     else:
         if method != "asymptotic":
@@ -121,8 +127,10 @@ def identify_cascade(
             10 if thresholds is None else check.count(thresholds, "thresholds"),
             10 if grid is None else check.count(grid, "grid"),
             check.threads(threads),
+            limit,
+            tell,
         )
-    return Result(json.loads(text), data=Record(x, y, step))
+    return _finished(Result(json.loads(text), data=Record(x, y, step)), limit, "identify_cascade")
 
 
 def identify_hysteresis(
@@ -133,6 +141,8 @@ def identify_hysteresis(
     ts: float = 1.0,
     initial_output: InitialOutput = "measured",
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Result:
     """Identifies a Coleman–Hodgdon hysteresis y = H[x] alone: separated linear regression
     with the switching threshold re-estimated, then output error. ``initial_output``:
@@ -140,6 +150,7 @@ def identify_hysteresis(
     :func:`identify_cascade`."""
     x, y, given_ts = check.pair(x, y, ("x", "y"), ts)
     step = check.sample_time(given_ts, 1.0)
+    limit, tell = watching(time_limit, progress)
     text = _hysid.identify_hysteresis(
         x,
         y,
@@ -147,8 +158,10 @@ def identify_hysteresis(
         step,
         check.choice(initial_output, "initial_output", typing.get_args(InitialOutput)),
         check.threads(threads),
+        limit,
+        tell,
     )
-    return Result(json.loads(text), data=Record(x, y, step))
+    return _finished(Result(json.loads(text), data=Record(x, y, step)), limit, "identify_hysteresis")
 
 
 def _configure(
@@ -200,6 +213,8 @@ def greybox_fit(
     substeps: int = 10,
     interpolation: Interpolation = "zoh",
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Result:
     """Output-error fit of a continuous-time grey-box model ẋ = f(t, x, u, θ), y = h(x, u, θ).
 
@@ -217,6 +232,7 @@ def greybox_fit(
     """
     u, y, ts = check.pair_channels(u, y, ts)
     ts = check.sample_time(ts)
+    limit, tell = watching(time_limit, progress)
     args = (
         check.count(starts, "starts"),
         check.count(seed, "seed"),
@@ -233,8 +249,15 @@ def greybox_fit(
             raise DataError(f"y has {len(y)} channel(s); the model has {user.outputs} output(s)")
         if user.equations is not None:
             params = [p.as_tuple() for p in user.parameters]
-            text = _hysid.greybox_fit_equations(user.equations, u, y, ts, params, *args, check.threads(threads))
-            return Result(json.loads(text))
+            text = _hysid.greybox_fit_equations(
+                user.equations, u, y, ts, params, *args, check.threads(threads), limit, tell
+            )
+            return _finished(Result(json.loads(text)), limit, "greybox_fit")
+        if limit is not None or tell is not None:
+            raise ConfigError(
+                "time_limit and progress are not available for a model written as Python functions (its "
+                "callbacks run on the fit's thread); write it as equations (GreyBoxModel.from_equations)"
+            )
         text = _hysid.greybox_fit_user(user._spec(), u, y, ts, *args)
         return Result(json.loads(text), user)
     if not isinstance(model, str):
@@ -242,8 +265,10 @@ def greybox_fit(
     defaults, _, _ = _hysid.model_parameters(model)
     built_in = [Parameter(n, v, lower=lo, upper=hi, fixed=f, unit=unit) for (n, v, lo, hi, f, unit) in defaults]
     chosen = _configure(built_in, init, fix, bounds)
-    text = _hysid.greybox_fit(model, u, y, ts, [p.as_tuple() for p in chosen], *args, check.threads(threads))
-    return Result(json.loads(text))
+    text = _hysid.greybox_fit(
+        model, u, y, ts, [p.as_tuple() for p in chosen], *args, check.threads(threads), limit, tell
+    )
+    return _finished(Result(json.loads(text)), limit, "greybox_fit")
 
 
 #: Sampling frequency of the Bouc–Wen benchmark records [Hz].
@@ -262,6 +287,8 @@ def benchmark_bouc_wen(
     substeps: int = 4,
     start_factor: float = 1.0,
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Result:
     """The Bouc–Wen hysteretic benchmark (Noël & Schoukens 2016): fits the Bouc–Wen
     oscillator m ÿ + c ẏ + k y + z = u, ż = α ẏ − β(γ|ẏ||z|^(ν−1) z − δ ẏ|z|^ν)
@@ -275,6 +302,8 @@ def benchmark_bouc_wen(
     """
     u, y, ts = check.pair(u_train, y_train, ("u_train", "y_train"), ts)
     ts = check.sample_time(ts, 1.0 / BOUC_WEN_FS)
+    limit, tell = watching(time_limit, progress)
+
     records = []
     for i, t in enumerate(tests):
         if hasattr(t, "u") and hasattr(t, "y"):
@@ -301,8 +330,10 @@ def benchmark_bouc_wen(
         check.count(seed, "seed"),
         check.count(substeps, "substeps"),
         check.threads(threads),
+        limit,
+        tell,
     )
-    return Result(json.loads(text))
+    return _finished(Result(json.loads(text)), limit, "benchmark_bouc_wen")
 
 
 def rigid_body_ls(
@@ -318,6 +349,8 @@ def rigid_body_ls(
     border: int = 50,
     inertia_name: str = "M",
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Result:
     """Rigid-body least squares (step 1 of Gunnar et al., ICRA 2006): position ``q``
     filtered by a zero-phase Butterworth low-pass (``order``, ``cutoff_hz``), velocity and
@@ -327,6 +360,7 @@ def rigid_body_ls(
     the report's details hold the relative error and condition numbers (the CLI's
     ``rigid-body ls`` report); the model is the built-in ``rigid_body`` model."""
     qa, ua, _ = check.pair(q, u, ("q", "u"), None)
+    limit, tell = watching(time_limit, progress)
     text = _hysid.rigid_body_ls(
         qa,
         ua,
@@ -339,5 +373,13 @@ def rigid_body_ls(
         check.count(border, "border"),
         str(inertia_name),
         check.threads(threads),
+        limit,
+        tell,
     )
-    return Result(json.loads(text))
+    return _finished(Result(json.loads(text)), limit, "rigid_body_ls")
+
+
+def _finished(result: Result, time_limit: Optional[float], what: str) -> Result:
+    """``result``, with the :class:`HysidWarning` of a search its time limit stopped."""
+    warn_if_stopped(result.termination_code, time_limit, what)
+    return result

@@ -26,8 +26,14 @@ if TYPE_CHECKING:  # pragma: no cover
 class Stepper:
     """A model one sample at a time (see the module doc)."""
 
-    def __init__(self, inner: Any) -> None:
+    def __init__(self, inner: Any, kind: str = "model", ts: float = math.nan) -> None:
         self._inner = inner
+        self._kind = kind
+        self._ts = ts
+
+    def __repr__(self) -> str:
+        ts = "" if math.isnan(self._ts) else f", ts={self._ts:g} s"
+        return f"Stepper({self._kind}: {self.n_inputs} input(s), {self.n_outputs} output(s){ts})"
 
     @property
     def n_inputs(self) -> int:
@@ -60,8 +66,14 @@ class Stepper:
 class Compensator:
     """A model's compensator one sample at a time (see the module doc)."""
 
-    def __init__(self, inner: Any) -> None:
+    def __init__(self, inner: Any, kind: str = "model", ts: float = math.nan) -> None:
         self._inner = inner
+        self._kind = kind
+        self._ts = ts
+
+    def __repr__(self) -> str:
+        ts = "" if math.isnan(self._ts) else f", ts={self._ts:g} s"
+        return f"Compensator({self._kind}: preview {self.preview}, {self.clipped} clipped{ts})"
 
     @property
     def clipped(self) -> int:
@@ -99,9 +111,12 @@ def _ts(model: "Model", ts: Optional[float]) -> float:
 
 def stepper(model: "Model", *, ts: Optional[float] = None, y0: Optional[float] = None) -> Stepper:
     """The :class:`Stepper` of ``model``."""
-    return Stepper(_hysid.model_stepper(json.dumps(model.file), _ts(model, ts), None if y0 is None else float(y0)))
+    step = _ts(model, ts)
+    inner = _hysid.model_stepper(json.dumps(model.file), step, None if y0 is None else float(y0))
+    return Stepper(inner, model.kind, step)
 
 
 def compensator(model: "Model", *, ts: Optional[float] = None) -> Compensator:
     """The :class:`Compensator` of ``model``."""
-    return Compensator(_hysid.model_compensator(json.dumps(model.file), _ts(model, ts)))
+    step = _ts(model, ts)
+    return Compensator(_hysid.model_compensator(json.dumps(model.file), step), model.kind, step)

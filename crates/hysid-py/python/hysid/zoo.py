@@ -19,6 +19,7 @@ from ._hysid import ConfigError
 from .comparison import Comparison
 from .compensation import Compensation
 from .models import Model, load_model
+from .progress import ProgressArg, warn_if_stopped, watching
 from .results import Record, Result
 
 #: ``families="all"``: every family of the registry.
@@ -40,6 +41,11 @@ def _family_options(
 ) -> _FamilyOptions:
     if isinstance(thresholds, (int, np.integer)) and not isinstance(thresholds, bool):
         count, values = check.count(thresholds, "thresholds"), []
+    elif isinstance(thresholds, (bool, float, np.floating, str)):
+        raise TypeError(
+            f"thresholds={thresholds!r}: give a count (an int, e.g. thresholds=20) or the thresholds "
+            "themselves (a sequence of increasing positive floats, e.g. thresholds=[0.5, 1.0, 2.0])"
+        )
     else:
         values = [float(r) for r in check.array(thresholds, "thresholds")]
         count = len(values)
@@ -67,6 +73,8 @@ def identify_operator(
     lambda_: float = 1e-6,
     dead_zones: int = 4,
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Result:
     """Fits one hysteresis family y = Γ[u] to a measured input ``u`` and output ``y`` from
     the data alone (no initial guess): the CLI's ``hysid identify operator``, the same
@@ -83,8 +91,11 @@ def identify_operator(
     step = check.sample_time(given_ts, 1.0)
     name = _family(family)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
-    text = _hysid.identify_operator(u, y, name, step, *options, check.threads(threads))
-    return Result(json.loads(text), data=Record(u, y, step))
+    limit, tell = watching(time_limit, progress)
+    text = _hysid.identify_operator(u, y, name, step, *options, check.threads(threads), limit, tell)
+    result = Result(json.loads(text), data=Record(u, y, step))
+    warn_if_stopped(result.termination_code, limit, "identify_operator")
+    return result
 
 
 def compare(
@@ -99,6 +110,8 @@ def compare(
     lambda_: float = 1e-6,
     dead_zones: int = 4,
     threads: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    progress: ProgressArg = None,
 ) -> Comparison:
     """Fits several hysteresis families to one record and ranks them by how well they
     predict data they were not fitted to: the CLI's ``hysid compare``, the same ranking
@@ -125,10 +138,13 @@ def compare(
             raise TypeError("validate: give a pair (u_val, y_val) or a record with .u and .y")
         u_val, y_val, _ = check.pair(pair[0], pair[1], ("validate u", "validate y"), None)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
+    limit, tell = watching(time_limit, progress)
     report, results, v_in, v_out, simulated = _hysid.compare(
-        u, y, u_val, y_val, names, step, *options, check.threads(threads)
+        u, y, u_val, y_val, names, step, *options, check.threads(threads), limit, tell
     )
-    return Comparison.from_extension(report, results, Record(v_in, v_out, step), simulated, Record(u, y, step))
+    comparison = Comparison.from_extension(report, results, Record(v_in, v_out, step), simulated, Record(u, y, step))
+    warn_if_stopped(comparison.termination_code, limit, "compare")
+    return comparison
 
 
 def _families(families: Any) -> List[str]:

@@ -197,14 +197,23 @@ fn a_report_with_a_non_finite_number_is_refused_naming_its_key() {
     ensure_finite_json(&value).unwrap();
 }
 
-/// Run as a child process by the next test: registers outputs, writes the temporaries,
-/// announces itself and waits to be killed.
+/// Run as a child process by the next tests: registers outputs, writes the temporaries,
+/// announces itself and waits to be killed. With `HYSID_SIGTERM_HANDLER` set it acts as a
+/// program that cleans up on a signal (as the `hysid` command line does): its own handler
+/// removes the temporaries and exits with 130. The library installs none.
 #[test]
-#[ignore = "helper: run only as the child of the SIGTERM test"]
+#[ignore = "helper: run only as the child of the SIGTERM tests"]
 fn sigterm_child() {
     let Ok(dir) = std::env::var("HYSID_SIGTERM_DIR") else {
         return;
     };
+    if std::env::var_os("HYSID_SIGTERM_HANDLER").is_some() {
+        ctrlc::set_handler(|| {
+            hysid::io::atomic::remove_live_temporaries();
+            std::process::exit(130);
+        })
+        .unwrap();
+    }
     let dir = Path::new(&dir);
     let mut outputs = OutputSet::new(&[]).unwrap();
     let tmp = outputs.file(&dir.join("report.json")).unwrap();
@@ -215,25 +224,28 @@ fn sigterm_child() {
     std::thread::sleep(std::time::Duration::from_secs(60));
 }
 
+/// Starts [`sigterm_child`] over `dir` (with its handler when `handler`), waits until it
+/// has written its temporaries, sends SIGTERM and returns its exit status.
 #[cfg(unix)]
-#[test]
-fn sigterm_removes_the_temporaries_and_keeps_the_previous_outputs() {
-    let dir = tempfile::tempdir().unwrap();
-    fs::write(dir.path().join("report.json"), "old").unwrap();
-    fs::create_dir(dir.path().join("plots")).unwrap();
-    let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+fn signalled_child(dir: &Path, handler: bool) -> std::process::ExitStatus {
+    fs::write(dir.join("report.json"), "old").unwrap();
+    fs::create_dir(dir.join("plots")).unwrap();
+    let mut command = std::process::Command::new(std::env::current_exe().unwrap());
+    command
         .args([
             "--ignored",
             "--exact",
             "atomic_outputs::sigterm_child",
             "--nocapture",
         ])
-        .env("HYSID_SIGTERM_DIR", dir.path())
+        .env("HYSID_SIGTERM_DIR", dir)
         .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let ready = dir.path().join("ready");
+        .stderr(std::process::Stdio::null());
+    if handler {
+        command.env("HYSID_SIGTERM_HANDLER", "1");
+    }
+    let mut child = command.spawn().unwrap();
+    let ready = dir.join("ready");
     // Wait for the child (bounded: 30 s of 10 ms polls), then signal it.
     for _ in 0..3000 {
         if ready.exists() {
@@ -242,21 +254,46 @@ fn sigterm_removes_the_temporaries_and_keeps_the_previous_outputs() {
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
     assert!(ready.exists(), "the child never got ready");
-    assert!(listing(dir.path()).iter().any(|n| n.contains("hysid-tmp")));
+    assert!(listing(dir).iter().any(|n| n.contains("hysid-tmp")));
     let status = std::process::Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()
         .unwrap();
     assert!(status.success());
     let exit = child.wait().unwrap();
-    assert_eq!(exit.code(), Some(130));
     fs::remove_file(&ready).unwrap();
+    exit
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_removes_the_temporaries_and_keeps_the_previous_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let exit = signalled_child(dir.path(), true);
+    assert_eq!(exit.code(), Some(130));
     assert_eq!(listing(dir.path()), ["plots", "report.json"]);
     assert_eq!(
         fs::read_to_string(dir.path().join("report.json")).unwrap(),
         "old"
     );
     assert!(listing(&dir.path().join("plots")).is_empty());
+}
+
+/// Signals belong to the program: an output set installs no handler, so a program without
+/// one ends by the signal's default action (its hidden temporaries stay, the previous
+/// outputs too), and a Python interpreter or any host keeps its own handlers.
+#[cfg(unix)]
+#[test]
+fn the_library_installs_no_signal_handler() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let exit = signalled_child(dir.path(), false);
+    assert_eq!(exit.signal(), Some(15), "{exit}");
+    assert_eq!(
+        fs::read_to_string(dir.path().join("report.json")).unwrap(),
+        "old"
+    );
+    assert!(listing(dir.path()).iter().any(|n| n.contains("hysid-tmp")));
 }
 
 /// The clash of a refused registration.

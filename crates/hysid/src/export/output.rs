@@ -5,7 +5,9 @@
 //! is an input of the run, holds one, or is a file), then refused when it exists and holds
 //! anything at all — an export never overwrites and never mixes its files with others. The
 //! files are written into a temporary directory beside it, which is renamed into place when
-//! complete; on any error (or SIGINT) the temporary goes and the directory stays as it was.
+//! complete; on any error the temporary goes and the directory stays as it was (on SIGINT
+//! too, in a program whose handler calls [`crate::io::atomic::remove_live_temporaries`], as the
+//! `hysid` command line does).
 
 use super::GeneratedFile;
 use crate::io::atomic::OutputSet;

@@ -22,9 +22,12 @@
 //!    back. A run killed at any moment leaves each output path with its previous complete
 //!    content or the new one.
 //!
-//! Dropping the set without committing (an error, a `?`) removes every temporary, and so
-//! does SIGINT or SIGTERM (a handler is installed with the first set; the process then exits
-//! with status 130): the previous outputs stay as they were.
+//! Dropping the set without committing (an error, a `?`) removes every temporary: the
+//! previous outputs stay as they were. Signals belong to the program, not to the library:
+//! this module installs no handler. A program that wants the temporaries gone on SIGINT or
+//! SIGTERM calls [`remove_live_temporaries`] from its own handler before it exits (the
+//! `hysid` command line does, then exits with status 130); a process killed without one
+//! (SIGKILL) leaves only hidden `.NAME.hysid-tmp-…` files, never a half-written output.
 //!
 //! [`ensure_finite`] refuses a report holding NaN or ±∞ before it is written, naming the key
 //! path of the first one (JSON has no such numbers; `serde_json` would write `null`).
@@ -32,7 +35,7 @@
 use std::fs;
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, Once};
+use std::sync::Mutex;
 
 use crate::error::{Clash, ClashKind, Error, Result};
 
@@ -42,11 +45,8 @@ const TMP_TAG: &str = "hysid-tmp";
 /// Distinguishes the temporaries of one process.
 static COUNTER: AtomicUsize = AtomicUsize::new(0);
 
-/// Temporaries of every live output set, by set, removed by the signal handler.
+/// Temporaries of every live output set, by set ([`remove_live_temporaries`]).
 static LIVE: Mutex<Vec<(usize, PathBuf)>> = Mutex::new(Vec::new());
-
-/// Installs the SIGINT/SIGTERM handler once.
-static HANDLER: Once = Once::new();
 
 /// The kind of a registered output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -156,7 +156,6 @@ impl OutputSet {
     /// `./a.csv`, `d/../a.csv`, a symbolic link to `a.csv` and a hard link of it are all
     /// `a.csv`. An input that does not exist yet counts by its path.
     pub fn new(inputs: &[&Path]) -> Result<Self> {
-        install_signal_cleanup();
         let mut found = Vec::new();
         for given in inputs {
             let Some(id) = Identity::of(given) else {
@@ -536,22 +535,21 @@ fn unregister(id: usize) {
     }
 }
 
-/// On SIGINT or SIGTERM, removes the temporaries of every live set and exits with 130.
-/// Does nothing when the program has installed its own handler already.
-fn install_signal_cleanup() {
-    HANDLER.call_once(|| {
-        let _ = ctrlc::set_handler(|| {
-            // A panicking thread may have poisoned the lock; the paths are still valid.
-            let live = match LIVE.lock() {
-                Ok(live) => live,
-                Err(poisoned) => poisoned.into_inner(),
-            };
-            for (_, path) in live.iter() {
-                remove_any(path);
-            }
-            std::process::exit(130);
-        });
-    });
+/// Removes the temporaries of every live output set of the process (the previous outputs
+/// stay as they were): for a program's own SIGINT/SIGTERM handler, called before it exits.
+/// The sets themselves are left registered; the process is expected to end.
+///
+/// It takes a lock, so call it from a handler that runs on an ordinary thread (as the
+/// `ctrlc` crate's does), not from an async-signal context.
+pub fn remove_live_temporaries() {
+    // A panicking thread may have poisoned the lock; the paths are still valid.
+    let live = match LIVE.lock() {
+        Ok(live) => live,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    for (_, path) in live.iter() {
+        remove_any(path);
+    }
 }
 
 /// The directory `path` is written into ("." for a bare name).

@@ -291,6 +291,16 @@ impl TerminationSummary {
         }
     }
 
+    /// A search a front end's time limit of `limit_s` seconds stopped: the code
+    /// `time_limit`, not converged (the results are the best found so far).
+    pub fn time_limit(limit_s: f64) -> Self {
+        Self {
+            code: "time_limit".into(),
+            message: format!("time limit of {limit_s} s reached; the best result so far"),
+            converged: false,
+        }
+    }
+
     /// A direct (non-iterative) solve, such as linear least squares.
     pub fn direct() -> Self {
         Self {
@@ -415,6 +425,19 @@ impl ValidationEntry {
 }
 
 impl Report {
+    /// The report of a run whose searches a front end's time limit of `limit_s` seconds
+    /// stopped: its `search.termination` says so ([`TerminationSummary::time_limit`]); a
+    /// report without a search of its own (`compare`, whose families each searched) says so
+    /// in `details.stopped_by_time_limit_s`.
+    pub fn stopped_by_time_limit(mut self, limit_s: f64) -> Self {
+        if let Some(search) = &mut self.search {
+            search.termination = TerminationSummary::time_limit(limit_s);
+        } else if let Some(details) = self.details.as_object_mut() {
+            details.insert("stopped_by_time_limit_s".into(), limit_s.into());
+        }
+        self
+    }
+
     /// An empty report of `command`: every key present, null where nothing is filled in.
     pub fn new(command: &str) -> Self {
         Self {
