@@ -188,13 +188,13 @@ fn a_planted_library_never_runs_from_a_cache_others_could_write() {
     let key = cache.join("key");
     let cases: [(&[PathBuf], u32, u32, &str); 5] = [
         (
-            &[native.clone()],
+            std::slice::from_ref(&native),
             0o777,
             0o700,
             "native-dir-writable-by-others",
         ),
         (
-            &[cache.clone()],
+            std::slice::from_ref(&cache),
             0o770,
             0o700,
             "base-dir-writable-by-the-group",
@@ -211,7 +211,7 @@ fn a_planted_library_never_runs_from_a_cache_others_could_write() {
 
     if root_user(dir.path()) {
         let owners: [(&[PathBuf], &str); 2] = [
-            (&[native.clone()], "native-dir-of-uid-65534"),
+            (std::slice::from_ref(&native), "native-dir-of-uid-65534"),
             (&libraries, "library-of-uid-65534"),
         ];
         for (paths, case) in owners {

@@ -184,7 +184,7 @@ impl Cache {
     /// most [`MAX_BYTES`] in all remain.
     fn trim(&self) {
         let mut entries = self.entries();
-        entries.sort_by(|a, b| b.0.cmp(&a.0));
+        entries.sort_by_key(|e| std::cmp::Reverse(e.0));
         let (mut count, mut bytes) = (0, 0);
         for (_, size, name) in entries {
             if count < MAX_ENTRIES && bytes + size <= MAX_BYTES {
