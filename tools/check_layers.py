@@ -5,10 +5,12 @@
    `crates/hysid/src/**.rs`, outside `#[cfg(test)]` modules, comments and string literals,
    must name a layer at or below the file's own layer:
 
-       error  <  numerics = data  <  model  <  experiments  <  identify  <  report  <  export
+       error  <  numerics = data = toolchain  <  model  <  experiments  <  identify  <  report
+             <  export
 
-   `numerics` and `data` are peers (each may use the other). `crate::Error` and
-   `crate::Result` are the re-exports of `error`.
+   `numerics` and `data` are peers (each may use the other); `toolchain` (the machine's C
+   compiler) is ranked with them. `crate::Error` and `crate::Result` are the re-exports of
+   `error`.
 
 2. Command line: `crates/hysid-cli/src` holds no numerical code. The check is a textual
    heuristic (it sees no types) that flags
@@ -39,6 +41,7 @@ RANK = {
     "error": 0,
     "numerics": 1,
     "data": 1,
+    "toolchain": 1,
     "model": 2,
     "experiments": 3,
     "identify": 4,

@@ -9,6 +9,7 @@
 //! 1. [`numerics`] — the Levenberg–Marquardt engine, least squares, a simplex minimiser,
 //!    filters and excitation signals, fit metrics; knows nothing of hysteresis. [`data`] —
 //!    the validated identification data set ([`data::IdData`]), CSV and .mat input.
+//!    [`toolchain`] — the machine's C compiler (`$CC`), for native code and FMU binaries.
 //! 2. [`model`] — parameters and every model (Coleman–Hodgdon hysteresis, linear blocks,
 //!    cascades, continuous-time grey-box models), each able to simulate itself, and the
 //!    saved-model file. No model imports an estimator.
@@ -40,5 +41,6 @@ pub mod io;
 pub mod model;
 pub mod numerics;
 pub mod report;
+pub mod toolchain;
 
 pub use error::{Error, Result};

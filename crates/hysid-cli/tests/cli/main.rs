@@ -14,6 +14,8 @@ mod hardening;
 mod hold_check_cli;
 #[cfg(unix)] // symbolic links
 mod inputs_sacred;
+#[cfg(target_os = "linux")] // the C route of equation files
+mod native_cache;
 mod operator_cascade_cli;
 mod outputs;
 mod report_schema;

@@ -36,7 +36,7 @@
 mod compile;
 pub mod description;
 
-pub use compile::Compiler;
+pub use crate::toolchain::Compiler;
 
 use super::zip::{archive, Entry};
 use super::{check_name, CCode, ExportOptions, GeneratedFile};
@@ -95,9 +95,12 @@ pub fn fmu(code: &CCode, compiler: Option<&Compiler>) -> Result<Vec<u8>> {
             .map(|(file, text)| (file.to_string(), text.as_bytes().to_vec())),
     );
     let binary = match compiler {
-        Some(cc) => {
-            Some(cc.shared_library(name, &sources, &description::compiled_sources(name))?)
-        }
+        Some(cc) => Some(compile::shared_library(
+            cc,
+            name,
+            &sources,
+            &description::compiled_sources(name),
+        )?),
         None => None,
     };
     let mut entries = vec![
@@ -177,21 +180,17 @@ fn escape_html(text: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// A GUID derived from `parts`: their 128-bit FNV-1a hash (each part followed by its
-/// length, so that moving bytes between parts changes it), written as
+/// A GUID derived from `parts`: the first 128 bits of their BLAKE3 hash (each part
+/// followed by its length, so that moving bytes between parts changes it), written as
 /// `{xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx}`.
 pub fn guid(parts: &[&[u8]]) -> String {
-    const OFFSET: u128 = 0x6c62_272e_07bb_0142_62b8_2175_6295_c58d;
-    const PRIME: u128 = 0x0000_0000_0100_0000_0000_0000_0000_013b;
-    let mut hash = OFFSET;
+    let mut hasher = blake3::Hasher::new();
     for part in parts {
-        let length = (part.len() as u64).to_le_bytes();
-        for &byte in part.iter().chain(&length) {
-            hash ^= u128::from(byte);
-            hash = hash.wrapping_mul(PRIME);
-        }
+        hasher.update(part);
+        hasher.update(&(part.len() as u64).to_le_bytes());
     }
-    let hex = format!("{hash:032x}");
+    let hex = hasher.finalize().to_hex();
+    let hex = &hex[..32];
     format!(
         "{{{}-{}-{}-{}-{}}}",
         &hex[..8],

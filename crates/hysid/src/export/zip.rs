@@ -185,32 +185,7 @@ fn put32(out: &mut Vec<u8>, v: u32) {
 }
 
 /// The CRC-32 of `data` (ISO 3309 / ITU-T V.42, the ZIP and gzip checksum: reflected
-/// polynomial 0xEDB88320, initial value and final XOR 0xFFFFFFFF).
+/// polynomial 0xEDB88320, initial value and final XOR 0xFFFFFFFF), by `crc32fast`.
 pub fn crc32(data: &[u8]) -> u32 {
-    !data.iter().fold(!0u32, |crc, &byte| {
-        CRC_TABLE[((crc ^ u32::from(byte)) & 0xff) as usize] ^ (crc >> 8)
-    })
-}
-
-/// The CRC of every byte value, one table lookup per byte.
-const CRC_TABLE: [u32; 256] = crc_table();
-
-const fn crc_table() -> [u32; 256] {
-    let mut table = [0u32; 256];
-    let mut n = 0;
-    while n < 256 {
-        let mut c = n as u32;
-        let mut bit = 0;
-        while bit < 8 {
-            c = if c & 1 == 1 {
-                0xEDB8_8320 ^ (c >> 1)
-            } else {
-                c >> 1
-            };
-            bit += 1;
-        }
-        table[n] = c;
-        n += 1;
-    }
-    table
+    crc32fast::hash(data)
 }

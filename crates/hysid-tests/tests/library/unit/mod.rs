@@ -13,3 +13,4 @@ mod model;
 mod numerics;
 mod report;
 mod test_signals;
+mod toolchain;

@@ -623,10 +623,15 @@ impl StateSpaceModel for EquationStateSpace {
             return Some(format!("tape interpreter (no native code: {why})"));
         }
         let (mut generated, mut compiled, mut cached) = (None::<f64>, None::<f64>, false);
+        let mut uncached = false;
         for b in built.iter().filter_map(|b| b.as_ref().ok()) {
             match b.provenance() {
                 Provenance::Generated(s) => *generated.get_or_insert(0.0) += s,
                 Provenance::Compiled(s) => *compiled.get_or_insert(0.0) += s,
+                Provenance::CompiledUncached(s) => {
+                    *compiled.get_or_insert(0.0) += s;
+                    uncached = true;
+                }
                 Provenance::Cached => cached = true,
             }
         }
@@ -635,9 +640,11 @@ impl StateSpaceModel for EquationStateSpace {
             how.push(format!("generated in the process in {:.1} ms", 1e3 * s));
         }
         if let Some(s) = compiled {
-            how.push(format!(
-                "compiled now: {s:.2} s of compiler time; cached for the next runs"
-            ));
+            how.push(if uncached {
+                format!("compiled now: {s:.2} s of compiler time; not cached (no usable cache)")
+            } else {
+                format!("compiled now: {s:.2} s of compiler time; cached for the next runs")
+            });
         }
         if cached {
             how.push("loaded from the cache".into());

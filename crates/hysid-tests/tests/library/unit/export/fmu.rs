@@ -160,6 +160,19 @@ fn the_binary_is_built_and_the_export_is_byte_identical() {
     assert_eq!(fmu(&filter("lp"), Some(&cc)).unwrap(), first);
 }
 
+/// A compiler given with arguments (`CC="env cc"`, as `CC="ccache cc"` would be) builds
+/// the same binary.
+#[test]
+fn a_compiler_with_arguments_builds_the_binary() {
+    let env_cc = Compiler::parse(std::ffi::OsStr::new("env cc"));
+    let first = fmu(&filter("lp"), Some(&env_cc)).unwrap();
+    assert!(names(&first).contains(&"binaries/linux64/lp.so".to_string()));
+    assert_eq!(
+        first,
+        fmu(&filter("lp"), Some(&Compiler::new("cc"))).unwrap()
+    );
+}
+
 #[test]
 fn no_compiler_is_one_line_naming_it_and_the_way_out() {
     let err = fmu(&filter("lp"), Some(&Compiler::new("/nonexistent/cc"))).unwrap_err();

@@ -27,8 +27,9 @@
 //! Which evaluator runs is [`Evaluator`]: `auto` (generated, else compiled, else the tape),
 //! `native` (an error when neither route builds), `jit` (generated only), `cc` (compiled
 //! only), `tape`; the default is read from the environment variable `HYSID_EVALUATOR`. The
-//! compiler is `$CC`, else `cc`; the cache is `$HYSID_CACHE_DIR`, else
-//! `$XDG_CACHE_HOME/hysid`, else `~/.cache/hysid`.
+//! compiler is [`crate::toolchain::Compiler`] (`$CC` as make reads it, else `cc`); the cache
+//! is `$HYSID_CACHE_DIR`, else `$XDG_CACHE_HOME/hysid`, else `~/.cache/hysid`, private and
+//! checked (`object.rs`: a library is loaded only if its MAC matches).
 //!
 //! The technique — generating code for a model's residual and Jacobian from its expression
 //! graph — is that of CasADi's code generation (J. A. E. Andersson et al., "CasADi: a
@@ -145,8 +146,11 @@ pub enum Provenance {
     Generated(f64),
     /// Loaded from the cache of compiled models.
     Cached,
-    /// Compiled now, in this many seconds.
+    /// Compiled now, in this many seconds, and stored in the cache for later runs.
     Compiled(f64),
+    /// Compiled now, in this many seconds, in a private temporary directory: no cache was
+    /// usable (refused by its checks, or none), so the next run compiles again.
+    CompiledUncached(f64),
 }
 
 type PrepareFn = unsafe extern "C" fn(*const f64, *mut f64);
