@@ -14,6 +14,7 @@ mod hardening;
 mod hold_check_cli;
 #[cfg(unix)] // symbolic links
 mod inputs_sacred;
+mod nist_cli;
 mod operator_cascade_cli;
 mod outputs;
 mod report_schema;
