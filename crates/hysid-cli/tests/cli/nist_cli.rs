@@ -4,7 +4,7 @@
 //! `--json` report read back: at least six correct digits in every parameter against NIST's
 //! certified values, three in every standard deviation, and a converged termination. The
 //! files are in `data/nist-strd/` (`csv/`, `models/`); the library's test of the same cases
-//! is `crates/hysid-tests/tests/library/nist.rs`.
+//! is `crates/hysid-tests/tests/library/nist.rs`. The 54 runs take about a second.
 
 use crate::common::{hysid, read_json, Assert};
 use std::path::{Path, PathBuf};
@@ -79,7 +79,6 @@ fn digits(estimates: &[f64], certified: &[f64]) -> f64 {
 }
 
 #[test]
-#[ignore = "long: 54 command-line fits (about 20 s); run by `cargo test --release -- --ignored` and CI"]
 fn every_nist_problem_from_both_starts_through_the_cli() {
     let dir = TempDir::new().unwrap();
     let mut failures = Vec::new();

@@ -17,6 +17,13 @@
 //! bound whose gradient pushes it outward is held for that step, the reduced system is solved
 //! and the trial point is projected onto the box. The predicted decrease uses the projected step.
 //!
+//! **Stopping at a minimum**: a small relative improvement of S ends the search only where
+//! the Gauss–Newton step is also small in every free parameter (|δᵢ| ≤ τ·|θᵢ|,
+//! [`LmConfig::parameter_tolerance`]); otherwise the search goes on and stops on that test
+//! ([`Termination::StepBelowTolerance`]), so a fit that stopped short is never reported as
+//! "relative improvement below tolerance". `docs/numerics.md` §1.1 certifies the engine on
+//! NIST's reference problems.
+//!
 //! **Diverging trials**: a trial point whose residuals cannot be computed (the simulation blows
 //! up or errors) counts as a failed step (λ grows) and is reported in
 //! [`LmReport::rejected_trials`]; it never aborts the fit.
