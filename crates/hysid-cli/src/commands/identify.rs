@@ -36,7 +36,7 @@ pub fn load_grouped(args: &DataArgs, n_inputs: usize, n_outputs: usize) -> Resul
             args.output.len()
         );
     } else {
-        let whole = args.input.len() % ni == 0 && args.output.len() % no == 0;
+        let whole = args.input.len().is_multiple_of(ni) && args.output.len().is_multiple_of(no);
         anyhow::ensure!(
             whole && args.input.len() / ni == args.output.len() / no,
             "the model has {ni} input(s) and {no} output(s): give {ni} --input and {no} --output \

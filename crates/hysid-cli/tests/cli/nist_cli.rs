@@ -70,10 +70,15 @@ fn digits(estimates: &[f64], certified: &[f64]) -> f64 {
     estimates
         .iter()
         .zip(certified)
-        .map(|(e, c)| match ((e - c).abs() / c.abs(), e.is_finite()) {
-            (_, false) => 0.0,
-            (r, _) if r == 0.0 => 15.0,
-            (r, _) => (-r.log10()).clamp(0.0, 15.0),
+        .map(|(e, c)| {
+            let r = (e - c).abs() / c.abs();
+            if !e.is_finite() {
+                0.0
+            } else if r == 0.0 {
+                15.0
+            } else {
+                (-r.log10()).clamp(0.0, 15.0)
+            }
         })
         .fold(f64::INFINITY, f64::min)
 }
