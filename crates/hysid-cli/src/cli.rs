@@ -334,7 +334,8 @@ pub struct SearchArgs {
     #[arg(long, default_value_t = 100, value_parser = crate::options::count::<1, 100_000>)]
     pub max_iterations: usize,
     /// Stop when the expected relative improvement falls below this (Gunnar et al. 2006:
-    /// 1e-4, i.e. 0.01 %). Range [1e-15, 1).
+    /// 1e-4, i.e. 0.01 %) and the Gauss–Newton step is below 1e-7·√(X/1e-10) of every
+    /// parameter (so a stop means a minimum; docs/numerics.md §1). Range [1e-15, 1).
     #[arg(long, default_value_t = 1e-10, value_parser = crate::options::tolerance)]
     pub tolerance: f64,
 }
@@ -553,10 +554,13 @@ pub struct DataArgs {
     #[arg(long)]
     pub data: PathBuf,
     /// Input column (the hysteresis input x). Repeat --input/--output pairs to fit several
-    /// experiments (e.g. loops measured separately) together.
+    /// experiments (e.g. loops measured separately) together. `greybox fit` takes the
+    /// model's inputs and outputs per experiment: with k inputs and one output,
+    /// `--input X1 … --input Xk --output Y` is one experiment (repeat the group for more).
     #[arg(long, required = true)]
     pub input: Vec<String>,
-    /// Output column (one per --input).
+    /// Output column (one per --input; `greybox fit`: as many per experiment as the model
+    /// has outputs).
     #[arg(long, required = true)]
     pub output: Vec<String>,
     /// Sample time [s]; otherwise from the time column, else 1. Range (0, 1e12].

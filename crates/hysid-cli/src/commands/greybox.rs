@@ -2,7 +2,7 @@
 
 use super::present::{print_fit, print_residuals, print_sensitivity};
 use crate::cli::{GreyboxFitArgs, IntegratorArg, InterpolationArg, SimulationArgs};
-use crate::commands::identify::load;
+use crate::commands::identify::load_grouped;
 use crate::output::Outputs;
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
@@ -37,7 +37,8 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         args.model_out.as_deref(),
         args.plots.as_deref(),
     )?;
-    let data = load(&args.data)?;
+    // A model with k inputs and m outputs takes k --input and m --output per experiment.
+    let data = load_grouped(&args.data, model.inputs().len(), model.outputs().len())?;
     out.fitted_on(&data);
     let params = configure(
         model.parameters(),

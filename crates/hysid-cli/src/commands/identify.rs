@@ -19,17 +19,38 @@ use serde_json::json;
 /// Reads the input and output columns of a CSV file: one experiment per --input/--output
 /// pair.
 pub fn load(args: &DataArgs) -> Result<IdData> {
-    anyhow::ensure!(
-        args.input.len() == args.output.len(),
-        "give one --output per --input ({} inputs, {} outputs)",
-        args.input.len(),
-        args.output.len()
-    );
+    load_grouped(args, 1, 1)
+}
+
+/// Reads the input and output columns of a CSV file for a model with `n_inputs` inputs and
+/// `n_outputs` outputs: the --input columns are taken `n_inputs` at a time and the --output
+/// columns `n_outputs` at a time, in the order given, each group one experiment (for a
+/// single-input, single-output model: one experiment per --input/--output pair).
+pub fn load_grouped(args: &DataArgs, n_inputs: usize, n_outputs: usize) -> Result<IdData> {
+    let (ni, no) = (n_inputs.max(1), n_outputs.max(1));
+    if (ni, no) == (1, 1) {
+        anyhow::ensure!(
+            args.input.len() == args.output.len(),
+            "give one --output per --input ({} inputs, {} outputs)",
+            args.input.len(),
+            args.output.len()
+        );
+    } else {
+        let whole = args.input.len().is_multiple_of(ni) && args.output.len().is_multiple_of(no);
+        anyhow::ensure!(
+            whole && args.input.len() / ni == args.output.len() / no,
+            "the model has {ni} input(s) and {no} output(s): give {ni} --input and {no} --output \
+             per experiment, in the model's order ({} --input and {} --output given)",
+            args.input.len(),
+            args.output.len()
+        );
+    }
+    let groups = args.input.chunks(ni).zip(args.output.chunks(no));
     let mut data: Option<IdData> = None;
-    for (k, (input, output)) in args.input.iter().zip(&args.output).enumerate() {
+    for (k, (inputs, outputs)) in groups.enumerate() {
         let spec = CsvSpec {
-            inputs: vec![input.clone()],
-            outputs: vec![output.clone()],
+            inputs: inputs.to_vec(),
+            outputs: outputs.to_vec(),
             time: args.time.clone(),
             ts: args.ts,
         };
@@ -40,7 +61,7 @@ pub fn load(args: &DataArgs) -> Result<IdData> {
         })?;
         data = Some(match data {
             None => experiment,
-            // Later pairs become further experiments under the first pair's channel names.
+            // Later groups become further experiments under the first group's channel names.
             Some(d) => {
                 let renamed = rename(experiment, d.input_channels(), d.output_channels(), k)?;
                 d.merge(renamed)?
@@ -55,8 +76,8 @@ fn rename(data: IdData, inputs: &[Channel], outputs: &[Channel], k: usize) -> Re
     let exp = data.experiment(0);
     let experiment = Experiment::new(
         format!("experiment {}", k + 1),
-        vec![exp.input(0).to_vec()],
-        vec![exp.output(0).to_vec()],
+        (0..inputs.len()).map(|i| exp.input(i).to_vec()).collect(),
+        (0..outputs.len()).map(|o| exp.output(o).to_vec()).collect(),
     )?;
     Ok(IdData::new(
         data.ts(),

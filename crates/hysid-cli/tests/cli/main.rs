@@ -16,6 +16,7 @@ mod hold_check_cli;
 mod inputs_sacred;
 #[cfg(target_os = "linux")] // the C route of equation files
 mod native_cache;
+mod nist_cli;
 mod operator_cascade_cli;
 mod outputs;
 mod report_schema;

@@ -12,6 +12,7 @@ mod fuzz_readers;
 mod greybox;
 mod hysteresis_alone;
 mod model_files;
+mod nist;
 mod preprocessing;
 mod properties;
 mod stream;

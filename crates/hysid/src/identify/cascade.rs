@@ -252,7 +252,8 @@ impl CascadeIdentification {
             uncertainty: Uncertainty::Asymptotic,
             bootstrap_seed: 0,
             grid: GlobalSearch::new(form, na, nb, delay),
-            lm: LmConfig::default(),
+            // The cascade's published figures come from the improvement rule alone.
+            lm: LmConfig::improvement_rule(),
             observer: Observer::none(),
         }
     }

@@ -291,7 +291,8 @@ impl HysteresisIdentification {
             profile_points: 60,
             max_switching_iterations: 50,
             scan: 6,
-            lm: LmConfig::default(),
+            // The published figures of the hysteresis fits come from the improvement rule.
+            lm: LmConfig::improvement_rule(),
         }
     }
 

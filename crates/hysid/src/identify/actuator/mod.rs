@@ -83,7 +83,8 @@ impl Default for ThreeSteps {
             lm: LmConfig {
                 max_iterations: 30,
                 improvement_tolerance: 1e-4,
-                ..LmConfig::default()
+                // Gunnar et al.'s rule: the expected improvement alone.
+                ..LmConfig::improvement_rule()
             },
             simulation: Simulation {
                 integrator: Integrator::Rk4 { substeps: 10 },
