@@ -15,6 +15,7 @@ mod hold_check_cli;
 #[cfg(unix)] // symbolic links
 mod inputs_sacred;
 mod operator_cascade_cli;
+mod orientation_cli;
 mod outputs;
 mod report_schema;
 mod tutorial_cli;

@@ -45,6 +45,7 @@ def identify_operator(
     lambda_: float,
     dead_zones: int,
     threads: int = 0,
+    orientation: Optional[str] = None,
 ) -> str: ...
 def identify_operator_cascade(
     x: _Array,
@@ -57,6 +58,7 @@ def identify_operator_cascade(
     thresholds: int,
     grid: int,
     threads: int = 0,
+    orientation: Optional[str] = None,
 ) -> str: ...
 def compare(
     u: _Array,
@@ -71,6 +73,7 @@ def compare(
     lambda_: float,
     dead_zones: int,
     threads: int = 0,
+    orientation: Optional[str] = None,
 ) -> Tuple[str, List[Tuple[str, Optional[str]]], _Array, _Array, List[_Array]]: ...
 def compensate(model_json: str, reference: _Array, ts: float, model_source: str) -> Tuple[str, _Array, _Array]: ...
 def residual_analysis(u: _Array, y: _Array, yhat: _Array, ts: float, max_lag: int) -> str: ...

@@ -23,6 +23,14 @@ from .results import Record, Result
 
 #: ``families="all"``: every family of the registry.
 AllFamilies = Literal["all"]
+#: A loop's turning sense in the (u, y) plane: ``"ccw"`` (the output lags the input) or ``"cw"``.
+LoopOrientation = Literal["ccw", "cw"]
+
+
+def _orientation(value: Optional[str]) -> Optional[str]:
+    if value is None:
+        return None
+    return check.choice(value, "orientation", ("ccw", "cw"))
 
 
 class _FamilyOptions(NamedTuple):
@@ -66,6 +74,7 @@ def identify_operator(
     grid: int = 20,
     lambda_: float = 1e-6,
     dead_zones: int = 4,
+    orientation: Optional[LoopOrientation] = None,
     threads: Optional[int] = None,
 ) -> Result:
     """Fits one hysteresis family y = Γ[u] to a measured input ``u`` and output ``y`` from
@@ -77,13 +86,20 @@ def identify_operator(
     (a uniform grid over the input range) or the thresholds themselves (strictly increasing,
     > 0). ``grid``: Preisach intervals; ``lambda_``: Preisach smoothness; ``dead_zones``: GPI
     dead zones per side. ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
+    ``orientation``: the loop's turning sense in the (u, y) plane, ``"ccw"``
+    (counter-clockwise: the output lags the input, as a piezo stack or a magnet's B(H)) or
+    ``"cw"``; None (default) detects it from the area between the ascending and descending
+    branches (a :class:`DataError` naming this argument when the record cannot tell); the
+    report's ``details.orientation`` and ``details.orientation_source`` say which was used.
     An unknown family or an option out of range is a :class:`ConfigError` (a ``ValueError``).
     """
     u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
     step = check.sample_time(given_ts, 1.0)
     name = _family(family)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
-    text = _hysid.identify_operator(u, y, name, step, *options, check.threads(threads))
+    text = _hysid.identify_operator(
+        u, y, name, step, *options, check.threads(threads), _orientation(orientation)
+    )
     return Result(json.loads(text), data=Record(u, y, step))
 
 
@@ -98,6 +114,7 @@ def compare(
     grid: int = 20,
     lambda_: float = 1e-6,
     dead_zones: int = 4,
+    orientation: Optional[LoopOrientation] = None,
     threads: Optional[int] = None,
 ) -> Comparison:
     """Fits several hysteresis families to one record and ranks them by how well they
@@ -126,7 +143,7 @@ def compare(
         u_val, y_val, _ = check.pair(pair[0], pair[1], ("validate u", "validate y"), None)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
     report, results, v_in, v_out, simulated = _hysid.compare(
-        u, y, u_val, y_val, names, step, *options, check.threads(threads)
+        u, y, u_val, y_val, names, step, *options, check.threads(threads), _orientation(orientation)
     )
     return Comparison.from_extension(report, results, Record(v_in, v_out, step), simulated, Record(u, y, step))
 

@@ -55,6 +55,7 @@ pub(crate) mod elementary;
 pub(crate) mod gpi;
 pub mod jiles_atherton;
 pub mod kp;
+pub mod orientation;
 pub(crate) mod maxwell_slip;
 pub(crate) mod pi;
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
@@ -73,6 +74,7 @@ pub use elementary::{
 pub use gpi::{DeadZones, GeneralizedPi};
 pub use jiles_atherton::{Anhysteretic, JaOutput, JilesAtherton};
 pub use kp::Kp;
+pub use orientation::{loop_evidence, LoopEvidence};
 pub use maxwell_slip::MaxwellSlip;
 pub use pi::PrandtlIshlinskii;
 pub use preisach::Preisach;
