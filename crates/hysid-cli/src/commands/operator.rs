@@ -16,7 +16,8 @@ const PRINTED_PARAMETERS: usize = 16;
 pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family).context("--family")?;
     let mut options = family_options(&args.options)?;
-    if options.loop_orientation.is_some() && !family.settings().contains(&FamilySetting::Orientation)
+    if options.loop_orientation.is_some()
+        && !family.settings().contains(&FamilySetting::Orientation)
     {
         let reading: Vec<&str> = Family::reading(FamilySetting::Orientation)
             .into_iter()

@@ -166,7 +166,10 @@ pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit
         n: options.n,
         estimate_n: options.estimate_n,
         sign: if u.len() == y.len() {
-            -options.orientation.unwrap_or_else(|| LoopOrientation::of_loop(u, y)).sign()
+            -options
+                .orientation
+                .unwrap_or_else(|| LoopOrientation::of_loop(u, y))
+                .sign()
         } else {
             1.0
         },

@@ -139,7 +139,9 @@ pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Da
         i: options.i,
         estimate_i: options.estimate_i,
         orientation: if u.len() == y.len() {
-            options.orientation.unwrap_or_else(|| LoopOrientation::of_loop(u, y))
+            options
+                .orientation
+                .unwrap_or_else(|| LoopOrientation::of_loop(u, y))
         } else {
             LoopOrientation::Clockwise
         },

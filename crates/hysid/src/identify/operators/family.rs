@@ -182,8 +182,12 @@ impl OrientationUsed {
         } else if cascade
             && matches!(
                 family,
-                Family::Pi | Family::MaxwellSlip | Family::Backlash | Family::Gpi
-                    | Family::Preisach | Family::Kp
+                Family::Pi
+                    | Family::MaxwellSlip
+                    | Family::Backlash
+                    | Family::Gpi
+                    | Family::Preisach
+                    | Family::Kp
             )
         {
             OrientationSource::Assumed

@@ -195,7 +195,9 @@ pub fn fit(
         anhysteretic: options.anhysteretic,
         output: options.output,
         orientation: if u.len() == y.len() {
-            options.orientation.unwrap_or_else(|| LoopOrientation::of_loop(u, y))
+            options
+                .orientation
+                .unwrap_or_else(|| LoopOrientation::of_loop(u, y))
         } else {
             LoopOrientation::CounterClockwise
         },

@@ -261,9 +261,7 @@ pub fn loop_evidence(u: &[f64], y: &[f64]) -> Result<LoopEvidence> {
         gaps.push((area / (r - l), r - l));
     }
     if gaps.is_empty() {
-        return Err(undetermined(
-            "no two branches share an input interval",
-        ));
+        return Err(undetermined("no two branches share an input interval"));
     }
     let median = weighted_median(&gaps);
     if median == 0.0 {

@@ -40,13 +40,21 @@ fn open_record(model: &OperatorModel, seed: u64) -> (Vec<f64>, Vec<f64>) {
     for r in 0..runs {
         // the first run sweeps most of the range (every example's loop opens there), the
         // others have their own range and offset
-        let a = if r == 0 { 0.92 } else { uniform(&mut rng, 0.5, 0.85) };
+        let a = if r == 0 {
+            0.92
+        } else {
+            uniform(&mut rng, 0.5, 0.85)
+        };
         let c = uniform(&mut rng, -(0.95 - a), 0.95 - a);
         let turns = 3 + (uniform(&mut rng, 0.0, 4.0) as usize);
         let step = uniform(&mut rng, 0.01, 0.05);
         let ur = run(&mut rng, c, a, turns, step);
         // the example Jiles–Atherton takes H in A/m: its loop opens at hundreds of A/m (k = 400)
-        let scale = if model.family().name() == "jiles-atherton" { 400.0 } else { 1.0 };
+        let scale = if model.family().name() == "jiles-atherton" {
+            400.0
+        } else {
+            1.0
+        };
         let ur: Vec<f64> = ur.iter().map(|v| scale * v).collect();
         lengths.push(ur.len());
         let yr = model.as_operator().simulate(&ur).unwrap();
@@ -57,7 +65,9 @@ fn open_record(model: &OperatorModel, seed: u64) -> (Vec<f64>, Vec<f64>) {
     // path integral of an open record then carries the offset times the net input travel
     let (ylo, yhi) = y
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
     let span = yhi - ylo;
     let offset = if seed % 2 == 0 { 3.0 } else { -3.0 } * span;
     let mut k = 0;
@@ -177,7 +187,10 @@ fn narrow_record(seed: u64) -> (Vec<f64>, Vec<f64>) {
     assert!((150..=600).contains(&u.len()), "{}", u.len());
     let r = 0.8;
     let loop_part: Vec<f64> = play(&u, r).iter().zip(&u).map(|(p, x)| p - x).collect();
-    let (nu, ny) = (Normal::new(0.0, 0.02).unwrap(), Normal::new(0.0, 0.1).unwrap());
+    let (nu, ny) = (
+        Normal::new(0.0, 0.02).unwrap(),
+        Normal::new(0.0, 0.1).unwrap(),
+    );
     let third = u.len() / 3;
     let y: Vec<f64> = u
         .iter()
@@ -210,7 +223,10 @@ fn narrow_loop_on_a_wide_range() {
         assert!(o.decreasing && o.loop_orientation() == LoopOrientation::Clockwise);
         // the whole path's integral reads this record the wrong way round
         if seed == 0 {
-            assert!(path_area(&u, &y) > 0.0, "the path integral says clockwise here");
+            assert!(
+                path_area(&u, &y) > 0.0,
+                "the path integral says clockwise here"
+            );
         }
     }
 }
@@ -300,7 +316,11 @@ fn pi_fit_of_an_open_record_detected_against_path_integral() {
     .unwrap();
     let n = u.len() as f64;
     let (mu, my) = (u.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
-    let slope = u.iter().zip(&y).map(|(a, b)| (a - mu) * (b - my)).sum::<f64>()
+    let slope = u
+        .iter()
+        .zip(&y)
+        .map(|(a, b)| (a - mu) * (b - my))
+        .sum::<f64>()
         / u.iter().map(|a| (a - mu).powi(2)).sum::<f64>();
     let line: Vec<f64> = u.iter().map(|a| my + slope * (a - mu)).collect();
     let line_fit = hysid::numerics::metrics::fit_percent(&y, &line);
@@ -327,4 +347,3 @@ fn pi_fit_of_an_open_record_detected_against_path_integral() {
     assert_eq!(used.orientation, LoopOrientation::Clockwise);
     assert_eq!(used.source, OrientationSource::Given);
 }
-
