@@ -602,6 +602,12 @@ pub struct CascadeArgs {
     /// refused for a family that has none, naming those that have.
     #[arg(long, alias = "levels", value_parser = crate::options::count::<1, 100>)]
     pub grid: Option<usize>,
+    /// Operator families: the turning sense of the operator's loop in the (u, y) plane, ccw
+    /// (the output lags the input) or cw. Default: the family's start decides (detected for
+    /// the differential families, counter-clockwise — clockwise for maxwell-slip — up to the
+    /// trend for the starts linear in the weights). A value a start cannot take is refused.
+    #[arg(long, value_enum)]
+    pub orientation: Option<crate::cli_zoo::OrientationArg>,
     /// Order n of A(q⁻¹). Range 0..=50.
     #[arg(long, value_parser = crate::options::count::<0, 50>)]
     pub na: usize,

@@ -3,8 +3,8 @@
 //! the outputs are the shared groups of [`crate::cli`] ([`DataArgs`], [`OutputArgs`]).
 
 use crate::cli::{DataArgs, OutputArgs};
-use clap::Args;
-use hysid::model::operators::Family;
+use clap::{Args, ValueEnum};
+use hysid::model::operators::{Family, LoopOrientation};
 use std::path::PathBuf;
 
 /// `lead`, then every family of the registry with its model and reference (the help text of
@@ -35,6 +35,31 @@ pub struct FamilyArgs {
     /// Dead zones on each side of the generalised PI, 0..=20.
     #[arg(long = "dead-zones", default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=20))]
     pub dead_zones: u32,
+    /// The loop's turning sense in the (u, y) plane, u horizontal: ccw (counter-clockwise:
+    /// the output lags the input, as a piezo stack or a magnet's B(H)) or cw. Default:
+    /// detected from the area between the ascending and descending branches (an error
+    /// naming this flag when the record cannot tell). The trend (y rising or falling with u)
+    /// is always detected.
+    #[arg(long, value_enum)]
+    pub orientation: Option<OrientationArg>,
+}
+
+/// The `--orientation` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OrientationArg {
+    /// Counter-clockwise: the ascending branch below the descending one.
+    Ccw,
+    /// Clockwise: the ascending branch above the descending one.
+    Cw,
+}
+
+impl From<OrientationArg> for LoopOrientation {
+    fn from(o: OrientationArg) -> Self {
+        match o {
+            OrientationArg::Ccw => LoopOrientation::CounterClockwise,
+            OrientationArg::Cw => LoopOrientation::Clockwise,
+        }
+    }
 }
 
 /// Options of `hysid identify operator`.

@@ -14,6 +14,7 @@ use hysid::identify::operators::{
     compare as compare_families, fit_operator, CompareOptions, Family, FamilyOptions, Split,
 };
 use hysid::model::compensate::compensate as invert;
+use hysid::model::operators::LoopOrientation;
 use hysid::model::saved::FittedModel;
 use hysid::report;
 use numpy::{PyArray1, PyReadonlyArray1};
@@ -59,11 +60,16 @@ fn family_options(
     }
 }
 
+/// The turning sense Python gives (`"ccw"`, `"cw"`), None to detect it.
+fn loop_orientation(text: Option<&str>) -> hysid::Result<Option<LoopOrientation>> {
+    text.map(LoopOrientation::parse).transpose()
+}
+
 /// Fits the hysteresis family `family` to input `u` and output `y`: the report of `hysid
 /// identify operator` as JSON text. `threshold_grid` empty: the uniform grid of
 /// `thresholds`.
 #[pyfunction]
-#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, time_limit=None, progress=None))]
+#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn identify_operator(
     py: Python<'_>,
@@ -77,12 +83,14 @@ fn identify_operator(
     lambda_: f64,
     dead_zones: usize,
     threads: usize,
+    orientation: Option<&str>,
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (u, y) = (samples(&u), samples(&y));
     let family = guard(py, || Family::parse(family))?;
-    let options = family_options(thresholds, threshold_grid, grid, lambda_, dead_zones);
+    let mut options = family_options(thresholds, threshold_grid, grid, lambda_, dead_zones);
+    options.loop_orientation = guard(py, || loop_orientation(orientation))?;
     run_on(
         py,
         threads,
@@ -116,7 +124,7 @@ fn operator_report(
 /// `nb` coefficients and delay `delay`: the report of `hysid identify cascade --hysteresis
 /// FAMILY` as JSON text.
 #[pyfunction]
-#[pyo3(signature = (x, y, family, na, nb, delay, ts, thresholds, grid, threads=0, time_limit=None, progress=None))]
+#[pyo3(signature = (x, y, family, na, nb, delay, ts, thresholds, grid, threads=0, orientation=None, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn identify_operator_cascade(
     py: Python<'_>,
@@ -130,11 +138,13 @@ fn identify_operator_cascade(
     thresholds: usize,
     grid: usize,
     threads: usize,
+    orientation: Option<&str>,
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<String> {
     let (x, y) = (samples(&x), samples(&y));
     let family = guard(py, || Family::parse_operator(family))?;
+    let loop_orientation = guard(py, || loop_orientation(orientation))?;
     run_on(
         py,
         threads,
@@ -145,6 +155,7 @@ fn identify_operator_cascade(
             id.options = FamilyOptions {
                 thresholds,
                 grid,
+                loop_orientation,
                 observer: watch.observer(),
                 ..FamilyOptions::default()
             };
@@ -171,7 +182,7 @@ type Compared<'py> = (
 /// Fits `families` to (u, y) and ranks them by validation fit % on (u_val, y_val), or on
 /// the last 40 % of (u, y) when those are None (`hysid compare`).
 #[pyfunction]
-#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, time_limit=None, progress=None))]
+#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn compare<'py>(
     py: Python<'py>,
@@ -187,15 +198,20 @@ fn compare<'py>(
     lambda_: f64,
     dead_zones: usize,
     threads: usize,
+    orientation: Option<&str>,
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Compared<'py>> {
     let (u, y) = (samples(&u), samples(&y));
     let validation = u_val.zip(y_val).map(|(a, b)| (samples(&a), samples(&b)));
     let families = guard(py, || families.iter().map(|f| Family::parse(f)).collect())?;
+    let loop_orientation = guard(py, || loop_orientation(orientation))?;
     let options = CompareOptions {
         families,
-        family: family_options(thresholds, threshold_grid, grid, lambda_, dead_zones),
+        family: FamilyOptions {
+            loop_orientation,
+            ..family_options(thresholds, threshold_grid, grid, lambda_, dead_zones)
+        },
         ..CompareOptions::default()
     };
     let (text, results, comparison) = run_on(

@@ -93,6 +93,18 @@ pub enum Error {
         reason: String,
     },
 
+    /// The turning sense of the measured loop cannot be told from the data (too few
+    /// reversals, or a loop indistinguishable from noise;
+    /// [`crate::model::operators::orientation`]): the user must give it.
+    #[error(
+        "the loop's orientation cannot be told from the data: {reason}; give it with \
+         --orientation ccw|cw (Python: orientation=\"ccw\" or \"cw\")"
+    )]
+    UndeterminedOrientation {
+        /// Why it cannot be told.
+        reason: String,
+    },
+
     /// The discrete Coleman–Hodgdon recursion left its valid range: α·|Δx(t)| > 1.
     #[error(
         "input moves too fast at sample {index}: alpha*|dx| = {product:.4} > 1 \
@@ -412,6 +424,7 @@ impl Error {
             | Error::InvalidData(_)
             | Error::TooFewSamples { .. }
             | Error::NotExciting { .. }
+            | Error::UndeterminedOrientation { .. }
             | Error::RateLimit { .. } => Category::Data,
             Error::InvalidParameter { .. }
             | Error::InvalidOption { .. }

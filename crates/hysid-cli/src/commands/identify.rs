@@ -93,6 +93,12 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         return super::operator_cascade::identify(args);
     }
     let form = ChForm::parse(&args.hysteresis)?;
+    anyhow::ensure!(
+        args.orientation.is_none(),
+        "--orientation applies to the operator families, not {} (the Coleman–Hodgdon \
+         hysteresis has no orientation setting)",
+        form.short_name()
+    );
     let mut out = register(&args.data, &args.output)?;
     let data = load(&args.data)?;
     out.fitted_on(&data);

@@ -6,7 +6,7 @@ use crate::output::Outputs;
 use crate::progress::FitProgress;
 use crate::report::{print_table, Row};
 use anyhow::{Context, Result};
-use hysid::identify::operators::{fit_operator, Family, FittedOperator};
+use hysid::identify::operators::{fit_operator, Family, FamilySetting, FittedOperator};
 use hysid::report::{operator_report, operator_simulation, Report};
 
 /// Parameters printed before the table is cut short (a Preisach plane has hundreds).
@@ -16,6 +16,18 @@ const PRINTED_PARAMETERS: usize = 16;
 pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family).context("--family")?;
     let mut options = family_options(&args.options)?;
+    if options.loop_orientation.is_some()
+        && !family.settings().contains(&FamilySetting::Orientation)
+    {
+        let reading: Vec<&str> = Family::reading(FamilySetting::Orientation)
+            .into_iter()
+            .map(Family::name)
+            .collect();
+        anyhow::bail!(
+            "--orientation applies to {}, not {family} (its orientation is a result of the fit)",
+            reading.join(", ")
+        );
+    }
     let o = &args.output;
     let mut out = Outputs::new(
         &[args.data.data.as_path()],

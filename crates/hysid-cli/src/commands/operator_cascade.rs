@@ -46,6 +46,7 @@ fn identification(args: &CascadeArgs) -> Result<OperatorCascadeIdentification> {
         // A cascade's Preisach (and KP) plane is smaller than `identify operator`'s: its cells share
         // the record with the linear block's coefficients.
         grid: args.grid.unwrap_or(10),
+        loop_orientation: args.orientation.map(Into::into),
         ..FamilyOptions::default()
     };
     Ok(id)

@@ -16,6 +16,7 @@ pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
         grid: args.grid as usize,
         lambda: args.lambda,
         dead_zones: args.dead_zones as usize,
+        loop_orientation: args.orientation.map(Into::into),
         ..FamilyOptions::default()
     };
     let text = args.thresholds.trim();

@@ -18,6 +18,7 @@ mod inputs_sacred;
 mod native_cache;
 mod nist_cli;
 mod operator_cascade_cli;
+mod orientation_cli;
 mod outputs;
 mod report_schema;
 mod tutorial_cli;

@@ -49,6 +49,7 @@ def identify_operator(
     lambda_: float,
     dead_zones: int,
     threads: int = 0,
+    orientation: Optional[str] = None,
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
 ) -> str: ...
@@ -63,6 +64,7 @@ def identify_operator_cascade(
     thresholds: int,
     grid: int,
     threads: int = 0,
+    orientation: Optional[str] = None,
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
 ) -> str: ...
@@ -79,6 +81,7 @@ def compare(
     lambda_: float,
     dead_zones: int,
     threads: int = 0,
+    orientation: Optional[str] = None,
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
 ) -> Tuple[str, List[Tuple[str, Optional[str]]], _Array, _Array, List[_Array]]: ...

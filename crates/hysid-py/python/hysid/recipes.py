@@ -65,6 +65,7 @@ def identify_cascade(
     replicates: int = 30,
     thresholds: Optional[int] = None,
     grid: Optional[int] = None,
+    orientation: Optional[str] = None,
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
@@ -80,7 +81,9 @@ def identify_cascade(
     --hysteresis FAMILY``). ``uncertainty``: ``"asymptotic"`` (σ²(JᵀJ)⁻¹) or, for ch4/ch6,
     ``"bootstrap"`` (parametric bootstrap, ``replicates`` re-identifications seeded by
     ``seed``). ``thresholds`` (PI, GPI, Maxwell-slip; default 10) and ``grid`` (Preisach;
-    default 10) size an operator's structure. ``x`` may be a record with ``.u``, ``.y``
+    default 10) size an operator's structure. ``orientation`` (operator families): the
+    operator loop's turning sense in the (u, y) plane, ``"ccw"`` or ``"cw"`` (None: the
+    family's start decides; a value a start cannot take is an error). ``x`` may be a record with ``.u``, ``.y``
     (then ``y`` is omitted). Runs with the GIL released; ``threads``: worker threads
     (None: the process default, all cores; 1 for concurrent fits). The report is the CLI's
     ``identify cascade`` report.
@@ -92,7 +95,7 @@ def identify_cascade(
     method = check.choice(uncertainty, "uncertainty", typing.get_args(UncertaintyMethod))
     orders = (check.count(na, "na"), check.count(nb, "nb"), check.count(delay, "delay"))
     if name in CH_FORMS:
-        for option, value in (("thresholds", thresholds), ("grid", grid)):
+        for option, value in (("thresholds", thresholds), ("grid", grid), ("orientation", orientation)):
             if value is not None:
                 raise ConfigError(f"{option} applies to operator cascades, not to {name}")
         text = _hysid.identify_cascade(
@@ -127,6 +130,7 @@ def identify_cascade(
             10 if thresholds is None else check.count(thresholds, "thresholds"),
             10 if grid is None else check.count(grid, "grid"),
             check.threads(threads),
+            None if orientation is None else check.choice(orientation, "orientation", ("ccw", "cw")),
             limit,
             tell,
         )

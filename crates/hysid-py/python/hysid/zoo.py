@@ -24,6 +24,14 @@ from .results import Record, Result
 
 #: ``families="all"``: every family of the registry.
 AllFamilies = Literal["all"]
+#: A loop's turning sense in the (u, y) plane: ``"ccw"`` (the output lags the input) or ``"cw"``.
+LoopOrientation = Literal["ccw", "cw"]
+
+
+def _orientation(value: Optional[str]) -> Optional[str]:
+    if value is None:
+        return None
+    return check.choice(value, "orientation", ("ccw", "cw"))
 
 
 class _FamilyOptions(NamedTuple):
@@ -72,6 +80,7 @@ def identify_operator(
     grid: int = 20,
     lambda_: float = 1e-6,
     dead_zones: int = 4,
+    orientation: Optional[LoopOrientation] = None,
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
@@ -85,6 +94,11 @@ def identify_operator(
     (a uniform grid over the input range) or the thresholds themselves (strictly increasing,
     > 0). ``grid``: Preisach intervals; ``lambda_``: Preisach smoothness; ``dead_zones``: GPI
     dead zones per side. ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
+    ``orientation``: the loop's turning sense in the (u, y) plane, ``"ccw"``
+    (counter-clockwise: the output lags the input, as a piezo stack or a magnet's B(H)) or
+    ``"cw"``; None (default) detects it from the area between the ascending and descending
+    branches (a :class:`DataError` naming this argument when the record cannot tell); the
+    report's ``details.orientation`` and ``details.orientation_source`` say which was used.
     An unknown family or an option out of range is a :class:`ConfigError` (a ``ValueError``).
     """
     u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
@@ -92,7 +106,9 @@ def identify_operator(
     name = _family(family)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
     limit, tell = watching(time_limit, progress)
-    text = _hysid.identify_operator(u, y, name, step, *options, check.threads(threads), limit, tell)
+    text = _hysid.identify_operator(
+        u, y, name, step, *options, check.threads(threads), _orientation(orientation), limit, tell
+    )
     result = Result(json.loads(text), data=Record(u, y, step))
     warn_if_stopped(result.termination_code, limit, "identify_operator")
     return result
@@ -109,6 +125,7 @@ def compare(
     grid: int = 20,
     lambda_: float = 1e-6,
     dead_zones: int = 4,
+    orientation: Optional[LoopOrientation] = None,
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
@@ -140,7 +157,7 @@ def compare(
     options = _family_options(thresholds, grid, lambda_, dead_zones)
     limit, tell = watching(time_limit, progress)
     report, results, v_in, v_out, simulated = _hysid.compare(
-        u, y, u_val, y_val, names, step, *options, check.threads(threads), limit, tell
+        u, y, u_val, y_val, names, step, *options, check.threads(threads), _orientation(orientation), limit, tell
     )
     comparison = Comparison.from_extension(report, results, Record(v_in, v_out, step), simulated, Record(u, y, step))
     warn_if_stopped(comparison.termination_code, limit, "compare")

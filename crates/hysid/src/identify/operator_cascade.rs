@@ -76,6 +76,8 @@ pub struct OperatorCascadeFit {
     /// How the start was obtained (`equation-error least squares, rank-one factorisation` or
     /// `family fit and ARX`).
     pub initialisation: &'static str,
+    /// The fitted operator's loop orientation and where it came from.
+    pub orientation: Option<family::OrientationUsed>,
     /// The output-error refinement (parameters, covariance, history, simulated output).
     pub output_error: OutputErrorFit,
     /// fit % = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) on the first experiment.
@@ -132,6 +134,8 @@ impl OperatorCascadeIdentification {
             .improvement_tolerance(1e-12)
             .estimate(&structure, data, &params, callback)?;
         let model = start.with_values(&oe.parameters.values())?;
+        let orientation =
+            family::OrientationUsed::of(self.family, Some(&model.operator), &self.options, true);
         let std = oe
             .std()
             .iter()
@@ -150,6 +154,7 @@ impl OperatorCascadeIdentification {
             model,
             start,
             initialisation,
+            orientation,
             output_error: oe,
             elapsed_s: started.elapsed().as_secs_f64(),
         })
@@ -185,8 +190,26 @@ impl OperatorCascadeIdentification {
     }
 
     /// The global initialisation (module doc): the family's [`Identify::cascade_start`].
+    /// A turning sense the user gave (`options.loop_orientation`) that the start cannot take
+    /// (a start linear in the weights has its family's native turning sense, up to the
+    /// trend) is refused.
     fn initialise(&self, u: &[f64], y: &[f64]) -> Result<(OperatorCascade, &'static str)> {
-        family::cascade_start(self.family, self, u, y, &self.options)
+        let (start, how) = family::cascade_start(self.family, self, u, y, &self.options)?;
+        if let Some(given) = self.options.loop_orientation {
+            let got = start.operator.loop_orientation();
+            if got != given {
+                return Err(Error::Unsupported(format!(
+                    "a {} cascade's start gives a {} operator on this record, not the {} one \
+                     asked for (--orientation {}); its start is linear in the weights and keeps \
+                     the family's own turning sense: drop --orientation or use another family",
+                    self.family.name(),
+                    got.short_name(),
+                    given.short_name(),
+                    given.short_name()
+                )));
+            }
+        }
+        Ok((start, how))
     }
 
     /// Equation-error least squares of y on past y and the lagged basis signals; returns

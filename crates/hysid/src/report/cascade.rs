@@ -137,6 +137,8 @@ pub fn operator_cascade_report(
         "linear_block_spectral_radius": fit.model.linear.spectral_radius(),
         "linear_block_zero_radius": fit.model.zero_radius(),
         "output_error_history": fit.output_error.report.history,
+        "orientation": fit.orientation.map(|o| o.orientation.short_name()),
+        "orientation_source": fit.orientation.map(|o| o.source.name()),
     });
     Ok(Report::of_output_error(
         "identify cascade",

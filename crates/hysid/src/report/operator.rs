@@ -23,7 +23,8 @@ pub fn operator_simulation(fitted: &FittedOperator, data: &IdData) -> Result<Vec
 /// The report of `fitted` on the first experiment of `data` (read from `sources`), whose
 /// [`operator_simulation`] is `simulated`: data, fit, search, uncertainty, the model, and
 /// `details` with the family, the number of estimated parameters, whether the search
-/// converged, AIC and FPE (null when not finite, e.g. the AIC of an exact fit).
+/// converged, AIC and FPE (null when not finite, e.g. the AIC of an exact fit), and the
+/// model's loop orientation (`ccw`/`cw`) with its source (`given`, `detected`, `fitted`).
 pub fn operator_report(
     fitted: &FittedOperator,
     data: &IdData,
@@ -64,6 +65,8 @@ pub fn operator_report(
         "converged": fit.termination.converged(),
         "aic": finite(fit.aic),
         "fpe": finite(fit.fpe),
+        "orientation": fitted.orientation.map(|o| o.orientation.short_name()),
+        "orientation_source": fitted.orientation.map(|o| o.source.name()),
     });
     Ok(report)
 }

@@ -236,7 +236,7 @@ impl Identify for Backlash {
             u,
             y,
             &BacklashOptions {
-                orientation: options.orientation,
+                orientation: options.given_orientation(u, y)?,
                 ..BacklashOptions::default()
             },
         )

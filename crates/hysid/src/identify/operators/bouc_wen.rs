@@ -42,6 +42,9 @@ pub struct BoucWenOptions {
     /// Sees the fit's grid, starts and iterations and may stop it (see
     /// [`Settings::observer`]).
     pub observer: Observer,
+    /// The loop's turning sense in the (u, y) plane; detected from the data when None
+    /// ([`LoopOrientation::of_loop`]).
+    pub orientation: Option<LoopOrientation>,
 }
 
 impl Default for BoucWenOptions {
@@ -52,6 +55,7 @@ impl Default for BoucWenOptions {
             starts: 4,
             config: driver::default_config(),
             observer: Observer::none(),
+            orientation: None,
         }
     }
 }
@@ -162,7 +166,10 @@ pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit
         n: options.n,
         estimate_n: options.estimate_n,
         sign: if u.len() == y.len() {
-            -LoopOrientation::of_loop(u, y).sign()
+            -options
+                .orientation
+                .unwrap_or_else(|| LoopOrientation::of_loop(u, y))
+                .sign()
         } else {
             1.0
         },
@@ -176,7 +183,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit
 }
 
 impl Identify for BoucWen {
-    const SETTINGS: &'static [FamilySetting] = &[];
+    const SETTINGS: &'static [FamilySetting] = &[FamilySetting::Orientation];
 
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
@@ -184,6 +191,7 @@ impl Identify for BoucWen {
             y,
             &BoucWenOptions {
                 observer: options.observer.clone(),
+                orientation: options.loop_orientation,
                 ..BoucWenOptions::default()
             },
         )

@@ -14,7 +14,8 @@
 //! on the training samples (Akaike 1974, MATLAB's `aic`); the fit's wall-clock time. A family
 //! whose fit or simulation fails carries its error in its row and the comparison goes on.
 
-use super::family::{fit_operator, Family, FamilyOptions, FittedOperator};
+use super::family::{fit_operator, Family, FamilyOptions, FittedOperator, OrientationSource};
+use crate::model::operators::LoopOrientation;
 use crate::model::saved::FittedModel;
 use crate::numerics::{metrics, Control};
 use crate::{Error, Result};
@@ -106,6 +107,11 @@ pub struct CompareRow {
     pub converged: Option<bool>,
     /// Why the search stopped.
     pub termination: Option<String>,
+    /// The turning sense of the fitted model's loop, `ccw` or `cw` (None when the family
+    /// failed, and for ch4/ch6).
+    pub orientation: Option<&'static str>,
+    /// Where it came from: `given`, `detected` or `fitted`.
+    pub orientation_source: Option<&'static str>,
     /// The one-line error of a family that failed.
     pub error: Option<String>,
     /// The fitted model (None when the family failed).
@@ -129,6 +135,8 @@ impl CompareRow {
             fit_time_s: None,
             converged: None,
             termination: None,
+            orientation: None,
+            orientation_source: None,
             error: Some(error.to_string()),
             fitted: None,
             validation_simulated: Vec::new(),
@@ -152,6 +160,10 @@ pub struct Comparison {
     /// True when the observer stopped the comparison (a time limit): the families after
     /// the stop have rows saying they were not fitted.
     pub stopped: bool,
+    /// The record's loop orientation: the given one, else the one detected on the training
+    /// samples (None when they cannot tell; each row then says what its family did).
+    #[serde(skip)]
+    pub orientation: Option<(LoopOrientation, OrientationSource)>,
 }
 
 impl Comparison {
@@ -218,6 +230,12 @@ pub fn compare(
         }
     }
     observer.report("family", total, total);
+    let orientation = match options.family.loop_orientation {
+        Some(l) => Some((l, OrientationSource::Given)),
+        None => LoopOrientation::detect(train.0, train.1)
+            .ok()
+            .map(|l| (l, OrientationSource::Detected)),
+    };
     let validation_input = scored(&split, valid.0).to_vec();
     let validation_output = scored(&split, valid.1).to_vec();
     Ok(Comparison {
@@ -226,6 +244,7 @@ pub fn compare(
         validation_input,
         validation_output,
         stopped,
+        orientation,
     })
 }
 
@@ -302,6 +321,8 @@ fn row(
         fit_time_s: Some(fit.elapsed_s),
         converged: Some(fit.termination.converged()),
         termination: Some(fit.termination.to_string()),
+        orientation: fitted.orientation.map(|o| o.orientation.short_name()),
+        orientation_source: fitted.orientation.map(|o| o.source.name()),
         error: None,
         fitted: Some(fitted),
         validation_simulated: simulated,

@@ -38,6 +38,9 @@ pub struct DahlOptions {
     /// Sees the fit's grid, starts and iterations and may stop it (see
     /// [`Settings::observer`]).
     pub observer: Observer,
+    /// The loop's turning sense in the (u, y) plane; detected from the data when None
+    /// ([`LoopOrientation::of_loop`]).
+    pub orientation: Option<LoopOrientation>,
 }
 
 impl Default for DahlOptions {
@@ -48,6 +51,7 @@ impl Default for DahlOptions {
             starts: 3,
             config: driver::default_config(),
             observer: Observer::none(),
+            orientation: None,
         }
     }
 }
@@ -135,7 +139,9 @@ pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Da
         i: options.i,
         estimate_i: options.estimate_i,
         orientation: if u.len() == y.len() {
-            LoopOrientation::of_loop(u, y)
+            options
+                .orientation
+                .unwrap_or_else(|| LoopOrientation::of_loop(u, y))
         } else {
             LoopOrientation::Clockwise
         },
@@ -149,7 +155,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Da
 }
 
 impl Identify for Dahl {
-    const SETTINGS: &'static [FamilySetting] = &[];
+    const SETTINGS: &'static [FamilySetting] = &[FamilySetting::Orientation];
 
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
@@ -157,6 +163,7 @@ impl Identify for Dahl {
             y,
             &DahlOptions {
                 observer: options.observer.clone(),
+                orientation: options.loop_orientation,
                 ..DahlOptions::default()
             },
         )

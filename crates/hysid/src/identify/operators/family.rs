@@ -14,7 +14,7 @@ use crate::identify::hysteresis::HysteresisIdentification;
 use crate::identify::operator_cascade::OperatorCascadeIdentification;
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 pub use crate::model::operators::Family;
-use crate::model::operators::{OperatorFamily, OperatorModel, Orientation};
+use crate::model::operators::{LoopOrientation, OperatorFamily, OperatorModel, Orientation};
 use crate::model::saved::FittedModel;
 use crate::model::OperatorCascade;
 use crate::model::{ChForm, Parameter, ParameterSet};
@@ -39,8 +39,15 @@ pub struct FamilyOptions {
     pub lambda: f64,
     /// Dead zones on each side of the generalised PI (4).
     pub dead_zones: usize,
-    /// The loop orientation; detected from the data when None (linear-in-weights families).
+    /// The loop orientation of the linear-in-weights families as their model files store it
+    /// (trend and Γ = G or G⁻¹); overrides `loop_orientation`. Detected from the data when
+    /// both are None.
     pub orientation: Option<Orientation>,
+    /// The loop's turning sense in the (u, y) plane as the user gives it (`--orientation
+    /// ccw|cw`, Python `orientation=`), the trend still detected; None: detected from the area
+    /// between the branches ([`LoopOrientation::detect`]). Read by every family with
+    /// [`FamilySetting::Orientation`].
+    pub loop_orientation: Option<LoopOrientation>,
     /// Sees the starts and iterations of the differential families' searches (Jiles–Atherton,
     /// Bouc–Wen, Duhem, Dahl) and may stop them with the best result so far.
     pub observer: Observer,
@@ -55,6 +62,7 @@ impl Default for FamilyOptions {
             lambda: 1e-6,
             dead_zones: 4,
             orientation: None,
+            loop_orientation: None,
             observer: Observer::none(),
         }
     }
@@ -104,6 +112,95 @@ impl FamilyOptions {
     }
 }
 
+impl FamilyOptions {
+    /// The orientation a linear-in-weights family with a counter-clockwise core is to use:
+    /// `orientation` if given, else `loop_orientation` with the data's trend
+    /// ([`Orientation::for_loop`]), else None (the family detects it).
+    pub fn given_orientation(&self, u: &[f64], y: &[f64]) -> Result<Option<Orientation>> {
+        match (self.orientation, self.loop_orientation) {
+            (Some(o), _) => Ok(Some(o)),
+            (None, Some(l)) => Ok(Some(Orientation::for_loop(l, Orientation::trend(u, y)?))),
+            (None, None) => Ok(None),
+        }
+    }
+}
+
+/// Where a fit's loop orientation came from (the reports' `details.orientation_source`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OrientationSource {
+    /// Given by the user (`--orientation`, `orientation=`).
+    Given,
+    /// Detected from the area between the branches ([`LoopOrientation::detect`]).
+    Detected,
+    /// A result of the fitted parameters (Duhem: the sign of c − a).
+    Fitted,
+    /// The family's native orientation, assumed (an operator cascade's start linear in the
+    /// weights, which is counter-clockwise, or clockwise for Maxwell-slip, up to the trend).
+    Assumed,
+}
+
+impl OrientationSource {
+    /// `given`, `detected`, `fitted` or `assumed`.
+    pub fn name(self) -> &'static str {
+        match self {
+            OrientationSource::Given => "given",
+            OrientationSource::Detected => "detected",
+            OrientationSource::Fitted => "fitted",
+            OrientationSource::Assumed => "assumed",
+        }
+    }
+}
+
+/// The loop orientation a fitted operator has, and where it came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OrientationUsed {
+    /// The turning sense of the fitted model's loop in the (u, y) plane.
+    pub orientation: LoopOrientation,
+    /// Given, detected, fitted or assumed.
+    pub source: OrientationSource,
+}
+
+impl OrientationUsed {
+    /// The orientation of the fitted operator `model` of `family` (None for ch4/ch6) and its
+    /// source: given when
+    /// `options` give one, fitted for a family that does not read the setting, else
+    /// detected (`cascade`: assumed for the cascade starts that are linear in the weights);
+    /// None for the Coleman–Hodgdon hysteresis.
+    pub fn of(
+        family: Family,
+        model: Option<&OperatorModel>,
+        options: &FamilyOptions,
+        cascade: bool,
+    ) -> Option<OrientationUsed> {
+        let orientation = model?.loop_orientation();
+        let reads = family.settings().contains(&FamilySetting::Orientation);
+        let source = if options.orientation.is_some() || options.loop_orientation.is_some() {
+            OrientationSource::Given
+        } else if !reads {
+            OrientationSource::Fitted
+        } else if cascade
+            && matches!(
+                family,
+                Family::Pi
+                    | Family::MaxwellSlip
+                    | Family::Backlash
+                    | Family::Gpi
+                    | Family::Preisach
+                    | Family::Kp
+            )
+        {
+            OrientationSource::Assumed
+        } else {
+            OrientationSource::Detected
+        };
+        Some(OrientationUsed {
+            orientation,
+            source,
+        })
+    }
+}
+
 /// A fitted model of any family and how it was obtained: the figures of [`OperatorFit`] on
 /// the estimation data, with the model as a [`FittedModel`].
 #[derive(Clone, Debug)]
@@ -112,6 +209,8 @@ pub struct FittedOperator {
     pub family: Family,
     /// The model and the fit figures; `fit.model` saves with [`FittedModel::to_file`].
     pub fit: OperatorFit<FittedModel>,
+    /// The fitted model's loop orientation and where it came from (None for ch4/ch6).
+    pub orientation: Option<OrientationUsed>,
 }
 
 impl FittedOperator {
@@ -144,8 +243,13 @@ pub trait Identify: OperatorFamily + Into<OperatorModel> {
         y: &[f64],
         options: &FamilyOptions,
     ) -> Result<(OperatorCascade, &'static str)> {
+        // Γ₀ = G (Γ₀ = G⁻¹ when the user gave a clockwise loop); the linear block carries
+        // the sign
         let options = FamilyOptions {
-            orientation: Some(Orientation::COUNTER_CLOCKWISE),
+            orientation: Some(match options.loop_orientation {
+                Some(LoopOrientation::Clockwise) => Orientation::CLOCKWISE,
+                _ => Orientation::COUNTER_CLOCKWISE,
+            }),
             ..options.clone()
         };
         let start = Self::identify(u, y, &options)?.model.into();
@@ -203,7 +307,16 @@ pub fn fit_operator(
         Family::Ch6 => coleman_hodgdon(ChForm::General6, u, y)?,
         operator => by_family::fit(operator, u, y, options)?,
     };
-    Ok(FittedOperator { family, fit })
+    let operator = match &fit.model {
+        FittedModel::Operator { model, .. } => Some(model),
+        _ => None,
+    };
+    let orientation = OrientationUsed::of(family, operator, options, false);
+    Ok(FittedOperator {
+        family,
+        fit,
+        orientation,
+    })
 }
 
 /// The start of an operator cascade of `family` (an operator family, not ch4/ch6).

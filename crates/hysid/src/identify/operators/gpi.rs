@@ -191,7 +191,7 @@ impl Identify for GeneralizedPi {
                 thresholds: options.thresholds,
                 grid: options.threshold_grid.clone(),
                 dead_zones: options.dead_zones,
-                orientation: options.orientation,
+                orientation: options.given_orientation(u, y)?,
                 ..GpiOptions::default()
             },
         )

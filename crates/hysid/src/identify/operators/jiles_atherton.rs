@@ -43,6 +43,9 @@ pub struct JilesAthertonOptions {
     /// Sees the fit's grid, starts and iterations and may stop it (see
     /// [`Settings::observer`]).
     pub observer: Observer,
+    /// The loop's turning sense in the (u, y) plane; detected from the data when None
+    /// ([`LoopOrientation::of_loop`]).
+    pub orientation: Option<LoopOrientation>,
 }
 
 impl Default for JilesAthertonOptions {
@@ -52,6 +55,7 @@ impl Default for JilesAthertonOptions {
             output: JaOutput::FluxDensity,
             config: driver::default_config(),
             observer: Observer::none(),
+            orientation: None,
         }
     }
 }
@@ -191,7 +195,9 @@ pub fn fit(
         anhysteretic: options.anhysteretic,
         output: options.output,
         orientation: if u.len() == y.len() {
-            LoopOrientation::of_loop(u, y)
+            options
+                .orientation
+                .unwrap_or_else(|| LoopOrientation::of_loop(u, y))
         } else {
             LoopOrientation::CounterClockwise
         },
@@ -219,7 +225,7 @@ fn inverse_langevin(t: f64) -> f64 {
 }
 
 impl Identify for JilesAtherton {
-    const SETTINGS: &'static [FamilySetting] = &[];
+    const SETTINGS: &'static [FamilySetting] = &[FamilySetting::Orientation];
 
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         fit(
@@ -227,6 +233,7 @@ impl Identify for JilesAtherton {
             y,
             &JilesAthertonOptions {
                 observer: options.observer.clone(),
+                orientation: options.loop_orientation,
                 ..JilesAthertonOptions::default()
             },
         )

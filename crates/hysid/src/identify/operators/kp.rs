@@ -271,7 +271,7 @@ impl Identify for Kp {
             &KpOptions {
                 levels: options.grid,
                 lambda: options.lambda,
-                orientation: options.orientation,
+                orientation: options.given_orientation(u, y)?,
                 ..KpOptions::default()
             },
         )

@@ -125,7 +125,15 @@ impl Identify for MaxwellSlip {
             &MaxwellSlipOptions {
                 elements: options.thresholds,
                 widths: options.threshold_grid.clone(),
-                orientation: options.orientation,
+                // the stops' own loop is clockwise: a given turning sense maps the other way
+                orientation: match (options.orientation, options.loop_orientation) {
+                    (Some(o), _) => Some(o),
+                    (None, Some(l)) => Some(Orientation::for_loop(
+                        l.reversed(),
+                        Orientation::trend(u, y)?,
+                    )),
+                    (None, None) => None,
+                },
                 ..MaxwellSlipOptions::default()
             },
         )

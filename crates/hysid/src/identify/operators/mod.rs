@@ -17,15 +17,19 @@
 //!   record, local searches, then bounded Levenberg–Marquardt on the full record with
 //!   sensitivities integrated in u, and a checked stop).
 //!
-//! The loop orientation is detected from the data ([`crate::model::operators::Orientation::detect`]) unless given; a
-//! clockwise loop is fitted in the inverse-operator parameterisation (the core operator from
+//! The loop orientation is detected from the area between the ascending and descending
+//! branches ([`crate::model::operators::Orientation::detect`],
+//! [`crate::model::operators::orientation`]) unless given; a clockwise loop is fitted in the inverse-operator parameterisation (the core operator from
 //! y to u).
 use crate::model::ParameterSet;
 use crate::numerics::Termination;
 use serde::Serialize;
 
 pub use compare::{compare, CompareOptions, CompareRow, Comparison, Split};
-pub use family::{fit_operator, Family, FamilyOptions, FamilySetting, FittedOperator};
+pub use family::{
+    fit_operator, Family, FamilyOptions, FamilySetting, FittedOperator, OrientationSource,
+    OrientationUsed,
+};
 
 pub mod backlash;
 pub mod bouc_wen;

@@ -158,7 +158,7 @@ impl Identify for PrandtlIshlinskii {
             &PiOptions {
                 thresholds: options.thresholds,
                 grid: options.threshold_grid.clone(),
-                orientation: options.orientation,
+                orientation: options.given_orientation(u, y)?,
                 select: None,
             },
         )

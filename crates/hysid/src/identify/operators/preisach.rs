@@ -181,7 +181,7 @@ impl Identify for Preisach {
             &PreisachOptions {
                 levels: options.grid,
                 lambda: options.lambda,
-                orientation: options.orientation,
+                orientation: options.given_orientation(u, y)?,
                 ..PreisachOptions::default()
             },
         )

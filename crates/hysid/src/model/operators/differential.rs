@@ -52,10 +52,20 @@ pub const TOLERANCE: f64 = 1e-10;
 /// Sub-steps allowed in one sample interval before the integration is declared divergent.
 const MAX_SUBSTEPS: usize = 100_000;
 
-/// The orientation of a hysteresis loop in the (u, y) plane.
+/// The orientation (turning sense) of a hysteresis loop in the (u, y) plane, u horizontal.
 ///
-/// Counter-clockwise: the ascending branch lies below the descending one (the output lags the
-/// input, as in most B(H) loops). Clockwise: the ascending branch lies above.
+/// Counter-clockwise (`ccw`): the ascending branch lies below the descending one (the output
+/// lags the input, as a piezo stack or a magnet's B(H) loop). Clockwise (`cw`): the ascending
+/// branch lies above (the output leads, as the friction force of an elasto-plastic contact).
+/// It is the sign of the area between the branches, ∫ (y_desc − y_asc) du > 0 for
+/// counter-clockwise (Mayergoyz, *Mathematical Models of Hysteresis*, 2003; MODELS.md §4.8),
+/// detected by [`LoopOrientation::detect`].
+///
+/// How it maps onto the linear-in-weights families' stored [`super::Orientation`]
+/// `{decreasing, inverse}` (whose core G is counter-clockwise): `ccw` is
+/// `inverse == decreasing` (Γ = G, or Γ = −G⁻¹ for a decreasing trend), `cw` is
+/// `inverse != decreasing` (Γ = G⁻¹, or Γ = −G); for Maxwell-slip, whose stop elements are
+/// clockwise, the other way round ([`super::Orientation::loop_orientation`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LoopOrientation {
@@ -66,19 +76,62 @@ pub enum LoopOrientation {
 }
 
 impl LoopOrientation {
-    /// The orientation of a measured loop from the sign of its enclosed area
-    /// ∮ y du = Σ ½(y_k + y_{k−1})(u_k − u_{k−1}), which is negative for a counter-clockwise
-    /// loop (Green's theorem).
+    /// The orientation of a measured loop from the area between its ascending and descending
+    /// branches, per reversal ([`super::orientation`]): right for open records, several runs,
+    /// offsets, a decreasing trend and narrow loops on a wide range; an
+    /// [`Error::UndeterminedOrientation`] when the record cannot tell (no reversal, a loop
+    /// indistinguishable from noise).
+    pub fn detect(u: &[f64], y: &[f64]) -> Result<Self> {
+        super::orientation::loop_evidence(u, y).map(|e| e.orientation)
+    }
+
+    /// [`LoopOrientation::detect`], or where the record cannot tell, the sign of the path
+    /// integral ∮ y du = Σ ½(y_k + y_{k−1})(u_k − u_{k−1}) (negative for a closed
+    /// counter-clockwise path, Green's theorem): what the differential families' fits use,
+    /// which judge a record's excitation themselves.
     pub fn of_loop(u: &[f64], y: &[f64]) -> Self {
-        let area: f64 = u
-            .windows(2)
-            .zip(y.windows(2))
-            .map(|(du, dy)| 0.5 * (dy[0] + dy[1]) * (du[1] - du[0]))
-            .sum();
-        if area > 0.0 {
-            LoopOrientation::Clockwise
-        } else {
-            LoopOrientation::CounterClockwise
+        Self::detect(u, y).unwrap_or_else(|_| {
+            let area: f64 = u
+                .windows(2)
+                .zip(y.windows(2))
+                .map(|(du, dy)| 0.5 * (dy[0] + dy[1]) * (du[1] - du[0]))
+                .sum();
+            if area > 0.0 {
+                LoopOrientation::Clockwise
+            } else {
+                LoopOrientation::CounterClockwise
+            }
+        })
+    }
+
+    /// The short name: `ccw` or `cw` (the command line's and the reports' spelling).
+    pub fn short_name(self) -> &'static str {
+        match self {
+            LoopOrientation::CounterClockwise => "ccw",
+            LoopOrientation::Clockwise => "cw",
+        }
+    }
+
+    /// Parses `ccw` / `cw` (also `counter-clockwise`, `counter_clockwise`, `clockwise`).
+    pub fn parse(text: &str) -> Result<Self> {
+        match text.trim().to_ascii_lowercase().as_str() {
+            "ccw" | "counter-clockwise" | "counter_clockwise" | "counterclockwise" => {
+                Ok(LoopOrientation::CounterClockwise)
+            }
+            "cw" | "clockwise" => Ok(LoopOrientation::Clockwise),
+            _ => Err(Error::invalid_option(
+                "orientation",
+                text,
+                format!("orientation '{text}' is neither ccw nor cw"),
+            )),
+        }
+    }
+
+    /// The other orientation.
+    pub fn reversed(self) -> Self {
+        match self {
+            LoopOrientation::CounterClockwise => LoopOrientation::Clockwise,
+            LoopOrientation::Clockwise => LoopOrientation::CounterClockwise,
         }
     }
 

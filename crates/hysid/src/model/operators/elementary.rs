@@ -3,6 +3,7 @@
 //! per-sample solve used by the numerical inverses.
 
 use super::Inversion;
+use super::LoopOrientation;
 use crate::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -96,6 +97,15 @@ pub(crate) fn check_finite(name: &str, value: f64) -> Result<()> {
 /// The inverse of Γ is then G⁻¹[±r] or G[±r] respectively. The Maxwell-slip elements
 /// (stop operators) are the exception: their own loop is clockwise, so for them `inverse`
 /// marks a counter-clockwise loop.
+///
+/// The user's `--orientation ccw|cw` (Python `orientation="ccw"|"cw"`) is the turning sense
+/// in the (u, y) plane, u horizontal ([`LoopOrientation`]); the trend stays detected (the
+/// sign of cov(u, y)). With a core G that is counter-clockwise: `ccw` is
+/// `{"inverse": false, "decreasing": false}` (Γ = G) or, decreasing, `{"inverse": true,
+/// "decreasing": true}` (Γ = −G⁻¹); `cw` is `{"inverse": true, "decreasing": false}`
+/// (Γ = G⁻¹) or `{"inverse": false, "decreasing": true}` (Γ = −G): see
+/// [`Orientation::for_loop`] and [`Orientation::loop_orientation`]. Model files keep storing
+/// `{inverse, decreasing}`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Orientation {
     /// True when Γ = G⁻¹ (a clockwise loop with an increasing trend).
@@ -116,10 +126,22 @@ impl Orientation {
         decreasing: false,
     };
 
-    /// Detects the orientation of a measured loop: the trend is the sign of cov(u, y); with
-    /// ỹ = ±y made increasing, the loop is clockwise when ∫ỹ du > 0 (the output is higher on
-    /// the rising branch than on the falling one), counter-clockwise when < 0.
+    /// Detects the orientation of a measured loop: the trend is the sign of cov(u, y) (as
+    /// before); the turning sense is the area between the ascending and descending branches
+    /// ([`LoopOrientation::detect`], module [`super::orientation`]): robust to open records,
+    /// several runs, offsets and narrow loops, where the path integral ∮ y du of the whole
+    /// record is not. Then Γ = G⁻¹ (`inverse`) exactly when the loop of ỹ = ±y (made
+    /// increasing) is clockwise, i.e. `inverse = cw XOR decreasing`
+    /// ([`Orientation::for_loop`]). An [`Error::UndeterminedOrientation`] when the record
+    /// cannot tell.
     pub fn detect(u: &[f64], y: &[f64]) -> Result<Orientation> {
+        let decreasing = Self::trend(u, y)?;
+        Ok(Self::for_loop(LoopOrientation::detect(u, y)?, decreasing))
+    }
+
+    /// True when the output decreases with the input (cov(u, y) < 0); an error when the
+    /// covariance is 0 or not finite.
+    pub fn trend(u: &[f64], y: &[f64]) -> Result<bool> {
         let n = u.len().min(y.len()) as f64;
         let (mu, my) = (u.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
         let cov: f64 = u.iter().zip(y).map(|(a, b)| (a - mu) * (b - my)).sum();
@@ -131,15 +153,30 @@ impl Orientation {
                     .into(),
             });
         }
-        let decreasing = cov < 0.0;
-        let s = if decreasing { -1.0 } else { 1.0 };
-        let area: f64 = (1..u.len().min(y.len()))
-            .map(|k| (u[k] - u[k - 1]) * s * (y[k] + y[k - 1]) / 2.0)
-            .sum();
-        Ok(Orientation {
-            inverse: area > 0.0,
+        Ok(cov < 0.0)
+    }
+
+    /// The orientation of a counter-clockwise core G for a loop of turning sense `turning`
+    /// in the (u, y) plane and the trend `decreasing`: exchanging the axes (Γ = G⁻¹) and
+    /// negating the output (Γ = −G) each reverse the turning sense, so
+    /// `inverse = (turning == cw) XOR decreasing`: ccw ↦ {inverse: false, decreasing: false}
+    /// or {inverse: true, decreasing: true}; cw ↦ {true, false} or {false, true}.
+    pub fn for_loop(turning: LoopOrientation, decreasing: bool) -> Orientation {
+        Orientation {
+            inverse: (turning == LoopOrientation::Clockwise) != decreasing,
             decreasing,
-        })
+        }
+    }
+
+    /// The turning sense in the (u, y) plane of Γ built on a counter-clockwise core G in
+    /// this orientation (the inverse of [`Orientation::for_loop`]); for a clockwise core
+    /// (the Maxwell-slip stops) it is the [`LoopOrientation::reversed`] one.
+    pub fn loop_orientation(&self) -> LoopOrientation {
+        if self.inverse == self.decreasing {
+            LoopOrientation::CounterClockwise
+        } else {
+            LoopOrientation::Clockwise
+        }
     }
 
     /// ±1: the output's sign.

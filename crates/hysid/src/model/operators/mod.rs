@@ -56,6 +56,7 @@ pub(crate) mod gpi;
 pub mod jiles_atherton;
 pub mod kp;
 pub(crate) mod maxwell_slip;
+pub mod orientation;
 pub(crate) mod pi;
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod preisach;
@@ -74,6 +75,7 @@ pub use gpi::{DeadZones, GeneralizedPi};
 pub use jiles_atherton::{Anhysteretic, JaOutput, JilesAtherton};
 pub use kp::Kp;
 pub use maxwell_slip::MaxwellSlip;
+pub use orientation::{loop_evidence, LoopEvidence};
 pub use pi::PrandtlIshlinskii;
 pub use preisach::Preisach;
 pub(crate) use registry::operator_families;

@@ -10,6 +10,7 @@ mod gpi;
 mod jiles_atherton;
 mod kp;
 mod maxwell_slip;
+mod orientation;
 mod pi;
 mod preisach;
 mod registry;
