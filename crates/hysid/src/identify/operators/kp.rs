@@ -89,6 +89,16 @@ impl Default for KpOptions {
 pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>> {
     let start = Instant::now();
     check_options(options)?;
+    // a given range is checked before the data are read for the orientation
+    if let Some((lower, upper)) = options.range {
+        if !(lower.is_finite() && upper.is_finite() && upper > lower) {
+            return Err(Error::invalid_option(
+                "range",
+                format!("[{lower}, {upper}]"),
+                format!("KP grid range [{lower}, {upper}] is empty; give lower < upper"),
+            ));
+        }
+    }
     let o = orientation(u, y, options.orientation)?;
     let (x, v) = o.core_data(u, y);
     let (lower, upper) = options.range.unwrap_or_else(|| range(&x));

@@ -60,6 +60,10 @@ pub fn fit(u: &[f64], y: &[f64], options: &PiOptions) -> Result<OperatorFit<Pran
         return fit_selected(u, y, options, candidates);
     }
     let start = Instant::now();
+    // a given grid is checked before the data are read for the orientation
+    if let Some(g) = &options.grid {
+        validate_thresholds("r", g)?;
+    }
     let o = orientation(u, y, options.orientation)?;
     let (x, v) = o.core_data(u, y);
     let grid = match &options.grid {

@@ -235,7 +235,7 @@ pub fn loop_evidence(u: &[f64], y: &[f64]) -> Result<LoopEvidence> {
     let reversals = turns.len().saturating_sub(2);
     if reversals == 0 {
         return Err(undetermined(
-            "the input never reverses (a curve, not a loop)",
+            "the input has no reversal (a curve, not a loop)",
         ));
     }
     let branches: Vec<Branch> = turns
