@@ -233,8 +233,9 @@ impl OutputSet {
         let id = self.check_new(path, Kind::Dir)?;
         probe(path, &parent)?;
         let staged = temporary_beside(path);
-        fs::create_dir(&staged).map_err(|source| io(&staged, source))?;
+        // Registered before it exists, so that a signal handler's removal never misses it.
         self.push(Kind::Dir, path, id, staged.clone());
+        fs::create_dir(&staged).map_err(|source| io(&staged, source))?;
         Ok(staged)
     }
 
@@ -536,21 +537,41 @@ fn unregister(id: usize) {
 }
 
 /// Removes the temporaries of every live output set of the process (the previous outputs
-/// stay as they were): for a program's own SIGINT/SIGTERM handler, called before it exits.
-/// The sets themselves are left registered; the process is expected to end.
+/// stay as they were): for a program's own SIGINT/SIGTERM handler, called right before it
+/// exits. The process must end after it: the registry's lock stays held, so that no output
+/// is registered (and no temporary made) between the removal and the exit; a later
+/// registration waits for ever.
 ///
 /// It takes a lock, so call it from a handler that runs on an ordinary thread (as the
-/// `ctrlc` crate's does), not from an async-signal context.
+/// `ctrlc` crate's does), not from an async-signal context. The run's other threads go on
+/// meanwhile: a file written into a temporary directory while it is being removed keeps
+/// the directory alive, so the removal is repeated until every temporary is gone (at most
+/// [`REMOVAL_ROUNDS`] rounds a millisecond apart). No new temporary can appear meanwhile:
+/// registering one takes the same lock, which is held from here on.
 pub fn remove_live_temporaries() {
     // A panicking thread may have poisoned the lock; the paths are still valid.
     let live = match LIVE.lock() {
         Ok(live) => live,
         Err(poisoned) => poisoned.into_inner(),
     };
-    for (_, path) in live.iter() {
-        remove_any(path);
+    for _ in 0..REMOVAL_ROUNDS {
+        for (_, path) in live.iter() {
+            remove_any(path);
+        }
+        if live
+            .iter()
+            .all(|(_, path)| fs::symlink_metadata(path).is_err())
+        {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
     }
+    // Held until the process ends (see above).
+    std::mem::forget(live);
 }
+
+/// Rounds of [`remove_live_temporaries`] at most.
+const REMOVAL_ROUNDS: usize = 100;
 
 /// The directory `path` is written into ("." for a bare name).
 fn parent_of(path: &Path) -> &Path {
