@@ -546,7 +546,7 @@ fn unregister(id: usize) {
 /// `ctrlc` crate's does), not from an async-signal context. The run's other threads go on
 /// meanwhile: a file written into a temporary directory while it is being removed keeps
 /// the directory alive, so the removal is repeated until every temporary is gone (at most
-/// [`REMOVAL_ROUNDS`] rounds a millisecond apart). No new temporary can appear meanwhile:
+/// a hundred rounds a millisecond apart). No new temporary can appear meanwhile:
 /// registering one takes the same lock, which is held from here on.
 pub fn remove_live_temporaries() {
     // A panicking thread may have poisoned the lock; the paths are still valid.
