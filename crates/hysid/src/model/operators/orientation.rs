@@ -50,7 +50,7 @@ pub const REVERSAL_FRACTION: f64 = 0.01;
 
 /// The smallest confidence |z| (the robust area in units of its noise standard deviation)
 /// at which an orientation is reported.
-pub const MIN_CONFIDENCE: f64 = 4.0;
+pub const MIN_CONFIDENCE: f64 = 3.0;
 
 /// The floor of the noise level σ̂ as a fraction of the output's range (1e-5).
 pub const SIGMA_FLOOR: f64 = 1e-5;
