@@ -262,6 +262,12 @@ impl OutputSet {
                 missing.target.display()
             )));
         }
+        // The registry stays locked through the replacements: a signal handler's
+        // [`remove_live_temporaries`] then runs wholly before them (and the process ends
+        // before they start) or wholly after them (with this set's temporaries no longer
+        // registered), never while a temporary directory being removed is swapped into
+        // place, which would empty the new output.
+        let mut live = lock_live();
         let mut replaced: Vec<Replaced> = Vec::with_capacity(self.outputs.len());
         for output in &self.outputs {
             match replace(output) {
@@ -270,12 +276,15 @@ impl OutputSet {
                     for (output, done) in self.outputs.iter().zip(&replaced).rev() {
                         undo(output, done);
                     }
+                    // Released before the set's drop removes the temporaries.
+                    drop(live);
                     return Err(io(&output.target, source));
                 }
             }
         }
         self.committed = true;
-        unregister(self.id);
+        live.retain(|(set, _)| *set != self.id);
+        drop(live);
         for done in replaced {
             // The new outputs are in place; a leftover previous copy is only untidy.
             if let Replaced::Previous(old) = done {
@@ -362,9 +371,7 @@ impl OutputSet {
     }
 
     fn push(&mut self, kind: Kind, target: &Path, id: Identity, staged: PathBuf) {
-        if let Ok(mut live) = LIVE.lock() {
-            live.push((self.id, staged.clone()));
-        }
+        lock_live().push((self.id, staged.clone()));
         let held = match kind {
             Kind::Dir => held_inodes(target),
             Kind::File => Vec::new(),
@@ -531,8 +538,15 @@ fn remove_any(path: &Path) {
 }
 
 fn unregister(id: usize) {
-    if let Ok(mut live) = LIVE.lock() {
-        live.retain(|(set, _)| *set != id);
+    lock_live().retain(|(set, _)| *set != id);
+}
+
+/// The registry of live temporaries, locked. A thread that panicked while holding it
+/// leaves it poisoned; the paths in it are still valid.
+fn lock_live() -> std::sync::MutexGuard<'static, Vec<(usize, PathBuf)>> {
+    match LIVE.lock() {
+        Ok(live) => live,
+        Err(poisoned) => poisoned.into_inner(),
     }
 }
 
@@ -547,13 +561,10 @@ fn unregister(id: usize) {
 /// meanwhile: a file written into a temporary directory while it is being removed keeps
 /// the directory alive, so the removal is repeated until every temporary is gone (at most
 /// a hundred rounds a millisecond apart). No new temporary can appear meanwhile:
-/// registering one takes the same lock, which is held from here on.
+/// registering one takes the same lock, which is held from here on. Nor can a commit put
+/// one in place meanwhile: [`OutputSet::commit`] holds the lock through its replacements.
 pub fn remove_live_temporaries() {
-    // A panicking thread may have poisoned the lock; the paths are still valid.
-    let live = match LIVE.lock() {
-        Ok(live) => live,
-        Err(poisoned) => poisoned.into_inner(),
-    };
+    let live = lock_live();
     for _ in 0..REMOVAL_ROUNDS {
         for (_, path) in live.iter() {
             remove_any(path);
