@@ -11,6 +11,7 @@ use crate::errors::{guard, run};
 use crate::pool::run_on;
 use crate::watch::{watching, Watch};
 use hysid::data::{Channel, Experiment, IdData};
+use hysid::identify::bouc_wen_benchmark::BoucWenBenchmark;
 use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::greybox::{GreyBoxEstimation, InitialStates};
 use hysid::identify::hysteresis::{HysteresisIdentification, InitialOutput};
@@ -357,16 +358,20 @@ fn benchmark_bouc_wen(
         threads,
         watching(py, time_limit, progress)?,
         move |watch| {
-            let sim = Simulation {
-                integrator: Integrator::Rk4 {
-                    substeps: substeps.max(1),
-                },
-                interpolation: InputInterpolation::BandLimited,
+            // The library's benchmark settings (integrator, the LM's stopping rule), so that
+            // the fit is the CLI's `benchmark bouc-wen` to the bit.
+            let benchmark = BoucWenBenchmark {
+                substeps,
+                starts,
+                seed,
+                steady_state,
+                observer: watch.observer(),
             };
+            let sim = benchmark.simulation();
             let data = id_data(ts, vec![u], vec![y])?;
             let params = parameter_set(&params)?;
             let model = models::BoucWen;
-            let fit = estimation(sim, starts, seed, watch).estimate(
+            let fit = benchmark.estimation().estimate(
                 Arc::new(model),
                 &data,
                 &params,

@@ -45,6 +45,8 @@ def test_a_missing_model_file_is_file_not_found(tmp_path):
     with pytest.raises(FileNotFoundError) as e:
         hysid.load_model(tmp_path / "nope.json")
     assert e.value.filename == str(tmp_path / "nope.json")
+    # Still the package's own error for an unreadable model file (earlier code catches it).
+    assert isinstance(e.value, hysid.ModelFileError)
 
 
 def test_stream_objects_print_what_they_are():

@@ -60,7 +60,7 @@ from .actuator import ACTUATOR_GEAR_RATIO, ACTUATOR_SADDLE_MASS, ActuatorRecord,
 from .comparison import CompareRow, Comparison
 from .compensation import Compensation
 from .greybox import GreyBoxModel
-from .models import Model, load_model
+from .models import Model, ModelFileNotFoundError, load_model
 from .parameters import Parameter
 from .progress import HysidWarning, Progress, ProgressArg
 from .recipes import (
@@ -113,6 +113,7 @@ __all__ = [
     "ConfigError",
     "NumericalError",
     "ModelFileError",
+    "ModelFileNotFoundError",
     "CallbackError",
     "InternalError",
     "HysidWarning",

@@ -181,11 +181,19 @@ def _model_from_json(text: str, user: Optional[Callbacks]) -> Model:
     return Model(json.loads(text), user)
 
 
+class ModelFileNotFoundError(ModelFileError, FileNotFoundError):
+    """No model file at the path given: a ``FileNotFoundError`` (``errno.ENOENT``, with
+    ``.filename``) as Python's own file functions raise, and a :class:`ModelFileError` as
+    every other unreadable model file."""
+
+
 def load_model(path: Union[str, "os.PathLike[str]"]) -> Model:
-    """Reads a model file written by the CLI (``--model``) or by :meth:`Model.save`."""
+    """Reads a model file written by the CLI (``--model``) or by :meth:`Model.save`; a
+    missing file is a :class:`ModelFileNotFoundError` (both ``FileNotFoundError`` and
+    :class:`ModelFileError`)."""
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path: expected a str or path, got {type(path).__name__}")
     where = os.fspath(path)
     if not os.path.exists(where):
-        raise FileNotFoundError(errno.ENOENT, "no model file there; check the path", where)
+        raise ModelFileNotFoundError(errno.ENOENT, "no model file there; check the path", where)
     return Model(json.loads(_hysid.load_model(where)))

@@ -294,6 +294,11 @@ impl Family {
 /// How [`Identify::cascade_start`]'s default start is obtained.
 pub const FAMILY_ARX: &str = "family fit and ARX";
 
+/// The smallest model of any family — (parameters, samples it needs): a gain and one shape
+/// parameter, with the samples the linear families'
+/// data check asks of that many parameters, max(2p, p + 10).
+const SMALLEST_MODEL: (usize, usize) = (2, 12);
+
 /// Fits `family` to input `u` and output `y` with `options`.
 pub fn fit_operator(
     family: Family,
@@ -302,6 +307,15 @@ pub fn fit_operator(
     options: &FamilyOptions,
 ) -> Result<FittedOperator> {
     options.validate()?;
+    // A record too short for any family's smallest model is said to be so before anything
+    // (its loop's orientation first) is read from it.
+    if u.len() < SMALLEST_MODEL.1 {
+        return Err(Error::TooFewSamples {
+            samples: u.len(),
+            parameters: SMALLEST_MODEL.0,
+            needed: SMALLEST_MODEL.1,
+        });
+    }
     let fit = match family {
         Family::Ch4 => coleman_hodgdon(ChForm::Saturated4, u, y)?,
         Family::Ch6 => coleman_hodgdon(ChForm::General6, u, y)?,
