@@ -33,8 +33,8 @@ def _check(fig, lines, xlabel, ylabel):
 
 
 def test_result_plots(fitted):
-    _check(fitted.plot(), [2, 1], "time [s]", "output y")
-    _check(fitted.plot_loop(), [2], "input u", "output y")
+    _check(fitted.plot(), [2, 1], "time [s]", "y")
+    _check(fitted.plot_loop(), [2], "u", "y")
     # r_ε and the two band lines; r_εu and its band
     _check(fitted.plot_residuals(), [3, 3], "lag τ [samples]", "r_ε(τ)")
     fig = fitted.plot()
@@ -54,9 +54,44 @@ def test_residuals_from_the_report_when_it_has_them(fitted):
 
 
 def test_comparison_and_compensation_plots(comparison):
-    _check(comparison.plot(), [1 + len(comparison.results)], "input u", "output y")
+    # Small multiples: one panel per family, the measurement and the family in each.
+    _check(comparison.plot(), [2] * len(comparison.results), "u", "y")
     c = hysid.compensate(comparison.model, comparison.validation.y)
-    _check(c.plot(), [2 + bool(c.clipped), 1], "time [s]", "output y")
+    _check(c.plot(), [1 + bool(c.clipped), 1], "time [s]", "y")
+
+
+def test_axes_carry_the_channels_names_and_units():
+    u, y = _loop(600)
+    names, units = ("current", "field"), ("A", "T")
+    r = hysid.identify_operator(u, y, family="pi", thresholds=5, names=names, units=units)
+    assert r.model.file["columns"] == {"inputs": ["current"], "outputs": ["field"]}
+    _check(r.plot(), [2, 1], "time [s]", "field [T]")
+    _check(r.plot_loop(), [2], "current [A]", "field [T]")
+    c = hysid.compare(u, y, families=["pi", "backlash"], names=names, units=units)
+    fig = c.plot()
+    assert [a.get_title().split(":")[0] for a in fig.axes] == [f"{k + 1}. {r['family']}" for k, r in enumerate(c.table)]
+    assert fig.axes[0].get_ylabel() == "field [T]" and fig.axes[-1].get_xlabel() == "current [A]"
+    plt.close(fig)
+    _check(c.plot(best=1), [2], "current [A]", "field [T]")
+    comp = hysid.compensate(c.results["pi"], 0.5 * y)
+    fig = comp.plot(plant=c.results["backlash"].model, units=units)
+    reference, command, error = fig.axes
+    assert reference.get_ylabel() == "field [T]" and command.get_ylabel() == "command current [A]"
+    assert error.get_ylabel() == "y − r [T]"
+    plant = c.results["backlash"].model.simulate(comp.u, ts=1.0)
+    assert abs(error.get_lines()[0].get_ydata() - (plant - comp.reference)).max() < 1e-12
+    plt.close(fig)
+
+
+def test_names_are_taken_from_pandas_columns():
+    pd = pytest.importorskip("pandas")
+    u, y = _loop(600)
+    frame = pd.DataFrame({"voltage": u, "displacement": y})
+    r = hysid.identify_operator(frame["voltage"], frame["displacement"], family="pi", thresholds=5, ts=0.001)
+    assert r.model.file["columns"] == {"inputs": ["voltage"], "outputs": ["displacement"]}
+    assert r.model.file["sample_time"] == 0.001
+    with pytest.raises(TypeError, match="names: give a pair of strings"):
+        hysid.identify_operator(u, y, family="pi", names="voltage")  # type: ignore[arg-type]
 
 
 def test_given_axes_hold_the_main_plot(fitted):

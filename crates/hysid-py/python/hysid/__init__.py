@@ -73,7 +73,7 @@ from .recipes import (
     rigid_body_ls,
     set_num_threads,
 )
-from .results import Record, Result, ValidationEntry
+from .results import FitResult, Record, Result, ValidationEntry
 from .stream import Compensator, Stepper
 from .zoo import compare, compensate, identify_operator
 
@@ -102,6 +102,7 @@ __all__ = [
     "Parameter",
     "GreyBoxModel",
     "Result",
+    "FitResult",
     "Record",
     "ValidationEntry",
     "ReportError",

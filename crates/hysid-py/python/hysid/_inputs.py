@@ -9,15 +9,41 @@ of range or unknown (both are also ``ValueError``).
 from __future__ import annotations
 
 import math
-from typing import Any, List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Protocol, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
 from ._hysid import ConfigError, DataError
 
-#: A float64 numpy array, the package's signal type.
+#: A float64 numpy array, the package's signal type: what every function returns.
 FloatArray = npt.NDArray[np.float64]
+
+#: Samples as every function takes them: anything numpy reads as an array of real numbers
+#: (a list, a tuple, a numpy or pandas array of ints or floats). Strings, booleans, complex
+#: numbers and objects are refused with a ``TypeError``.
+Samples = npt.ArrayLike
+
+
+class RecordLike(Protocol):
+    """A record holding a measured input ``.u`` and output ``.y`` (and, if it has one, a
+    ``.sampling_time`` in seconds), such as ``nonlinear_benchmarks.Input_output_data``:
+    accepted wherever a pair of arrays is."""
+
+    @property
+    def u(self) -> npt.ArrayLike:
+        """The input samples."""
+        ...
+
+    @property
+    def y(self) -> npt.ArrayLike:
+        """The output samples."""
+        ...
+
+
+#: An input's samples, or a record holding the input and the output (the output argument
+#: is then omitted).
+SamplesOrRecord = Union[npt.ArrayLike, RecordLike]
 
 
 def array(a: Any, name: str, *, ndim: Tuple[int, ...] = (1,)) -> FloatArray:
@@ -136,3 +162,24 @@ def choice(v: Any, name: str, allowed: Optional[Sequence[str]] = None) -> str:
 def threads(v: Any) -> int:
     """``threads`` as the extension takes it: 0 for the process default."""
     return 0 if v is None else count(v, "threads")
+
+
+def channel_labels(
+    names: Optional[Sequence[str]], units: Optional[Sequence[str]], u: Any, y: Any
+) -> Tuple[Tuple[str, str], Tuple[str, str]]:
+    """The (input, output) names and units of a record: as given, else the names the arrays
+    carry (a pandas Series' ``.name``, the CSV column it was read from), else ``("u", "y")``;
+    units ``("", "")`` unless given. A pair of strings each, or a ``TypeError``."""
+
+    def pair(v: Sequence[str], what: str) -> Tuple[str, str]:
+        if isinstance(v, str) or len(v) != 2 or not all(isinstance(s, str) for s in v):
+            raise TypeError(f"{what}: give a pair of strings (input, output), e.g. {what}=('voltage', 'displacement')")
+        return (v[0], v[1])
+
+    if names is None:
+        carried = [getattr(a, "name", None) for a in (u, y)]
+        found = [c if isinstance(c, str) and c else d for c, d in zip(carried, ("u", "y"))]
+        given_names = (found[0], found[1])
+    else:
+        given_names = pair(names, "names")
+    return given_names, ("", "") if units is None else pair(units, "units")

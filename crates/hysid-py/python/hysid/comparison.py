@@ -13,7 +13,7 @@ from ._fields import Fields, ReportError
 from ._inputs import FloatArray
 from .models import Model, model_in
 from .plot import Axes, Figure
-from .results import REPORT_SCHEMA, Record, Result
+from .results import REPORT_SCHEMA, FitResult, Record, labelled
 
 
 class CompareRow(TypedDict):
@@ -55,7 +55,7 @@ class Comparison:
 
     ``best``: the best family's name (None when every family failed); ``table``: one
     :class:`CompareRow` per family, best first, failed families last (family, validation
-    fit %, RMSE, parameter count, AIC, fit time, …); ``results``: family → :class:`Result`
+    fit %, RMSE, parameter count, AIC, fit time, …); ``results``: family → :class:`FitResult`
     of its fit on the training samples (the families that succeeded, ranked); ``errors``:
     family → the one-line error of those that failed; ``model``: the best family's
     :class:`Model`; ``split``: how the data were split, in words; ``validation``: the
@@ -66,7 +66,7 @@ class Comparison:
 
     best: Optional[str]
     table: List[CompareRow]
-    results: Dict[str, Result]
+    results: Dict[str, FitResult]
     errors: Dict[str, str]
     model: Optional[Model]
     split: str
@@ -99,8 +99,10 @@ class Comparison:
         self.model = model_in(f.raw("model"), "report.model")
         if [name for name, _ in results] != [r["family"] for r in self.table] or len(simulated) != len(self.table):
             raise ReportError("compare: the families' results do not match the report's rows")
-        fitted = Record(training.u[:train], training.y[:train], training.ts)
-        self.results = {name: Result(json.loads(text), data=fitted) for name, text in results if text is not None}
+        fitted = training._replace(u=training.u[:train], y=training.y[:train])
+        self.results = {
+            name: FitResult(labelled(json.loads(text), fitted), data=fitted) for name, text in results if text is not None
+        }
         self.errors = {r["family"]: r["error"] for r in self.table if r["error"] is not None}
         self.validation = validation
         self.simulated = {r["family"]: s for r, s in zip(self.table, simulated) if r["family"] in self.results}
@@ -135,12 +137,12 @@ class Comparison:
         rows = [{**{c: r[c] for c in COLUMNS}, "error": r["error"]} for r in self.table]  # type: ignore[literal-required]
         return pd.DataFrame(rows, columns=[*COLUMNS, "error"]).set_index("family")
 
-    def plot(self, *, ax: Optional[Axes] = None) -> Figure:
-        """The measured validation loop with every family's over it, ranked
-        (:func:`hysid.plot.comparison`)."""
+    def plot(self, *, ax: Optional[Axes] = None, best: Optional[int] = None) -> Figure:
+        """Small multiples of the validation loops, one panel per family, ranked, the
+        measurement in each; ``best`` keeps the best few (:func:`hysid.plot.comparison`)."""
         from .plot import comparison
 
-        return comparison(self, ax=ax)
+        return comparison(self, ax=ax, best=best)
 
     def __repr__(self) -> str:
         ranked = ", ".join(

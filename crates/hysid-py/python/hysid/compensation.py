@@ -9,7 +9,7 @@ import json
 from typing import Any, Dict, List, Optional, Tuple
 
 from ._fields import Fields, ReportError
-from ._inputs import FloatArray
+from ._inputs import FloatArray, Samples
 from .models import Model, model_in
 from .plot import Axes, Figure
 from .results import REPORT_SCHEMA
@@ -68,12 +68,20 @@ class Compensation:
         """The ``hysid.report/1`` report of ``hysid compensate`` as a dict (a copy)."""
         return copy.deepcopy(self._report)
 
-    def plot(self, *, ax: Optional[Axes] = None) -> Figure:
-        """Reference and predicted output, the compensating input below
+    def plot(
+        self,
+        *,
+        ax: Optional[Axes] = None,
+        measured: Optional[Samples] = None,
+        plant: Optional[Model] = None,
+        units: Optional[Tuple[str, str]] = None,
+    ) -> Figure:
+        """The reference, the command below it and, given the ``measured`` response to the
+        command or a ``plant`` model to simulate it, the tracking error
         (:func:`hysid.plot.compensation`)."""
         from .plot import compensation
 
-        return compensation(self, ax=ax)
+        return compensation(self, ax=ax, measured=measured, plant=plant, units=units)
 
     def __repr__(self) -> str:
         kind = self.model.family or self.model.kind

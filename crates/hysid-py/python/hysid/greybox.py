@@ -13,7 +13,7 @@ import numpy as np
 
 from . import _hysid
 from ._hysid import CallbackError, ConfigError, DataError, ModelFileError
-from ._inputs import FloatArray, array, choice, count
+from ._inputs import FloatArray, Samples, array, choice, count
 from .models import CallbackSpec, Model
 from .parameters import Parameter
 
@@ -198,7 +198,7 @@ class GreyBoxModel:
 
     def simulate(
         self,
-        u: Any,
+        u: Samples,
         *,
         ts: float,
         integrator: Integrator = "rk4",

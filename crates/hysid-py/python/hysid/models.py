@@ -19,7 +19,7 @@ import numpy as np
 from . import _hysid
 from ._fields import Fields, ReportError
 from ._hysid import ModelFileError
-from ._inputs import FloatArray, channels, sample_time
+from ._inputs import FloatArray, Samples, channels, sample_time
 from .export import Target, export
 from .parameters import Parameter, ParameterTuple
 from .stream import Compensator, Stepper, compensator, stepper
@@ -88,7 +88,7 @@ class Model:
         """The parameters by name (copies: changing one leaves the model as it is)."""
         return {p.name: copy.copy(p) for p in self._parameters}
 
-    def simulate(self, u: Any, *, ts: float, y0: Optional[float] = None) -> FloatArray:
+    def simulate(self, u: Samples, *, ts: float, y0: Optional[float] = None) -> FloatArray:
         """The model's output for input ``u`` (1-D, or 2-D (samples, inputs)) sampled every
         ``ts`` seconds; ``y0`` is the measured initial output, for a hysteresis that starts
         from it."""

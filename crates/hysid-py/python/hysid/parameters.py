@@ -53,6 +53,14 @@ class Parameter:
         if math.isnan(self.lower) or math.isnan(self.upper) or self.lower > self.upper:
             raise ConfigError(f"parameter {name}: bounds [{self.lower}, {self.upper}] are not an interval")
 
+    @property
+    def at_bound(self) -> bool:
+        """True when the estimate sits on one of its bounds (``value == lower`` or
+        ``value == upper``) and was not held fixed: its standard deviation is then not given
+        (``std`` is None), since the asymptotic covariance holds for an interior optimum
+        only (as lmfit, which reports no uncertainty for a parameter at a bound)."""
+        return bool(not self.fixed and self.std is None and self.value in (self.lower, self.upper))
+
     def to_record(self) -> Dict[str, Any]:
         """The model file's record of the parameter (infinite bounds are null)."""
         return {
@@ -72,7 +80,7 @@ class Parameter:
     def __repr__(self) -> str:
         std = "" if self.std is None else f" ± {self.std:.3e}"
         unit = f" {self.unit}" if self.unit else ""
-        fixed = " (fixed)" if self.fixed else ""
+        fixed = " (fixed)" if self.fixed else " (at bound)" if self.at_bound else ""
         return f"Parameter({self.name} = {self.value!r}{std}{unit}{fixed})"
 
     def __eq__(self, other: object) -> bool:

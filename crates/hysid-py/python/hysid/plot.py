@@ -64,7 +64,7 @@ def _fitted(result: "Result") -> Tuple[FloatArray, FloatArray, FloatArray, float
         )
     if result.model is None:
         raise ValueError("this result has no model to simulate")
-    u, y, ts = result.data
+    u, y, ts = result.data.u, result.data.y, result.data.ts
     yhat = np.ravel(result.model.simulate(u, ts=ts, y0=float(y[0])))
     return u, y, yhat, ts
 
@@ -73,9 +73,23 @@ def _time(n: int, ts: float) -> FloatArray:
     return np.arange(n, dtype=np.float64) * ts
 
 
+def _label(name: str, unit: str) -> str:
+    """An axis label: the channel's name and, when known, its unit in brackets."""
+    return f"{name} [{unit}]" if unit else name
+
+
+def _labels(result: "Result") -> Tuple[str, str, str]:
+    """(input label, output label, the output's unit) of a result's data."""
+    if result.data is None:
+        return "input u", "output y", ""
+    (ni, no), (ui, uo) = result.data.names, result.data.units
+    return _label(ni, ui), _label(no, uo), uo
+
+
 def fit(result: "Result", *, ax: Optional[Axes] = None) -> Figure:
     """Measured and simulated output against time; below, the residual y − ŷ."""
     u, y, yhat, ts = _fitted(result)
+    x_label, y_label, y_unit = _labels(result)
     fig, axes = _axes(ax, 2)
     t = _time(len(y), ts)
     main = axes[0]
@@ -83,13 +97,13 @@ def fit(result: "Result", *, ax: Optional[Axes] = None) -> Figure:
     fit = "" if result.fit_percent is None else f" (fit {result.fit_percent:.2f} %)"
     main.plot(t, yhat, "--", label=f"simulated{fit}")
     main.set_xlabel("time [s]")
-    main.set_ylabel("output y")
+    main.set_ylabel(y_label)
     main.set_title(f"{_name(result)}: measured and simulated output")
     main.legend(loc="best")
     if len(axes) > 1:
         axes[1].plot(t, y - yhat, color="C3", label="residual")
         axes[1].set_xlabel("time [s]")
-        axes[1].set_ylabel("y − ŷ")
+        axes[1].set_ylabel(_label("residual y − ŷ", y_unit))
     fig.tight_layout()
     return fig
 
@@ -97,12 +111,13 @@ def fit(result: "Result", *, ax: Optional[Axes] = None) -> Figure:
 def loop(result: "Result", *, ax: Optional[Axes] = None) -> Figure:
     """The input–output loop: measured and simulated output against the input."""
     u, y, yhat, _ = _fitted(result)
+    x_label, y_label, _ = _labels(result)
     fig, axes = _axes(ax, 1)
     main = axes[0]
     main.plot(u, y, label="measured", linewidth=1.0)
     main.plot(u, yhat, "--", label="simulated", linewidth=1.0)
-    main.set_xlabel("input u")
-    main.set_ylabel("output y")
+    main.set_xlabel(x_label)
+    main.set_ylabel(y_label)
     main.set_title(f"{_name(result)}: input–output loop")
     main.legend(loc="best")
     fig.tight_layout()
@@ -146,43 +161,106 @@ def _residual_analysis(result: "Result", lags: int) -> Any:
     return json.loads(_hysid.residual_analysis(u, y, yhat, ts, lags))
 
 
-def comparison(c: "Comparison", *, ax: Optional[Axes] = None) -> Figure:
-    """The measured validation loop and, over it, each family's (ranked, best first)."""
-    fig, axes = _axes(ax, 1)
-    main = axes[0]
-    u, y, _ = c.validation
-    main.plot(u, y, color="black", linewidth=2.0, label="measured")
-    for row in c.table:
+def comparison(c: "Comparison", *, ax: Optional[Axes] = None, best: Optional[int] = None) -> Figure:
+    """Small multiples of the validation loops: one panel per family, ranked (best first),
+    each with the measured loop in grey beneath the family's simulated one and its
+    validation fit % in the title, on shared axes; ``best`` keeps the best few panels.
+    Given ``ax``, the best family alone is drawn there over the measurement."""
+    u, y = c.validation.u, c.validation.y
+    (ni, no), (ui, uo) = c.validation.names, c.validation.units
+    ranked = [row for row in c.table if row["family"] in c.simulated]
+    if best is not None:
+        ranked = ranked[: max(1, int(best))]
+    if ax is not None:
+        ranked = ranked[:1]
+    if not ranked:
+        raise ValueError("no family of this comparison has a simulated output to plot (every fit failed)")
+    if ax is not None:
+        fig, panels = cast(Figure, ax.figure), [ax]
+    else:
+        plt = _pyplot()
+        cols = min(3, len(ranked))
+        rows = -(-len(ranked) // cols)
+        fig, grid = plt.subplots(rows, cols, squeeze=False, sharex=True, sharey=True, figsize=(3.6 * cols, 3.0 * rows))
+        panels = list(grid.ravel())
+        for extra in panels[len(ranked) :]:
+            extra.set_visible(False)
+    for k, (panel, row) in enumerate(zip(panels, ranked)):
         name = row["family"]
-        if name in c.simulated:
-            main.plot(u, c.simulated[name], linewidth=1.0, label=f"{name} ({row['validation_fit_percent']:.2f} %)")
-    main.set_xlabel("input u")
-    main.set_ylabel("output y")
-    main.set_title("Validation loops: measured and every family, ranked")
-    main.legend(loc="best", fontsize="small")
+        panel.plot(u, y, color="0.7", linewidth=2.0, label="measured")
+        panel.plot(u, c.simulated[name], color="C0", linewidth=1.0, label=name)
+        panel.set_title(f"{k + 1}. {name}: {row['validation_fit_percent']:.2f} %", fontsize="medium")
+        cols = len(panels) if len(panels) < 3 else 3
+        if k + cols >= len(ranked):  # the lowest panel of its column
+            panel.set_xlabel(_label(ni, ui))
+            panel.tick_params(labelbottom=True)
+        if k % cols == 0:
+            panel.set_ylabel(_label(no, uo))
+    panels[0].legend(loc="best", fontsize="small")
+    fig.suptitle("Validation loops, ranked by validation fit %")
     fig.tight_layout()
     return fig
 
 
-def compensation(c: "Compensation", *, ax: Optional[Axes] = None) -> Figure:
-    """Reference and predicted output against time; below, the compensating input."""
-    fig, axes = _axes(ax, 2)
+def compensation(
+    c: "Compensation",
+    *,
+    ax: Optional[Axes] = None,
+    measured: Optional[Any] = None,
+    plant: Optional[Any] = None,
+    units: Optional[Tuple[str, str]] = None,
+) -> Figure:
+    """The reference r against time (the clipped samples marked); below, the command u;
+    and, where a measured response (``measured``, the output the plant gave for u) or a
+    plant model (``plant``, a :class:`~hysid.Model` simulated with u) is given, the
+    tracking error y − r. Axes carry the model's channel names and ``units``
+    (input, output). Given ``ax``, the reference panel alone is drawn there."""
+    names = _columns(c)
+    (ui, uo) = units if units is not None else ("", "")
+    response: Optional[FloatArray] = None
+    if measured is not None:
+        response = np.asarray(measured, dtype=np.float64).ravel()
+        if response.shape != c.reference.shape:
+            raise ValueError(f"measured has {response.size} samples; the reference has {c.reference.size}")
+    elif plant is not None:
+        response = np.ravel(plant.simulate(c.u, ts=c.ts))
+    fig, axes = _axes(ax, 2 if response is None else 3)
     t = _time(len(c.u), c.ts)
     main = axes[0]
     main.plot(t, c.reference, label="reference r")
-    main.plot(t, c.predicted, "--", label="predicted output")
+    if response is not None:
+        main.plot(t, response, "--", label="measured" if measured is not None else "plant output")
     if c.clipped:
-        main.plot(t[c.clipped], c.reference[c.clipped], "x", color="C3", label="clipped")
+        main.plot(t[c.clipped], c.reference[c.clipped], "x", color="C3", label=f"clipped ({len(c.clipped)})")
     main.set_xlabel("time [s]")
-    main.set_ylabel("output y")
+    main.set_ylabel(_label(names[1], uo))
     main.set_title(f"Compensation with the {c.model.family or c.model.kind} model")
     main.legend(loc="best")
     if len(axes) > 1:
         axes[1].plot(t, c.u, color="C2", label="command u")
         axes[1].set_xlabel("time [s]")
-        axes[1].set_ylabel("command u")
+        axes[1].set_ylabel(_label(f"command {names[0]}", ui))
+    if len(axes) > 2 and response is not None:
+        error = response - c.reference
+        rms = float(np.sqrt(np.mean(error**2)))
+        axes[2].plot(t, error, color="C3", label=f"tracking error (RMS {rms:.3g})")
+        axes[2].axhline(0.0, color="0.5", linewidth=0.8)
+        axes[2].set_xlabel("time [s]")
+        axes[2].set_ylabel(_label("y − r", uo))
+        axes[2].legend(loc="best", fontsize="small")
     fig.tight_layout()
     return fig
+
+
+def _columns(c: "Compensation") -> Tuple[str, str]:
+    """The compensated model's (input, output) channel names from its model file's
+    ``columns``, else ``("u", "y")``."""
+    columns = c.model.file.get("columns")
+    if isinstance(columns, dict):
+        ins, outs = columns.get("inputs"), columns.get("outputs")
+        if isinstance(ins, list) and isinstance(outs, list) and ins and outs:
+            return str(ins[0]), str(outs[0])
+    return "u", "y"
 
 
 def _name(result: "Result") -> str:

@@ -1,7 +1,8 @@
 """The recipes of the seed papers and the grey-box engine: Coleman–Hodgdon cascades and
 hysteresis (Vörös 2015), grey-box output error, the Bouc–Wen benchmark (Noël & Schoukens
 2016), rigid-body least squares (Gunnar et al. 2006); and the worker threads of every call.
-Each returns a :class:`Result` built on the report the CLI writes for the same command."""
+Each returns a :class:`FitResult` (a :class:`Result` whose model and fit are always there) built
+on the report the CLI writes for the same command."""
 
 from __future__ import annotations
 
@@ -11,14 +12,17 @@ import math
 import typing
 from typing import Any, Dict, Iterable, List, Literal, Optional, Sequence, Tuple, Union
 
+import numpy as np
+
 from . import _hysid
 from . import _inputs as check
 from ._families import FAMILIES, FamilyName
 from ._hysid import ConfigError, DataError
+from ._inputs import Samples, SamplesOrRecord
 from .greybox import GreyBoxModel, Integrator, Interpolation
 from .parameters import Parameter
 from .progress import ProgressArg, warn_if_stopped, watching
-from .results import Record, Result
+from .results import FitResult, Record, labelled
 
 
 def set_num_threads(n: Optional[int]) -> None:
@@ -52,8 +56,8 @@ InitialOutput = Literal["measured", "zero"]
 
 
 def identify_cascade(
-    x: Any,
-    y: Any = None,
+    x: SamplesOrRecord,
+    y: Optional[Samples] = None,
     *,
     hysteresis: FamilyName = "ch4",
     na: int,
@@ -69,7 +73,9 @@ def identify_cascade(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
-) -> Result:
+    names: Optional[Tuple[str, str]] = None,
+    units: Optional[Tuple[str, str]] = None,
+) -> FitResult:
     """Identifies a hysteresis + linear-block cascade: v(k) = H[x](k), A(q⁻¹) y(k) =
     q⁻ᵈᵉˡᵃʸ B(q⁻¹) v(k) with ``na`` denominator and ``nb`` numerator coefficients.
 
@@ -88,6 +94,7 @@ def identify_cascade(
     (None: the process default, all cores; 1 for concurrent fits). The report is the CLI's
     ``identify cascade`` report.
     """
+    labels, unit_labels = check.channel_labels(names, units, x, y)
     x, y, given_ts = check.pair(x, y, ("x", "y"), ts)
     step = check.sample_time(given_ts, 1.0)
     limit, tell = watching(time_limit, progress)
@@ -134,12 +141,13 @@ def identify_cascade(
             limit,
             tell,
         )
-    return _finished(Result(json.loads(text), data=Record(x, y, step)), limit, "identify_cascade")
+    record = Record(x, y, step, labels, unit_labels)
+    return _finished(FitResult(labelled(json.loads(text), record), data=record), limit, "identify_cascade")
 
 
 def identify_hysteresis(
-    x: Any,
-    y: Any = None,
+    x: SamplesOrRecord,
+    y: Optional[Samples] = None,
     *,
     hysteresis: ChForm = "ch4",
     ts: float = 1.0,
@@ -147,11 +155,14 @@ def identify_hysteresis(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
-) -> Result:
+    names: Optional[Tuple[str, str]] = None,
+    units: Optional[Tuple[str, str]] = None,
+) -> FitResult:
     """Identifies a Coleman–Hodgdon hysteresis y = H[x] alone: separated linear regression
     with the switching threshold re-estimated, then output error. ``initial_output``:
     ``"measured"`` (the model starts from y[0]) or ``"zero"``. ``threads``: as for
     :func:`identify_cascade`."""
+    labels, unit_labels = check.channel_labels(names, units, x, y)
     x, y, given_ts = check.pair(x, y, ("x", "y"), ts)
     step = check.sample_time(given_ts, 1.0)
     limit, tell = watching(time_limit, progress)
@@ -165,7 +176,8 @@ def identify_hysteresis(
         limit,
         tell,
     )
-    return _finished(Result(json.loads(text), data=Record(x, y, step)), limit, "identify_hysteresis")
+    record = Record(x, y, step, labels, unit_labels)
+    return _finished(FitResult(labelled(json.loads(text), record), data=record), limit, "identify_hysteresis")
 
 
 def _configure(
@@ -204,8 +216,8 @@ def _configure(
 
 def greybox_fit(
     model: Union[BuiltinModel, GreyBoxModel],
-    u: Any,
-    y: Any = None,
+    u: SamplesOrRecord,
+    y: Optional[Samples] = None,
     *,
     ts: Optional[float] = None,
     init: Optional[Dict[str, float]] = None,
@@ -219,7 +231,7 @@ def greybox_fit(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
-) -> Result:
+) -> FitResult:
     """Output-error fit of a continuous-time grey-box model ẋ = f(t, x, u, θ), y = h(x, u, θ).
 
     ``model``: a built-in name (``"bouc-wen"``, ``"rigid-body"``, ``"actuator-fixed"``,
@@ -236,6 +248,8 @@ def greybox_fit(
     """
     u, y, ts = check.pair_channels(u, y, ts)
     ts = check.sample_time(ts)
+    # The fitted record, kept for best_fit, residuals and the plots.
+    fitted = Record(_joined(u), _joined(y), ts)
     limit, tell = watching(time_limit, progress)
     args = (
         check.count(starts, "starts"),
@@ -256,14 +270,14 @@ def greybox_fit(
             text = _hysid.greybox_fit_equations(
                 user.equations, u, y, ts, params, *args, check.threads(threads), limit, tell
             )
-            return _finished(Result(json.loads(text)), limit, "greybox_fit")
+            return _finished(FitResult(json.loads(text), data=fitted), limit, "greybox_fit")
         if limit is not None or tell is not None:
             raise ConfigError(
                 "time_limit and progress are not available for a model written as Python functions (its "
                 "callbacks run on the fit's thread); write it as equations (GreyBoxModel.from_equations)"
             )
         text = _hysid.greybox_fit_user(user._spec(), u, y, ts, *args)
-        return Result(json.loads(text), user)
+        return FitResult(json.loads(text), user, fitted)
     if not isinstance(model, str):
         raise TypeError(f"model: give a built-in model name or a hysid.GreyBoxModel, got {type(model).__name__}")
     defaults, _, _ = _hysid.model_parameters(model)
@@ -272,7 +286,7 @@ def greybox_fit(
     text = _hysid.greybox_fit(
         model, u, y, ts, [p.as_tuple() for p in chosen], *args, check.threads(threads), limit, tell
     )
-    return _finished(Result(json.loads(text)), limit, "greybox_fit")
+    return _finished(FitResult(json.loads(text), data=fitted), limit, "greybox_fit")
 
 
 #: Sampling frequency of the Bouc–Wen benchmark records [Hz].
@@ -280,8 +294,8 @@ BOUC_WEN_FS = 750.0
 
 
 def benchmark_bouc_wen(
-    u_train: Any,
-    y_train: Any = None,
+    u_train: SamplesOrRecord,
+    y_train: Optional[Samples] = None,
     *,
     tests: Sequence[Any] = (),
     steady_state: bool = False,
@@ -293,7 +307,7 @@ def benchmark_bouc_wen(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
-) -> Result:
+) -> FitResult:
     """The Bouc–Wen hysteretic benchmark (Noël & Schoukens 2016): fits the Bouc–Wen
     oscillator m ÿ + c ẏ + k y + z = u, ż = α ẏ − β(γ|ẏ||z|^(ν−1) z − δ ẏ|z|^ν)
     (RK4 with ``substeps`` per sample, band-limited input) on the training record from the
@@ -337,12 +351,12 @@ def benchmark_bouc_wen(
         limit,
         tell,
     )
-    return _finished(Result(json.loads(text)), limit, "benchmark_bouc_wen")
+    return _finished(FitResult(json.loads(text)), limit, "benchmark_bouc_wen")
 
 
 def rigid_body_ls(
-    q: Any,
-    u: Any,
+    q: Samples,
+    u: Samples,
     *,
     ts: float,
     gain: float = 1.0,
@@ -355,7 +369,7 @@ def rigid_body_ls(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
-) -> Result:
+) -> FitResult:
     """Rigid-body least squares (step 1 of Gunnar et al., ICRA 2006): position ``q``
     filtered by a zero-phase Butterworth low-pass (``order``, ``cutoff_hz``), velocity and
     acceleration by central differences, and g·u = M q̈ + Fv q̇ + Fc sgn(q̇) (+ offset)
@@ -380,10 +394,15 @@ def rigid_body_ls(
         limit,
         tell,
     )
-    return _finished(Result(json.loads(text)), limit, "rigid_body_ls")
+    return _finished(FitResult(json.loads(text)), limit, "rigid_body_ls")
 
 
-def _finished(result: Result, time_limit: Optional[float], what: str) -> Result:
+def _joined(channels: List[check.FloatArray]) -> check.FloatArray:
+    """One channel as it is, several as the columns of one (samples, channels) array."""
+    return channels[0] if len(channels) == 1 else np.column_stack(channels)
+
+
+def _finished(result: FitResult, time_limit: Optional[float], what: str) -> FitResult:
     """``result``, with the :class:`HysidWarning` of a search its time limit stopped."""
     warn_if_stopped(result.termination_code, time_limit, what)
     return result

@@ -12,6 +12,8 @@ import json
 import math
 from typing import Any, Dict, List, NamedTuple, Optional, Tuple, TypedDict
 
+import numpy as np
+
 from ._fields import Fields, ReportError
 from ._inputs import FloatArray
 from .models import Callbacks, Model, model_in
@@ -34,11 +36,27 @@ class ValidationEntry(TypedDict):
 
 
 class Record(NamedTuple):
-    """The signals a model was fitted to: input ``u``, output ``y``, sample time ``ts``."""
+    """The signals a model was fitted to: input ``u``, output ``y``, sample time ``ts``, and
+    the channels' ``names`` and ``units`` (input, output), which label the plots' axes and
+    name the model file's columns."""
 
     u: FloatArray
     y: FloatArray
     ts: float
+    names: Tuple[str, str] = ("u", "y")
+    units: Tuple[str, str] = ("", "")
+
+
+def labelled(report: Dict[str, Any], record: Record) -> Dict[str, Any]:
+    """``report`` with its model file carrying the record's sample time and channel names
+    (``sample_time``, ``columns``) where the library left them out, as the command line's
+    model files do: so that every export (an FMU needs its sample time) works from a model
+    fitted in Python."""
+    model = report.get("model")
+    if isinstance(model, dict):
+        model.setdefault("sample_time", record.ts)
+        model.setdefault("columns", {"inputs": [record.names[0]], "outputs": [record.names[1]]})
+    return report
 
 
 def _validation_entry(f: Fields) -> ValidationEntry:
@@ -83,6 +101,7 @@ class Result:
     converged: bool
     iterations: Optional[int]
     elapsed_s: Optional[float]
+    nfev: Optional[int]
     uncertainty: Optional[str]
     validation: List[ValidationEntry]
     warnings: List[str]
@@ -100,8 +119,11 @@ class Result:
         fit = f.object("fit")
         self.fit_percent = None if fit is None else fit.get("fit_percent", float)
         self.rmse = None if fit is None else fit.get("rmse", float)
-        self.aic = None if fit is None else fit.optional("aic", float)
-        self.fpe = None if fit is None else fit.optional("fpe", float)
+        raw_details = f.raw("details")
+        details = Fields(raw_details, "report.details") if isinstance(raw_details, dict) else None
+        # A recipe puts AIC and FPE in `fit` or, for one family's fit, in `details`.
+        self.aic = _figure(fit, details, "aic")
+        self.fpe = _figure(fit, details, "fpe")
         search = f.object("search")
         term = None if search is None else search.object("termination")
         if search is not None and term is None:
@@ -111,6 +133,7 @@ class Result:
         self.converged = False if term is None else term.get("converged", bool)
         self.iterations = None if search is None else search.get("iterations", int)
         self.elapsed_s = None if search is None else search.get("elapsed_s", float)
+        self.nfev = None if search is None else search.get("evaluations", int)
         uncertainty = f.object("uncertainty")
         self.uncertainty = None if uncertainty is None else uncertainty.get("method", str)
         self.validation = [_validation_entry(v) for v in f.objects("validation")]
@@ -119,6 +142,35 @@ class Result:
         self.data = data
         self._report = report
         self._user = user
+        self._best_fit: Optional[FloatArray] = None
+
+    @property
+    def free_parameters(self) -> Tuple[str, ...]:
+        """The names of the parameters that were estimated and have a standard deviation
+        (neither fixed nor at a bound), in the model's order."""
+        return tuple(n for n, p in self.parameters.items() if not p.fixed and p.std is not None)
+
+    @property
+    def best_fit(self) -> Optional[FloatArray]:
+        """The model's output on the data it was fitted to, simulated from the first
+        measured output as the report's fit % is computed (so ``100 (1 − ‖residuals‖ /
+        ‖y − ȳ‖)`` is ``fit_percent``); None when the result keeps no data (``data``)."""
+        if self.data is None or self.model is None:
+            return None
+        if self._best_fit is None:
+            u, y, ts = self.data.u, self.data.y, self.data.ts
+            y0 = float(y[0]) if y.ndim == 1 else None
+            self._best_fit = np.asarray(self.model.simulate(u, ts=ts, y0=y0), dtype=np.float64)
+        return self._best_fit.copy()
+
+    @property
+    def residuals(self) -> Optional[FloatArray]:
+        """y − :attr:`best_fit` on the fitted data: the system-identification sign, measured
+        minus simulated (lmfit's ``residual`` is the opposite); None without ``data``."""
+        fitted = self.best_fit
+        if fitted is None or self.data is None:
+            return None
+        return np.asarray(self.data.y - fitted, dtype=np.float64)
 
     def report(self) -> Dict[str, Any]:
         """The ``hysid.report/1`` report as a dict (a copy)."""
@@ -137,6 +189,8 @@ class Result:
             ("RMSE", _num(self.rmse, ".6e")),
             ("AIC", _num(self.aic, ".2f")),
             ("FPE", _num(self.fpe, ".6e")),
+            ("# fcn evals", "" if self.nfev is None else str(self.nfev)),
+            ("# variables", str(len(self.free_parameters))),
         ]
         lines = [f"[[Fit: {self.command}]]"]
         lines += [f"    {name:<12}= {value}" for name, value in figures if value]
@@ -219,7 +273,38 @@ class Result:
         return f"Result({self.command}: {values}; fit {fit})"
 
     def __reduce__(self) -> Tuple[Any, ...]:
-        return (_result_from_json, (json.dumps(self._report), self._user, self.data))
+        return (_rebuilt, (type(self), json.dumps(self._report), self._user, self.data))
+
+
+class FitResult(Result):
+    """The :class:`Result` of a recipe that always fits a model and scores it
+    (:func:`~hysid.identify_operator`, :func:`~hysid.identify_cascade`,
+    :func:`~hysid.identify_hysteresis`, :func:`~hysid.greybox_fit`,
+    :func:`~hysid.benchmark_bouc_wen`, :func:`~hysid.rigid_body_ls`, and each family's result
+    in a :class:`~hysid.Comparison`): ``model``, ``fit_percent`` and ``rmse`` are never None,
+    so typed code uses them without a check. A report without a model or a fit is a
+    :class:`ReportError` at construction."""
+
+    model: Model
+    fit_percent: float
+    rmse: float
+
+    def __init__(self, report: Dict[str, Any], user: Optional[Callbacks] = None, data: Optional[Record] = None) -> None:
+        super().__init__(report, user, data)
+        # The base class reads them as optional; this class promises them.
+        if self.model is None:
+            raise ReportError(f"report.model is null; a {self.command} report holds the fitted model")
+        if self.fit_percent is None or self.rmse is None:
+            raise ReportError(f"report.fit is null; a {self.command} report scores its fit")
+
+
+def _figure(fit: Optional[Fields], details: Optional[Fields], key: str) -> Optional[float]:
+    """The number ``key`` of the report's ``fit`` or, when that holds none, of its
+    ``details``; None when neither has one."""
+    value = None if fit is None else fit.optional(key, float)
+    if value is None and details is not None:
+        value = details.absent_or(key, float)
+    return value
 
 
 def _num(v: Optional[float], spec: str) -> str:
@@ -236,8 +321,16 @@ def _parameter_line(p: Parameter) -> str:
         text += f" [{p.unit}]"
     if p.fixed:
         text += " (fixed)"
+    elif p.at_bound:
+        text += " (at bound)"
     return text
 
 
 def _result_from_json(text: str, user: Optional[Callbacks] = None, data: Optional[Record] = None) -> Result:
+    # Kept for results pickled before FitResult existed.
     return Result(json.loads(text), user, data)
+
+
+def _rebuilt(cls: type[Result], text: str, user: Optional[Callbacks], data: Optional[Record]) -> Result:
+    """An unpickled :class:`Result` or :class:`FitResult`: rebuilt from its report."""
+    return cls(json.loads(text), user, data)

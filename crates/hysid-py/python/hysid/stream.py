@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import json
 import math
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 import numpy as np
 
 from . import _hysid
+from ._inputs import FloatArray, Samples
 
 if TYPE_CHECKING:  # pragma: no cover
     from .models import Model
@@ -47,14 +48,14 @@ class Stepper:
         """Back to the model's initial state."""
         self._inner.reset()
 
-    def step(self, u: Any) -> Any:
+    def step(self, u: Union[float, Samples]) -> Union[float, FloatArray]:
         """The output for one input sample (a float, or one value per input); a float for a
         model of one output, else an array."""
         values = [float(v) for v in np.atleast_1d(np.asarray(u, dtype=np.float64))]
         y = self._inner.step(values)
         return y[0] if len(y) == 1 else np.asarray(y)
 
-    def run(self, u: Any) -> np.ndarray:
+    def run(self, u: Samples) -> FloatArray:
         """The outputs for the input samples ``u`` (1-D, or 2-D (samples, inputs)) from the
         current state: 1-D for one output, ``(samples, outputs)`` otherwise."""
         a = np.asarray(u, dtype=np.float64)
@@ -94,7 +95,7 @@ class Compensator:
         u, _, _ = self._inner.step(float(r))
         return float(u)
 
-    def run(self, r: Any) -> np.ndarray:
+    def run(self, r: Samples) -> FloatArray:
         """The commands for the references ``r`` (1-D) from the current state."""
         u, _ = self._inner.run(np.ascontiguousarray(np.asarray(r, dtype=np.float64)))
         return np.asarray(u, dtype=np.float64)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from typing import Any, List, Literal, NamedTuple, Optional, Sequence, Union
+from typing import Any, List, Literal, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -16,11 +16,12 @@ from . import _hysid
 from . import _inputs as check
 from ._families import FAMILIES, FamilyName
 from ._hysid import ConfigError
+from ._inputs import RecordLike, Samples, SamplesOrRecord
 from .comparison import Comparison
 from .compensation import Compensation
 from .models import Model, load_model
 from .progress import ProgressArg, warn_if_stopped, watching
-from .results import Record, Result
+from .results import FitResult, Record, Result, labelled
 
 #: ``families="all"``: every family of the registry.
 AllFamilies = Literal["all"]
@@ -71,8 +72,8 @@ def _family(name: Any, what: str = "family") -> str:
 
 
 def identify_operator(
-    u: Any,
-    y: Any = None,
+    u: SamplesOrRecord,
+    y: Optional[Samples] = None,
     *,
     family: FamilyName,
     ts: float = 1.0,
@@ -84,7 +85,9 @@ def identify_operator(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
-) -> Result:
+    names: Optional[Tuple[str, str]] = None,
+    units: Optional[Tuple[str, str]] = None,
+) -> FitResult:
     """Fits one hysteresis family y = Γ[u] to a measured input ``u`` and output ``y`` from
     the data alone (no initial guess): the CLI's ``hysid identify operator``, the same
     estimates and report.
@@ -100,7 +103,12 @@ def identify_operator(
     branches (a :class:`DataError` naming this argument when the record cannot tell); the
     report's ``details.orientation`` and ``details.orientation_source`` say which was used.
     An unknown family or an option out of range is a :class:`ConfigError` (a ``ValueError``).
+    ``names`` and ``units``: the (input, output) channels' names and units, e.g.
+    ``names=("voltage", "displacement"), units=("V", "µm")``, which label the plots' axes
+    and name the model file's columns (default: the names the arrays carry, a pandas
+    Series' ``.name``, else ``("u", "y")``).
     """
+    labels, unit_labels = check.channel_labels(names, units, u, y)
     u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
     step = check.sample_time(given_ts, 1.0)
     name = _family(family)
@@ -109,16 +117,17 @@ def identify_operator(
     text = _hysid.identify_operator(
         u, y, name, step, *options, check.threads(threads), _orientation(orientation), limit, tell
     )
-    result = Result(json.loads(text), data=Record(u, y, step))
+    record = Record(u, y, step, labels, unit_labels)
+    result = FitResult(labelled(json.loads(text), record), data=record)
     warn_if_stopped(result.termination_code, limit, "identify_operator")
     return result
 
 
 def compare(
-    u: Any,
-    y: Any = None,
+    u: SamplesOrRecord,
+    y: Optional[Samples] = None,
     *,
-    validate: Any = None,
+    validate: Union[RecordLike, Tuple[Samples, Samples], None] = None,
     families: Union[AllFamilies, Sequence[FamilyName]] = "all",
     ts: float = 1.0,
     thresholds: Union[int, Sequence[float]] = 10,
@@ -129,6 +138,8 @@ def compare(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
+    names: Optional[Tuple[str, str]] = None,
+    units: Optional[Tuple[str, str]] = None,
 ) -> Comparison:
     """Fits several hysteresis families to one record and ranks them by how well they
     predict data they were not fitted to: the CLI's ``hysid compare``, the same ranking
@@ -140,26 +151,39 @@ def compare(
     training part carries over). ``families``: ``"all"`` (the registry's, :data:`FAMILIES`)
     or a list of names. The options are :func:`identify_operator`'s. A family whose fit
     fails keeps its error in its row (:attr:`Comparison.errors`); the others go on.
+    ``names`` and ``units``: the (input, output) channels' names and units, e.g.
+    ``names=("voltage", "displacement"), units=("V", "µm")``, which label the plots' axes
+    and name the model file's columns (default: the names the arrays carry, a pandas
+    Series' ``.name``, else ``("u", "y")``).
     """
+    labels, unit_labels = check.channel_labels(names, units, u, y)
     u, y, given_ts = check.pair(u, y, ("u", "y"), ts)
     step = check.sample_time(given_ts, 1.0)
-    names = _families(families)
+    chosen = _families(families)
     u_val: Optional[check.FloatArray] = None
     y_val: Optional[check.FloatArray] = None
     if validate is not None:
-        if hasattr(validate, "u") and hasattr(validate, "y"):
-            pair = (validate.u, validate.y)
-        elif isinstance(validate, (tuple, list)) and len(validate) == 2:
+        pair: Tuple[Samples, Samples]
+        if isinstance(validate, (tuple, list)) and len(validate) == 2:
             pair = (validate[0], validate[1])
+        elif hasattr(validate, "u") and hasattr(validate, "y"):
+            record: RecordLike = validate
+            pair = (record.u, record.y)
         else:
             raise TypeError("validate: give a pair (u_val, y_val) or a record with .u and .y")
         u_val, y_val, _ = check.pair(pair[0], pair[1], ("validate u", "validate y"), None)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
     limit, tell = watching(time_limit, progress)
     report, results, v_in, v_out, simulated = _hysid.compare(
-        u, y, u_val, y_val, names, step, *options, check.threads(threads), _orientation(orientation), limit, tell
+        u, y, u_val, y_val, chosen, step, *options, check.threads(threads), _orientation(orientation), limit, tell
     )
-    comparison = Comparison.from_extension(report, results, Record(v_in, v_out, step), simulated, Record(u, y, step))
+    comparison = Comparison.from_extension(
+        report,
+        results,
+        Record(v_in, v_out, step, labels, unit_labels),
+        simulated,
+        Record(u, y, step, labels, unit_labels),
+    )
     warn_if_stopped(comparison.termination_code, limit, "compare")
     return comparison
 
@@ -180,7 +204,7 @@ def _families(families: Any) -> List[str]:
 
 def compensate(
     model: Union[Model, Result, str, "os.PathLike[str]"],
-    reference: Any,
+    reference: Samples,
     *,
     ts: Optional[float] = None,
 ) -> Compensation:
@@ -207,4 +231,8 @@ def compensate(
     r = check.array(reference, "reference")
     step = check.sample_time(ts, 1.0)
     report, u, predicted = _hysid.compensate(json.dumps(model.file), r, step, source)
-    return Compensation(json.loads(report), r, u, predicted, step)
+    parsed = json.loads(report)
+    # The report's model keeps the given model's channel names (the plots' labels).
+    if isinstance(parsed.get("model"), dict) and "columns" in model.file:
+        parsed["model"].setdefault("columns", model.file["columns"])
+    return Compensation(parsed, r, u, predicted, step)
