@@ -101,7 +101,9 @@ class Comparison:
             raise ReportError("compare: the families' results do not match the report's rows")
         fitted = training._replace(u=training.u[:train], y=training.y[:train])
         self.results = {
-            name: FitResult(labelled(json.loads(text), fitted), data=fitted) for name, text in results if text is not None
+            name: FitResult(labelled(json.loads(text), fitted), data=fitted)
+            for name, text in results
+            if text is not None
         }
         self.errors = {r["family"]: r["error"] for r in self.table if r["error"] is not None}
         self.validation = validation
