@@ -105,6 +105,10 @@ class Comparison:
             for name, text in results
             if text is not None
         }
+        # The best family's model as its result holds it (with the record's sample time and
+        # channel names), the same as the report's otherwise.
+        if self.best is not None and self.best in self.results:
+            self.model = self.results[self.best].model
         self.errors = {r["family"]: r["error"] for r in self.table if r["error"] is not None}
         self.validation = validation
         self.simulated = {r["family"]: s for r, s in zip(self.table, simulated) if r["family"] in self.results}
