@@ -4,6 +4,7 @@ Optional; AIC/FPE wherever the report has them; each parameter's `at_bound`; the
 parameters; the fitted output and the residuals, checked against the report's fit %; the
 number of function evaluations."""
 
+import pathlib
 import pickle
 import typing
 
@@ -63,7 +64,7 @@ def fit_percent_of(y: np.ndarray, yhat: np.ndarray) -> float:
 def results() -> typing.Dict[str, hysid.FitResult]:
     u, y = play_record()
     x = np.repeat([5.0, 4.0, 3.5, 2.5], 250) * np.sin(2 * np.pi * np.arange(1000) / 40)
-    truth = hysid.load_model(__import__("pathlib").Path(__file__).parent / "data" / "example1_cli_model.json")
+    truth = hysid.load_model(pathlib.Path(__file__).parent / "data" / "example1_cli_model.json")
     yc = truth.simulate(x, ts=1.0) + 0.01 * np.random.default_rng(0).standard_normal(x.size)
     ub, yb = bouc_wen_record()
     ug = np.sin(np.arange(400) * 0.05) + 0.5 * np.sin(np.arange(400) * 0.37)

@@ -62,11 +62,10 @@ def _fitted(result: "Result") -> Tuple[FloatArray, FloatArray, FloatArray, float
             "this result keeps no data to plot (the recipes of one input and one output keep it: "
             "identify_operator, identify_cascade, identify_hysteresis, compare)"
         )
-    if result.model is None:
+    fitted = result.best_fit
+    if fitted is None:
         raise ValueError("this result has no model to simulate")
-    u, y, ts = result.data.u, result.data.y, result.data.ts
-    yhat = np.ravel(result.model.simulate(u, ts=ts, y0=float(y[0])))
-    return u, y, yhat, ts
+    return result.data.u, result.data.y, np.ravel(fitted), result.data.ts
 
 
 def _time(n: int, ts: float) -> FloatArray:
