@@ -22,3 +22,16 @@ def test_notebook_runs(name, monkeypatch):
     errors = [o for c in book.cells if c.cell_type == "code" for o in c.get("outputs", []) if o.output_type == "error"]
     assert not errors
     assert sum(c.cell_type == "code" for c in book.cells) >= 4
+
+
+@pytest.mark.parametrize("name", ["piezo_compensation.ipynb", "bouc_wen_benchmark.ipynb"])
+def test_notebook_ships_with_its_outputs(name):
+    """The shipped file holds one run from top to bottom (`examples/notebooks/execute.py`):
+    every code cell executed, in order, and each one that prints or draws kept its output."""
+    book = nbformat.read(NOTEBOOKS / name, as_version=4)
+    code = [c for c in book.cells if c.cell_type == "code"]
+    assert [c.execution_count for c in code] == list(range(1, len(code) + 1))
+    assert all(c.outputs for c in code)
+    assert not [o for c in code for o in c.outputs if o.output_type == "error"]
+    if name == "piezo_compensation.ipynb":
+        assert any("image/png" in o.get("data", {}) for c in code for o in c.outputs)
