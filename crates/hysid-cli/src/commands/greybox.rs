@@ -56,7 +56,7 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         lm: LmConfig {
             max_iterations: args.search.max_iterations,
             improvement_tolerance: args.search.tolerance,
-            ..LmConfig::default()
+            ..GreyBoxEstimation::default().lm
         },
         starts: args.search.starts.max(1),
         seed: args.search.seed,

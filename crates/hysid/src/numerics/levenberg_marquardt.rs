@@ -9,7 +9,10 @@
 //! ```
 //!
 //! for the free parameters, where J = ∂r/∂θ. Scaling by diag(JᵀJ) makes the step invariant to
-//! the parameters' units. The damping λ follows Nielsen's rule (λ·max(1/3, 1 − (2ρ − 1)³) on
+//! the parameters' units. With [`DampingScale::RunningMax`] D is instead the largest
+//! diag(JᵀJ) seen so far on the search's path (Moré 1978, §3; the scaling of MINPACK's
+//! `lmder`): a parameter whose column shrinks along the path (a saturating exponential, an
+//! amplitude heading to zero) keeps the damping it had, so the search does not leap along it. The damping λ follows Nielsen's rule (λ·max(1/3, 1 − (2ρ − 1)³) on
 //! success, λ·ν with ν doubling on failure), where ρ is the ratio of the actual to the
 //! predicted decrease of S.
 //!
@@ -185,6 +188,19 @@ pub struct LmConfig {
     pub initial_damping: f64,
     /// Relative finite-difference step (times max(|θⱼ|, 1e-3·typical)).
     pub fd_step: f64,
+    /// The scale D of the damping term λ·D.
+    pub damping_scale: DampingScale,
+}
+
+/// The scale D of the damping term λ·D of [`LmConfig`] (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DampingScale {
+    /// D = diag(JᵀJ) at the current point (Marquardt 1963).
+    Current,
+    /// D = the elementwise largest diag(JᵀJ) of the points the search has accepted (Moré
+    /// 1978), which the grey-box fits use: it takes NIST's MGH09, Eckerle4 and MGH17 from
+    /// their far starts to the certified minimum (`docs/numerics.md` §1.1).
+    RunningMax,
 }
 
 impl Default for LmConfig {
@@ -197,6 +213,7 @@ impl Default for LmConfig {
             gradient_tolerance: 1e-12,
             initial_damping: 1e-3,
             fd_step: 1e-7,
+            damping_scale: DampingScale::Current,
         }
     }
 }
@@ -391,7 +408,12 @@ struct State<'a> {
     /// True once the improvement test has passed at a point where the Gauss–Newton step was
     /// not yet small: the search then stops on the parameter test alone.
     refining: bool,
+    /// D of the damping term, per free parameter ([`LmConfig::damping_scale`]).
+    scale: Vec<f64>,
 }
+
+/// Gauss–Newton steps at most at an exact fit ([`State::polish`]).
+const POLISH_STEPS: usize = 5;
 
 /// Outcome of one damped step.
 enum StepOutcome {
@@ -448,6 +470,7 @@ impl<'a> State<'a> {
             rejected: 0,
             history: Vec::new(),
             refining: false,
+            scale: Vec::new(),
         };
         state.system = match analytic {
             Some(system) => {
@@ -466,6 +489,7 @@ impl<'a> State<'a> {
             }
         };
         state.initial_cost = state.system.cost;
+        state.scale = state.system.jtj.diagonal().iter().copied().collect();
         // D = diag(JᵀJ) carries the scale, so λ itself is dimensionless.
         state.lambda = config.initial_damping;
         Ok(state)
@@ -480,6 +504,7 @@ impl<'a> State<'a> {
         }
         loop {
             if self.problem.is_exact_fit(self.system.cost) {
+                self.polish();
                 return Ok(Termination::ZeroResidual);
             }
             if self.gradient_is_small() {
@@ -531,6 +556,45 @@ impl<'a> State<'a> {
                         self.refining = true;
                     }
                 }
+            }
+        }
+    }
+
+    /// At an exact fit (S at the problem's rounding floor), Gauss–Newton steps while they
+    /// lower S, at most [`POLISH_STEPS`]: the floor is a bound, and S — hence σ² and the
+    /// standard deviations, which scale with √S — settles only at the rounding level itself
+    /// (NIST's Lanczos1, S ≈ 1.4·10⁻²⁵). Only the rule with the parameter test polishes
+    /// ([`LmConfig::parameter_tolerance`] finite); the improvement rule keeps its bits.
+    fn polish(&mut self) {
+        if !self.config.parameter_tolerance.is_finite() {
+            return;
+        }
+        for _ in 0..POLISH_STEPS {
+            let Some(candidate) = self.candidate_with(0.0) else {
+                return;
+            };
+            let mut trial = std::mem::take(&mut self.trial);
+            trial.resize(self.problem.n_residuals(), 0.0);
+            self.fevals += 1;
+            self.plain_evals += 1;
+            let cost = self.problem.residuals_and_cost(&candidate, &mut trial);
+            let better = matches!(cost, Ok(c) if c < self.system.cost);
+            if better {
+                let saved = std::mem::replace(&mut self.theta, candidate);
+                std::mem::swap(&mut self.residuals, &mut trial);
+                match self.normal_equations() {
+                    Ok(system) => self.system = system,
+                    Err(_) => {
+                        self.theta = saved;
+                        std::mem::swap(&mut self.residuals, &mut trial);
+                        self.trial = trial;
+                        return;
+                    }
+                }
+            }
+            self.trial = trial;
+            if !better {
+                return;
             }
         }
     }
@@ -626,6 +690,7 @@ impl<'a> State<'a> {
                 match self.normal_equations() {
                     Ok(system) => {
                         self.system = system;
+                        self.update_scale();
                         self.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
                         self.nu = 2.0;
                         return StepOutcome::Accepted {
@@ -648,6 +713,17 @@ impl<'a> State<'a> {
     fn grow_damping(&mut self) {
         self.lambda *= self.nu;
         self.nu *= 2.0;
+    }
+
+    /// D after a new point's normal equations ([`DampingScale`]).
+    fn update_scale(&mut self) {
+        let diagonal = self.system.jtj.diagonal();
+        for (d, &now) in self.scale.iter_mut().zip(diagonal.iter()) {
+            *d = match self.config.damping_scale {
+                DampingScale::Current => now,
+                DampingScale::RunningMax => d.max(now),
+            };
+        }
     }
 
     /// The projected trial point for the current λ, or None when the damped system cannot be
@@ -691,7 +767,7 @@ impl<'a> State<'a> {
         let a = DMatrix::from_fn(m, m, |r, c| {
             let v = jtj[(idx[r], idx[c])];
             if r == c {
-                v + lambda * jtj[(idx[r], idx[r])].max(floor)
+                v + lambda * self.scale[idx[r]].max(floor)
             } else {
                 v
             }

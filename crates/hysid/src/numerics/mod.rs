@@ -28,7 +28,9 @@ pub mod signal;
 pub mod termination;
 
 pub use least_squares::{least_squares, LsSolution};
-pub use levenberg_marquardt::{Control, Covariance, IterationRecord, LmConfig, LmReport};
+pub use levenberg_marquardt::{
+    Control, Covariance, DampingScale, IterationRecord, LmConfig, LmReport,
+};
 pub use progress::{Observer, Progress};
 pub use termination::Termination;
 
