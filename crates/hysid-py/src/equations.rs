@@ -106,6 +106,7 @@ fn equation_model_file(
             parameters,
             simulation: simulation(integrator, substeps, interpolation)?,
             initial_state: x0,
+            evaluator: hysid::model::greybox::native::Evaluator::Auto,
         }
         .to_file();
         serde_json::to_string(&file).map_err(|e| Error::Serialization(format!("model: {e}")))

@@ -2,7 +2,7 @@
 //! on the benchmark's estimation record, saved, and re-simulated by `hysid simulate` on the
 //! validation record; and the one-line errors of a bad file or of two models.
 
-use crate::common::{hysid, one_line_error, read_json, Assert};
+use crate::common::{fails_with, hysid, one_line_error, read_json, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
@@ -102,19 +102,21 @@ fn a_bad_equation_file_is_one_line_with_its_place() {
         .contains("cannot be used with"));
 }
 
-/// The evaluator of equation files (`HYSID_EVALUATOR`): native code generated in the
-/// process (no compiler needed), native code compiled by the C compiler into the cache
-/// `HYSID_CACHE_DIR`, the tape interpreter, and `auto` without a compiler all give the same
-/// report figures to the bit, and the report says which ran; `cc` without a compiler and
-/// an unknown evaluator are one-line errors.
+/// The evaluator of equation files, chosen by `--evaluator auto|cc|tape` or else by
+/// `HYSID_EVALUATOR`: native code compiled by the C compiler into the cache
+/// `HYSID_CACHE_DIR` (then loaded from it), the tape interpreter, and `auto` without a
+/// compiler all give the same report figures to the bit, and the report says which ran;
+/// `--evaluator cc` without a compiler (exit 1), `HYSID_EVALUATOR=jit` (the removed encoder)
+/// and an unknown evaluator (exit 2) are one-line errors, and the flag wins over the
+/// variable.
 #[test]
 fn native_code_and_the_tape_fit_the_same() {
     let dir = TempDir::new().unwrap();
     let cache = dir.path().join("cache");
-    let fit = |evaluator: &str, cc: &str, name: &str| {
+    let fit = |flag: Option<&str>, env: Option<&str>, cc: &str, name: &str| {
         let report = dir.path().join(format!("{name}.json"));
         let mut cmd = hysid();
-        cmd.env("HYSID_EVALUATOR", evaluator)
+        cmd.env_remove("HYSID_EVALUATOR")
             .env("HYSID_CACHE_DIR", &cache)
             .env("CC", cc)
             .args(["-q", "greybox", "fit", "--model-file"])
@@ -124,6 +126,12 @@ fn native_code_and_the_tape_fit_the_same() {
             .args(["--input", "u_V", "--output", "y_V", "--starts", "1"])
             .args(["--substeps", "2", "--json"])
             .arg(&report);
+        if let Some(flag) = flag {
+            cmd.args(["--evaluator", flag]);
+        }
+        if let Some(env) = env {
+            cmd.env("HYSID_EVALUATOR", env);
+        }
         (cmd, report)
     };
     let figures = |report: &Path| {
@@ -136,48 +144,60 @@ fn native_code_and_the_tape_fit_the_same() {
             .unwrap()
             .to_string()
     };
-    let generated = hysid::model::greybox::native::Backend::Generated.available();
 
-    let (mut compiled, compiled_report) = fit("cc", "cc", "cc");
+    let (mut compiled, compiled_report) = fit(Some("cc"), Some("jit"), "cc", "cc");
     compiled.assert().success();
     let objects = fs::read_dir(cache.join("native")).unwrap().count();
     assert!(objects >= 2, "{objects} files in the cache");
-    assert!(evaluation(&compiled_report).starts_with("native code (compiled now"));
-    let (mut tape, tape_report) = fit("tape", "cc", "tape");
-    tape.assert().success();
-    assert_eq!(figures(&compiled_report), figures(&tape_report));
+    let said = evaluation(&compiled_report);
+    assert!(said.starts_with("native code (compiled now: "), "{said}");
+    let (mut cached, cached_report) = fit(None, Some("native"), "cc", "cached");
+    cached.assert().success();
+    assert_eq!(figures(&compiled_report), figures(&cached_report));
     assert_eq!(
-        evaluation(&tape_report),
-        "tape interpreter (HYSID_EVALUATOR=tape)"
+        evaluation(&cached_report),
+        "native code (loaded from the cache)"
     );
-    let (mut auto, auto_report) = fit("auto", "/nonexistent/cc", "auto");
+    for (flag, env, name) in [
+        (Some("tape"), Some("cc"), "tape"),
+        (None, Some("tape"), "env"),
+    ] {
+        let (mut tape, tape_report) = fit(flag, env, "cc", name);
+        tape.assert().success();
+        assert_eq!(figures(&compiled_report), figures(&tape_report));
+        assert_eq!(
+            evaluation(&tape_report),
+            "tape interpreter (evaluator tape chosen)"
+        );
+    }
+    let (mut auto, auto_report) = fit(Some("auto"), None, "/nonexistent/cc", "auto");
+    auto.env("HYSID_CACHE_DIR", dir.path().join("auto-cache"));
     auto.assert().success();
     assert_eq!(figures(&compiled_report), figures(&auto_report));
     let auto = evaluation(&auto_report);
-    if generated {
-        assert!(
-            auto.starts_with("native code (generated in the process in "),
-            "{auto}"
-        );
-        let (mut jit, jit_report) = fit("jit", "/nonexistent/cc", "jit");
-        jit.assert().success();
-        assert_eq!(figures(&compiled_report), figures(&jit_report));
-    } else {
-        assert!(
-            auto.starts_with("tape interpreter (no native code: no C compiler"),
-            "{auto}"
-        );
-    }
-
-    let (mut refused, _) = fit("cc", "/nonexistent/cc", "refused");
-    let fresh = dir.path().join("empty-cache");
-    refused.env("HYSID_CACHE_DIR", &fresh);
-    let err = one_line_error(&mut refused);
     assert!(
-        err.contains("no native code") && err.contains("/nonexistent/cc"),
+        auto.starts_with("tape interpreter (no native code: ") && auto.contains("/nonexistent/cc"),
+        "{auto}"
+    );
+
+    let (mut refused, _) = fit(Some("cc"), None, "/nonexistent/cc", "refused");
+    refused.env("HYSID_CACHE_DIR", dir.path().join("empty-cache"));
+    let err = fails_with(&mut refused, 1);
+    assert!(
+        err.contains("no native code for the evaluator 'cc'") && err.contains("/nonexistent/cc"),
         "{err}"
     );
-    let (mut unknown, _) = fit("fast", "cc", "unknown");
-    let err = one_line_error(&mut unknown);
-    assert!(err.contains("HYSID_EVALUATOR is 'fast'"), "{err}");
+    let (mut jit, _) = fit(None, Some("jit"), "cc", "jit");
+    let err = fails_with(&mut jit, 2);
+    assert!(
+        err.contains("HYSID_EVALUATOR")
+            && err.contains("removed")
+            && err.contains("auto, native, cc or tape"),
+        "{err}"
+    );
+    let (mut unknown, _) = fit(None, Some("fast"), "cc", "unknown");
+    let err = fails_with(&mut unknown, 2);
+    assert!(err.contains("'fast' is not an equation evaluator"), "{err}");
+    let (mut flag, _) = fit(Some("jit"), None, "cc", "flag");
+    fails_with(&mut flag, 2);
 }

@@ -46,8 +46,8 @@
 
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
-use crate::model::greybox::native::Evaluator;
 use crate::model::greybox::models::GreyBoxKind;
+use crate::model::greybox::native::Evaluator;
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::operators::OperatorModel;
 use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};

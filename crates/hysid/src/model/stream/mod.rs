@@ -304,8 +304,8 @@ impl FittedModel {
                 evaluator,
                 ..
             } => {
-                let model = EquationStateSpace::parse(equations, "saved model")?
-                    .with_evaluator(*evaluator);
+                let model =
+                    EquationStateSpace::parse(equations, "saved model")?.with_evaluator(*evaluator);
                 grey_box(
                     Box::new(model),
                     parameters.values(),
