@@ -201,3 +201,70 @@ fn native_code_and_the_tape_fit_the_same() {
     let (mut flag, _) = fit(Some("jit"), None, "cc", "flag");
     fails_with(&mut flag, 2);
 }
+
+/// A grey-box fit (built-in model or equation file) of a record whose input is constant is
+/// refused in one line with the non-exciting-input error (exit 1), no report written,
+/// instead of a report with undefined (null) input–residual cross-correlations; the same
+/// record with a moving input fits.
+#[test]
+fn a_constant_input_is_refused_as_not_exciting() {
+    let dir = TempDir::new().unwrap();
+    let model = dir.path().join("first_order.toml");
+    fs::write(
+        &model,
+        "[model]\nname = \"first_order\"\nstates = [\"x\"]\ninputs = [\"u\"]\noutputs = [\"y\"]\n\
+         [parameters]\na = { value = 1.0, lower = 0.01, upper = 100.0 }\n\
+         b = { value = 1.0, lower = -100.0, upper = 100.0 }\n\
+         [equations]\nx = \"-a*x + b*u\"\n[output]\ny = \"x\"\n",
+    )
+    .unwrap();
+    let record = |name: &str, u: fn(f64) -> f64| {
+        let path = dir.path().join(name);
+        let mut text = String::from("t,u,y\n");
+        for k in 0..400 {
+            let t = 0.05 * k as f64;
+            text += &format!("{t},{},{}\n", u(t), (0.3 * t).sin());
+        }
+        fs::write(&path, text).unwrap();
+        path
+    };
+    let constant = record("constant.csv", |_| 1.5);
+    let moving = record("moving.csv", |t| (0.3 * t).cos());
+    let fit = |data: &Path, how: &[&str], name: &str| {
+        let report = dir.path().join(format!("{name}.json"));
+        let mut cmd = hysid();
+        cmd.env_remove("HYSID_EVALUATOR")
+            .args(["-q", "greybox", "fit"])
+            .args(how)
+            .arg("--data")
+            .arg(data)
+            .args(["--input", "u", "--output", "y", "--json"])
+            .arg(&report);
+        (cmd, report)
+    };
+    let file = model.to_str().unwrap();
+    for (how, name) in [
+        (&["--model-file", file, "--evaluator", "tape"][..], "equations"),
+        (&["--model", "bouc-wen"][..], "built-in"),
+    ] {
+        let (mut cmd, report) = fit(&constant, how, name);
+        let err = fails_with(&mut cmd, 1);
+        assert!(
+            err.contains("input 'u' does not excite the system") && err.contains("constant"),
+            "{name}: {err}"
+        );
+        assert!(!report.exists(), "{name}: a report was written");
+    }
+    let (mut cmd, report) = fit(&moving, &["--model-file", file, "--evaluator", "tape"], "moving");
+    cmd.assert().success();
+    let r = json(&report);
+    let analysis = &r["details"]["residual_analysis"];
+    assert!(
+        !analysis.to_string().contains("null"),
+        "{analysis}"
+    );
+    // --evaluator is about equation files: with a built-in model it is a usage error.
+    let (mut cmd, _) = fit(&moving, &["--model", "bouc-wen", "--evaluator", "cc"], "usage");
+    let err = fails_with(&mut cmd, 2);
+    assert!(err.contains("--evaluator") && err.contains("--model-file"), "{err}");
+}
