@@ -244,7 +244,10 @@ fn a_constant_input_is_refused_as_not_exciting() {
     };
     let file = model.to_str().unwrap();
     for (how, name) in [
-        (&["--model-file", file, "--evaluator", "tape"][..], "equations"),
+        (
+            &["--model-file", file, "--evaluator", "tape"][..],
+            "equations",
+        ),
         (&["--model", "bouc-wen"][..], "built-in"),
     ] {
         let (mut cmd, report) = fit(&constant, how, name);
@@ -255,16 +258,24 @@ fn a_constant_input_is_refused_as_not_exciting() {
         );
         assert!(!report.exists(), "{name}: a report was written");
     }
-    let (mut cmd, report) = fit(&moving, &["--model-file", file, "--evaluator", "tape"], "moving");
+    let (mut cmd, report) = fit(
+        &moving,
+        &["--model-file", file, "--evaluator", "tape"],
+        "moving",
+    );
     cmd.assert().success();
     let r = json(&report);
     let analysis = &r["details"]["residual_analysis"];
-    assert!(
-        !analysis.to_string().contains("null"),
-        "{analysis}"
-    );
+    assert!(!analysis.to_string().contains("null"), "{analysis}");
     // --evaluator is about equation files: with a built-in model it is a usage error.
-    let (mut cmd, _) = fit(&moving, &["--model", "bouc-wen", "--evaluator", "cc"], "usage");
+    let (mut cmd, _) = fit(
+        &moving,
+        &["--model", "bouc-wen", "--evaluator", "cc"],
+        "usage",
+    );
     let err = fails_with(&mut cmd, 2);
-    assert!(err.contains("--evaluator") && err.contains("--model-file"), "{err}");
+    assert!(
+        err.contains("--evaluator") && err.contains("--model-file"),
+        "{err}"
+    );
 }
