@@ -19,7 +19,8 @@ from . import _inputs as check
 from ._families import FAMILIES, FamilyName
 from ._hysid import ConfigError, DataError
 from ._inputs import Samples, SamplesOrRecord
-from .greybox import Evaluator, GreyBoxModel, Integrator, Interpolation
+from .greybox import GreyBoxModel, Integrator, Interpolation
+from .models import Evaluator
 from .parameters import Parameter
 from .progress import ProgressArg, warn_if_stopped, watching
 from .results import FitResult, Record, labelled
