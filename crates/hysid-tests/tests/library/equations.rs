@@ -656,8 +656,8 @@ fn bouc_wen_file_fit_equals_the_built_in_fit() {
 
 /// The performance issue's user-model route: the Bouc–Wen equation file fitted to the
 /// benchmark's training record from every free parameter at twice its nominal value (one
-/// start, RK4 × 4, band-limited input), run as native code (generated in the process, and
-/// compiled by the C compiler) and by the tape interpreter, against the built-in model from
+/// start, RK4 × 4, band-limited input), run as native code (compiled by the C compiler) and
+/// by the tape interpreter, against the built-in model from
 /// the same start. Native and tape give the same estimates to the bit; the file gives the
 /// built-in's to 1e-9 relative.
 #[test]
@@ -693,7 +693,7 @@ fn bouc_wen_file_fit_from_twice_nominal_is_the_built_in_fit_native_or_taped() {
     let tape = fit(Arc::new(
         example("bouc_wen").with_evaluator(Evaluator::Tape),
     ));
-    // Native code by each route this machine has: generated in the process, compiled.
+    // Native code where this machine has the route (the C compiler's).
     for evaluator in [Evaluator::Cc] {
         if evaluator.backends().iter().any(|b| !b.available()) {
             continue;
