@@ -66,6 +66,44 @@ fn equation_file_fit_saves_a_self_contained_model() {
         .success();
     let rmse = json(&sim)["fit"]["rmse"].as_f64().unwrap();
     assert!((rmse - 0.3384).abs() < 0.005, "validation RMSE {rmse} V");
+    // `simulate --evaluator`: the tape and the C compiler's code give the same signals to
+    // the bit; without a compiler `cc` is a one-line error (exit 1).
+    let simulated = |evaluator: &str, cc: &str, name: &str| {
+        let csv = dir.path().join(format!("{name}.csv"));
+        let mut cmd = hysid();
+        cmd.env_remove("HYSID_EVALUATOR")
+            .env("HYSID_CACHE_DIR", dir.path().join(format!("cache-{name}")))
+            .env("CC", cc)
+            .args(["simulate", "--model"])
+            .arg(&model)
+            .arg("--data")
+            .arg(root().join("data/cascaded-tanks/validation.csv"))
+            .args([
+                "--input",
+                "u_V",
+                "--output",
+                "y_V",
+                "--evaluator",
+                evaluator,
+                "--csv",
+            ])
+            .arg(&csv);
+        (cmd, csv)
+    };
+    let (mut tape, tape_csv) = simulated("tape", "cc", "tape");
+    tape.assert().success();
+    let (mut cc, cc_csv) = simulated("cc", "cc", "cc");
+    cc.assert().success();
+    assert_eq!(
+        fs::read_to_string(&tape_csv).unwrap(),
+        fs::read_to_string(&cc_csv).unwrap()
+    );
+    let (mut refused, _) = simulated("cc", "/nonexistent/cc", "refused");
+    let err = fails_with(&mut refused, 1);
+    assert!(
+        err.contains("no native code for the evaluator 'cc'"),
+        "{err}"
+    );
 }
 
 #[test]
