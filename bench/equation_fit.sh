@@ -4,17 +4,19 @@
 # training record from every free parameter at twice its nominal value, one start, RK4 × 4,
 # band-limited input — run back to back in turn, RUNS times each (default 9):
 #
-#   file     the default (HYSID_EVALUATOR=auto): machine code generated in the process
-#            (x86-64 with AVX), nothing cached
-#   cc       HYSID_EVALUATOR=cc: the C compiler's code loaded from the cache (every run
-#            after a machine's first)
-#   cold     HYSID_EVALUATOR=cc, the cache emptied before each run: the compilation counted
-#   tape     HYSID_EVALUATOR=tape: the tape interpreter
+#   file     the default (--evaluator auto): the C compiler's code, loaded from the cache
+#            (every run after a machine's first)
+#   cc       --evaluator cc: the same, the C route demanded
+#   cold     --evaluator cc, the cache emptied before each run: the compilation counted
+#   tape     --evaluator tape: the tape interpreter
 #   builtin  --model bouc-wen
 #
-# Prints per route the median, min and max wall seconds (/usr/bin/time) and the paired ratio
-# of medians to the built-in; checks once that the file's estimates equal the built-in's to
-# 1e-9 relative and that every route's equal the tape's to the bit.
+# Prints per route the median, min and max wall seconds (/usr/bin/time), the ratio of
+# medians to the built-in and the median of the round-by-round ratios (each round runs every
+# route once, in turn, so a drift of the machine's speed cancels); checks once that the
+# file's estimates equal the built-in's to 1e-9 relative and that every route's equal the
+# tape's to the bit. For a tighter paired figure of one route, farm-bench pairs two commands
+# run by run (the closing comment gives the command).
 #
 #   bench/equation_fit.sh
 set -euo pipefail
@@ -43,22 +45,24 @@ stats() { sort -n | awk '{v[NR]=$1} END {printf "median %.3f s (min %.3f, max %.
 median() { sort -n | awk '{v[NR]=$1} END {print v[int((NR+1)/2)]}'; }
 
 export HYSID_CACHE_DIR="$dir/cache"
-HYSID_EVALUATOR=cc "$bin" "${file[@]}" >/dev/null # fill the cache
+unset HYSID_EVALUATOR
+"$bin" "${file[@]}" --evaluator cc >/dev/null # fill the cache
 routes=(file cc cold tape builtin)
 for route in "${routes[@]}"; do : >"$dir/$route.t"; done
 for _ in $(seq "$runs"); do
   once file "$bin" "${file[@]}" >>"$dir/file.t"
-  HYSID_EVALUATOR=cc once cc "$bin" "${file[@]}" >>"$dir/cc.t"
+  once cc "$bin" "${file[@]}" --evaluator cc >>"$dir/cc.t"
   rm -rf "$dir/cache"
-  HYSID_EVALUATOR=cc once cold "$bin" "${file[@]}" >>"$dir/cold.t"
-  HYSID_EVALUATOR=tape once tape "$bin" "${file[@]}" >>"$dir/tape.t"
+  once cold "$bin" "${file[@]}" --evaluator cc >>"$dir/cold.t"
+  once tape "$bin" "${file[@]}" --evaluator tape >>"$dir/tape.t"
   once builtin "$bin" "${builtin[@]}" >>"$dir/builtin.t"
 done
 base=$(median <"$dir/builtin.t")
 for route in "${routes[@]}"; do
   m=$(median <"$dir/$route.t")
-  printf '%-8s %s, %.2f× the built-in\n' "$route" "$(stats <"$dir/$route.t")" \
-    "$(python3 -c "print($m / $base)")"
+  paired=$(paste "$dir/$route.t" "$dir/builtin.t" | awk '{print $1 / $2}' | median)
+  printf '%-8s %s, %.2f× the built-in (round by round: %.2f×)\n' "$route" \
+    "$(stats <"$dir/$route.t")" "$(python3 -c "print($m / $base)")" "$paired"
 done
 python3 - "$dir" <<'EOF'
 import json, sys
@@ -72,3 +76,6 @@ same = all(values(route) == tape for route in ("file", "cc", "cold"))
 print(f"estimates: file vs built-in max relative difference {worst:.1e}; "
       f"every route == tape to the bit: {same}")
 EOF
+# Paired run by run (A B A B …), e.g. the cached C route against the built-in model:
+#   HYSID_CACHE_DIR=/tmp/c farm-bench -n 21 --timeout 600 \
+#     --vs "target/release/hysid ${builtin[*]}" -- target/release/hysid ${file[*]} --evaluator cc

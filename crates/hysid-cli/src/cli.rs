@@ -251,6 +251,8 @@ pub struct GreyboxFitArgs {
     #[arg(long = "model-file")]
     pub model_file: Option<PathBuf>,
     #[command(flatten)]
+    pub evaluator: EvaluatorArgs,
+    #[command(flatten)]
     pub data: DataArgs,
     /// Keep this parameter at its value (repeatable).
     #[arg(long)]
@@ -298,6 +300,28 @@ pub struct SimulationArgs {
     /// Input between samples.
     #[arg(long, value_enum, default_value_t = InterpolationArg::Zoh)]
     pub interpolation: InterpolationArg,
+}
+
+/// The evaluator of an equation model's tapes.
+#[derive(Debug, Args)]
+pub struct EvaluatorArgs {
+    /// How an equation model's equations are evaluated: auto (native code from the C
+    /// compiler, cached, else the tape interpreter), cc (native code only: exit 1 when no C
+    /// compiler works) or tape (the interpreter). Default: $HYSID_EVALUATOR (auto, native,
+    /// cc or tape), else auto. The report's details.evaluation says which ran.
+    #[arg(long, value_enum)]
+    pub evaluator: Option<EvaluatorArg>,
+}
+
+/// Evaluators of equation models.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EvaluatorArg {
+    /// Native code from the C compiler (or the cache), else the tape interpreter.
+    Auto,
+    /// Native code from the C compiler (or the cache) only.
+    Cc,
+    /// The tape interpreter.
+    Tape,
 }
 
 /// Integrators.
@@ -733,6 +757,8 @@ pub struct SimulateArgs {
     /// model sees them (filtered or decimated where its fit was). Only with one --data.
     #[arg(long)]
     pub csv: Option<PathBuf>,
+    #[command(flatten)]
+    pub evaluator: EvaluatorArgs,
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,

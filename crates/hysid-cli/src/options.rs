@@ -123,6 +123,24 @@ pub fn seconds(text: &str) -> Result<f64, String> {
     }
 }
 
+/// The evaluator of equation models: `--evaluator` when given, else `$HYSID_EVALUATOR`
+/// (`auto`, `native`, `cc` or `tape`), else auto. An unknown `$HYSID_EVALUATOR` (`jit`
+/// among them: the in-process encoder was removed) is a usage error (exit 2).
+pub fn evaluator(
+    args: &crate::cli::EvaluatorArgs,
+) -> Result<hysid::model::greybox::native::Evaluator, crate::exit::UsageError> {
+    use crate::cli::EvaluatorArg;
+    use hysid::model::greybox::native::Evaluator;
+    match args.evaluator {
+        Some(EvaluatorArg::Auto) => Ok(Evaluator::Auto),
+        Some(EvaluatorArg::Cc) => Ok(Evaluator::Cc),
+        Some(EvaluatorArg::Tape) => Ok(Evaluator::Tape),
+        None => Evaluator::from_env().map_err(|e| {
+            crate::exit::UsageError(format!("{e}; or give --evaluator auto, cc or tape"))
+        }),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

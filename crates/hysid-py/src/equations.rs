@@ -15,6 +15,7 @@ use crate::recipes::{estimation, id_data, parameter_set, samples, simulation, so
 use crate::watch::watching;
 use hysid::identify::greybox::InitialStates;
 use hysid::model::greybox::equation_model::EquationStateSpace;
+use hysid::model::greybox::native::Evaluator;
 use hysid::model::greybox::StateSpaceModel;
 use hysid::model::saved::FittedModel;
 use hysid::{Error, Result};
@@ -106,6 +107,7 @@ fn equation_model_file(
             parameters,
             simulation: simulation(integrator, substeps, interpolation)?,
             initial_state: x0,
+            evaluator: hysid::model::greybox::native::Evaluator::Auto,
         }
         .to_file();
         serde_json::to_string(&file).map_err(|e| Error::Serialization(format!("model: {e}")))
@@ -132,9 +134,10 @@ fn checked_parameters(
 
 /// Output-error fit of the equation model `text` from the parameters `params`; the initial
 /// state is `[initial]` of the file (states with `fixed = false` estimated). Returns the
-/// report's JSON (the CLI's `greybox fit --model-file`).
+/// report's JSON (the CLI's `greybox fit --model-file`). `evaluator`: auto, native, cc or tape
+/// (None: `HYSID_EVALUATOR`, else auto).
 #[pyfunction]
-#[pyo3(signature = (text, u, y, ts, params, starts, seed, integrator, substeps, interpolation, threads=0, time_limit=None, progress=None))]
+#[pyo3(signature = (text, u, y, ts, params, starts, seed, integrator, substeps, interpolation, threads=0, time_limit=None, progress=None, evaluator=None))]
 #[allow(clippy::too_many_arguments)]
 fn greybox_fit_equations(
     py: Python<'_>,
@@ -151,7 +154,9 @@ fn greybox_fit_equations(
     threads: usize,
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
+    evaluator: Option<&str>,
 ) -> PyResult<String> {
+    let evaluator = evaluator.map(str::to_string);
     let u: Vec<Vec<f64>> = u.iter().map(samples).collect();
     let y: Vec<Vec<f64>> = y.iter().map(samples).collect();
     let (text, integrator, interpolation) = (
@@ -164,7 +169,14 @@ fn greybox_fit_equations(
         threads,
         watching(py, time_limit, progress)?,
         move |watch| {
-            let eq = Arc::new(EquationStateSpace::parse(&text, "equation model")?);
+            // The evaluator given, else HYSID_EVALUATOR, else auto.
+            let evaluator = match &evaluator {
+                Some(name) => name.parse::<Evaluator>()?,
+                None => Evaluator::from_env()?,
+            };
+            let eq = Arc::new(
+                EquationStateSpace::parse(&text, "equation model")?.with_evaluator(evaluator),
+            );
             let model: Arc<dyn StateSpaceModel> = eq.clone();
             let sim = simulation(&integrator, substeps, &interpolation)?;
             let data = id_data(ts, u, y)?;

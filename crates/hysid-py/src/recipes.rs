@@ -477,20 +477,28 @@ fn rigid_body_ls(
     )
 }
 
-/// Simulates a saved model (`hysid.model/1` JSON) for the input channels `inputs`.
+/// Simulates a saved model (`hysid.model/1` JSON) for the input channels `inputs`; an
+/// equation model's tapes run by `evaluator` (auto, native, cc or tape; None:
+/// `HYSID_EVALUATOR`, else auto).
 #[pyfunction]
-#[pyo3(signature = (model_json, inputs, ts, y0=None))]
+#[pyo3(signature = (model_json, inputs, ts, y0=None, evaluator=None))]
 fn simulate_model<'py>(
     py: Python<'py>,
     model_json: &str,
     inputs: Vec<PyReadonlyArray1<'py, f64>>,
     ts: f64,
     y0: Option<f64>,
+    evaluator: Option<&str>,
 ) -> PyResult<Vec<Bound<'py, PyArray1<f64>>>> {
     let inputs: Vec<Vec<f64>> = inputs.iter().map(samples).collect();
     let model_json = model_json.to_string();
+    let evaluator = evaluator.map(str::to_string);
     let outputs = run(py, move || {
-        let model = FittedModel::from_file(&parse_model(&model_json)?)?;
+        let evaluator = match &evaluator {
+            Some(name) => name.parse::<hysid::model::greybox::native::Evaluator>()?,
+            None => hysid::model::greybox::native::Evaluator::from_env()?,
+        };
+        let model = FittedModel::from_file(&parse_model(&model_json)?)?.with_evaluator(evaluator);
         crate::user_model::check_inputs(&inputs, ts)?;
         let refs: Vec<&[f64]> = inputs.iter().map(Vec::as_slice).collect();
         model.simulate(&refs, ts, y0)

@@ -122,3 +122,36 @@ def test_equation_fit_uses_threads(duffing, duffing_record):
     a = hysid.greybox_fit(duffing, u, y, ts=TS, threads=1)
     b = hysid.greybox_fit(duffing, u, y, ts=TS, threads=2)
     assert a.parameters == b.parameters
+
+
+def test_the_evaluator_is_chosen_and_reported(duffing, duffing_record, tmp_path, monkeypatch):
+    """evaluator= (the CLI's --evaluator): the tape and the C compiler's code give the same
+    estimates and simulation to the bit, the report says which ran; a C route without a
+    compiler, an unknown name and an evaluator for a built-in model are refused."""
+    u, y = duffing_record
+    monkeypatch.setenv("HYSID_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.delenv("HYSID_EVALUATOR", raising=False)
+    tape = hysid.greybox_fit(duffing, u, y, ts=TS, evaluator="tape")
+    assert tape.report()["details"]["evaluation"] == "tape interpreter (evaluator tape chosen)"
+    cc = hysid.greybox_fit(duffing, u, y, ts=TS, evaluator="cc")
+    assert cc.report()["details"]["evaluation"].startswith("native code (compiled now: ")
+    assert [p.value for p in cc.parameters.values()] == [p.value for p in tape.parameters.values()]
+    again = hysid.greybox_fit(duffing, u, y, ts=TS)  # auto: the cached library
+    assert again.report()["details"]["evaluation"] == "native code (loaded from the cache)"
+    fitted = cc.model
+    assert np.array_equal(fitted.simulate(u, ts=TS, evaluator="tape"), fitted.simulate(u, ts=TS, evaluator="cc"))
+    monkeypatch.setenv("HYSID_EVALUATOR", "tape")  # the default when evaluator= is not given
+    env = hysid.greybox_fit(duffing, u, y, ts=TS)
+    assert env.report()["details"]["evaluation"] == "tape interpreter (evaluator tape chosen)"
+    monkeypatch.setenv("HYSID_EVALUATOR", "jit")
+    with pytest.raises(hysid.ConfigError, match="removed"):
+        hysid.greybox_fit(duffing, u, y, ts=TS)
+    monkeypatch.delenv("HYSID_EVALUATOR")
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    monkeypatch.setenv("HYSID_CACHE_DIR", str(tmp_path / "empty"))
+    with pytest.raises(hysid.ConfigError, match="no native code for the evaluator 'cc'"):
+        hysid.greybox_fit(duffing, u, y, ts=TS, evaluator="cc")
+    with pytest.raises(hysid.ConfigError, match="evaluator"):
+        hysid.greybox_fit(duffing, u, y, ts=TS, evaluator="fast")  # type: ignore[arg-type]
+    with pytest.raises(hysid.ConfigError, match="equation model"):
+        hysid.greybox_fit("bouc-wen", u, y, ts=TS, evaluator="tape")

@@ -55,6 +55,7 @@ pub fn identify(args: &ActuatorIdentifyArgs) -> Result<()> {
     let id = run(&steps, &records)?;
     let sources = vec![args.data.display().to_string()];
     publish(
+        "actuator identify",
         &id,
         truth.as_deref(),
         &records,
@@ -86,6 +87,7 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     let id = run(&steps, &records)?;
     let sources = vec![data_dir.display().to_string()];
     publish(
+        "demo actuator",
         &id,
         Some(&rig.truth),
         &records,
@@ -109,9 +111,10 @@ fn run(steps: &ThreeSteps, records: &BTreeMap<usize, Record>) -> Result<Actuator
     Ok(steps.run_reporting(records, &mut |stage| progress.show(stage))?)
 }
 
-/// Prints the tables; writes Markdown and plots, the report and the m67 model (read from
-/// `sources`, simulated with `simulation`), all in one transaction.
+/// Prints the tables; writes Markdown and plots, the report (of the command `command`) and
+/// the m67 model (read from `sources`, simulated with `simulation`), all in one transaction.
 fn publish(
+    command: &str,
     id: &ActuatorIdentification,
     truth: Option<&[f64]>,
     records: &BTreeMap<usize, Record>,
@@ -134,6 +137,7 @@ fn publish(
     }
     let report = if out.json.is_some() {
         let mut report = three_steps_report(id, truth, sources, simulation)?;
+        report.command = command.into();
         if let (Some(obj), serde_json::Value::Object(more)) =
             (report.details.as_object_mut(), details)
         {

@@ -21,8 +21,17 @@ use std::sync::Arc;
 /// Runs `hysid greybox fit`.
 pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     // A built-in model by name, or an equation file (whose [initial] and text also count).
+    if args.model_file.is_none() && args.evaluator.evaluator.is_some() {
+        return Err(crate::exit::UsageError(
+            "--evaluator chooses how an equation file is evaluated; give it with --model-file, or leave it out".into(),
+        )
+        .into());
+    }
     let equations = match &args.model_file {
-        Some(path) => Some(Arc::new(EquationStateSpace::load(path)?)),
+        Some(path) => Some(Arc::new(
+            EquationStateSpace::load(path)?
+                .with_evaluator(crate::options::evaluator(&args.evaluator)?),
+        )),
         None => None,
     };
     let model: Arc<dyn StateSpaceModel> = match (&equations, &args.model) {

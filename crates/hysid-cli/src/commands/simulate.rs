@@ -22,7 +22,8 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     inputs.extend(args.data.iter().map(|p| p.as_path()));
     let mut out = Outputs::new(&inputs, args.json.as_deref(), None, None)?;
     let csv = out.file(args.csv.as_deref())?;
-    let model = FittedModel::load(&args.model)?;
+    let model =
+        FittedModel::load(&args.model)?.with_evaluator(crate::options::evaluator(&args.evaluator)?);
     let spec = CsvSpec {
         inputs: args.input.clone(),
         outputs: args.output.iter().cloned().collect(),

@@ -121,6 +121,7 @@ fn demo_runs_the_rig_and_all_three_steps() {
         "{stdout}"
     );
     let r = json(&report);
+    assert_eq!(r["command"], "demo actuator");
     for m in ["m0", "m67", "m68", "m67f", "m68f"] {
         let fits = r["details"]["fit_table"][m].as_array().unwrap();
         assert!(

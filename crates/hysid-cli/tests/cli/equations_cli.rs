@@ -2,7 +2,7 @@
 //! on the benchmark's estimation record, saved, and re-simulated by `hysid simulate` on the
 //! validation record; and the one-line errors of a bad file or of two models.
 
-use crate::common::{hysid, one_line_error, read_json, Assert};
+use crate::common::{fails_with, hysid, one_line_error, read_json, Assert};
 use std::fs;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
@@ -66,6 +66,44 @@ fn equation_file_fit_saves_a_self_contained_model() {
         .success();
     let rmse = json(&sim)["fit"]["rmse"].as_f64().unwrap();
     assert!((rmse - 0.3384).abs() < 0.005, "validation RMSE {rmse} V");
+    // `simulate --evaluator`: the tape and the C compiler's code give the same signals to
+    // the bit; without a compiler `cc` is a one-line error (exit 1).
+    let simulated = |evaluator: &str, cc: &str, name: &str| {
+        let csv = dir.path().join(format!("{name}.csv"));
+        let mut cmd = hysid();
+        cmd.env_remove("HYSID_EVALUATOR")
+            .env("HYSID_CACHE_DIR", dir.path().join(format!("cache-{name}")))
+            .env("CC", cc)
+            .args(["simulate", "--model"])
+            .arg(&model)
+            .arg("--data")
+            .arg(root().join("data/cascaded-tanks/validation.csv"))
+            .args([
+                "--input",
+                "u_V",
+                "--output",
+                "y_V",
+                "--evaluator",
+                evaluator,
+                "--csv",
+            ])
+            .arg(&csv);
+        (cmd, csv)
+    };
+    let (mut tape, tape_csv) = simulated("tape", "cc", "tape");
+    tape.assert().success();
+    let (mut cc, cc_csv) = simulated("cc", "cc", "cc");
+    cc.assert().success();
+    assert_eq!(
+        fs::read_to_string(&tape_csv).unwrap(),
+        fs::read_to_string(&cc_csv).unwrap()
+    );
+    let (mut refused, _) = simulated("cc", "/nonexistent/cc", "refused");
+    let err = fails_with(&mut refused, 1);
+    assert!(
+        err.contains("no native code for the evaluator 'cc'"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -102,19 +140,21 @@ fn a_bad_equation_file_is_one_line_with_its_place() {
         .contains("cannot be used with"));
 }
 
-/// The evaluator of equation files (`HYSID_EVALUATOR`): native code generated in the
-/// process (no compiler needed), native code compiled by the C compiler into the cache
-/// `HYSID_CACHE_DIR`, the tape interpreter, and `auto` without a compiler all give the same
-/// report figures to the bit, and the report says which ran; `cc` without a compiler and
-/// an unknown evaluator are one-line errors.
+/// The evaluator of equation files, chosen by `--evaluator auto|cc|tape` or else by
+/// `HYSID_EVALUATOR`: native code compiled by the C compiler into the cache
+/// `HYSID_CACHE_DIR` (then loaded from it), the tape interpreter, and `auto` without a
+/// compiler all give the same report figures to the bit, and the report says which ran;
+/// `--evaluator cc` without a compiler (exit 1), `HYSID_EVALUATOR=jit` (the removed encoder)
+/// and an unknown evaluator (exit 2) are one-line errors, and the flag wins over the
+/// variable.
 #[test]
 fn native_code_and_the_tape_fit_the_same() {
     let dir = TempDir::new().unwrap();
     let cache = dir.path().join("cache");
-    let fit = |evaluator: &str, cc: &str, name: &str| {
+    let fit = |flag: Option<&str>, env: Option<&str>, cc: &str, name: &str| {
         let report = dir.path().join(format!("{name}.json"));
         let mut cmd = hysid();
-        cmd.env("HYSID_EVALUATOR", evaluator)
+        cmd.env_remove("HYSID_EVALUATOR")
             .env("HYSID_CACHE_DIR", &cache)
             .env("CC", cc)
             .args(["-q", "greybox", "fit", "--model-file"])
@@ -124,6 +164,12 @@ fn native_code_and_the_tape_fit_the_same() {
             .args(["--input", "u_V", "--output", "y_V", "--starts", "1"])
             .args(["--substeps", "2", "--json"])
             .arg(&report);
+        if let Some(flag) = flag {
+            cmd.args(["--evaluator", flag]);
+        }
+        if let Some(env) = env {
+            cmd.env("HYSID_EVALUATOR", env);
+        }
         (cmd, report)
     };
     let figures = |report: &Path| {
@@ -136,48 +182,138 @@ fn native_code_and_the_tape_fit_the_same() {
             .unwrap()
             .to_string()
     };
-    let generated = hysid::model::greybox::native::Backend::Generated.available();
 
-    let (mut compiled, compiled_report) = fit("cc", "cc", "cc");
+    let (mut compiled, compiled_report) = fit(Some("cc"), Some("jit"), "cc", "cc");
     compiled.assert().success();
     let objects = fs::read_dir(cache.join("native")).unwrap().count();
     assert!(objects >= 2, "{objects} files in the cache");
-    assert!(evaluation(&compiled_report).starts_with("native code (compiled now"));
-    let (mut tape, tape_report) = fit("tape", "cc", "tape");
-    tape.assert().success();
-    assert_eq!(figures(&compiled_report), figures(&tape_report));
+    let said = evaluation(&compiled_report);
+    assert!(said.starts_with("native code (compiled now: "), "{said}");
+    let (mut cached, cached_report) = fit(None, Some("native"), "cc", "cached");
+    cached.assert().success();
+    assert_eq!(figures(&compiled_report), figures(&cached_report));
     assert_eq!(
-        evaluation(&tape_report),
-        "tape interpreter (HYSID_EVALUATOR=tape)"
+        evaluation(&cached_report),
+        "native code (loaded from the cache)"
     );
-    let (mut auto, auto_report) = fit("auto", "/nonexistent/cc", "auto");
+    for (flag, env, name) in [
+        (Some("tape"), Some("cc"), "tape"),
+        (None, Some("tape"), "env"),
+    ] {
+        let (mut tape, tape_report) = fit(flag, env, "cc", name);
+        tape.assert().success();
+        assert_eq!(figures(&compiled_report), figures(&tape_report));
+        assert_eq!(
+            evaluation(&tape_report),
+            "tape interpreter (evaluator tape chosen)"
+        );
+    }
+    let (mut auto, auto_report) = fit(Some("auto"), None, "/nonexistent/cc", "auto");
+    auto.env("HYSID_CACHE_DIR", dir.path().join("auto-cache"));
     auto.assert().success();
     assert_eq!(figures(&compiled_report), figures(&auto_report));
     let auto = evaluation(&auto_report);
-    if generated {
-        assert!(
-            auto.starts_with("native code (generated in the process in "),
-            "{auto}"
-        );
-        let (mut jit, jit_report) = fit("jit", "/nonexistent/cc", "jit");
-        jit.assert().success();
-        assert_eq!(figures(&compiled_report), figures(&jit_report));
-    } else {
-        assert!(
-            auto.starts_with("tape interpreter (no native code: no C compiler"),
-            "{auto}"
-        );
-    }
-
-    let (mut refused, _) = fit("cc", "/nonexistent/cc", "refused");
-    let fresh = dir.path().join("empty-cache");
-    refused.env("HYSID_CACHE_DIR", &fresh);
-    let err = one_line_error(&mut refused);
     assert!(
-        err.contains("no native code") && err.contains("/nonexistent/cc"),
+        auto.starts_with("tape interpreter (no native code: ") && auto.contains("/nonexistent/cc"),
+        "{auto}"
+    );
+
+    let (mut refused, _) = fit(Some("cc"), None, "/nonexistent/cc", "refused");
+    refused.env("HYSID_CACHE_DIR", dir.path().join("empty-cache"));
+    let err = fails_with(&mut refused, 1);
+    assert!(
+        err.contains("no native code for the evaluator 'cc'") && err.contains("/nonexistent/cc"),
         "{err}"
     );
-    let (mut unknown, _) = fit("fast", "cc", "unknown");
-    let err = one_line_error(&mut unknown);
-    assert!(err.contains("HYSID_EVALUATOR is 'fast'"), "{err}");
+    let (mut jit, _) = fit(None, Some("jit"), "cc", "jit");
+    let err = fails_with(&mut jit, 2);
+    assert!(
+        err.contains("HYSID_EVALUATOR")
+            && err.contains("removed")
+            && err.contains("auto, native, cc or tape"),
+        "{err}"
+    );
+    let (mut unknown, _) = fit(None, Some("fast"), "cc", "unknown");
+    let err = fails_with(&mut unknown, 2);
+    assert!(err.contains("'fast' is not an equation evaluator"), "{err}");
+    let (mut flag, _) = fit(Some("jit"), None, "cc", "flag");
+    fails_with(&mut flag, 2);
+}
+
+/// A grey-box fit (built-in model or equation file) of a record whose input is constant is
+/// refused in one line with the non-exciting-input error (exit 1), no report written,
+/// instead of a report with undefined (null) input–residual cross-correlations; the same
+/// record with a moving input fits.
+#[test]
+fn a_constant_input_is_refused_as_not_exciting() {
+    let dir = TempDir::new().unwrap();
+    let model = dir.path().join("first_order.toml");
+    fs::write(
+        &model,
+        "[model]\nname = \"first_order\"\nstates = [\"x\"]\ninputs = [\"u\"]\noutputs = [\"y\"]\n\
+         [parameters]\na = { value = 1.0, lower = 0.01, upper = 100.0 }\n\
+         b = { value = 1.0, lower = -100.0, upper = 100.0 }\n\
+         [equations]\nx = \"-a*x + b*u\"\n[output]\ny = \"x\"\n",
+    )
+    .unwrap();
+    let record = |name: &str, u: fn(f64) -> f64| {
+        let path = dir.path().join(name);
+        let mut text = String::from("t,u,y\n");
+        for k in 0..400 {
+            let t = 0.05 * k as f64;
+            text += &format!("{t},{},{}\n", u(t), (0.3 * t).sin());
+        }
+        fs::write(&path, text).unwrap();
+        path
+    };
+    let constant = record("constant.csv", |_| 1.5);
+    let moving = record("moving.csv", |t| (0.3 * t).cos());
+    let fit = |data: &Path, how: &[&str], name: &str| {
+        let report = dir.path().join(format!("{name}.json"));
+        let mut cmd = hysid();
+        cmd.env_remove("HYSID_EVALUATOR")
+            .args(["-q", "greybox", "fit"])
+            .args(how)
+            .arg("--data")
+            .arg(data)
+            .args(["--input", "u", "--output", "y", "--json"])
+            .arg(&report);
+        (cmd, report)
+    };
+    let file = model.to_str().unwrap();
+    for (how, name) in [
+        (
+            &["--model-file", file, "--evaluator", "tape"][..],
+            "equations",
+        ),
+        (&["--model", "bouc-wen"][..], "built-in"),
+    ] {
+        let (mut cmd, report) = fit(&constant, how, name);
+        let err = fails_with(&mut cmd, 1);
+        assert!(
+            err.contains("input 'u' does not excite the system") && err.contains("constant"),
+            "{name}: {err}"
+        );
+        assert!(!report.exists(), "{name}: a report was written");
+    }
+    let (mut cmd, report) = fit(
+        &moving,
+        &["--model-file", file, "--evaluator", "tape"],
+        "moving",
+    );
+    cmd.assert().success();
+    let r = json(&report);
+    let analysis = &r["details"]["residual_analysis"];
+    assert!(!analysis.to_string().contains("null"), "{analysis}");
+    // --evaluator is about equation files: with a built-in model it is a usage error.
+    let (mut cmd, _) = fit(
+        &moving,
+        &["--model", "bouc-wen", "--evaluator", "cc"],
+        "usage",
+    );
+    let err = fails_with(&mut cmd, 2);
+    assert!(
+        err.contains("--evaluator") && err.contains("--model-file"),
+        "{err}"
+    );
 }

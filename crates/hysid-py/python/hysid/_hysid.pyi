@@ -154,7 +154,11 @@ def rigid_body_ls(
     progress: Optional[_Progress] = None,
 ) -> str: ...
 def simulate_model(
-    model_json: str, inputs: Sequence[_Array], ts: float, y0: Optional[float] = None
+    model_json: str,
+    inputs: Sequence[_Array],
+    ts: float,
+    y0: Optional[float] = None,
+    evaluator: Optional[str] = None,
 ) -> List[_Array]: ...
 def simulate_user(
     spec: _Spec, inputs: Sequence[_Array], ts: float, integrator: str, substeps: int, interpolation: str
@@ -183,6 +187,7 @@ def greybox_fit_equations(
     threads: int = 0,
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
+    evaluator: Optional[str] = None,
 ) -> str: ...
 def actuator_parameter_names() -> List[str]: ...
 def actuator_rig_truth() -> List[float]: ...

@@ -14,7 +14,7 @@ import numpy as np
 from . import _hysid
 from ._hysid import CallbackError, ConfigError, DataError, ModelFileError
 from ._inputs import FloatArray, Samples, array, choice, count
-from .models import CallbackSpec, Model
+from .models import CallbackSpec, Evaluator, Model
 from .parameters import Parameter
 
 #: How a continuous-time model is integrated between samples.
@@ -204,12 +204,14 @@ class GreyBoxModel:
         integrator: Integrator = "rk4",
         substeps: int = 10,
         interpolation: Interpolation = "zoh",
+        evaluator: Optional[Evaluator] = None,
     ) -> FloatArray:
         """The output for input ``u`` (1-D, or 2-D (samples, inputs)) sampled every ``ts``
         seconds, from ``x0`` with the current parameter values (RK4 with ``substeps`` per
-        sample; inputs ``zoh``, ``linear`` or ``band-limited`` between samples)."""
+        sample; inputs ``zoh``, ``linear`` or ``band-limited`` between samples); an
+        equation model's ``evaluator`` as in :meth:`Model.simulate`."""
         model = self.to_model(integrator=integrator, substeps=substeps, interpolation=interpolation)
-        return model.simulate(u, ts=ts)
+        return model.simulate(u, ts=ts, evaluator=evaluator)
 
     def _spec(self, values: Optional[Sequence[float]] = None) -> CallbackSpec:
         """The model as the extension module takes it, with ``values`` for the parameters."""

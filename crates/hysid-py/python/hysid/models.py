@@ -12,17 +12,22 @@ import errno
 import json
 import math
 import os
-from typing import Any, Callable, Dict, List, Optional, Protocol, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Literal, Optional, Protocol, Sequence, Tuple, Union, get_args
 
 import numpy as np
 
 from . import _hysid
 from ._fields import Fields, ReportError
 from ._hysid import ModelFileError
-from ._inputs import FloatArray, Samples, channels, sample_time
+from ._inputs import FloatArray, Samples, channels, choice, sample_time
 from .export import Target, export
 from .parameters import Parameter, ParameterTuple
 from .stream import Compensator, Stepper, compensator, stepper
+
+#: How an equation model's equations are evaluated: native code from the C compiler
+#: (cached) else the tape interpreter (``auto``), native code only (``cc``: an error when no
+#: C compiler works), or the tape interpreter (``tape``).
+Evaluator = Literal["auto", "cc", "tape"]
 
 #: A model written as Python functions, as the extension module takes it: (rhs, output,
 #: state names, inputs, outputs, parameters, initial state).
@@ -88,10 +93,15 @@ class Model:
         """The parameters by name (copies: changing one leaves the model as it is)."""
         return {p.name: copy.copy(p) for p in self._parameters}
 
-    def simulate(self, u: Samples, *, ts: float, y0: Optional[float] = None) -> FloatArray:
+    def simulate(
+        self, u: Samples, *, ts: float, y0: Optional[float] = None, evaluator: Optional[Evaluator] = None
+    ) -> FloatArray:
         """The model's output for input ``u`` (1-D, or 2-D (samples, inputs)) sampled every
         ``ts`` seconds; ``y0`` is the measured initial output, for a hysteresis that starts
-        from it."""
+        from it. ``evaluator`` (an equation model's, the CLI's ``--evaluator``): ``"auto"``,
+        ``"cc"`` (native code only: :class:`ConfigError` when no C compiler works) or
+        ``"tape"``; None: ``HYSID_EVALUATOR``, else ``"auto"``; other models ignore it."""
+        how = None if evaluator is None else choice(evaluator, "evaluator", get_args(Evaluator))
         step = sample_time(ts)
         inputs = channels(u, "u")
         start = None if y0 is None else float(y0)
@@ -100,7 +110,7 @@ class Model:
                 self._user._spec([p.value for p in self._parameters]), inputs, step, *self._callback_simulation
             )
         else:
-            outs = _hysid.simulate_model(json.dumps(self.file), inputs, step, start)
+            outs = _hysid.simulate_model(json.dumps(self.file), inputs, step, start, how)
         return outs[0] if len(outs) == 1 else np.column_stack(outs)
 
     def save(self, path: Union[str, "os.PathLike[str]"]) -> None:

@@ -20,6 +20,7 @@ from ._families import FAMILIES, FamilyName
 from ._hysid import ConfigError, DataError
 from ._inputs import Samples, SamplesOrRecord
 from .greybox import GreyBoxModel, Integrator, Interpolation
+from .models import Evaluator
 from .parameters import Parameter
 from .progress import ProgressArg, warn_if_stopped, watching
 from .results import FitResult, Record, labelled
@@ -231,6 +232,7 @@ def greybox_fit(
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
+    evaluator: Optional[Evaluator] = None,
 ) -> FitResult:
     """Output-error fit of a continuous-time grey-box model ẋ = f(t, x, u, θ), y = h(x, u, θ).
 
@@ -245,6 +247,11 @@ def greybox_fit(
     ``threads`` workers (None: the process default, all cores); a :class:`GreyBoxModel`
     written as Python functions uses finite differences, on one thread. The report is the
     CLI's ``greybox fit`` report (``--model-file`` for an equation model).
+    ``evaluator`` (equation models only, the CLI's ``--evaluator``): ``"auto"`` (native
+    code from the C compiler, cached, else the tape interpreter), ``"cc"`` (native code
+    only: :class:`ConfigError` when no C compiler works) or ``"tape"``; None: the
+    environment variable ``HYSID_EVALUATOR``, else ``"auto"``. The report's
+    ``details["evaluation"]`` says which ran.
     """
     u, y, ts = check.pair_channels(u, y, ts)
     ts = check.sample_time(ts)
@@ -258,6 +265,9 @@ def greybox_fit(
         check.count(substeps, "substeps"),
         check.choice(interpolation, "interpolation"),
     )
+    chosen_evaluator = None if evaluator is None else check.choice(evaluator, "evaluator", typing.get_args(Evaluator))
+    if chosen_evaluator is not None and not (isinstance(model, GreyBoxModel) and model.equations is not None):
+        raise ConfigError("evaluator: applies to an equation model (GreyBoxModel.from_equations); leave it out")
     if isinstance(model, GreyBoxModel):
         user = copy.copy(model)
         user.parameters = _configure([copy.copy(p) for p in model.parameters], init, fix, bounds)
@@ -268,7 +278,7 @@ def greybox_fit(
         if user.equations is not None:
             params = [p.as_tuple() for p in user.parameters]
             text = _hysid.greybox_fit_equations(
-                user.equations, u, y, ts, params, *args, check.threads(threads), limit, tell
+                user.equations, u, y, ts, params, *args, check.threads(threads), limit, tell, chosen_evaluator
             )
             return _finished(FitResult(json.loads(text), data=fitted), limit, "greybox_fit")
         if limit is not None or tell is not None:

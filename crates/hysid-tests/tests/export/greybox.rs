@@ -79,6 +79,7 @@ pub fn equations(text: &str, simulation: Simulation) -> FittedModel {
         std: no_std(model.parameters().len()),
         simulation,
         initial_state: model.initial_values(),
+        evaluator: hysid::model::greybox::native::Evaluator::Auto,
     }
 }
 

@@ -470,6 +470,7 @@ fn cascaded_tanks_validation_rmse() {
         std: fit.fit.std()[..p].to_vec(),
         simulation,
         initial_state: values[p..p + 2].to_vec(),
+        evaluator: hysid::model::greybox::native::Evaluator::Auto,
     };
     let y = fitted
         .simulate(&[val.experiment(0).input(0)], val.ts(), None)
@@ -503,6 +504,7 @@ fn saved_equation_models_round_trip() {
         std: vec![0.01, 0.02, f64::NAN, 0.04],
         simulation: rk4(4, InputInterpolation::ZeroOrderHold),
         initial_state: vec![0.0, 0.0],
+        evaluator: hysid::model::greybox::native::Evaluator::Auto,
     };
     let json = serde_json::to_string(&fitted.to_file()).unwrap();
     assert!(json.contains("\"kind\":\"equations\"") && json.contains("\"equations\":\"#"));
@@ -596,6 +598,7 @@ fn discrete_backlash_round_trip() {
         std: vec![0.0; 3],
         simulation: rk4(1, InputInterpolation::ZeroOrderHold),
         initial_state: vec![0.0, 0.0],
+        evaluator: hysid::model::greybox::native::Evaluator::Auto,
     };
     let json = serde_json::to_string(&fitted.to_file()).unwrap();
     let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
@@ -653,8 +656,8 @@ fn bouc_wen_file_fit_equals_the_built_in_fit() {
 
 /// The performance issue's user-model route: the Bouc–Wen equation file fitted to the
 /// benchmark's training record from every free parameter at twice its nominal value (one
-/// start, RK4 × 4, band-limited input), run as native code (generated in the process, and
-/// compiled by the C compiler) and by the tape interpreter, against the built-in model from
+/// start, RK4 × 4, band-limited input), run as native code (compiled by the C compiler) and
+/// by the tape interpreter, against the built-in model from
 /// the same start. Native and tape give the same estimates to the bit; the file gives the
 /// built-in's to 1e-9 relative.
 #[test]
@@ -690,8 +693,8 @@ fn bouc_wen_file_fit_from_twice_nominal_is_the_built_in_fit_native_or_taped() {
     let tape = fit(Arc::new(
         example("bouc_wen").with_evaluator(Evaluator::Tape),
     ));
-    // Native code by each route this machine has: generated in the process, compiled.
-    for evaluator in [Evaluator::Jit, Evaluator::Cc] {
+    // Native code where this machine has the route (the C compiler's).
+    for evaluator in [Evaluator::Cc] {
         if evaluator.backends().iter().any(|b| !b.available()) {
             continue;
         }

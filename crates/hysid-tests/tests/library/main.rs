@@ -6,6 +6,7 @@ mod actuator;
 mod atomic_outputs;
 mod cascade_examples;
 mod cascade_statistics;
+mod docs_paths;
 mod emps;
 mod equations;
 mod fuzz_readers;

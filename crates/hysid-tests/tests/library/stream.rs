@@ -309,6 +309,7 @@ fn equation_models_stream_as_they_simulate() {
                 std: no_std(model.parameters().len()),
                 simulation,
                 initial_state: model.initial_values(),
+                evaluator: hysid::model::greybox::native::Evaluator::Auto,
             };
             let what = format!("{} {simulation:?}", model.name());
             match fitted.stepper(1e-2, None) {

@@ -47,6 +47,7 @@
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
 use crate::model::greybox::models::GreyBoxKind;
+use crate::model::greybox::native::Evaluator;
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
 use crate::model::operators::OperatorModel;
 use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
@@ -696,6 +697,9 @@ pub enum FittedModel {
         simulation: Simulation,
         /// Its initial state.
         initial_state: Vec<f64>,
+        /// Which code runs its tapes when it is simulated (not saved: a setting of the run,
+        /// [`FittedModel::with_evaluator`]; [`Evaluator::Auto`] when read from a file).
+        evaluator: Evaluator,
     },
     /// A hysteresis operator of one of the families of [`crate::model::operators`].
     Operator {
@@ -825,9 +829,11 @@ impl FittedModel {
                 parameters,
                 simulation,
                 initial_state,
+                evaluator,
                 ..
             } => {
-                let model = EquationStateSpace::parse(equations, "saved model")?;
+                let model =
+                    EquationStateSpace::parse(equations, "saved model")?.with_evaluator(*evaluator);
                 simulate_outputs(
                     &model,
                     &parameters.values(),
@@ -958,6 +964,34 @@ impl FittedModel {
                 std,
                 simulation,
                 initial_state,
+                evaluator: Evaluator::Auto,
+            },
+            other => other,
+        }
+    }
+
+    /// The same model with its equation tapes run by `evaluator` (an equation model, also
+    /// inside a pre-filtered one); other models unchanged.
+    pub fn with_evaluator(self, evaluator: Evaluator) -> Self {
+        match self {
+            FittedModel::Equations {
+                equations,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                ..
+            } => FittedModel::Equations {
+                equations,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                evaluator,
+            },
+            FittedModel::Prefiltered { model, prefilter } => FittedModel::Prefiltered {
+                model: Box::new(model.with_evaluator(evaluator)),
+                prefilter,
             },
             other => other,
         }
@@ -1026,6 +1060,7 @@ impl FittedModel {
                 std,
                 simulation,
                 initial_state,
+                ..
             } => SavedModel::Equations {
                 parameters: records(parameters, std),
                 simulation: Some(SimulationSpec::of(simulation)),

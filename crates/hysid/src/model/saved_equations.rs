@@ -45,6 +45,7 @@ pub(crate) fn equations_from_file(
         std,
         simulation,
         initial_state,
+        evaluator: crate::model::greybox::native::Evaluator::Auto,
     })
 }
 

@@ -133,9 +133,45 @@ impl GreyBoxFit {
     }
 }
 
+/// Errors ([`Error::NotExciting`], naming the first input channel and the record) unless
+/// every record has an input that takes more than one value.
+fn check_inputs_move(data: &IdData) -> Result<()> {
+    let channels = data.input_channels().len();
+    for e in 0..data.n_experiments() {
+        let moves = (0..channels).any(|c| {
+            let u = data.input(e, c);
+            u.split_first()
+                .is_some_and(|(first, rest)| rest.iter().any(|v| v != first))
+        });
+        if !moves {
+            let channel = data
+                .input_channels()
+                .first()
+                .map_or_else(|| "u".to_string(), |c| c.name.clone());
+            let record = if data.n_experiments() > 1 {
+                format!(" in record {}", e + 1)
+            } else {
+                String::new()
+            };
+            return Err(Error::NotExciting {
+                channel,
+                reason: format!(
+                    "it is constant{record}, so the record cannot show how the model responds \
+                     to it; fit a record whose input varies (a step, a sweep, a multisine)"
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl GreyBoxEstimation {
     /// Fits `model` to `data` from the parameters `model_params` (values, bounds, fixed flags
     /// of the model's own parameters) and the initial states `initial`.
+    ///
+    /// Errors: [`Error::NotExciting`] when a record's inputs are all constant (the output
+    /// error's cross-correlation with the input is then undefined, and the record cannot
+    /// tell the input's effect from the parameters'); the model's and the data's errors.
     pub fn estimate(
         &self,
         model: Arc<dyn StateSpaceModel>,
@@ -146,6 +182,7 @@ impl GreyBoxEstimation {
     ) -> Result<GreyBoxFit> {
         let clock = Instant::now();
         check_names(model.as_ref(), model_params)?;
+        check_inputs_move(data)?;
         let structure = GreyBox::new(model.clone(), data, self.simulation, initial.clone())?;
         let params = structure.parameter_set(model_params);
         params.validate()?;

@@ -216,7 +216,7 @@ impl EquationStateSpace {
             .map_err(|e| Error::InvalidModel(format!("{origin}: {e}")))?;
         Ok(Self {
             free_columns: model.rhs_jacobian_columns(&parameters.free_indices()),
-            evaluator: Evaluator::from_env()?,
+            evaluator: Evaluator::Auto,
             native: Arc::default(),
             states: model.states().iter().map(channel).collect(),
             inputs: model.inputs().iter().map(channel).collect(),
@@ -251,7 +251,8 @@ impl EquationStateSpace {
         self.model.initial().iter().map(|s| !s.fixed).collect()
     }
 
-    /// The same model run by `evaluator` (the default is [`Evaluator::from_env`]).
+    /// The same model run by `evaluator` (the default is [`Evaluator::Auto`]; a front end
+    /// passes the user's choice, or [`Evaluator::from_env`]).
     pub fn with_evaluator(mut self, evaluator: Evaluator) -> Self {
         self.evaluator = evaluator;
         self.native = Arc::default();
@@ -277,9 +278,10 @@ impl EquationStateSpace {
         match found {
             Ok(f) => Ok(Some(f)),
             Err(why) if self.evaluator.requires_native() => Err(Error::Unsupported(format!(
-                "equation model '{}': no native code ({why}); unset HYSID_EVALUATOR (or set \
-                 it to auto) to run the tape interpreter",
-                self.name()
+                "equation model '{}': no native code for the evaluator '{}' ({why}); choose \
+                 the evaluator auto or tape to run the tape interpreter",
+                self.name(),
+                self.evaluator.name()
             ))),
             Err(_) => Ok(None),
         }
@@ -312,7 +314,7 @@ impl EquationStateSpace {
     }
 
     /// The native code of `key` by the first of the evaluator's routes that builds it
-    /// ([`Evaluator::backends`]: in the process, else the C compiler), or why none did.
+    /// ([`Evaluator::backends`]: the C compiler), or why none did.
     fn build_native(&self, key: &NativeKey) -> std::result::Result<Arc<NativeFunction>, String> {
         let mut why = Vec::new();
         for &backend in self.evaluator.backends() {
@@ -607,12 +609,11 @@ impl StateSpaceModel for EquationStateSpace {
     }
 
     /// "native code (…)" when every simulation that asked for native code got it (how:
-    /// generated in the process, compiled now with the compiler's time, or loaded from the
-    /// cache), "tape interpreter (…)" with the reason otherwise; None before any
+    /// compiled now with the compiler's time, or loaded from the cache), "tape interpreter (…)" with the reason otherwise; None before any
     /// simulation.
     fn evaluation(&self) -> Option<String> {
         if self.evaluator == Evaluator::Tape {
-            return Some("tape interpreter (HYSID_EVALUATOR=tape)".into());
+            return Some("tape interpreter (evaluator tape chosen)".into());
         }
         let cells = self.native.lock().unwrap_or_else(|e| e.into_inner());
         let built: Vec<_> = cells.iter().filter_map(|(_, cell)| cell.get()).collect();
@@ -622,11 +623,10 @@ impl StateSpaceModel for EquationStateSpace {
         if let Some(Err(why)) = built.iter().find(|b| b.is_err()) {
             return Some(format!("tape interpreter (no native code: {why})"));
         }
-        let (mut generated, mut compiled, mut cached) = (None::<f64>, None::<f64>, false);
+        let (mut compiled, mut cached) = (None::<f64>, false);
         let mut uncached = false;
         for b in built.iter().filter_map(|b| b.as_ref().ok()) {
             match b.provenance() {
-                Provenance::Generated(s) => *generated.get_or_insert(0.0) += s,
                 Provenance::Compiled(s) => *compiled.get_or_insert(0.0) += s,
                 Provenance::CompiledUncached(s) => {
                     *compiled.get_or_insert(0.0) += s;
@@ -636,9 +636,6 @@ impl StateSpaceModel for EquationStateSpace {
             }
         }
         let mut how = Vec::new();
-        if let Some(s) = generated {
-            how.push(format!("generated in the process in {:.1} ms", 1e3 * s));
-        }
         if let Some(s) = compiled {
             how.push(if uncached {
                 format!("compiled now: {s:.2} s of compiler time; not cached (no usable cache)")

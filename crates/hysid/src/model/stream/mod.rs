@@ -301,9 +301,11 @@ impl FittedModel {
                 parameters,
                 simulation,
                 initial_state,
+                evaluator,
                 ..
             } => {
-                let model = EquationStateSpace::parse(equations, "saved model")?;
+                let model =
+                    EquationStateSpace::parse(equations, "saved model")?.with_evaluator(*evaluator);
                 grey_box(
                     Box::new(model),
                     parameters.values(),

@@ -1,44 +1,39 @@
 //! Equation-file models as machine code: the tape of f, ∂f/∂x and ∂f/∂θ — for a fit, with
 //! the forward-sensitivity rates Ṡ = [f_θ, 0] + f_x·S, ẋ alone and a sample interval's RK4
-//! sub-steps of x and S ([`Layout`]) — turned into machine code, so that a fit of a model
-//! written as equations runs at the speed of a built-in model. Two routes ([`Backend`]) make
-//! the same functions, with the same C signatures:
-//!
-//! * generated in the process (`jit/`, Linux on x86-64 with AVX): x86-64 code emitted from
-//!   the listing in well under a millisecond, without a compiler or a file;
-//! * compiled (`source.rs` prints C, `object.rs` compiles it with the machine's C compiler
-//!   into a cache keyed by its content and loads it): about 0.1 s the first time on a
-//!   machine, a cache load in well under a millisecond afterwards.
+//! sub-steps of x and S ([`Layout`]) — printed as C (`source.rs`), compiled by the
+//! machine's C compiler into a private cache keyed by its content and loaded (`object.rs`;
+//! [`Backend::Compiled`]), so that a fit of a model written as equations runs at the speed
+//! of a built-in model: about 0.1 s the first time on a machine, a cache load in well under
+//! a millisecond afterwards. hysid emits no machine code itself: the compiler does.
 //!
 //! When a fit (or a simulation) of an equation model starts, the model asks for the native
 //! form of the tape it is about to run ([`NativeFunction::build`]). The tape interpreter
-//! stays: it is the fallback (neither route available, a compiler error), it is what
+//! stays: it is the fallback (no C compiler, a compiler error, a refused cache), it is what
 //! [`Evaluator::Tape`] selects, and it is the reference the native code is held to. Every
 //! native function is evaluated beside the tape at sample points before it is used, and
 //! refused unless every result has the tape's bits ([`NativeFunction::build`]'s `check`);
-//! both routes perform the tape's operations in its order with its rounding (no fused
+//! the C performs the tape's operations in its order with its rounding (no fused
 //! multiply–add, no reordering), so the two agree to the bit and a fit gives the same
 //! estimates either way (`native_code_equals_the_tape_for_every_operation`,
 //! `native_code_equals_the_tape_on_the_example_files`,
 //! `native_code_equals_the_tape_on_random_expressions` and
-//! `bouc_wen_file_fit_from_twice_nominal_is_the_built_in_fit_native_or_taped` in the tests,
-//! each for both routes).
+//! `bouc_wen_file_fit_from_twice_nominal_is_the_built_in_fit_native_or_taped` in the tests).
 //!
-//! Which evaluator runs is [`Evaluator`]: `auto` (generated, else compiled, else the tape),
-//! `native` (an error when neither route builds), `jit` (generated only), `cc` (compiled
-//! only), `tape`; the default is read from the environment variable `HYSID_EVALUATOR`. The
+//! Which evaluator runs is [`Evaluator`], a setting of the model
+//! ([`super::equation_model::EquationStateSpace::with_evaluator`]; the front ends' option
+//! `--evaluator`, `evaluator=` in Python): `auto` (compiled, else the tape), `cc` (compiled
+//! only: an error when it cannot be built), `tape`; `native` is the best native route
+//! available (today the C compiler's, so `cc`). [`Evaluator::from_env`] reads the same
+//! names from the environment variable `HYSID_EVALUATOR`, the front ends' default. The
 //! compiler is [`crate::toolchain::Compiler`] (`$CC` as make reads it, else `cc`); the cache
 //! is `$HYSID_CACHE_DIR`, else `$XDG_CACHE_HOME/hysid`, else `~/.cache/hysid`, private and
 //! checked (`object.rs`: a library is loaded only if its MAC matches).
 //!
 //! The technique — generating code for a model's residual and Jacobian from its expression
-//! graph — is that of CasADi's code generation (J. A. E. Andersson et al., "CasADi: a
-//! software framework for nonlinear optimization and optimal control", *Mathematical
-//! Programming Computation* 11, 2019), which prints C for the system compiler; emitting the
-//! machine code directly is what a JIT compiler does.
+//! graph and handing it to the system's C compiler — is that of CasADi's code generation
+//! (J. A. E. Andersson et al., "CasADi: a software framework for nonlinear optimization and
+//! optimal control", *Mathematical Programming Computation* 11, 2019).
 
-#[cfg(all(target_os = "linux", target_arch = "x86_64"))]
-mod jit;
 #[cfg(target_os = "linux")]
 mod object;
 mod source;
@@ -47,58 +42,74 @@ use crate::{Error, Result};
 use hysid_equations::Listing;
 use std::sync::Arc;
 
-/// Which code evaluates an equation model's tapes in a simulation.
+/// Which code evaluates an equation model's tapes in a simulation (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Evaluator {
-    /// Native code when it can be built (emitted in the process, else by a C compiler),
-    /// else the tape interpreter.
+    /// Native code when the C compiler builds it (or the cache has it), else the tape
+    /// interpreter.
     #[default]
     Auto,
-    /// Native code by either route; a simulation fails with the reason when it cannot be
-    /// built.
+    /// Native code by the best route available (the C compiler's, as [`Evaluator::Cc`]); a
+    /// simulation fails with the reason when it cannot be built.
     Native,
-    /// Native code emitted in the process only ([`Backend::Generated`]).
-    Jit,
-    /// Native code from the C compiler only ([`Backend::Compiled`]).
+    /// Native code from the C compiler only ([`Backend::Compiled`]); a simulation fails
+    /// with the reason when it cannot be built.
     Cc,
     /// The tape interpreter.
     Tape,
 }
 
+/// The names [`Evaluator`] parses, for messages.
+const EVALUATORS: &str = "auto, native, cc or tape";
+
 impl Evaluator {
     /// The evaluator the environment variable `HYSID_EVALUATOR` names (`auto`, `native`,
-    /// `jit`, `cc` or `tape`; unset or empty: `auto`).
+    /// `cc` or `tape`; unset or empty: `auto`). The library never reads it by itself: a
+    /// front end calls this for its default and passes the result to the model.
+    ///
+    /// Errors: [`Error::InvalidOption`] for any other value (`jit` names the in-process
+    /// encoder, which was removed).
     pub fn from_env() -> Result<Self> {
         match std::env::var("HYSID_EVALUATOR") {
             Err(_) => Ok(Self::Auto),
-            Ok(v) => v.parse(),
+            Ok(v) => v.parse().map_err(|e: Error| match e {
+                Error::InvalidOption { value, reason, .. } => Error::InvalidOption {
+                    option: "HYSID_EVALUATOR".into(),
+                    value,
+                    reason: format!("HYSID_EVALUATOR: {reason}"),
+                },
+                other => other,
+            }),
+        }
+    }
+
+    /// The name the front ends use (`auto`, `native`, `cc`, `tape`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::Native => "native",
+            Self::Cc => "cc",
+            Self::Tape => "tape",
         }
     }
 
     /// The routes to native code this evaluator tries, in order (none for the tape).
     pub fn backends(self) -> &'static [Backend] {
         match self {
-            Self::Auto | Self::Native if Backend::Generated.available() => {
-                &[Backend::Generated, Backend::Compiled]
-            }
             Self::Auto | Self::Native | Self::Cc => &[Backend::Compiled],
-            Self::Jit => &[Backend::Generated],
             Self::Tape => &[],
         }
     }
 
     /// Whether a simulation fails when native code cannot be built.
     pub fn requires_native(self) -> bool {
-        matches!(self, Self::Native | Self::Jit | Self::Cc)
+        matches!(self, Self::Native | Self::Cc)
     }
 }
 
 /// How a listing becomes machine code.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Backend {
-    /// Emitted as x86-64 machine code in the process (`jit/`; Linux on x86-64 with AVX):
-    /// well under a millisecond.
-    Generated,
     /// Printed as C (`source.rs`), compiled by the system's C compiler and cached
     /// (`object.rs`; Linux): about 0.1 s the first time on a machine.
     Compiled,
@@ -109,10 +120,6 @@ impl Backend {
     /// found out when it runs).
     pub fn available(self) -> bool {
         match self {
-            #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
-            Backend::Generated => jit::available(),
-            #[cfg(not(all(target_os = "linux", target_arch = "x86_64")))]
-            Backend::Generated => false,
             Backend::Compiled => cfg!(target_os = "linux"),
         }
     }
@@ -120,20 +127,28 @@ impl Backend {
 
 impl std::str::FromStr for Evaluator {
     type Err = Error;
+    /// `auto` (or empty), `native`, `cc` or `tape`, surrounding blanks ignored.
+    ///
+    /// Errors: [`Error::InvalidOption`] (option `evaluator`) for any other name, `jit`
+    /// with the note that the in-process encoder was removed.
     fn from_str(s: &str) -> Result<Self> {
         match s.trim() {
             "" | "auto" => Ok(Self::Auto),
             "native" => Ok(Self::Native),
-            "jit" => Ok(Self::Jit),
             "cc" => Ok(Self::Cc),
             "tape" => Ok(Self::Tape),
-            other => Err(Error::invalid_option(
-                "HYSID_EVALUATOR",
-                other,
+            "jit" => Err(Error::invalid_option(
+                "evaluator",
+                "jit",
                 format!(
-                    "HYSID_EVALUATOR is '{other}'; the equation evaluator is auto, native, jit, cc \
-                     or tape"
+                    "the evaluator 'jit' (the in-process machine-code encoder) was removed; \
+                     choose {EVALUATORS}"
                 ),
+            )),
+            other => Err(Error::invalid_option(
+                "evaluator",
+                other,
+                format!("'{other}' is not an equation evaluator; choose {EVALUATORS}"),
             )),
         }
     }
@@ -142,8 +157,6 @@ impl std::str::FromStr for Evaluator {
 /// How a native function was obtained, for a report.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Provenance {
-    /// Emitted in the process ([`Backend::Generated`]), in this many seconds.
-    Generated(f64),
     /// Loaded from the cache of compiled models.
     Cached,
     /// Compiled now, in this many seconds, and stored in the cache for later runs.
@@ -237,7 +250,7 @@ pub struct NativeFunction {
     provenance: Provenance,
 }
 
-/// The entry points of a loaded or generated unit, by their C names.
+/// The entry points of a loaded library, by their C names.
 struct Found {
     prepare: PrepareFn,
     entry: Entry,
@@ -251,8 +264,8 @@ impl Found {
         layout: &Layout,
     ) -> std::result::Result<Self, String> {
         type Address = *mut std::ffi::c_void;
-        // SAFETY: each name is a function of `source.rs` (or its generated twin) with the
-        // C signature it is transmuted to.
+        // SAFETY: each name is a function of `source.rs` with the C signature it is
+        // transmuted to.
         unsafe {
             let prepare = std::mem::transmute::<Address, PrepareFn>(symbol(c"hysid_prepare")?);
             let (entry, rates) = match layout {
@@ -350,7 +363,6 @@ impl NativeFunction {
             return Err(format!("{backend:?} native code is not available here"));
         }
         let native = Arc::new(match backend {
-            Backend::Generated => Self::generate(listing, layout, shape)?,
             Backend::Compiled => {
                 let source = match &layout {
                     Layout::Results { values, positions } => {
@@ -386,32 +398,6 @@ impl NativeFunction {
     #[cfg(not(target_os = "linux"))]
     fn load(_: &source::Source, _: Layout, _: Shape) -> std::result::Result<Self, String> {
         Err("native code is built on Linux only".into())
-    }
-
-    /// The functions of `source.rs` emitted in the process.
-    #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
-    fn generate(
-        listing: &Listing,
-        layout: Layout,
-        shape: Shape,
-    ) -> std::result::Result<Self, String> {
-        let started = std::time::Instant::now();
-        let (code, entries, prepared) = jit::assemble(listing, &layout, shape)?;
-        let provenance = Provenance::Generated(started.elapsed().as_secs_f64());
-        let symbol = |name: &std::ffi::CStr| {
-            entries
-                .iter()
-                .find(|(entry, _)| *entry == name)
-                .map(|&(_, offset)| code.entry(offset))
-                .ok_or_else(|| format!("no function {name:?} was generated"))
-        };
-        let found = Found::look_up(symbol, &layout)?;
-        Ok(found.function(Arc::new(code), layout, shape, prepared, provenance))
-    }
-
-    #[cfg(not(all(target_os = "linux", target_arch = "x86_64")))]
-    fn generate(_: &Listing, _: Layout, _: Shape) -> std::result::Result<Self, String> {
-        Err("native code is generated on x86-64 Linux only".into())
     }
 
     /// How the code was obtained.

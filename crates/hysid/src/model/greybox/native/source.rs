@@ -53,8 +53,7 @@ pub(super) enum Class {
     Varying,
 }
 
-/// A listing split into what θ alone determines (`hysid_prepare`) and the rest; the
-/// in-process code generator (`jit`) emits the same split.
+/// A listing split into what θ alone determines (`hysid_prepare`) and the rest.
 pub(super) struct Split<'a> {
     pub listing: &'a Listing,
     /// Per operation, whether it reads t, x or u (directly or through another).

@@ -130,7 +130,7 @@ fn equation_path_equals_the_generic_path() {
     }
     for (model, case) in &cases {
         let generic = crate::unit::generic_path::GenericPath(*model);
-        for evaluator in [Evaluator::Tape, Evaluator::Jit, Evaluator::Cc] {
+        for evaluator in [Evaluator::Tape, Evaluator::Cc] {
             // Each route to native code this machine has, held to the generic path.
             if evaluator.backends().iter().any(|b| !b.available()) {
                 continue;

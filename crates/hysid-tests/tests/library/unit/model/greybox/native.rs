@@ -71,10 +71,9 @@ fn results(values: usize, positions: Vec<usize>) -> Layout {
     Layout::Results { values, positions }
 }
 
-/// The routes to native code this machine has (the C compiler's on Linux; the in-process
-/// generator on x86-64 with AVX).
+/// The routes to native code this machine has (the C compiler's on Linux).
 fn backends() -> Vec<Backend> {
-    let all = [Backend::Generated, Backend::Compiled];
+    let all = [Backend::Compiled];
     let here: Vec<Backend> = all.into_iter().filter(|b| b.available()).collect();
     assert!(!here.is_empty(), "no route to native code on this machine");
     here
@@ -380,41 +379,33 @@ fn the_compiled_code_is_cached_and_checked() {
     }
 }
 
-/// The in-process route emits code without a compiler or a cache: it says so, with the
-/// time it took.
+/// The evaluators' names (`HYSID_EVALUATOR`, `--evaluator`, `evaluator=`): auto, native, cc
+/// and tape; `jit` (the removed in-process encoder) and anything else are refused in one
+/// line that names the accepted values; every evaluator but the tape goes to the C compiler.
 #[test]
-fn generated_code_needs_no_compiler() {
-    if !Backend::Generated.available() {
-        return;
-    }
-    let m = EquationModel::parse(EVERY_OPERATION).unwrap();
-    let f = NativeFunction::build(
-        &m.rhs_listing(),
-        results(2, vec![0, 1]),
-        shape(&m),
-        Backend::Generated,
-        |_| true,
-    )
-    .unwrap();
-    assert!(matches!(f.provenance(), Provenance::Generated(s) if (0.0..1.0).contains(&s)));
-}
-
-#[test]
-fn evaluators_are_named_auto_native_jit_cc_and_tape() {
+fn evaluators_are_named_auto_native_cc_and_tape() {
     assert_eq!("auto".parse::<Evaluator>().unwrap(), Evaluator::Auto);
     assert_eq!("".parse::<Evaluator>().unwrap(), Evaluator::Auto);
     assert_eq!("native".parse::<Evaluator>().unwrap(), Evaluator::Native);
-    assert_eq!("jit".parse::<Evaluator>().unwrap(), Evaluator::Jit);
     assert_eq!("cc".parse::<Evaluator>().unwrap(), Evaluator::Cc);
     assert_eq!(" tape ".parse::<Evaluator>().unwrap(), Evaluator::Tape);
-    let e = "fast".parse::<Evaluator>().unwrap_err().to_string();
-    assert!(
-        e.contains("HYSID_EVALUATOR") && e.contains("auto, native, jit, cc or tape"),
-        "{e}"
-    );
-    assert_eq!(Evaluator::Cc.backends(), &[Backend::Compiled]);
-    assert_eq!(Evaluator::Jit.backends(), &[Backend::Generated]);
+    for (name, said) in [
+        ("fast", "'fast' is not an equation evaluator"),
+        ("jit", "removed"),
+    ] {
+        let e = name.parse::<Evaluator>().unwrap_err().to_string();
+        assert!(
+            e.contains(said) && e.contains("auto, native, cc or tape") && !e.contains('\n'),
+            "{e}"
+        );
+    }
+    for evaluator in [Evaluator::Auto, Evaluator::Native, Evaluator::Cc] {
+        assert_eq!(evaluator.backends(), &[Backend::Compiled]);
+        assert_eq!(evaluator.name().parse::<Evaluator>().unwrap(), evaluator);
+    }
     assert!(Evaluator::Tape.backends().is_empty());
+    assert!(Evaluator::Cc.requires_native() && Evaluator::Native.requires_native());
+    assert!(!Evaluator::Auto.requires_native() && !Evaluator::Tape.requires_native());
 }
 
 /// A random expression over the states a, b, the inputs u, w and the parameters k, m, n, e
