@@ -98,6 +98,9 @@ pub const AGREEMENT: f64 = 1e-6;
 pub const RESTART_THRESHOLD: f64 = 1e-9;
 /// Above this relative promise, a point the engine stopped at is a flat region, not a minimum.
 pub const FLAT_THRESHOLD: f64 = 1e-6;
+/// Shape points of the grid scored from the descending and ascending states too when the
+/// initial state is estimated: the best ones from the family's own start.
+pub const HISTORY_POINTS: usize = 12;
 /// Restarts of the engine at a point that still promises a decrease.
 pub const MAX_RESTARTS: usize = 3;
 
@@ -608,20 +611,19 @@ impl<F: DifferentialFamily> Driver<'_, F> {
         &self,
         u: &[f64],
         y: &[f64],
-        shape: &LoopShape,
+        points: &[Vec<f64>],
         starts: &[Start],
-    ) -> Vec<(f64, Vec<f64>, Start)> {
-        let points = self.family.shape_grid(u, y, shape);
+    ) -> Vec<(f64, Vec<f64>, Start, usize)> {
         let x0 = self.family.initial_state_index();
         let (lo, hi) = range(u);
         let span = (hi - lo).max(f64::MIN_POSITIVE);
-        let work: Vec<(&Vec<f64>, Start)> = points
-            .iter()
-            .flat_map(|p| starts.iter().map(move |s| (p, *s)))
+        let work: Vec<(usize, Start)> = (0..points.len())
+            .flat_map(|i| starts.iter().map(move |s| (i, *s)))
             .collect();
-        let mut scored: Vec<(f64, Vec<f64>, Start)> = work
+        let mut scored: Vec<(f64, Vec<f64>, Start, usize)> = work
             .par_iter()
-            .filter_map(|&(point, start)| {
+            .filter_map(|&(index, start)| {
+                let point = &points[index];
                 // A history's basis: the record after a turn 2 spans beyond it.
                 let turn = match start {
                     Start::History(InitialStateUsed::Descending) => Some(hi + 2.0 * span),
@@ -661,7 +663,7 @@ impl<F: DifferentialFamily> Driver<'_, F> {
                 }
                 self.family.model(&theta).ok()?;
                 sse.is_finite()
-                    .then(|| (sse, self.family.phi_of(&theta), start))
+                    .then(|| (sse, self.family.phi_of(&theta), start, index))
             })
             .collect();
         self.settings
@@ -725,7 +727,27 @@ pub fn fit<F: DifferentialFamily>(
     let kept = decimate(u, DECIMATED_SAMPLES);
     let ud: Vec<f64> = kept.iter().map(|&k| u[k]).collect();
     let yd: Vec<f64> = kept.iter().map(|&k| y[k]).collect();
-    let grid = driver.grid(&ud, &yd, &shape, &starts);
+    let points = family.shape_grid(&ud, &yd, &shape);
+    let grid = if declared.is_none() {
+        // The family's own start everywhere, the two histories at the best shape points
+        // only (the grid's cost grows by a fraction, not threefold).
+        let mut grid = driver.grid(&ud, &yd, &points, &starts[..1]);
+        let mut best: Vec<usize> = Vec::new();
+        for g in &grid {
+            if best.len() == HISTORY_POINTS {
+                break;
+            }
+            if !best.contains(&g.3) {
+                best.push(g.3);
+            }
+        }
+        let subset: Vec<Vec<f64>> = best.iter().map(|&i| points[i].clone()).collect();
+        grid.extend(driver.grid(&ud, &yd, &subset, &starts[1..]));
+        grid.sort_by(|a, b| a.0.total_cmp(&b.0));
+        grid
+    } else {
+        driver.grid(&ud, &yd, &points, &starts)
+    };
     evaluations += grid.len();
     if grid.is_empty() {
         return Err(Error::NotExciting {
