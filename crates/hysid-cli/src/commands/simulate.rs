@@ -45,20 +45,30 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     let history = args
         .history
         .as_ref()
-        .map(|path| IdData::from_file(path, &CsvSpec { outputs: Vec::new(), ..spec.clone() }))
+        .map(|path| {
+            IdData::from_file(
+                path,
+                &CsvSpec {
+                    outputs: Vec::new(),
+                    ..spec.clone()
+                },
+            )
+        })
         .transpose()
         .with_context(|| "reading --history".to_string())?;
     let (report, predictions) =
-        simulate_report_after(&model, &records, history.as_ref(), args.warm_up).with_context(|| {
-        format!(
-            "simulating on {}",
-            records
-                .iter()
-                .map(|(s, _)| s.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    })?;
+        simulate_report_after(&model, &records, history.as_ref(), args.warm_up).with_context(
+            || {
+                format!(
+                    "simulating on {}",
+                    records
+                        .iter()
+                        .map(|(s, _)| s.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            },
+        )?;
     if let (Some(csv), Some(p)) = (&csv, predictions.first()) {
         let mut headers: Vec<&str> = args.input.iter().map(String::as_str).collect();
         headers.push("simulated");

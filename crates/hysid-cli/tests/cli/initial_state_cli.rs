@@ -56,11 +56,27 @@ fn a_declared_history_is_saved_reported_and_reapplied_by_simulate() {
     let plant = BoucWen::new(0.3, -1.0, 2.5, 1.5, 1.0).unwrap();
     let train_u = through(&[-1.0, 1.0, -0.2, 0.6, -0.7, 0.9, 0.1, -1.0, 0.5]);
     let valid_u = through(&[-0.8, 0.7, -0.4, 1.0, 0.0, -0.6, 0.8]);
-    let train = write(dir.path(), "train.csv", &train_u, &saturated(&plant, &train_u));
-    let valid = write(dir.path(), "valid.csv", &valid_u, &saturated(&plant, &valid_u));
+    let train = write(
+        dir.path(),
+        "train.csv",
+        &train_u,
+        &saturated(&plant, &train_u),
+    );
+    let valid = write(
+        dir.path(),
+        "valid.csv",
+        &valid_u,
+        &saturated(&plant, &valid_u),
+    );
     let (model, report) = (dir.path().join("m.json"), dir.path().join("r.json"));
     hysid()
-        .args(["identify", "operator", "--family", "bouc-wen", "--initial-state"])
+        .args([
+            "identify",
+            "operator",
+            "--family",
+            "bouc-wen",
+            "--initial-state",
+        ])
         .arg("descending")
         .arg("--data")
         .arg(&train)

@@ -233,7 +233,8 @@ pub enum SavedModel {
         family: String,
         /// The operator's full structure: thresholds, weights, grids, orientation and
         /// initial state, as the family defines them. Checked on reading.
-        operator: serde_json::Value,        /// The initial state the operator starts from (`demagnetised`, `descending`,
+        operator: serde_json::Value,
+        /// The initial state the operator starts from (`demagnetised`, `descending`,
         /// `ascending`, `estimated`: `hysid::model::operators::InitialStateUsed`); a declared
         /// history is re-applied at every record's first input. Absent: the structure's own
         /// state, as before the field existed.
@@ -712,7 +713,8 @@ pub enum FittedModel {
         /// The operator.
         model: OperatorModel,
         /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
-        std: Vec<f64>,        /// The initial state it starts from (None: as its structure holds it).
+        std: Vec<f64>,
+        /// The initial state it starts from (None: as its structure holds it).
         initial_state: Option<InitialStateUsed>,
     },
     /// A model fitted to pre-filtered records: it filters every record (inputs and measured

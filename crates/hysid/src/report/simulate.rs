@@ -58,8 +58,7 @@ pub fn simulate_report_after(
             )));
         }
         let mut inputs: Vec<Vec<f64>> = vec![Vec::new(); channels];
-        let mut measured: Option<Vec<f64>> =
-            (!data.output_channels().is_empty()).then(Vec::new);
+        let mut measured: Option<Vec<f64>> = (!data.output_channels().is_empty()).then(Vec::new);
         if let Some(h) = history {
             if h.input_channels().len() != channels {
                 return Err(Error::InvalidData(format!(

@@ -19,10 +19,10 @@ use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopSha
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
+use crate::model::operators::InitialState;
 use crate::model::operators::{Dahl, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
-use crate::model::operators::InitialState;
 use crate::Result;
 
 /// Options of the Dahl fit.

@@ -64,11 +64,11 @@
 //! *System Identification*, 2nd ed., Prentice Hall 1999.
 
 use super::OperatorFit;
+use crate::model::operators::differential::states_with_tolerance;
 use crate::model::operators::differential::{
     check_signal, simulate_with_sensitivities, simulate_with_tolerance, InputOdeSensitivity,
     LoopOrientation, MAX_SENSITIVITIES, TOLERANCE,
 };
-use crate::model::operators::differential::states_with_tolerance;
 use crate::model::operators::{HysteresisOperator, InitialState, InitialStateUsed};
 use crate::numerics::levenberg_marquardt::{
     minimize, Control, LeastSquaresProblem, LmConfig, LmReport, NormalEquations,

@@ -18,9 +18,9 @@ use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::Duhem;
+use crate::model::operators::InitialState;
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
-use crate::model::operators::InitialState;
 use crate::Result;
 
 /// Options of the Duhem fit.

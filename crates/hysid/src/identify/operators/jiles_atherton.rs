@@ -26,10 +26,10 @@ use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::jiles_atherton::{langevin, MU0};
+use crate::model::operators::InitialState;
 use crate::model::operators::{Anhysteretic, JaOutput, JilesAtherton, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
-use crate::model::operators::InitialState;
 use crate::Result;
 
 /// Options of the Jiles–Atherton fit.

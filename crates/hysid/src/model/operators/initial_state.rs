@@ -104,9 +104,7 @@ impl InitialState {
 
 /// The initial state a fitted operator uses, resolved: what a model file saves as
 /// `"initial_state"` and what `simulate` applies to a new record (module doc).
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum InitialStateUsed {
     /// The family's neutral state, as the operator's structure holds it.

@@ -445,7 +445,10 @@ impl HysteresisOperator for Kp {
 
     /// Twice the threshold grid's extent from 0 and the ridge width: every kernel saturates.
     fn memory_reach(&self) -> f64 {
-        let (lo, hi) = (self.thresholds.first().copied().unwrap_or(0.0), self.thresholds.last().copied().unwrap_or(0.0));
+        let (lo, hi) = (
+            self.thresholds.first().copied().unwrap_or(0.0),
+            self.thresholds.last().copied().unwrap_or(0.0),
+        );
         2.0 * (lo.abs() + hi.abs()) + 2.0 * self.width.abs()
     }
 }

@@ -114,11 +114,14 @@ fn a_record_starting_in_saturation_is_fitted_from_its_estimated_state() {
     use hysid::numerics::metrics::fit_percent;
     let mut plant = BoucWen::new(0.3, -1.0, 2.5, 1.5, 1.0).unwrap();
     let in_saturation = |plant: &BoucWen, u0: f64| {
-        let w = hysid::model::operators::differential::states(plant, &[u0, u0 + 100.0, u0])
-            .unwrap();
+        let w =
+            hysid::model::operators::differential::states(plant, &[u0, u0 + 100.0, u0]).unwrap();
         w[2]
     };
-    let train_u = through(&[-1.0, 1.0, -0.2, 0.6, -0.7, 0.9, 0.1, 0.4, -1.0, 0.5], 200.0);
+    let train_u = through(
+        &[-1.0, 1.0, -0.2, 0.6, -0.7, 0.9, 0.1, 0.4, -1.0, 0.5],
+        200.0,
+    );
     let valid_u = through(&[-1.0, 0.7, -0.4, 1.0, 0.0, 0.5, -0.8, 0.8], 200.0);
     plant.w0 = in_saturation(&plant, train_u[0]);
     let train_y = with_noise(&plant.simulate(&train_u).unwrap(), 46.0, 11);
@@ -140,7 +143,9 @@ fn a_record_starting_in_saturation_is_fitted_from_its_estimated_state() {
     let estimated = validation(InitialState::Estimate);
     let best = validation(InitialState::Descending);
     let before = validation(InitialState::Demagnetised);
-    eprintln!("validation fit %: estimate {estimated:.3}, true state {best:.3}, demagnetised {before:.3}");
+    eprintln!(
+        "validation fit %: estimate {estimated:.3}, true state {best:.3}, demagnetised {before:.3}"
+    );
     assert!(estimated >= 99.3, "{estimated}");
     assert!(estimated >= best - 0.1, "{estimated} vs {best}");
     assert!(before < estimated - 1.0, "{before} vs {estimated}");

@@ -3,8 +3,8 @@
 
 use hysid::model::operators::initial_state::{self, HISTORY_SAMPLES};
 use hysid::model::operators::{
-    BoucWen, HysteresisOperator, InitialState, InitialStateUsed, OperatorModel,
-    PrandtlIshlinskii, Orientation,
+    BoucWen, HysteresisOperator, InitialState, InitialStateUsed, OperatorModel, Orientation,
+    PrandtlIshlinskii,
 };
 use hysid::model::saved::{FittedModel, ModelFile};
 
@@ -35,9 +35,15 @@ fn a_descending_history_puts_every_play_on_its_upper_edge() {
     .unwrap();
     let u = [0.1, 0.3, -0.4];
     let y = initial_state::simulate(&pi, Some(InitialStateUsed::Descending), &u).unwrap();
-    assert!((y[0] - (0.5 * 0.1 + 1.0 * 0.35 + 2.0 * 0.6)).abs() < 1e-12, "{y:?}");
+    assert!(
+        (y[0] - (0.5 * 0.1 + 1.0 * 0.35 + 2.0 * 0.6)).abs() < 1e-12,
+        "{y:?}"
+    );
     let y = initial_state::simulate(&pi, Some(InitialStateUsed::Ascending), &u).unwrap();
-    assert!((y[0] - (0.5 * 0.1 + 1.0 * -0.15 + 2.0 * -0.4)).abs() < 1e-12, "{y:?}");
+    assert!(
+        (y[0] - (0.5 * 0.1 + 1.0 * -0.15 + 2.0 * -0.4)).abs() < 1e-12,
+        "{y:?}"
+    );
     assert_eq!(
         initial_state::history(&pi, InitialStateUsed::Descending, &u).len(),
         HISTORY_SAMPLES
@@ -50,11 +56,22 @@ fn a_descending_bouc_wen_start_is_near_negative_saturation_at_the_minimum() {
     let bw = BoucWen::new(0.5, 1.0, 3.0, 1.0, 1.0).unwrap();
     let u = [-1.0, -0.5, 1.0];
     let y = initial_state::simulate(&bw, Some(InitialStateUsed::Descending), &u).unwrap();
-    let w0 = y[0] - 0.5 * -1.0;
-    assert!((w0 + bw.w_max()).abs() < 1e-6, "w0 = {w0}, w_max = {}", bw.w_max());
+    let w0 = y[0] + 0.5; // y = k_x·u + k_w·w with k_x = 0.5, u₀ = −1, k_w = 1
+    assert!(
+        (w0 + bw.w_max()).abs() < 1e-6,
+        "w0 = {w0}, w_max = {}",
+        bw.w_max()
+    );
     // Demagnetised and estimated states are the structure's own (w0 = 0 here).
-    for s in [None, Some(InitialStateUsed::Demagnetised), Some(InitialStateUsed::Estimated)] {
-        assert_eq!(initial_state::simulate(&bw, s, &u).unwrap(), bw.simulate(&u).unwrap());
+    for s in [
+        None,
+        Some(InitialStateUsed::Demagnetised),
+        Some(InitialStateUsed::Estimated),
+    ] {
+        assert_eq!(
+            initial_state::simulate(&bw, s, &u).unwrap(),
+            bw.simulate(&u).unwrap()
+        );
     }
 }
 
@@ -67,14 +84,16 @@ fn a_model_file_saves_the_state_and_a_file_without_it_reads_as_before() {
     let text = serde_json::to_string(&file).unwrap();
     assert!(!text.contains("initial_state"), "{text}");
     let back = FittedModel::from_file(&serde_json::from_str::<ModelFile>(&text).unwrap()).unwrap();
-    assert_eq!(back.simulate(&[&u], 1.0, None).unwrap()[0], bw.simulate(&u).unwrap());
+    assert_eq!(
+        back.simulate(&[&u], 1.0, None).unwrap()[0],
+        bw.simulate(&u).unwrap()
+    );
 
     let declared = plain.with_initial_state(Some(InitialStateUsed::Descending));
     let text = serde_json::to_string(&declared.to_file()).unwrap();
     assert!(text.contains("\"initial_state\":\"descending\""), "{text}");
     let back = FittedModel::from_file(&serde_json::from_str::<ModelFile>(&text).unwrap()).unwrap();
-    let expected =
-        initial_state::simulate(&bw, Some(InitialStateUsed::Descending), &u).unwrap();
+    let expected = initial_state::simulate(&bw, Some(InitialStateUsed::Descending), &u).unwrap();
     assert_eq!(back.simulate(&[&u], 1.0, None).unwrap()[0], expected);
     assert_ne!(expected, bw.simulate(&u).unwrap());
 }
