@@ -759,6 +759,15 @@ pub struct SimulateArgs {
     pub csv: Option<PathBuf>,
     #[command(flatten)]
     pub evaluator: EvaluatorArgs,
+    /// Run the first N rows of each record to set the model's state without scoring them
+    /// (nor writing them to --csv). Range 0..=1e9, fewer than the record's rows.
+    #[arg(long = "warm-up", default_value_t = 0, value_parser = crate::options::count::<0, 1_000_000_000>)]
+    pub warm_up: usize,
+    /// A record (same --input columns) run through the model first: each --data record is
+    /// simulated from the state it leaves (a saved declared initial state is applied at the
+    /// history's first input instead).
+    #[arg(long)]
+    pub history: Option<PathBuf>,
     /// Write the JSON report here.
     #[arg(long)]
     pub json: Option<PathBuf>,

@@ -6,7 +6,7 @@ use crate::output::Outputs;
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::model::saved::FittedModel;
-use hysid::report::simulate_report;
+use hysid::report::simulate_report_after;
 
 /// Runs the model on every record (processed as its fit processed them) and compares with
 /// the output column when given. The outputs are one transaction: written to temporaries,
@@ -20,6 +20,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     let mut inputs = vec![args.model.as_path()];
     inputs.extend(args.data.iter().map(|p| p.as_path()));
+    inputs.extend(args.history.iter().map(|p| p.as_path()));
     let mut out = Outputs::new(&inputs, args.json.as_deref(), None, None)?;
     let csv = out.file(args.csv.as_deref())?;
     let model =
@@ -42,16 +43,33 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         .zip(&data)
         .collect();
     // Errors (never returns) when the simulated output is not finite.
-    let (report, predictions) = simulate_report(&model, &records).with_context(|| {
-        format!(
-            "simulating on {}",
-            records
-                .iter()
-                .map(|(s, _)| s.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    })?;
+    let history = args
+        .history
+        .as_ref()
+        .map(|path| {
+            IdData::from_file(
+                path,
+                &CsvSpec {
+                    outputs: Vec::new(),
+                    ..spec.clone()
+                },
+            )
+        })
+        .transpose()
+        .with_context(|| "reading --history".to_string())?;
+    let (report, predictions) =
+        simulate_report_after(&model, &records, history.as_ref(), args.warm_up).with_context(
+            || {
+                format!(
+                    "simulating on {}",
+                    records
+                        .iter()
+                        .map(|(s, _)| s.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            },
+        )?;
     if let (Some(csv), Some(p)) = (&csv, predictions.first()) {
         let mut headers: Vec<&str> = args.input.iter().map(String::as_str).collect();
         headers.push("simulated");

@@ -17,6 +17,7 @@ pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
         lambda: args.lambda,
         dead_zones: args.dead_zones as usize,
         loop_orientation: args.orientation.map(Into::into),
+        initial_state: args.initial_state.into(),
         ..FamilyOptions::default()
     };
     let text = args.thresholds.trim();

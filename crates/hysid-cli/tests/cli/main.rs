@@ -13,6 +13,7 @@ mod export_cli;
 mod hardening;
 mod hold_check_cli;
 #[cfg(unix)] // symbolic links
+mod initial_state_cli;
 mod inputs_sacred;
 #[cfg(target_os = "linux")] // the C route of equation files
 mod native_cache;

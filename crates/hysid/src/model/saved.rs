@@ -49,7 +49,8 @@ use crate::model::greybox::equation_model::{EquationStateSpace, EQUATIONS_KIND};
 use crate::model::greybox::models::GreyBoxKind;
 use crate::model::greybox::native::Evaluator;
 use crate::model::greybox::{models, InputInterpolation, Integrator, Simulation};
-use crate::model::operators::OperatorModel;
+use crate::model::operators::initial_state;
+use crate::model::operators::{InitialStateUsed, OperatorModel};
 use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
 use crate::model::saved_equations::{equations_from_file, simulate_outputs};
 use crate::model::OperatorCascade;
@@ -234,6 +235,12 @@ pub enum SavedModel {
         /// The operator's full structure: thresholds, weights, grids, orientation and
         /// initial state, as the family defines them. Checked on reading.
         operator: serde_json::Value,
+        /// The initial state the operator starts from (`demagnetised`, `descending`,
+        /// `ascending`, `estimated`: `hysid::model::operators::InitialStateUsed`); a declared
+        /// history is re-applied at every record's first input. Absent: the structure's own
+        /// state, as before the field existed.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        initial_state: Option<InitialStateUsed>,
     },
     /// A grey-box model of the library's user (its own [`StateSpaceModel`], e.g. Python
     /// callbacks), under the kind the model gives itself: written into reports, never read
@@ -298,6 +305,8 @@ enum SavedModelReader {
         parameters: Vec<ParameterRecord>,
         family: String,
         operator: serde_json::Value,
+        #[serde(default)]
+        initial_state: Option<InitialStateUsed>,
     },
 }
 
@@ -709,6 +718,8 @@ pub enum FittedModel {
         model: OperatorModel,
         /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
         std: Vec<f64>,
+        /// The initial state it starts from (None: as its structure holds it).
+        initial_state: Option<InitialStateUsed>,
     },
     /// A model fitted to pre-filtered records: it filters every record (inputs and measured
     /// output alike) before it simulates.
@@ -803,9 +814,15 @@ impl FittedModel {
                 preprocessing.predict(&self.rigid_body()?, first()?, ts)?.1,
             ]),
             FittedModel::OperatorCascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
-            FittedModel::Operator { model, .. } => {
-                Ok(vec![model.as_operator().simulate(first()?)?])
-            }
+            FittedModel::Operator {
+                model,
+                initial_state,
+                ..
+            } => Ok(vec![initial_state::simulate(
+                model.as_operator(),
+                *initial_state,
+                first()?,
+            )?]),
             FittedModel::GreyBox {
                 kind,
                 parameters,
@@ -1082,11 +1099,17 @@ impl FittedModel {
                     ..model.to_file()
                 }
             }
-            FittedModel::Operator { family, model, std } => SavedModel::Operator {
+            FittedModel::Operator {
+                family,
+                model,
+                std,
+                initial_state,
+            } => SavedModel::Operator {
                 parameters: records(&model.as_operator().parameters(), std),
                 family: family.to_string(),
                 // As for the operator cascade: a failure would only leave the structure null.
                 operator: model.structure().unwrap_or_default(),
+                initial_state: *initial_state,
             },
         };
         ModelFile::new(model)
@@ -1098,6 +1121,23 @@ impl FittedModel {
             family: model.family().name(),
             model,
             std,
+            initial_state: None,
+        }
+    }
+
+    /// The same model starting from `state` (an operator; other kinds are returned as they
+    /// are).
+    pub fn with_initial_state(self, state: Option<InitialStateUsed>) -> Self {
+        match self {
+            FittedModel::Operator {
+                family, model, std, ..
+            } => FittedModel::Operator {
+                family,
+                model,
+                std,
+                initial_state: state,
+            },
+            other => other,
         }
     }
 
@@ -1160,7 +1200,10 @@ impl FittedModel {
                 delay, operator, ..
             } => operator_cascade_from_file(*delay, operator, &records),
             SavedModel::Operator {
-                family, operator, ..
+                family,
+                operator,
+                initial_state,
+                ..
             } => {
                 let model = OperatorModel::from_structure(family, operator)?;
                 let names = model.as_operator().parameters();
@@ -1168,7 +1211,7 @@ impl FittedModel {
                 for p in names.iter() {
                     std.push(records.get(&p.name)?.std_or_nan());
                 }
-                Ok(Self::operator(model, std))
+                Ok(Self::operator(model, std).with_initial_state(*initial_state))
             }
             SavedModel::Equations {
                 parameters,

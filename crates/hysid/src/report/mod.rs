@@ -42,7 +42,7 @@ pub use compensation::compensation_report;
 pub use greybox::{bouc_wen_benchmark_report, greybox_report, greybox_residuals};
 pub use operator::{operator_report, operator_simulation};
 pub use rigid_body::{rigid_body_model, rigid_body_report, RigidBodyRecord};
-pub use simulate::simulate_report;
+pub use simulate::{simulate_report, simulate_report_after};
 
 use crate::data::IdData;
 use crate::identify::OutputErrorFit;

@@ -67,6 +67,9 @@ pub fn operator_report(
         "fpe": finite(fit.fpe),
         "orientation": fitted.orientation.map(|o| o.orientation.short_name()),
         "orientation_source": fitted.orientation.map(|o| o.source.name()),
+        // The state the fitted model starts from (`demagnetised` for a family whose
+        // structure holds its start).
+        "initial_state": fit.initial_state.map_or("demagnetised", |s| s.name()),
     });
     Ok(report)
 }

@@ -23,6 +23,7 @@ use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopSha
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::states_with_tolerance;
+use crate::model::operators::InitialState;
 use crate::model::operators::{BoucWen, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
@@ -45,6 +46,9 @@ pub struct BoucWenOptions {
     /// The loop's turning sense in the (u, y) plane; detected from the data when None
     /// ([`LoopOrientation::of_loop`]).
     pub orientation: Option<LoopOrientation>,
+    /// The initial state (default: estimated, [`InitialState::Estimate`]; see
+    /// [`crate::model::operators::initial_state`]).
+    pub initial_state: InitialState,
 }
 
 impl Default for BoucWenOptions {
@@ -54,6 +58,7 @@ impl Default for BoucWenOptions {
             estimate_n: false,
             starts: 4,
             config: driver::default_config(),
+            initial_state: InitialState::Estimate,
             observer: Observer::none(),
             orientation: None,
         }
@@ -73,6 +78,9 @@ impl DifferentialFamily for Family {
     type Model = BoucWen;
     fn name(&self) -> &'static str {
         "bouc-wen"
+    }
+    fn initial_state_index(&self) -> usize {
+        6
     }
     fn model(&self, t: &[f64]) -> Result<BoucWen> {
         let m = BoucWen {
@@ -178,6 +186,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &BoucWenOptions) -> Result<OperatorFit
         starts: options.starts,
         config: options.config.clone(),
         observer: options.observer.clone(),
+        initial_state: options.initial_state,
     };
     driver::fit(&family, u, y, &settings)
 }
@@ -190,6 +199,7 @@ impl Identify for BoucWen {
             u,
             y,
             &BoucWenOptions {
+                initial_state: options.initial_state,
                 observer: options.observer.clone(),
                 orientation: options.loop_orientation,
                 ..BoucWenOptions::default()

@@ -112,6 +112,9 @@ pub struct CompareRow {
     pub orientation: Option<&'static str>,
     /// Where it came from: `given`, `detected` or `fitted`.
     pub orientation_source: Option<&'static str>,
+    /// The initial state the fitted model starts from (`demagnetised`, `descending`,
+    /// `ascending`, `estimated`; None when the family failed).
+    pub initial_state: Option<&'static str>,
     /// The one-line error of a family that failed.
     pub error: Option<String>,
     /// The fitted model (None when the family failed).
@@ -137,6 +140,7 @@ impl CompareRow {
             termination: None,
             orientation: None,
             orientation_source: None,
+            initial_state: None,
             error: Some(error.to_string()),
             fitted: None,
             validation_simulated: Vec::new(),
@@ -323,6 +327,7 @@ fn row(
         termination: Some(fit.termination.to_string()),
         orientation: fitted.orientation.map(|o| o.orientation.short_name()),
         orientation_source: fitted.orientation.map(|o| o.source.name()),
+        initial_state: Some(fit.initial_state.map_or("demagnetised", |s| s.name())),
         error: None,
         fitted: Some(fitted),
         validation_simulated: simulated,

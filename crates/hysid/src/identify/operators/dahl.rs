@@ -19,6 +19,7 @@ use super::differential_fit::{self as driver, Basis, DifferentialFamily, LoopSha
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
+use crate::model::operators::InitialState;
 use crate::model::operators::{Dahl, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
@@ -41,6 +42,9 @@ pub struct DahlOptions {
     /// The loop's turning sense in the (u, y) plane; detected from the data when None
     /// ([`LoopOrientation::of_loop`]).
     pub orientation: Option<LoopOrientation>,
+    /// The initial state (default: estimated, [`InitialState::Estimate`]; see
+    /// [`crate::model::operators::initial_state`]).
+    pub initial_state: InitialState,
 }
 
 impl Default for DahlOptions {
@@ -50,6 +54,7 @@ impl Default for DahlOptions {
             estimate_i: true,
             starts: 3,
             config: driver::default_config(),
+            initial_state: InitialState::Estimate,
             observer: Observer::none(),
             orientation: None,
         }
@@ -67,6 +72,9 @@ impl DifferentialFamily for Family {
     type Model = Dahl;
     fn name(&self) -> &'static str {
         "dahl"
+    }
+    fn initial_state_index(&self) -> usize {
+        3
     }
     fn model(&self, t: &[f64]) -> Result<Dahl> {
         let m = Dahl {
@@ -150,6 +158,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &DahlOptions) -> Result<OperatorFit<Da
         starts: options.starts,
         config: options.config.clone(),
         observer: options.observer.clone(),
+        initial_state: options.initial_state,
     };
     driver::fit(&family, u, y, &settings)
 }
@@ -162,6 +171,7 @@ impl Identify for Dahl {
             u,
             y,
             &DahlOptions {
+                initial_state: options.initial_state,
                 observer: options.observer.clone(),
                 orientation: options.loop_orientation,
                 ..DahlOptions::default()

@@ -64,11 +64,12 @@
 //! *System Identification*, 2nd ed., Prentice Hall 1999.
 
 use super::OperatorFit;
+use crate::model::operators::differential::states_with_tolerance;
 use crate::model::operators::differential::{
     check_signal, simulate_with_sensitivities, simulate_with_tolerance, InputOdeSensitivity,
     LoopOrientation, MAX_SENSITIVITIES, TOLERANCE,
 };
-use crate::model::operators::HysteresisOperator;
+use crate::model::operators::{HysteresisOperator, InitialState, InitialStateUsed};
 use crate::numerics::levenberg_marquardt::{
     minimize, Control, LeastSquaresProblem, LmConfig, LmReport, NormalEquations,
 };
@@ -97,6 +98,9 @@ pub const AGREEMENT: f64 = 1e-6;
 pub const RESTART_THRESHOLD: f64 = 1e-9;
 /// Above this relative promise, a point the engine stopped at is a flat region, not a minimum.
 pub const FLAT_THRESHOLD: f64 = 1e-6;
+/// Shape points of the grid scored from the descending and ascending states too when the
+/// initial state is estimated: the best ones from the family's own start.
+pub const HISTORY_POINTS: usize = 12;
 /// Restarts of the engine at a point that still promises a decrease.
 pub const MAX_RESTARTS: usize = 3;
 
@@ -173,6 +177,8 @@ pub trait DifferentialFamily: Sync {
     type Model: HysteresisOperator + InputOdeSensitivity + Clone;
     /// The family's name in messages (`bouc-wen`).
     fn name(&self) -> &'static str;
+    /// The index in θ of the state at the first sample x₀ (`w0`, `y0`, `f0`, `m0`).
+    fn initial_state_index(&self) -> usize;
     /// The operator of θ, or an error where θ leaves the family's domain.
     fn model(&self, theta: &[f64]) -> Result<Self::Model>;
     /// The indices of the estimated parameters (the same in θ and φ).
@@ -212,6 +218,10 @@ pub struct Settings {
     pub config: LmConfig,
     /// Sees the "grid", "start" and "iteration" progress; may stop the fit.
     pub observer: Observer,
+    /// The initial state: declared (x₀ held: 0, or the state after the declared history run
+    /// before the record) or estimated (the demagnetised, descending and ascending starts
+    /// scored in the grid, x₀ then free).
+    pub initial_state: InitialState,
 }
 
 /// The default engine settings of these fits: 200 iterations, a relative improvement
@@ -350,6 +360,8 @@ struct OutputError<'a, F: DifferentialFamily> {
     u: &'a [f64],
     y: &'a [f64],
     n_phi: usize,
+    /// Leading samples (a declared history) simulated but not scored.
+    skip: usize,
     floor: f64,
     tolerance: f64,
     last_system: Mutex<Option<LastSystem>>,
@@ -377,15 +389,17 @@ impl<'a, F: DifferentialFamily> OutputError<'a, F> {
         n_phi: usize,
         tolerance: f64,
         keep_output: bool,
+        skip: usize,
     ) -> Self {
         // The integration is accurate to ~1e-10 of the signal's scale: residuals below 1e-9
         // of the output's spread are an exact fit.
-        let s = 1e-9 * metrics::std_dev(y);
+        let s = 1e-9 * metrics::std_dev(&y[skip.min(y.len())..]);
         Self {
             family,
             u,
             y,
             n_phi,
+            skip,
             floor: y.len() as f64 * s * s,
             tolerance,
             last_system: Mutex::new(None),
@@ -410,6 +424,7 @@ impl<'a, F: DifferentialFamily> OutputError<'a, F> {
             .y
             .iter()
             .zip(&yhat)
+            .skip(self.skip)
             .map(|(y, h)| (y - h) * (y - h))
             .sum();
         if !cost.is_finite() {
@@ -445,6 +460,9 @@ impl<'a, F: DifferentialFamily> OutputError<'a, F> {
         let (mut row, mut row_theta) = ([0.0; MAX_SENSITIVITIES], [0.0; MAX_SENSITIVITIES]);
         let mut finite = true;
         simulate_with_sensitivities(&model, self.u, self.tolerance, |k, yhat, dtheta| {
+            if k < self.skip {
+                return;
+            }
             let r = self.y[k] - yhat;
             self.family.chain(dtheta, &mut dphi[..n_theta]);
             for (a, &i) in free.iter().enumerate() {
@@ -492,8 +510,8 @@ impl<F: DifferentialFamily> LeastSquaresProblem for OutputError<'_, F> {
     }
     fn residuals(&self, phi: &[f64], r: &mut [f64]) -> Result<()> {
         let (yhat, _) = self.output(phi)?;
-        for ((r, y), yh) in r.iter_mut().zip(self.y).zip(&yhat) {
-            *r = y - yh;
+        for (k, ((r, y), yh)) in r.iter_mut().zip(self.y).zip(&yhat).enumerate() {
+            *r = if k < self.skip { 0.0 } else { y - yh };
         }
         Ok(())
     }
@@ -556,6 +574,8 @@ struct Driver<'a, F: DifferentialFamily> {
     free: Vec<usize>,
     lower: Vec<f64>,
     upper: Vec<f64>,
+    /// x₀ estimated (free, its start chosen in the grid).
+    estimate: bool,
 }
 
 impl<F: DifferentialFamily> Driver<'_, F> {
@@ -585,30 +605,84 @@ impl<F: DifferentialFamily> Driver<'_, F> {
         Ok(Run { report, stopped })
     }
 
-    /// The best linear completion of every grid point on the decimated record, best first.
-    fn grid(&self, u: &[f64], y: &[f64], shape: &LoopShape) -> Vec<(f64, Vec<f64>)> {
-        let points = self.family.shape_grid(u, y, shape);
-        let mut scored: Vec<(f64, Vec<f64>)> = points
+    /// The best linear completion of every grid point on the decimated record from each of
+    /// the `starts`, best first, with the start of each.
+    fn grid(
+        &self,
+        u: &[f64],
+        y: &[f64],
+        points: &[Vec<f64>],
+        starts: &[Start],
+    ) -> Vec<(f64, Vec<f64>, Start, usize)> {
+        let x0 = self.family.initial_state_index();
+        let (lo, hi) = range(u);
+        let span = (hi - lo).max(f64::MIN_POSITIVE);
+        let work: Vec<(usize, Start)> = (0..points.len())
+            .flat_map(|i| starts.iter().map(move |s| (i, *s)))
+            .collect();
+        let mut scored: Vec<(f64, Vec<f64>, Start, usize)> = work
             .par_iter()
-            .filter_map(|point| {
-                let basis = self.family.basis(point, u, COARSE_TOLERANCE).ok()?;
+            .filter_map(|&(index, start)| {
+                let point = &points[index];
+                // A history's basis: the record after a turn 2 spans beyond it.
+                let turn = match start {
+                    Start::History(InitialStateUsed::Descending) => Some(hi + 2.0 * span),
+                    Start::History(InitialStateUsed::Ascending) => Some(lo - 2.0 * span),
+                    _ => None,
+                };
+                let path: Vec<f64> = match turn {
+                    Some(t) => [u[0], t].iter().chain(u).copied().collect(),
+                    None => u.to_vec(),
+                };
+                let skip = path.len() - u.len();
+                let mut basis = self.family.basis(point, &path, COARSE_TOLERANCE).ok()?;
+                basis.columns.iter_mut().for_each(|c| {
+                    c.drain(..skip);
+                });
+                if let Some(f) = basis.fixed.as_mut() {
+                    f.drain(..skip);
+                }
                 let target: Vec<f64> = match &basis.fixed {
                     Some(f) => y.iter().zip(f).map(|(y, f)| y - f).collect(),
                     None => y.to_vec(),
                 };
                 let cols: Vec<&[f64]> = basis.columns.iter().map(Vec::as_slice).collect();
                 let (c, sse) = linear_fit(&cols, &target)?;
-                let theta = self.family.assemble(point, &c)?;
+                let mut theta = self.family.assemble(point, &c)?;
+                match start {
+                    Start::Zero => theta[x0] = 0.0,
+                    Start::History(state) if self.estimate => {
+                        // x₀ is the state this model reaches after the history.
+                        let model = self.family.model(&theta).ok()?;
+                        let turn = state.turning_input(&model, u)?;
+                        theta[x0] = *states_with_tolerance(&model, &[u[0], turn, u[0]], TOLERANCE)
+                            .ok()?
+                            .last()?;
+                    }
+                    _ => {}
+                }
                 self.family.model(&theta).ok()?;
-                sse.is_finite().then(|| (sse, self.family.phi_of(&theta)))
+                sse.is_finite()
+                    .then(|| (sse, self.family.phi_of(&theta), start, index))
             })
             .collect();
         self.settings
             .observer
-            .report("grid", points.len(), points.len());
+            .report("grid", work.len(), work.len());
         scored.sort_by(|a, b| a.0.total_cmp(&b.0));
         scored
     }
+}
+
+/// Where a grid point's state starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Start {
+    /// The family's own grid start (its x₀ as the family places it).
+    Own,
+    /// x₀ = 0 (declared demagnetised).
+    Zero,
+    /// After a declared history.
+    History(InitialStateUsed),
 }
 
 /// Fits `family` to input `u` and output `y` (module doc).
@@ -619,7 +693,12 @@ pub fn fit<F: DifferentialFamily>(
     settings: &Settings,
 ) -> Result<OperatorFit<F::Model>> {
     let started = Instant::now();
-    let free = family.free();
+    let declared = settings.initial_state.declared();
+    let x0 = family.initial_state_index();
+    let mut free = family.free();
+    if declared.is_some() {
+        free.retain(|&i| i != x0);
+    }
     check_record(family.name(), u, y, free.len())?;
     let shape = LoopShape::of(u, y);
     let (lower, upper) = family.bounds(&shape);
@@ -629,6 +708,16 @@ pub fn fit<F: DifferentialFamily>(
         free,
         lower,
         upper,
+        estimate: declared.is_none(),
+    };
+    let starts: Vec<Start> = match declared {
+        None => vec![
+            Start::Own,
+            Start::History(InitialStateUsed::Descending),
+            Start::History(InitialStateUsed::Ascending),
+        ],
+        Some(InitialStateUsed::Demagnetised) => vec![Start::Zero],
+        Some(state) => vec![Start::History(state)],
     };
     let n_phi = driver.lower.len();
     let observer = &settings.observer;
@@ -638,7 +727,27 @@ pub fn fit<F: DifferentialFamily>(
     let kept = decimate(u, DECIMATED_SAMPLES);
     let ud: Vec<f64> = kept.iter().map(|&k| u[k]).collect();
     let yd: Vec<f64> = kept.iter().map(|&k| y[k]).collect();
-    let grid = driver.grid(&ud, &yd, &shape);
+    let points = family.shape_grid(&ud, &yd, &shape);
+    let grid = if declared.is_none() {
+        // The family's own start everywhere, the two histories at the best shape points
+        // only (the grid's cost grows by a fraction, not threefold).
+        let mut grid = driver.grid(&ud, &yd, &points, &starts[..1]);
+        let mut best: Vec<usize> = Vec::new();
+        for g in &grid {
+            if best.len() == HISTORY_POINTS {
+                break;
+            }
+            if !best.contains(&g.3) {
+                best.push(g.3);
+            }
+        }
+        let subset: Vec<Vec<f64>> = best.iter().map(|&i| points[i].clone()).collect();
+        grid.extend(driver.grid(&ud, &yd, &subset, &starts[1..]));
+        grid.sort_by(|a, b| a.0.total_cmp(&b.0));
+        grid
+    } else {
+        driver.grid(&ud, &yd, &points, &starts)
+    };
     evaluations += grid.len();
     if grid.is_empty() {
         return Err(Error::NotExciting {
@@ -651,8 +760,27 @@ pub fn fit<F: DifferentialFamily>(
         });
     }
 
+    // A declared history: the records with it prepended, its samples not scored; the turn
+    // placed for the best grid point's model (module doc of `initial_state`).
+    let history = match declared {
+        Some(state @ (InitialStateUsed::Descending | InitialStateUsed::Ascending)) => {
+            let model = family.model(&family.theta_of(&grid[0].1))?;
+            state.turning_input(&model, u).map(|t| (state, t))
+        }
+        _ => None,
+    };
+    let prefixed = |v: &[f64], first: f64| -> Vec<f64> {
+        match history {
+            Some((_, turn)) => [first, turn].iter().chain(v).copied().collect(),
+            None => v.to_vec(),
+        }
+    };
+    let (ud, yd) = (prefixed(&ud, ud[0]), prefixed(&yd, yd[0]));
+    let (up, yp) = (prefixed(u, u[0]), prefixed(y, y[0]));
+    let skip = up.len() - u.len();
+
     // 3: local searches on the decimated record, in parallel.
-    let decimated = OutputError::new(family, (&ud, &yd), n_phi, COARSE_TOLERANCE, false);
+    let decimated = OutputError::new(family, (&ud, &yd), n_phi, COARSE_TOLERANCE, false, skip);
     let local = local_config(&settings.config);
     // A record short enough to be kept whole makes every local search cheap: three times
     // as many then (measured loops of a hundred samples have many shallow minima).
@@ -674,12 +802,12 @@ pub fn fit<F: DifferentialFamily>(
         observer.report("start", starts.len(), starts.len());
     }
     if minima.is_empty() {
-        minima.push(grid[0].clone());
+        minima.push((grid[0].0, grid[0].1.clone()));
     }
     minima.sort_by(|a, b| a.0.total_cmp(&b.0));
 
     // 4–5: the full record from the best minimum (and a close rival), checked.
-    let full = OutputError::new(family, (u, y), n_phi, TOLERANCE, true);
+    let full = OutputError::new(family, (&up, &yp), n_phi, TOLERANCE, true, skip);
     let mut candidates = vec![minima[0].1.clone()];
     if let Some(rival) = minima[1..].iter().find(|m| {
         m.0 > minima[0].0 * (1.0 + AGREEMENT)
@@ -728,14 +856,16 @@ pub fn fit<F: DifferentialFamily>(
             (lm_report(&phi, &driver.free, system, u.len()), termination)
         }
     };
-    report_fit(
+    let mut fit = report_fit(
         &driver,
         &full,
         &report.theta,
         termination,
         (iterations, evaluations),
         started,
-    )
+    )?;
+    fit.initial_state = Some(declared.unwrap_or(InitialStateUsed::Estimated));
+    Ok(fit)
 }
 
 /// True when two points differ by more than 0.1 % (relative) in a free coordinate.
@@ -835,14 +965,29 @@ fn report_fit<F: DifferentialFamily>(
 ) -> Result<OperatorFit<F::Model>> {
     let theta = driver.family.theta_of(phi);
     let model = driver.family.model(&theta)?;
-    let y = problem.y;
+    let y = &problem.y[problem.skip..];
     let system = problem.system(phi, &driver.free)?;
     let normal = NormalEquations {
         jtj: system.theta_jtj,
         ..system.phi
     };
     let covariance = lm_report(&theta, &driver.free, normal, y.len()).covariance();
-    let (simulated, _) = problem.output(phi)?;
+    let (mut simulated, _) = problem.output(phi)?;
+    let simulated = simulated.split_off(problem.skip);
+    // After a declared history the saved x₀ is the state the history leaves at the first
+    // sample (a later record re-applies the history; this one simulates the same).
+    let model = match problem.skip {
+        0 => model,
+        _ => {
+            let x0 = driver.family.initial_state_index();
+            let mut theta = theta.clone();
+            theta[x0] = states_with_tolerance(&model, &problem.u[..problem.skip + 1], TOLERANCE)?
+                .last()
+                .copied()
+                .unwrap_or(theta[x0]);
+            driver.family.model(&theta)?
+        }
+    };
     let parameters = model.parameters();
     let std = (0..parameters.len())
         .map(|i| {
@@ -866,6 +1011,7 @@ fn report_fit<F: DifferentialFamily>(
         evaluations,
         termination,
         elapsed_s: started.elapsed().as_secs_f64(),
+        initial_state: None,
     })
 }
 

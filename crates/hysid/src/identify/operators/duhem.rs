@@ -18,6 +18,7 @@ use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::Duhem;
+use crate::model::operators::InitialState;
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
 use crate::Result;
@@ -32,6 +33,9 @@ pub struct DuhemOptions {
     /// Sees the fit's grid, starts and iterations and may stop it (see
     /// [`Settings::observer`]).
     pub observer: Observer,
+    /// The initial state (default: estimated, [`InitialState::Estimate`]; see
+    /// [`crate::model::operators::initial_state`]).
+    pub initial_state: InitialState,
 }
 
 impl Default for DuhemOptions {
@@ -39,6 +43,7 @@ impl Default for DuhemOptions {
         Self {
             starts: 3,
             config: driver::default_config(),
+            initial_state: InitialState::Estimate,
             observer: Observer::none(),
         }
     }
@@ -52,6 +57,9 @@ impl DifferentialFamily for Family {
     type Model = Duhem;
     fn name(&self) -> &'static str {
         "duhem"
+    }
+    fn initial_state_index(&self) -> usize {
+        4
     }
     fn model(&self, t: &[f64]) -> Result<Duhem> {
         let m = Duhem {
@@ -111,6 +119,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &DuhemOptions) -> Result<OperatorFit<D
         starts: options.starts,
         config: options.config.clone(),
         observer: options.observer.clone(),
+        initial_state: options.initial_state,
     };
     driver::fit(&Family, u, y, &settings)
 }
@@ -123,6 +132,7 @@ impl Identify for Duhem {
             u,
             y,
             &DuhemOptions {
+                initial_state: options.initial_state,
                 observer: options.observer.clone(),
                 ..DuhemOptions::default()
             },

@@ -14,7 +14,9 @@ use crate::identify::hysteresis::HysteresisIdentification;
 use crate::identify::operator_cascade::OperatorCascadeIdentification;
 use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
 pub use crate::model::operators::Family;
-use crate::model::operators::{LoopOrientation, OperatorFamily, OperatorModel, Orientation};
+use crate::model::operators::{
+    InitialState, LoopOrientation, OperatorFamily, OperatorModel, Orientation,
+};
 use crate::model::saved::FittedModel;
 use crate::model::OperatorCascade;
 use crate::model::{ChForm, Parameter, ParameterSet};
@@ -51,6 +53,12 @@ pub struct FamilyOptions {
     /// Sees the starts and iterations of the differential families' searches (Jiles–Atherton,
     /// Bouc–Wen, Duhem, Dahl) and may stop them with the best result so far.
     pub observer: Observer,
+    /// The initial state (`--initial-state`, Python `initial_state=`; default
+    /// [`InitialState::Estimate`]). The differential families (Jiles–Atherton, Bouc–Wen,
+    /// Duhem, Dahl) read every value; the other families start demagnetised (their
+    /// structure's documented state) under `estimate` and `demagnetised` and refuse a
+    /// declared history for now.
+    pub initial_state: InitialState,
 }
 
 impl Default for FamilyOptions {
@@ -64,6 +72,7 @@ impl Default for FamilyOptions {
             orientation: None,
             loop_orientation: None,
             observer: Observer::none(),
+            initial_state: InitialState::Estimate,
         }
     }
 }
@@ -316,6 +325,22 @@ pub fn fit_operator(
             needed: SMALLEST_MODEL.1,
         });
     }
+    let differential = matches!(
+        family,
+        Family::JilesAtherton | Family::BoucWen | Family::Duhem | Family::Dahl
+    );
+    if !differential
+        && matches!(
+            options.initial_state,
+            InitialState::Descending | InitialState::Ascending
+        )
+    {
+        return Err(Error::Unsupported(format!(
+            "{family}: a declared initial state '{}' is implemented for the differential \
+             families only (jiles-atherton, bouc-wen, duhem, dahl); use demagnetised or estimate",
+            options.initial_state.name()
+        )));
+    }
     let fit = match family {
         Family::Ch4 => coleman_hodgdon(ChForm::Saturated4, u, y)?,
         Family::Ch6 => coleman_hodgdon(ChForm::General6, u, y)?,
@@ -398,7 +423,7 @@ mod by_family {
 fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>) -> OperatorFit<FittedModel> {
     let std = fit.std.iter().map(|s| s.unwrap_or(f64::NAN)).collect();
     OperatorFit {
-        model: FittedModel::operator(fit.model.into(), std),
+        model: FittedModel::operator(fit.model.into(), std).with_initial_state(fit.initial_state),
         parameters: fit.parameters,
         std: fit.std,
         simulated: fit.simulated,
@@ -411,6 +436,7 @@ fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>) -> OperatorFit<FittedModel
         evaluations: fit.evaluations,
         termination: fit.termination,
         elapsed_s: fit.elapsed_s,
+        initial_state: fit.initial_state,
     }
 }
 
@@ -455,5 +481,6 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
         evaluations: report.function_evaluations,
         termination: report.termination.clone(),
         elapsed_s: started.elapsed().as_secs_f64(),
+        initial_state: None,
     })
 }

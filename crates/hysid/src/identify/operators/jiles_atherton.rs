@@ -26,6 +26,7 @@ use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::OperatorFit;
 use crate::model::operators::differential::simulate_with_tolerance;
 use crate::model::operators::jiles_atherton::{langevin, MU0};
+use crate::model::operators::InitialState;
 use crate::model::operators::{Anhysteretic, JaOutput, JilesAtherton, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
@@ -46,6 +47,9 @@ pub struct JilesAthertonOptions {
     /// The loop's turning sense in the (u, y) plane; detected from the data when None
     /// ([`LoopOrientation::of_loop`]).
     pub orientation: Option<LoopOrientation>,
+    /// The initial state (default: estimated, [`InitialState::Estimate`]; see
+    /// [`crate::model::operators::initial_state`]).
+    pub initial_state: InitialState,
 }
 
 impl Default for JilesAthertonOptions {
@@ -54,6 +58,7 @@ impl Default for JilesAthertonOptions {
             anhysteretic: Anhysteretic::Langevin,
             output: JaOutput::FluxDensity,
             config: driver::default_config(),
+            initial_state: InitialState::Estimate,
             observer: Observer::none(),
             orientation: None,
         }
@@ -102,6 +107,9 @@ impl DifferentialFamily for Family {
     type Model = JilesAtherton;
     fn name(&self) -> &'static str {
         "jiles-atherton"
+    }
+    fn initial_state_index(&self) -> usize {
+        5
     }
     fn model(&self, t: &[f64]) -> Result<JilesAtherton> {
         let m = self.operator(t, self.output);
@@ -206,6 +214,7 @@ pub fn fit(
         starts: STARTS,
         config: options.config.clone(),
         observer: options.observer.clone(),
+        initial_state: options.initial_state,
     };
     driver::fit(&family, u, y, &settings)
 }
@@ -232,6 +241,7 @@ impl Identify for JilesAtherton {
             u,
             y,
             &JilesAthertonOptions {
+                initial_state: options.initial_state,
                 observer: options.observer.clone(),
                 orientation: options.loop_orientation,
                 ..JilesAthertonOptions::default()

@@ -265,6 +265,7 @@ pub(crate) fn finish<M: HysteresisOperator + Core>(
         evaluations,
         termination,
         elapsed_s: start.elapsed().as_secs_f64(),
+        initial_state: None,
     }
 }
 

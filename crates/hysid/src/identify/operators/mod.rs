@@ -21,6 +21,7 @@
 //! branches ([`crate::model::operators::Orientation::detect`],
 //! [`crate::model::operators::orientation`]) unless given; a clockwise loop is fitted in the inverse-operator parameterisation (the core operator from
 //! y to u).
+use crate::model::operators::InitialStateUsed;
 use crate::model::ParameterSet;
 use crate::numerics::Termination;
 use serde::Serialize;
@@ -74,4 +75,8 @@ pub struct OperatorFit<M> {
     pub termination: Termination,
     /// Wall-clock seconds of the fit.
     pub elapsed_s: f64,
+    /// The initial state the fitted operator starts from (None: as its structure holds it,
+    /// the family's neutral state; [`crate::model::operators::initial_state`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub initial_state: Option<InitialStateUsed>,
 }

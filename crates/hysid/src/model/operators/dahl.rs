@@ -161,6 +161,11 @@ impl HysteresisOperator for Dahl {
         self.validate()?;
         differential::invert(self, reference)
     }
+    /// 100 of the family's longest sub-steps (its input scale): the state forgets its start
+    /// over that distance.
+    fn memory_reach(&self) -> f64 {
+        100.0 * InputOde::max_substep(self)
+    }
 }
 
 impl super::OperatorFamily for Dahl {

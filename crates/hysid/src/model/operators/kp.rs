@@ -442,6 +442,15 @@ impl HysteresisOperator for Kp {
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, reference)
     }
+
+    /// Twice the threshold grid's extent from 0 and the ridge width: every kernel saturates.
+    fn memory_reach(&self) -> f64 {
+        let (lo, hi) = (
+            self.thresholds.first().copied().unwrap_or(0.0),
+            self.thresholds.last().copied().unwrap_or(0.0),
+        );
+        2.0 * (lo.abs() + hi.abs()) + 2.0 * self.width.abs()
+    }
 }
 
 impl super::OperatorFamily for Kp {

@@ -41,7 +41,8 @@
 //!
 //! **Initial states.** Every differential operator carries its state at the first input
 //! sample as a parameter (`m0`, `w0`, `y0`, `f0`), so a record that starts anywhere on a loop
-//! can be simulated and fitted.
+//! can be simulated and fitted. A declared history (descending, ascending: [`initial_state`])
+//! is run through the operator before the record, for every family alike.
 use crate::model::ParameterSet;
 use crate::Result;
 use serde::{Deserialize, Serialize};
@@ -53,6 +54,7 @@ pub mod differential;
 pub mod duhem;
 pub(crate) mod elementary;
 pub(crate) mod gpi;
+pub mod initial_state;
 pub mod jiles_atherton;
 pub mod kp;
 pub(crate) mod maxwell_slip;
@@ -72,6 +74,7 @@ pub use elementary::{
     play, play_step, solve_monotone, stop, validate_thresholds, Branch, Orientation,
 };
 pub use gpi::{DeadZones, GeneralizedPi};
+pub use initial_state::{InitialState, InitialStateUsed};
 pub use jiles_atherton::{Anhysteretic, JaOutput, JilesAtherton};
 pub use kp::Kp;
 pub use maxwell_slip::MaxwellSlip;
@@ -105,4 +108,11 @@ pub trait HysteresisOperator: Send + Sync + std::fmt::Debug {
     /// The input that makes Γ follow `reference`, from the same initial state; samples outside the
     /// reachable range are clipped to it and listed, never silently.
     fn invert(&self, reference: &[f64]) -> Result<Inversion>;
+    /// The input distance beyond the record over which a monotone excursion wipes out the
+    /// operator's memory ([`initial_state`]): twice the largest play threshold, the span of a
+    /// Preisach grid, 100 sub-steps of a differential family's input scale. 0 (the default):
+    /// twice the record's span is enough.
+    fn memory_reach(&self) -> f64 {
+        0.0
+    }
 }

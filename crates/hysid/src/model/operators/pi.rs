@@ -273,6 +273,11 @@ impl HysteresisOperator for PrandtlIshlinskii {
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, reference)
     }
+
+    /// Twice the largest threshold: every play then sits on an edge.
+    fn memory_reach(&self) -> f64 {
+        2.0 * self.thresholds.last().copied().unwrap_or(0.0)
+    }
 }
 
 /// The parameter list `a0, a1…an, r1…rn (fixed), c` shared by the PI-like families.

@@ -520,6 +520,11 @@ impl HysteresisOperator for Preisach {
     fn invert(&self, reference: &[f64]) -> Result<Inversion> {
         oriented_invert(self, reference)
     }
+
+    /// Twice the grid's extent from 0: a history then leaves the grid and saturates every cell.
+    fn memory_reach(&self) -> f64 {
+        2.0 * (self.grid.lower.abs() + self.grid.upper.abs())
+    }
 }
 
 impl super::OperatorFamily for Preisach {

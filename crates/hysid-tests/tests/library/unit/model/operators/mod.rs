@@ -7,6 +7,7 @@ mod differential;
 mod duhem;
 mod elementary;
 mod gpi;
+mod initial_state;
 mod jiles_atherton;
 mod kp;
 mod maxwell_slip;
