@@ -59,6 +59,7 @@ pub mod solve;
 pub mod stmt;
 pub mod zip;
 
+use crate::model::limits::Limits;
 use crate::model::saved::{FittedModel, ModelFile};
 use crate::{Error, Result};
 use interface::SampleTime;
@@ -119,6 +120,10 @@ pub struct ExportOptions {
     /// `initial_output: measured`, which its forward step starts from (as `hysid simulate`
     /// starts from the record's first measured output); ignored by every other model.
     pub initial_output: Option<f64>,
+    /// The command limits of a compensator (`--limits LO:HI`,
+    /// [`crate::model::limits`]); None takes the model file's `input_range`, and a file
+    /// without one exports an unlimited compensator ([`export_limits`] says which).
+    pub limits: Option<Limits>,
 }
 
 impl Default for ExportOptions {
@@ -128,8 +133,19 @@ impl Default for ExportOptions {
             sample_time: None,
             binary: true,
             initial_output: None,
+            limits: None,
         }
     }
+}
+
+/// The limits an export of `file` applies to its compensator's command: `--limits`
+/// ([`ExportOptions::limits`]), else the file's `input_range`, else none (the front end
+/// warns); None for a forward export.
+pub fn export_limits(file: &ModelFile, options: &ExportOptions) -> Option<Limits> {
+    if !options.inverse {
+        return None;
+    }
+    options.limits.or_else(|| file.limits())
 }
 
 /// One file of an export, its path relative to the output directory.
@@ -217,6 +233,11 @@ fn prepare(
     options: &ExportOptions,
 ) -> Result<(program::Program, Interface, String)> {
     check_name(name)?;
+    let given = options;
+    let options = &ExportOptions {
+        limits: export_limits(file, given),
+        ..given.clone()
+    };
     let sample_time = SampleTime::of(file, options)?;
     let model = FittedModel::from_file(file)?;
     let program = kinds::program(&model, options, sample_time.seconds())?;
@@ -227,7 +248,7 @@ fn prepare(
         (program.n_inputs, program.n_outputs)
     };
     let interface = interface::interface(file, name, options, sample_time, sizes);
-    let comment = interface::comment(file, &interface, options, sample_time);
+    let comment = interface::comment(file, &interface, given, sample_time);
     Ok((program, interface, comment))
 }
 
