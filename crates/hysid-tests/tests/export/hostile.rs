@@ -9,7 +9,7 @@ use crate::cases::{self, Case};
 use hysid::model::limits::Limits;
 use hysid::model::saved::FittedModel;
 
-/// The sample time every case is exported with.
+/// The sample time of a case that gives none.
 const TS: f64 = 1e-3;
 
 /// `base` (its first 1200 samples) with bad samples inserted — NaN, +∞, −∞ alone and in
@@ -74,6 +74,7 @@ struct Run {
 
 fn library(case: &Case, input: &[f64]) -> Run {
     let model = FittedModel::from_file(&case.file).expect("the case's model");
+    let ts = case.options.sample_time.unwrap_or(TS);
     let mut run = Run {
         y: Vec::new(),
         clipped: None,
@@ -81,7 +82,7 @@ fn library(case: &Case, input: &[f64]) -> Run {
         flags: Vec::new(),
     };
     if case.options.inverse {
-        let mut c = model.compensator(TS).expect("a compensator");
+        let mut c = model.compensator(ts).expect("a compensator");
         c.set_limits(case.options.limits);
         for r in input {
             let step = c
@@ -94,7 +95,7 @@ fn library(case: &Case, input: &[f64]) -> Run {
         run.faults = c.faults();
     } else {
         let mut s = model
-            .stepper(TS, case.options.initial_output)
+            .stepper(ts, case.options.initial_output)
             .expect("a stepper");
         let mut y = [0.0];
         for u in input {
