@@ -115,7 +115,12 @@ fn hostile_cases() -> Vec<Case> {
     cases::all()
         .into_iter()
         .filter(|c| !c.name.ends_with("_beyond"))
-        .filter(|c| FittedModel::from_file(&c.file).is_ok_and(|m| m.stepper(TS, c.options.initial_output).is_ok_and(|s| s.n_inputs() == 1)))
+        .filter(|c| {
+            FittedModel::from_file(&c.file).is_ok_and(|m| {
+                m.stepper(TS, c.options.initial_output)
+                    .is_ok_and(|s| s.n_inputs() == 1)
+            })
+        })
         .map(|mut c| {
             if c.options.inverse {
                 c.options.limits = Some(limits_of(&c));
@@ -132,16 +137,29 @@ fn check_library(case: &Case) -> Run {
     let run = library(case, &case.input);
     let name = &case.name;
     let bad: Vec<bool> = case.input.iter().map(|v| !v.is_finite()).collect();
-    assert_eq!(run.faults, bad.iter().filter(|b| **b).count(), "{name}: faults");
-    assert_eq!(run.flags, bad, "{name}: the error flag is not 'the last sample was bad'");
-    assert!(run.y.iter().all(|v| v.is_finite()), "{name}: a non-finite output");
+    assert_eq!(
+        run.faults,
+        bad.iter().filter(|b| **b).count(),
+        "{name}: faults"
+    );
+    assert_eq!(
+        run.flags, bad,
+        "{name}: the error flag is not 'the last sample was bad'"
+    );
+    assert!(
+        run.y.iter().all(|v| v.is_finite()),
+        "{name}: a non-finite output"
+    );
     let first = if case.options.inverse {
         let limits = case.options.limits.expect("limits");
         assert!(
             run.y.iter().all(|u| limits.lo() <= *u && *u <= limits.hi()),
             "{name}: a command beyond the limits"
         );
-        assert!(run.clipped.unwrap_or(0) > 0, "{name}: the limits never acted");
+        assert!(
+            run.clipped.unwrap_or(0) > 0,
+            "{name}: the limits never acted"
+        );
         limits.midpoint()
     } else {
         0.0
@@ -150,7 +168,11 @@ fn check_library(case: &Case) -> Run {
     let mut last = first;
     for (k, (y, b)) in run.y.iter().zip(&bad).enumerate() {
         if *b {
-            assert_eq!(y.to_bits(), last.to_bits(), "{name}: sample {k} is not held");
+            assert_eq!(
+                y.to_bits(),
+                last.to_bits(),
+                "{name}: sample {k} is not held"
+            );
         }
         last = *y;
     }
@@ -192,7 +214,11 @@ fn generated_c_is_safe_on_hostile_input_and_equals_the_library() {
         let got: Vec<u64> = y.iter().map(|v| v.to_bits()).collect();
         let expected: Vec<u64> = run.y.iter().map(|v| v.to_bits()).collect();
         assert_eq!(got, expected, "{name}: the C differs from the library");
-        assert_eq!(cases::parse_faults(&text), Some(run.faults), "{name}: faults");
+        assert_eq!(
+            cases::parse_faults(&text),
+            Some(run.faults),
+            "{name}: faults"
+        );
         assert_eq!(cases::parse_clipped(&text), run.clipped, "{name}: clipped");
     }
 }

@@ -77,9 +77,9 @@ pub use crate::model::operators::CompensatorStep;
 
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::compensate::Compensation;
-use crate::model::limits::{is_bad, Limits};
 use crate::model::greybox::equation_model::EquationStateSpace;
 use crate::model::greybox::{models, InputInterpolation};
+use crate::model::limits::{is_bad, Limits};
 use crate::model::saved::FittedModel;
 use crate::{Error, Result};
 
