@@ -14,6 +14,7 @@ mod hardening;
 mod hold_check_cli;
 #[cfg(unix)] // symbolic links
 mod inputs_sacred;
+mod limits_cli;
 #[cfg(target_os = "linux")] // the C route of equation files
 mod native_cache;
 mod nist_cli;
