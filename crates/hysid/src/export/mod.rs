@@ -25,8 +25,10 @@
 //! uses), [`rust_crate`] and [`export`] (the files of any target, paths relative to the
 //! output directory). The sample time is the model file's, else
 //! [`ExportOptions::sample_time`], else 0 for a rate-independent `operator` file; any other
-//! kind without one is an error asking for `--ts` ([`interface::SampleTime::of`]). Every
-//! state carries an error flag, set once a step cannot be computed where the library's
+//! kind without one is an error asking for `--ts` ([`interface::SampleTime::of`]). A
+//! compensator's command is limited and a non-finite sample skipped and counted (`error`,
+//! `NAME_faults`) by the one rule of [`crate::model::limits`]. Every state carries a diverged
+//! flag, set once a step cannot be computed where the library's
 //! simulation would fail (an integration beyond its sub-step budget, a Preisach memory beyond
 //! its capacity, a non-finite output); the outputs then hold their last values until the
 //! state is initialised again. The compensator of an operator cascade with delay k takes the
