@@ -715,6 +715,12 @@ pub struct ExportArgs {
     /// `hysid simulate` takes it from the record). Any finite number.
     #[arg(long, allow_hyphen_values = true, value_parser = crate::options::finite)]
     pub y0: Option<f64>,
+    /// With --inverse: limit the command to [LO, HI], written LO:HI (e.g. -10:150), stated in
+    /// the generated header; a command beyond them is set to the nearer limit and counted as
+    /// clipped. Default: the model file's input_range (the fitted data's input range); a file
+    /// without one exports an unlimited compensator (with a warning).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::options::limits)]
+    pub limits: Option<hysid::model::limits::Limits>,
 }
 
 /// Export targets.

@@ -161,4 +161,9 @@ pub struct CompensateArgs {
     /// Directory for plots (SVG): reference, input and predicted output.
     #[arg(long)]
     pub plots: Option<PathBuf>,
+    /// Limit the command to [LO, HI], written LO:HI (e.g. -10:150): a command beyond them is
+    /// set to the nearer limit and counted as clipped. Default: the model file's input_range
+    /// (the fitted data's input range); a file without one is not limited (with a warning).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::options::limits)]
+    pub limits: Option<hysid::model::limits::Limits>,
 }

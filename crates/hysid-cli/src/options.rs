@@ -67,6 +67,13 @@ pub fn positive(text: &str) -> Result<f64, String> {
     }
 }
 
+/// Command limits `LO:HI`, two finite numbers with LO <= HI (`--limits`).
+pub fn limits(text: &str) -> Result<hysid::model::limits::Limits, String> {
+    hysid::model::limits::Limits::parse(text).map_err(|_| {
+        format!("'{text}' is not LO:HI, two finite numbers with LO <= HI (e.g. -10:150)")
+    })
+}
+
 /// A finite number in [-1e300, 1e300]: a measured value of a signal.
 pub fn finite(text: &str) -> Result<f64, String> {
     within(text, -1e300, 1e300)

@@ -33,6 +33,8 @@ pub struct Outputs {
     /// The sample time and column names of the data the model was fitted on, saved with it
     /// in the model file and the report's `model` ([`Outputs::fitted_on`]).
     data: Option<(f64, Columns)>,
+    /// The input range of the data the model was fitted on (`input_range`).
+    input_range: Option<Vec<[f64; 2]>>,
 }
 
 impl Outputs {
@@ -49,6 +51,7 @@ impl Outputs {
             model_out: None,
             plots: None,
             data: None,
+            input_range: None,
         };
         // The directory first: a file inside it is then refused as a clash, even before
         // the directory exists.
@@ -95,6 +98,7 @@ impl Outputs {
             outputs: names(data.output_channels()),
         };
         self.fitted_on_columns(data.ts(), columns);
+        self.input_range = Some(hysid::model::limits::input_range_of(data));
     }
 
     /// [`Outputs::fitted_on`] for a model whose columns are not those of an [`IdData`].
@@ -113,9 +117,15 @@ impl Outputs {
     /// Writes the report and the model file when asked for, renames every output into
     /// place and says where they are.
     pub fn finish(self, report: Option<&Report>, model: Option<&FittedModel>) -> Result<()> {
-        let with_data = |file: ModelFile| match &self.data {
-            Some((ts, columns)) => file.with_data(*ts, columns.clone()),
-            None => file,
+        let with_data = |file: ModelFile| {
+            let mut file = match &self.data {
+                Some((ts, columns)) => file.with_data(*ts, columns.clone()),
+                None => file,
+            };
+            if self.input_range.is_some() {
+                file.input_range.clone_from(&self.input_range);
+            }
+            file
         };
         if let (Some(out), Some(report)) = (&self.json, report) {
             let mut report = report.clone();

@@ -65,6 +65,7 @@ fn export_model(
             sample_time: ts,
             binary,
             initial_output: y0,
+            limits: None,
         };
         let files = export(&file, target, &name, &options)?;
         let paths = files.iter().map(|f| dir.path().join(&f.path)).collect();

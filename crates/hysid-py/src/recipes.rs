@@ -531,7 +531,10 @@ fn check_model(py: Python<'_>, model_json: &str) -> PyResult<String> {
     guard(py, || {
         let file = parse_model(model_json)?;
         let model = FittedModel::from_file(&file)?;
-        let saved = model.to_file();
+        let saved = ModelFile {
+            input_range: file.input_range.clone(),
+            ..model.to_file()
+        };
         let saved = match (file.sample_time, file.columns) {
             (Some(ts), Some(columns)) => saved.with_data(ts, columns),
             (ts, columns) => ModelFile {

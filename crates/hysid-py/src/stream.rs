@@ -51,6 +51,18 @@ impl Stepper {
         lock(&self.inner).reset();
     }
 
+    /// How many bad (non-finite) input samples since the last reset.
+    #[getter]
+    fn faults(&self) -> usize {
+        lock(&self.inner).faults()
+    }
+
+    /// True when the last input sample was bad (non-finite).
+    #[getter]
+    fn error(&self) -> bool {
+        lock(&self.inner).error()
+    }
+
     /// y_k for the inputs u_k (one value per input); the state moves on.
     fn step(&self, py: Python<'_>, u: Vec<f64>) -> PyResult<Vec<f64>> {
         let mut stepper = lock(&self.inner);
@@ -100,9 +112,27 @@ impl Compensator {
         lock(&self.inner).clipped()
     }
 
-    /// Back to the model's initial state (and the clipped count to 0).
+    /// Back to the model's initial state (and the clipped and fault counts to 0).
     fn reset(&self) {
         lock(&self.inner).reset();
+    }
+
+    /// How many bad (non-finite) references since the last reset.
+    #[getter]
+    fn faults(&self) -> usize {
+        lock(&self.inner).faults()
+    }
+
+    /// True when the last reference was bad (non-finite).
+    #[getter]
+    fn error(&self) -> bool {
+        lock(&self.inner).error()
+    }
+
+    /// The command limits (lo, hi), or None when the command is not limited.
+    #[getter]
+    fn limits(&self) -> Option<(f64, f64)> {
+        lock(&self.inner).limits().map(|l| (l.lo(), l.hi()))
     }
 
     /// (command, predicted output, clipped) for the reference `r`; the state moves on.
@@ -145,11 +175,22 @@ fn model_stepper(py: Python<'_>, model_json: &str, ts: f64, y0: Option<f64>) -> 
     })
 }
 
-/// The compensator of a saved model (`hysid.model/1` JSON).
+/// The compensator of a saved model (`hysid.model/1` JSON), its command limited to `limits`
+/// (lo, hi), else to the file's `input_range`, else not at all.
 #[pyfunction]
-fn model_compensator(py: Python<'_>, model_json: &str, ts: f64) -> PyResult<Compensator> {
+#[pyo3(signature = (model_json, ts, limits=None))]
+fn model_compensator(
+    py: Python<'_>,
+    model_json: &str,
+    ts: f64,
+    limits: Option<(f64, f64)>,
+) -> PyResult<Compensator> {
     let inner = guard(py, || {
-        FittedModel::from_file(&parse_model(model_json)?)?.compensator(ts)
+        let file = parse_model(model_json)?;
+        let limits = crate::zoo::limits_of(&file, limits)?;
+        let mut c = FittedModel::from_file(&file)?.compensator(ts)?;
+        c.set_limits(limits);
+        Ok(c)
     })?;
     Ok(Compensator {
         inner: Mutex::new(inner),

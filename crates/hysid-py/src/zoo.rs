@@ -13,7 +13,7 @@ use hysid::identify::operator_cascade::OperatorCascadeIdentification;
 use hysid::identify::operators::{
     compare as compare_families, fit_operator, CompareOptions, Family, FamilyOptions, Split,
 };
-use hysid::model::compensate::compensate as invert;
+use hysid::model::compensate::compensate_within;
 use hysid::model::operators::LoopOrientation;
 use hysid::model::saved::FittedModel;
 use hysid::report;
@@ -276,22 +276,38 @@ fn compare<'py>(
 /// details), the compensating input u, the model's output for it.
 type Compensated<'py> = (String, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
 
-/// The input that makes the model `model_json` follow `reference` (`hysid compensate`).
+/// The command limits of a compensator of `file`: `given` (lo, hi), else the file's
+/// `input_range`, else none.
+pub(crate) fn limits_of(
+    file: &hysid::model::saved::ModelFile,
+    given: Option<(f64, f64)>,
+) -> hysid::Result<Option<hysid::model::limits::Limits>> {
+    match given {
+        Some((lo, hi)) => hysid::model::limits::Limits::new(lo, hi).map(Some),
+        None => Ok(file.limits()),
+    }
+}
+
+/// The input that makes the model `model_json` follow `reference` (`hysid compensate`), the
+/// command limited to `limits` (lo, hi), else to the file's `input_range`, else not at all.
 #[pyfunction]
-#[pyo3(signature = (model_json, reference, ts, model_source))]
+#[pyo3(signature = (model_json, reference, ts, model_source, limits=None))]
 fn compensate<'py>(
     py: Python<'py>,
     model_json: &str,
     reference: PyReadonlyArray1<'py, f64>,
     ts: f64,
     model_source: &str,
+    limits: Option<(f64, f64)>,
 ) -> PyResult<Compensated<'py>> {
     let reference = samples(&reference);
     let (model_json, model_source) = (model_json.to_string(), model_source.to_string());
     let (text, c) = crate::errors::run(py, move || {
-        let model = FittedModel::from_file(&parse_model(&model_json)?)?;
+        let file = parse_model(&model_json)?;
+        let limits = limits_of(&file, limits)?;
+        let model = FittedModel::from_file(&file)?;
         let data = id_data(ts, vec![reference], Vec::new())?;
-        let c = invert(&model, data.experiment(0).input(0))?;
+        let c = compensate_within(&model, data.experiment(0).input(0), limits)?;
         let r =
             report::compensation_report(&model, &data, &c, source(), "reference", &model_source);
         Ok((r.to_json()?, c))

@@ -5,8 +5,8 @@ use crate::cli_zoo::CompensateArgs;
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
 use hysid::io::atomic::OutputSet;
-use hysid::model::compensate::compensate;
-use hysid::model::saved::{FittedModel, SavedModel};
+use hysid::model::compensate::compensate_within;
+use hysid::model::saved::{FittedModel, ModelFile, SavedModel};
 use hysid::report::compensation_report;
 
 /// Clipped ranges printed in the warning before it is cut short (the report lists all).
@@ -19,7 +19,15 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
     let plots_tmp = args.plots.as_deref().map(|p| files.dir(p)).transpose()?;
     let csv_tmp = files.file(&args.csv)?;
     let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
-    let model = FittedModel::load(&args.model)?;
+    let saved = ModelFile::load(&args.model)?;
+    let model = FittedModel::from_file(&saved)?;
+    let limits = args.limits.or_else(|| saved.limits());
+    if limits.is_none() {
+        eprintln!(
+            "warning: {} records no input_range (a file of an earlier version) and no --limits was given: the command is not limited",
+            args.model.display()
+        );
+    }
     let spec = CsvSpec {
         inputs: vec![args.reference.clone()],
         outputs: Vec::new(),
@@ -29,7 +37,7 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
     let data = IdData::from_file(&args.data, &spec)
         .with_context(|| format!("reading {}", args.data.display()))?;
     let reference = data.experiment(0).input(0);
-    let c = compensate(&model, reference)
+    let c = compensate_within(&model, reference, limits)
         .with_context(|| format!("compensating with {}", args.model.display()))?;
     let (rms, max) = c.tracking_error();
     let ranges = c.clipped_ranges();
@@ -62,7 +70,7 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
             ""
         };
         eprintln!(
-            "warning: {} of {} reference samples lie outside the model's reachable range and were clipped (samples {}{more}); see the report",
+            "warning: {} of {} reference samples lie outside the model's reachable range or need a command beyond the limits, and were clipped (samples {}{more}); see the report",
             c.clipped.len(),
             reference.len(),
             shown.join(", ")

@@ -28,7 +28,20 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         sample_time: args.ts,
         binary: !args.no_binary,
         initial_output: args.y0,
+        limits: args.limits,
     };
+    if args.limits.is_some() && !args.inverse {
+        return Err(UsageError(
+            "--limits applies to --inverse only (a compensator's command); leave it out; run 'hysid export --help' for the options".into(),
+        )
+        .into());
+    }
+    if args.inverse && hysid::export::export_limits(&file, &options).is_none() {
+        eprintln!(
+            "warning: {} records no input_range (a file of an earlier version) and no --limits was given: the compensator's command is not limited",
+            args.model.display()
+        );
+    }
     let files = export(&file, target, &args.name, &options).with_context(|| {
         format!(
             "exporting {} ({}) to {}",

@@ -15,6 +15,7 @@ mod hold_check_cli;
 #[cfg(unix)] // symbolic links
 mod initial_state_cli;
 mod inputs_sacred;
+mod limits_cli;
 #[cfg(target_os = "linux")] // the C route of equation files
 mod native_cache;
 mod nist_cli;

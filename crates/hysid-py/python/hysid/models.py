@@ -131,9 +131,10 @@ class Model:
         file's sample time."""
         return stepper(self, ts=ts, y0=y0)
 
-    def compensator(self, *, ts: Optional[float] = None) -> Compensator:
-        """The model's compensator one sample at a time (:mod:`hysid.stream`)."""
-        return compensator(self, ts=ts)
+    def compensator(self, *, ts: Optional[float] = None, limits: Optional[Tuple[float, float]] = None) -> Compensator:
+        """The model's compensator one sample at a time (:mod:`hysid.stream`), its command
+        limited to ``limits`` (lo, hi), else to the model file's ``input_range``."""
+        return compensator(self, ts=ts, limits=limits)
 
     def export(
         self,

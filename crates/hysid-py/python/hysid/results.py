@@ -49,13 +49,15 @@ class Record(NamedTuple):
 
 def labelled(report: Dict[str, Any], record: Record) -> Dict[str, Any]:
     """``report`` with its model file carrying the record's sample time and channel names
-    (``sample_time``, ``columns``) where the library left them out, as the command line's
+    (``sample_time``, ``columns``, ``input_range``) where the library left them out, as the command line's
     model files do: so that every export (an FMU needs its sample time) works from a model
     fitted in Python."""
     model = report.get("model")
     if isinstance(model, dict):
         model.setdefault("sample_time", record.ts)
         model.setdefault("columns", {"inputs": [record.names[0]], "outputs": [record.names[1]]})
+        if len(record.u):
+            model.setdefault("input_range", [[float(np.min(record.u)), float(np.max(record.u))]])
     return report
 
 

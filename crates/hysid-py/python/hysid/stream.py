@@ -6,14 +6,18 @@ its state; ``Model.compensator()`` a :class:`Compensator` whose ``step(r)`` give
 command that makes the model follow the reference ``r`` (clipped to the reachable range as
 ``hysid compensate`` clips, and counted in ``.clipped``). Both have ``run(array)``, which
 feeds a whole record from the current state, and ``reset()``, back to the model's initial
-state. The semantics are the library's (``hysid::model::stream``).
+state. The semantics are the library's (``hysid::model::stream``), with its two safety
+rules (``docs/export.md``, "Limits and bad samples"): a compensator's command is limited to
+``limits`` (default: the model file's ``input_range``), a limited command counting as
+clipped; a NaN or infinite sample leaves the state unchanged, repeats the last good output
+(a compensator: the limits' midpoint before any) and is counted in ``.faults``.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from typing import TYPE_CHECKING, Any, Optional, Union
+from typing import TYPE_CHECKING, Any, Optional, Tuple, Union
 
 import numpy as np
 
@@ -43,6 +47,11 @@ class Stepper:
     @property
     def n_outputs(self) -> int:
         return int(self._inner.n_outputs)
+
+    @property
+    def faults(self) -> int:
+        """How many bad (non-finite) input samples since the last reset."""
+        return int(self._inner.faults)
 
     def reset(self) -> None:
         """Back to the model's initial state."""
@@ -82,12 +91,23 @@ class Compensator:
         return int(self._inner.clipped)
 
     @property
+    def faults(self) -> int:
+        """How many bad (non-finite) references since the last reset."""
+        return int(self._inner.faults)
+
+    @property
+    def limits(self) -> Optional[Tuple[float, float]]:
+        """The command limits (lo, hi), or None when the command is not limited."""
+        limits = self._inner.limits
+        return None if limits is None else (float(limits[0]), float(limits[1]))
+
+    @property
     def preview(self) -> int:
         """How many samples ahead the reference is given (a cascade's delay; 0 otherwise)."""
         return int(self._inner.preview)
 
     def reset(self) -> None:
-        """Back to the model's initial state (and ``clipped`` to 0)."""
+        """Back to the model's initial state (and ``clipped`` and ``faults`` to 0)."""
         self._inner.reset()
 
     def step(self, r: float) -> float:
@@ -117,7 +137,22 @@ def stepper(model: "Model", *, ts: Optional[float] = None, y0: Optional[float] =
     return Stepper(inner, model.kind, step)
 
 
-def compensator(model: "Model", *, ts: Optional[float] = None) -> Compensator:
-    """The :class:`Compensator` of ``model``."""
+def compensator(
+    model: "Model", *, ts: Optional[float] = None, limits: Optional[Tuple[float, float]] = None
+) -> Compensator:
+    """The :class:`Compensator` of ``model``, its command limited to ``limits`` (lo, hi),
+    else to the model file's ``input_range``, else not at all."""
     step = _ts(model, ts)
-    return Compensator(_hysid.model_compensator(json.dumps(model.file), step), model.kind, step)
+    inner = _hysid.model_compensator(json.dumps(model.file), step, _limits(limits))
+    return Compensator(inner, model.kind, step)
+
+
+def _limits(limits: Optional[Tuple[float, float]]) -> Optional[Tuple[float, float]]:
+    """``limits`` checked: None, or two numbers (lo, hi)."""
+    if limits is None:
+        return None
+    try:
+        lo, hi = limits
+    except (TypeError, ValueError):
+        raise TypeError(f"limits: give (lo, hi), two numbers, got {limits!r}") from None
+    return (float(lo), float(hi))

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import warnings
 from typing import Any, List, Literal, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -20,8 +21,9 @@ from ._inputs import RecordLike, Samples, SamplesOrRecord
 from .comparison import Comparison
 from .compensation import Compensation
 from .models import Model, load_model
-from .progress import ProgressArg, warn_if_stopped, watching
+from .progress import HysidWarning, ProgressArg, warn_if_stopped, watching
 from .results import FitResult, Record, Result, labelled
+from .stream import _limits
 
 #: ``families="all"``: every family of the registry.
 AllFamilies = Literal["all"]
@@ -207,6 +209,7 @@ def compensate(
     reference: Samples,
     *,
     ts: Optional[float] = None,
+    limits: Optional[Tuple[float, float]] = None,
 ) -> Compensation:
     """The input u that makes a fitted hysteresis model's output follow ``reference``: the
     CLI's ``hysid compensate``, the same library inverse and report.
@@ -216,7 +219,10 @@ def compensate(
     cascade with a minimum-phase linear block (other kinds are a :class:`NumericalError`).
     ``ts``: the reference's sample time (default 1). A reference sample the model cannot
     reach is clipped to the nearest reachable output and listed in
-    :attr:`Compensation.clipped`, never silently.
+    :attr:`Compensation.clipped`, never silently. ``limits``: the command's range (lo, hi)
+    (``--limits``); default the model file's ``input_range``; a command beyond it is set to
+    the nearer limit and clipped. When samples were clipped a :class:`HysidWarning` gives
+    their count.
     """
     if isinstance(model, (str, os.PathLike)):
         source, model = os.fspath(model), load_model(model)
@@ -230,9 +236,17 @@ def compensate(
         raise TypeError(f"model: give a hysid.Model, a hysid.Result or a model file's path, got {type(model).__name__}")
     r = check.array(reference, "reference")
     step = check.sample_time(ts, 1.0)
-    report, u, predicted = _hysid.compensate(json.dumps(model.file), r, step, source)
+    report, u, predicted = _hysid.compensate(json.dumps(model.file), r, step, source, _limits(limits))
     parsed = json.loads(report)
     # The report's model keeps the given model's channel names (the plots' labels).
     if isinstance(parsed.get("model"), dict) and "columns" in model.file:
         parsed["model"].setdefault("columns", model.file["columns"])
-    return Compensation(parsed, r, u, predicted, step)
+    result = Compensation(parsed, r, u, predicted, step)
+    if result.clipped:
+        warnings.warn(
+            f"{len(result.clipped)} of {len(r)} reference samples were clipped (beyond the model's "
+            "reach or needing a command beyond the limits); see Compensation.clipped",
+            HysidWarning,
+            stacklevel=2,
+        )
+    return result

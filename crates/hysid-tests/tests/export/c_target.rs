@@ -17,7 +17,7 @@ const FLAGS: [&str; 6] = [
     "-O2",
 ];
 
-fn driver(name: &str, inverse: bool) -> String {
+pub fn driver(name: &str, inverse: bool) -> String {
     let clipped = if inverse {
         format!("    printf(\"clipped %zu\\n\", {name}_clipped(&s));\n")
     } else {
@@ -32,13 +32,21 @@ fn driver(name: &str, inverse: bool) -> String {
          \x20   {name}_init(&s);\n\
          \x20   while (fscanf(in, \"%lf\", &u[0]) == 1) {{\n\
          \x20       {name}_step(&s, u, y);\n        printf(\"%.17g\\n\", y[0]);\n    }}\n\
-         \x20   fclose(in);\n    if (s.error) {{\n        printf(\"error\\n\");\n    }}\n{clipped}    return 0;\n}}\n"
+         \x20   fclose(in);\n    if (s.diverged) {{\n        printf(\"error\\n\");\n    }}\n\
+         \x20   printf(\"faults %zu\\n\", {name}_faults(&s));\n{clipped}    return 0;\n}}\n"
     )
 }
 
-/// Compiles and runs the C of `case` in `dir`: the outputs, the error flag and, for a
+/// Compiles and runs the C of `case` in `dir`: the outputs, the diverged flag and, for a
 /// compensator, its clipped count.
-fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool, Option<usize>) {
+pub fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool, Option<usize>) {
+    let text = run_text(case, dir);
+    let (y, error) = cases::parse_outputs(&text);
+    (y, error, cases::parse_clipped(&text))
+}
+
+/// Compiles and runs the C of `case` in `dir`: what the driver printed.
+pub fn run_text(case: &Case, dir: &Path) -> String {
     let name = &case.name;
     let code = c_code(&case.file, name, &case.options)
         .unwrap_or_else(|e| panic!("{name}: c_code failed: {e}"));
@@ -74,9 +82,7 @@ fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool, Option<usize>) {
         .output()
         .expect("run the driver");
     assert!(ran.status.success(), "{name}: the driver failed");
-    let text = String::from_utf8_lossy(&ran.stdout);
-    let (y, error) = cases::parse_outputs(&text);
-    (y, error, cases::parse_clipped(&text))
+    String::from_utf8_lossy(&ran.stdout).into_owned()
 }
 
 #[test]

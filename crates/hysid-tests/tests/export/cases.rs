@@ -279,12 +279,23 @@ pub fn parse_clipped(text: &str) -> Option<usize> {
         .map(|n| n.parse().expect("a count"))
 }
 
-/// The outputs a driver printed, one a line; a last line `error` when the error flag was set
-/// (and, for a compensator, a line `clipped N`: [`parse_clipped`]).
+/// The fault count a driver printed (a line `faults N`), if any.
+pub fn parse_faults(text: &str) -> Option<usize> {
+    text.lines()
+        .find_map(|l| l.trim().strip_prefix("faults "))
+        .map(|n| n.parse().expect("a count"))
+}
+
+/// The outputs a driver printed, one a line; a line `error` when the diverged flag was set,
+/// a line `faults N` (the bad samples: [`parse_faults`]) and, for a compensator, a line
+/// `clipped N` ([`parse_clipped`]).
 pub fn parse_outputs(text: &str) -> (Vec<f64>, bool) {
     let mut error = false;
     let mut values = Vec::new();
-    for line in text.lines().filter(|l| !l.starts_with("clipped ")) {
+    for line in text
+        .lines()
+        .filter(|l| !l.starts_with("clipped ") && !l.starts_with("faults "))
+    {
         if line.trim() == "error" {
             error = true;
         } else {

@@ -8,5 +8,6 @@ mod api;
 mod c_target;
 mod cases;
 mod greybox;
+mod hostile;
 mod newmark_lu;
 mod rust_target;

@@ -40,7 +40,7 @@ fn generated_rust_equals_the_library() {
          \x20       for line in text.lines() {\n\
          \x20           let y = m.step(&[line.parse::<f64>().unwrap()]);\n\
          \x20           out.push_str(&format!(\"{:?}\\n\", y[0]));\n        }\n\
-         \x20       if m.error() {\n            out.push_str(\"error\\n\");\n        }\n\
+         \x20       if m.diverged() {\n            out.push_str(\"error\\n\");\n        }\n\
          \x20       $(out.push_str(&format!(\"clipped {}\\n\", m.$clipped()));)?\n\
          \x20       std::fs::write(format!(\"{}.out\", $name), out).unwrap();\n    }};\n}\n\nfn main() {\n",
     );

@@ -452,3 +452,31 @@ fn a_grey_box_model_of_the_user_is_written_under_its_own_kind_and_not_read_back(
     };
     assert!(matches!(builtin.to_file().model, SavedModel::RigidBody(_)));
 }
+
+#[test]
+fn input_range_round_trips_gives_the_default_limits_and_is_optional() {
+    use hysid::data::IdData;
+    use hysid::model::limits::Limits;
+    use hysid::model::operators::OperatorModel;
+    use hysid::model::saved::{FittedModel, ModelFile};
+    let op = OperatorModel::examples().unwrap().remove(0);
+    let n = op.as_operator().parameters().len();
+    let file = FittedModel::operator(op, vec![f64::NAN; n]).to_file();
+    let u = vec![0.5, -2.0, 3.0, 1.0];
+    let data = IdData::siso(1e-3, "u", u.clone(), "y", u).unwrap();
+    let ranged = file.clone().with_input_range(&data);
+    assert_eq!(ranged.input_range, Some(vec![[-2.0, 3.0]]));
+    let text = serde_json::to_string(&ranged).unwrap();
+    assert!(text.contains("\"input_range\":[[-2.0,3.0]]"), "{text}");
+    let back: ModelFile = serde_json::from_str(&text).unwrap();
+    assert_eq!(back.limits(), Some(Limits::new(-2.0, 3.0).unwrap()));
+    // A file of an earlier version: no range, no limits, the same model.
+    let old: ModelFile = serde_json::from_str(&serde_json::to_string(&file).unwrap()).unwrap();
+    assert_eq!((old.input_range.clone(), old.limits()), (None, None));
+    // A range that is not [min, max] is refused in one line.
+    let bad = text.replace("[[-2.0,3.0]]", "[[3.0,-2.0]]");
+    let err = serde_json::from_str::<ModelFile>(&bad)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("input_range") && !err.contains('\n'), "{err}");
+}

@@ -4,10 +4,11 @@
 //! one-line errors.
 
 use hysid::model::coleman_hodgdon::InitialOutput;
-use hysid::model::compensate::compensate;
+use hysid::model::compensate::{compensate, compensate_within};
 use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::models::GreyBoxKind;
 use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::limits::Limits;
 use hysid::model::operators::OperatorModel;
 use hysid::model::saved::FittedModel;
 use hysid::model::stream::{compensate_stream, run, Stepper};
@@ -379,17 +380,66 @@ fn kinds_that_cannot_stream_or_invert_say_so_in_one_line() {
 }
 
 #[test]
-fn bad_samples_are_one_line_errors() {
+fn bad_samples_are_skipped_and_counted_and_wrong_shapes_are_one_line_errors() {
     let model = OperatorModel::examples().unwrap().remove(0);
     let mut stepper = model.stepper().unwrap();
-    let mut y = [0.0];
-    let err = stepper.step(&[f64::NAN], &mut y).unwrap_err().to_string();
-    assert!(err.contains("input 1") && !err.contains('\n'), "{err}");
+    let mut y = [1.0];
+    // Before any good sample a forward model gives 0; the flag and the count.
+    stepper.step(&[f64::NAN], &mut y).unwrap();
+    assert_eq!((y[0], stepper.error(), stepper.faults()), (0.0, true, 1));
+    stepper.step(&[0.4], &mut y).unwrap();
+    let good = y[0];
+    assert!(!stepper.error());
+    stepper.step(&[f64::NEG_INFINITY], &mut y).unwrap();
+    assert_eq!((y[0], stepper.error(), stepper.faults()), (good, true, 2));
+    // The next good sample is the one the sequence without the bad ones gives.
+    stepper.step(&[-0.3], &mut y).unwrap();
+    let clean = model.as_operator().simulate(&[0.4, -0.3]).unwrap();
+    assert_eq!(y[0].to_bits(), clean[1].to_bits());
     let err = stepper.step(&[0.0, 1.0], &mut y).unwrap_err().to_string();
-    assert!(err.contains("1 input(s)"), "{err}");
+    assert!(err.contains("1 input(s)") && !err.contains('\n'), "{err}");
+    stepper.reset();
+    assert_eq!((stepper.error(), stepper.faults()), (false, 0));
+
+    // A limited compensator: the midpoint before any good reference, the limits after.
     let mut compensator = model.compensator().unwrap();
-    let err = compensator.step(f64::INFINITY).unwrap_err().to_string();
-    assert!(err.contains("reference") && !err.contains('\n'), "{err}");
+    let limits = Limits::parse("-0.5:0.25").unwrap();
+    compensator.set_limits(Some(limits));
+    let step = compensator.step(f64::INFINITY).unwrap();
+    assert_eq!((step.u, step.clipped), (-0.125, false));
+    assert_eq!((compensator.error(), compensator.faults()), (true, 1));
+    let step = compensator.step(1e3).unwrap();
+    assert_eq!((step.u, step.clipped), (0.25, true));
+    let step = compensator.step(-1e3).unwrap();
+    assert_eq!(
+        (step.u, step.clipped, compensator.clipped()),
+        (-0.5, true, 2)
+    );
+    assert!(!compensator.error());
+    // The batch with the same limits agrees.
+    let batch = compensate_within(
+        &FittedModel::operator(
+            model.clone(),
+            vec![f64::NAN; model.as_operator().parameters().len()],
+        ),
+        &[1e3, -1e3],
+        Some(limits),
+    )
+    .unwrap();
+    assert_eq!((batch.u, batch.clipped), (vec![0.25, -0.5], vec![0, 1]));
+}
+
+#[test]
+fn limits_parse_apply_and_refuse_in_one_line() {
+    let l = Limits::parse("-10:150").unwrap();
+    assert_eq!((l.lo(), l.hi(), l.midpoint()), (-10.0, 150.0, 70.0));
+    assert_eq!(l.apply(-11.0), (-10.0, true));
+    assert_eq!(l.apply(151.0), (150.0, true));
+    assert_eq!(l.apply(3.0), (3.0, false));
+    for bad in ["150:-10", "1", "a:b", "nan:1", "0:inf"] {
+        let err = Limits::parse(bad).unwrap_err().to_string();
+        assert!(err.contains("LO:HI") && !err.contains('\n'), "{bad}: {err}");
+    }
 }
 
 #[test]

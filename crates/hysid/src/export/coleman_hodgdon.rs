@@ -9,7 +9,7 @@
 //! its compensator starts from the first reference, as `hysid compensate` does.
 
 use super::code::{call, local, select, Expr, Ty};
-use super::program::{mark_clip, Ns, Program, ERROR_FIELD};
+use super::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
 use super::solve;
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::ColemanHodgdon;
@@ -79,7 +79,7 @@ pub fn forward(ch: &ColemanHodgdon, v0: f64, ns: &Ns, prog: &mut Program) -> Res
             |b| {
                 let rate = alpha * (v.clone() - x.clone()).abs();
                 b.if_(rate.gt(1.0 + 1e-12), |b| {
-                    b.set_state(ERROR_FIELD, Expr::Flag(true))
+                    b.set_state(DIVERGED_FIELD, Expr::Flag(true))
                 });
                 b.set_state(
                     &rec.y,

@@ -10,11 +10,12 @@
 //!
 //! | grey-box, `equations` | the integration of the last interval, then h(x, u) ([`greybox`]) | none (not invertible) |
 //!
-//! Every step sets the error flag where the library's `simulate` errors on a non-finite
-//! output.
+//! Every step sets the diverged flag where the library's `simulate` errors on a non-finite
+//! output; a compensator's command is limited to [`ExportOptions::limits`] and a bad
+//! (non-finite) sample skipped, by the rule of [`crate::model::limits`].
 
-use super::code::{call, local, Expr};
-use super::program::{count_clip, Ns, Program, ERROR_FIELD};
+use super::code::{call, Expr};
+use super::program::{count_clip, limit, Ns, Program, DIVERGED_FIELD};
 use super::{coleman_hodgdon, families, greybox, linear, ExportOptions};
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::saved::FittedModel;
@@ -108,18 +109,29 @@ pub fn program(model: &FittedModel, options: &ExportOptions, ts: f64) -> Result<
         }
     };
     let counting = prog.counts_clipped();
+    // A compensator's command is limited (`model::limits`), as the library's compensator.
+    let limits = options.limits.filter(|_| inverse);
     prog.fallible_step(|b| {
         count_clip(counting, b, |b| {
             let mut value = Expr::Input(0);
             for (i, helper) in chain.iter().enumerate() {
                 value = b.let_(&format!("stage{i}"), call(helper, vec![value]));
             }
-            b.let_("y0", value);
-        });
-        let y = local("y0");
-        b.if_(y.is_finite().not(), |b| {
-            b.set_state(ERROR_FIELD, Expr::Flag(true))
+            b.if_(value.clone().is_finite().not(), |b| {
+                b.set_state(DIVERGED_FIELD, Expr::Flag(true))
+            });
+            match &limits {
+                Some(limits) => {
+                    limit(b, "y0", value, limits);
+                }
+                None => {
+                    b.let_("y0", value);
+                }
+            }
         });
     })?;
+    if let Some(limits) = limits {
+        prog.hold_initially(&[limits.midpoint()]);
+    }
     Ok(prog)
 }

@@ -25,8 +25,10 @@
 //! uses), [`rust_crate`] and [`export`] (the files of any target, paths relative to the
 //! output directory). The sample time is the model file's, else
 //! [`ExportOptions::sample_time`], else 0 for a rate-independent `operator` file; any other
-//! kind without one is an error asking for `--ts` ([`interface::SampleTime::of`]). Every
-//! state carries an error flag, set once a step cannot be computed where the library's
+//! kind without one is an error asking for `--ts` ([`interface::SampleTime::of`]). A
+//! compensator's command is limited and a non-finite sample skipped and counted (`error`,
+//! `NAME_faults`) by the one rule of [`crate::model::limits`]. Every state carries a diverged
+//! flag, set once a step cannot be computed where the library's
 //! simulation would fail (an integration beyond its sub-step budget, a Preisach memory beyond
 //! its capacity, a non-finite output); the outputs then hold their last values until the
 //! state is initialised again. The compensator of an operator cascade with delay k takes the
@@ -59,6 +61,7 @@ pub mod solve;
 pub mod stmt;
 pub mod zip;
 
+use crate::model::limits::Limits;
 use crate::model::saved::{FittedModel, ModelFile};
 use crate::{Error, Result};
 use interface::SampleTime;
@@ -119,6 +122,10 @@ pub struct ExportOptions {
     /// `initial_output: measured`, which its forward step starts from (as `hysid simulate`
     /// starts from the record's first measured output); ignored by every other model.
     pub initial_output: Option<f64>,
+    /// The command limits of a compensator (`--limits LO:HI`,
+    /// [`crate::model::limits`]); None takes the model file's `input_range`, and a file
+    /// without one exports an unlimited compensator ([`export_limits`] says which).
+    pub limits: Option<Limits>,
 }
 
 impl Default for ExportOptions {
@@ -128,8 +135,19 @@ impl Default for ExportOptions {
             sample_time: None,
             binary: true,
             initial_output: None,
+            limits: None,
         }
     }
+}
+
+/// The limits an export of `file` applies to its compensator's command: `--limits`
+/// ([`ExportOptions::limits`]), else the file's `input_range`, else none (the front end
+/// warns); None for a forward export.
+pub fn export_limits(file: &ModelFile, options: &ExportOptions) -> Option<Limits> {
+    if !options.inverse {
+        return None;
+    }
+    options.limits.or_else(|| file.limits())
 }
 
 /// One file of an export, its path relative to the output directory.
@@ -217,6 +235,11 @@ fn prepare(
     options: &ExportOptions,
 ) -> Result<(program::Program, Interface, String)> {
     check_name(name)?;
+    let given = options;
+    let options = &ExportOptions {
+        limits: export_limits(file, given),
+        ..given.clone()
+    };
     let sample_time = SampleTime::of(file, options)?;
     let model = FittedModel::from_file(file)?;
     let program = kinds::program(&model, options, sample_time.seconds())?;
@@ -227,7 +250,7 @@ fn prepare(
         (program.n_inputs, program.n_outputs)
     };
     let interface = interface::interface(file, name, options, sample_time, sizes);
-    let comment = interface::comment(file, &interface, options, sample_time);
+    let comment = interface::comment(file, &interface, given, sample_time);
     Ok((program, interface, comment))
 }
 

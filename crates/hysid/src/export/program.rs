@@ -2,7 +2,8 @@
 //! fixed-size state, its constant tables, its helper functions, the initialisation and the
 //! step. The model kinds and families build one; a renderer prints it as C or Rust.
 
-use super::code::{literals, Block, Expr, Function, Stmt, Ty};
+use super::code::{literals, select, Block, Expr, Function, Stmt, Ty};
+use crate::model::limits::Limits;
 use crate::{Error, Result};
 use std::ops::Not;
 
@@ -28,10 +29,18 @@ pub struct Table {
     pub values: Vec<f64>,
 }
 
-/// The name of the state's error flag: set when a step could not be computed (see
-/// [`Program::fallible_step`]); every program has it.
+/// The name of the state's flag "the last sample was bad" (a non-finite input, skipped by
+/// the rule of [`crate::model::limits`]; cleared by the next good sample); every program has
+/// it.
 pub const ERROR_FIELD: &str = "error";
-/// The name of the state's copy of the last outputs, held while the error flag is set.
+/// The name of the state's count of bad samples since init (`NAME_faults`, `Model::faults`).
+pub const FAULTS_FIELD: &str = "faults";
+/// The name of the state's latched flag: set when a step could not be computed (see
+/// [`Program::fallible_step`]: a divergence, a budget or capacity overflow); every program
+/// has it.
+pub const DIVERGED_FIELD: &str = "diverged";
+/// The name of the state's copy of the last good outputs, held on a bad sample and once
+/// diverged.
 const HELD_FIELD: &str = "held";
 /// The name of a compensator's flag "this step clipped its reference" (see
 /// [`Program::count_clipped`]): the inverse emitters set it where the library's
@@ -74,6 +83,20 @@ impl Program {
         };
         program.fields.push(Field {
             name: ERROR_FIELD.into(),
+            ty: Ty::Flag,
+            len: None,
+            doc: "nonzero when the last sample was bad (not finite): the state stayed and the \
+                  outputs repeat the last good ones; cleared by the next good sample"
+                .into(),
+        });
+        program.fields.push(Field {
+            name: FAULTS_FIELD.into(),
+            ty: Ty::Index,
+            len: None,
+            doc: "the bad (non-finite) samples since init".into(),
+        });
+        program.fields.push(Field {
+            name: DIVERGED_FIELD.into(),
             ty: Ty::Flag,
             len: None,
             doc: "nonzero once a step could not be computed; the outputs then hold their last \
@@ -170,31 +193,63 @@ impl Program {
         self.init.extend(Block::build(build));
     }
 
-    /// Makes the step fallible: once a helper has set the error flag the outputs hold their
-    /// last values (a field `held`) and later steps compute nothing until the next init.
-    /// `body` computes the outputs into the locals `y0`, `y1`, … that it declares.
+    /// Makes the step fallible and safe on bad input. A sample with a non-finite input is
+    /// skipped by the rule of [`crate::model::limits`]: the flag [`ERROR_FIELD`] is set, the
+    /// count [`FAULTS_FIELD`] goes up, the state stays and the outputs repeat the last good
+    /// ones (a field `held`: 0 at init, or [`Program::hold_initially`]). A good sample clears
+    /// the flag and runs `body`, which computes the outputs into the locals `y0`, `y1`, …
+    /// that it declares; once a helper has set [`DIVERGED_FIELD`] the outputs hold their last
+    /// values and later steps compute nothing until the next init.
     pub fn fallible_step(&mut self, body: impl FnOnce(&mut Block)) -> Result<()> {
         let n = self.n_outputs;
-        let held = self.field(HELD_FIELD, Ty::F64, Some(n), "the last outputs")?;
-        let error = Expr::State(ERROR_FIELD.into());
+        let held = self.field(HELD_FIELD, Ty::F64, Some(n), "the last good outputs")?;
+        let diverged = Expr::State(DIVERGED_FIELD.into());
         let hold = |b: &mut Block| {
             for i in 0..n {
                 b.output(i, Expr::StateAt(held.clone(), Box::new(Expr::Index(i))));
             }
         };
+        let bad = (0..self.n_inputs)
+            .map(|i| Expr::Input(i).is_finite().not())
+            .reduce(Expr::or)
+            .unwrap_or(Expr::Flag(false));
         self.step = Block::build(|b| {
-            b.if_else(error.clone(), hold, |b| {
-                body(b);
-                b.if_else(error.clone(), hold, |b| {
-                    for i in 0..n {
-                        let y = Expr::Local(format!("y{i}"));
-                        b.set_at(&held, Expr::Index(i), y.clone());
-                        b.output(i, y);
-                    }
-                });
+            b.if_else(diverged.clone(), hold, |b| {
+                b.if_else(
+                    bad,
+                    |b| {
+                        b.set_state(ERROR_FIELD, Expr::Flag(true));
+                        b.set_state(
+                            FAULTS_FIELD,
+                            Expr::State(FAULTS_FIELD.into()) + Expr::Index(1),
+                        );
+                        hold(b);
+                    },
+                    |b| {
+                        b.set_state(ERROR_FIELD, Expr::Flag(false));
+                        body(b);
+                        b.if_else(diverged.clone(), hold, |b| {
+                            for i in 0..n {
+                                let y = Expr::Local(format!("y{i}"));
+                                b.set_at(&held, Expr::Index(i), y.clone());
+                                b.output(i, y);
+                            }
+                        });
+                    },
+                );
             });
         });
         Ok(())
+    }
+
+    /// Sets the outputs a fallible step repeats on a bad sample before any good one (0
+    /// otherwise): a compensator's midpoint of its limits.
+    pub fn hold_initially(&mut self, values: &[f64]) {
+        self.init(|b| {
+            for (i, v) in values.iter().enumerate() {
+                b.set_at(HELD_FIELD, Expr::Index(i), Expr::from(*v));
+            }
+        });
     }
 
     /// The step without failure: `body` writes every output.
@@ -223,8 +278,8 @@ impl Program {
 
 /// Emits into `b` the step `solve` of a program, and when `counting` (a compensator that counts
 /// its clipped steps, [`Program::counts_clipped`]) clears the clip flag before it and adds the
-/// flag to the count after it (a step that set the error flag is not counted: the library's
-/// step failed).
+/// flag to the count after it (a step that set the diverged flag is not counted: the
+/// library's step failed).
 pub fn count_clip(counting: bool, b: &mut Block, solve: impl FnOnce(&mut Block)) {
     if !counting {
         solve(b);
@@ -232,7 +287,7 @@ pub fn count_clip(counting: bool, b: &mut Block, solve: impl FnOnce(&mut Block))
     }
     b.set_state(CLIP_FIELD, Expr::Flag(false));
     solve(b);
-    let counted = Expr::State(CLIP_FIELD.into()).and(Expr::State(ERROR_FIELD.into()).not());
+    let counted = Expr::State(CLIP_FIELD.into()).and(Expr::State(DIVERGED_FIELD.into()).not());
     b.if_(counted, |b| {
         b.set_state(
             CLIPPED_FIELD,
@@ -245,6 +300,18 @@ pub fn count_clip(counting: bool, b: &mut Block, solve: impl FnOnce(&mut Block))
 /// inverse emitter (the flag [`CLIP_FIELD`] of [`Program::count_clipped`]).
 pub fn mark_clip(b: &mut Block, condition: Expr) {
     b.if_(condition, |b| b.set_state(CLIP_FIELD, Expr::Flag(true)));
+}
+
+/// Emits into `b` the command `value` limited to `limits` (the library's
+/// [`Limits::apply`](crate::model::limits::Limits::apply), the same comparisons: lo if
+/// value < lo, hi if value > hi, else value) into the local `name`, marking the step clipped
+/// where it was changed; returns the local.
+pub fn limit(b: &mut Block, name: &str, value: Expr, limits: &Limits) -> Expr {
+    let (lo, hi) = (Expr::from(limits.lo()), Expr::from(limits.hi()));
+    let below = value.clone().lt(lo.clone());
+    let above = value.clone().gt(hi.clone());
+    mark_clip(b, below.clone().or(above.clone()));
+    b.let_(name, select(below, lo, select(above, hi, value)))
 }
 
 /// The names of one component of a program (an operator, a linear block): every field,

@@ -19,8 +19,10 @@
 //!
 //! A reference sample the model cannot reach (beyond a saturation level, or faster than the
 //! rate limit allows) is clipped to the nearest reachable output and listed in
-//! [`Compensation::clipped`], never silently.
+//! [`Compensation::clipped`], never silently; so is a command beyond the actuator's limits
+//! ([`compensate_within`], the one rule of [`crate::model::limits`]).
 
+use crate::model::limits::Limits;
 use crate::model::saved::FittedModel;
 use crate::model::stream::compensate_stream;
 use crate::numerics::metrics;
@@ -99,7 +101,31 @@ pub(crate) fn not_invertible(model: &FittedModel) -> Error {
     }
 }
 
-/// The input that makes `model` follow `reference` (see the module doc).
+/// [`compensate`] with the command limited to `limits` ([`crate::model::limits`]): each
+/// command beyond them is set to the nearer limit and its sample counted as clipped (the
+/// predicted output stays the model's output for the unlimited command); None: unlimited.
+/// Equal to the stream ([`compensate_stream`] of a compensator with the same limits).
+pub fn compensate_within(
+    model: &FittedModel,
+    reference: &[f64],
+    limits: Option<Limits>,
+) -> Result<Compensation> {
+    let mut c = compensate(model, reference)?;
+    if let Some(limits) = limits {
+        let mut clipped = std::mem::take(&mut c.clipped).into_iter().peekable();
+        for (k, u) in c.u.iter_mut().enumerate() {
+            let (v, limited) = limits.apply(*u);
+            *u = v;
+            let by_model = clipped.next_if_eq(&k).is_some();
+            if limited || by_model {
+                c.clipped.push(k);
+            }
+        }
+    }
+    Ok(c)
+}
+
+/// The input that makes `model` follow `reference` (see the module doc), unlimited.
 pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation> {
     check_reference(reference)?;
     let mut settled_from = 0;

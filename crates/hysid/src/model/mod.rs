@@ -20,6 +20,7 @@ mod cascade;
 pub mod coleman_hodgdon;
 pub mod compensate;
 pub mod greybox;
+pub mod limits;
 mod linear;
 pub mod operator_cascade;
 pub mod operators;

@@ -154,6 +154,11 @@ pub struct ModelFile {
     /// versions): an export names its inputs and outputs after them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub columns: Option<Columns>,
+    /// \[min, max\] of each input of the data the model was fitted on, in the model's order
+    /// of inputs (absent in files of earlier versions): a compensator's default command
+    /// limits ([`crate::model::limits`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub input_range: Option<Vec<[f64; 2]>>,
 }
 
 /// The data columns a model was fitted on, in the model's order of inputs and outputs.
@@ -426,6 +431,7 @@ impl ModelFile {
             inverse_dynamics: None,
             sample_time: None,
             columns: None,
+            input_range: None,
         }
     }
 
@@ -435,6 +441,19 @@ impl ModelFile {
         self.sample_time = Some(ts);
         self.columns = Some(columns);
         self
+    }
+
+    /// The file with the input range of `data`, the data the model was fitted on
+    /// (`input_range`, [`crate::model::limits::input_range_of`]).
+    pub fn with_input_range(mut self, data: &crate::data::IdData) -> Self {
+        self.input_range = Some(crate::model::limits::input_range_of(data));
+        self
+    }
+
+    /// The default command limits of the model's compensator: its file's `input_range` of
+    /// input 0, None when the file has none.
+    pub fn limits(&self) -> Option<crate::model::limits::Limits> {
+        crate::model::limits::Limits::of_range(self.input_range.as_deref(), 0)
     }
 
     /// The model kind (the `kind` key).
@@ -496,6 +515,22 @@ impl ModelFile {
             .map(serde_json::from_value::<Columns>)
             .transpose()
             .map_err(|e| bad(format!("\"columns\": {e}")))?;
+        let input_range = object
+            .remove("input_range")
+            .filter(|value| !value.is_null())
+            .map(serde_json::from_value::<Vec<[f64; 2]>>)
+            .transpose()
+            .map_err(|e| bad(format!("\"input_range\": {e}")))?;
+        if let Some([lo, hi]) = input_range
+            .iter()
+            .flatten()
+            .find(|[lo, hi]| !(lo.is_finite() && hi.is_finite() && lo <= hi))
+        {
+            return Err(bad(format!(
+                "\"input_range\" holds [{lo}, {hi}]; give each input's [min, max], finite \
+                 numbers with min <= max"
+            )));
+        }
         let read = |object: serde_json::Map<String, serde_json::Value>| {
             serde_json::from_value::<SavedModel>(serde_json::Value::Object(object))
         };
@@ -530,6 +565,7 @@ impl ModelFile {
             inverse_dynamics,
             sample_time,
             columns,
+            input_range,
         })
     }
 }

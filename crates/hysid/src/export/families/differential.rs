@@ -12,7 +12,7 @@
 //! flag: the outputs then hold their last values until the next init.
 
 use crate::export::code::{call, idx, lit, local, select, Block, Expr, Ty};
-use crate::export::program::{mark_clip, Ns, Program, ERROR_FIELD};
+use crate::export::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
 use crate::model::operators::differential::{InputOde, TOLERANCE};
 use crate::Result;
 use std::ops::Not;
@@ -222,7 +222,7 @@ pub fn forward<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
     prog.function(&ns.name("step"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
         let v = local("v");
         b.if_(v.clone().is_finite().not(), |b| {
-            b.set_state(ERROR_FIELD, Expr::Flag(true))
+            b.set_state(DIVERGED_FIELD, Expr::Flag(true))
         });
         b.if_else(
             Expr::State(d.started.clone()),
@@ -234,7 +234,7 @@ pub fn forward<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
                 ];
                 b.set_state(&d.x, call(&d.advance, args));
                 b.if_(Expr::State(d.fail.clone()), |b| {
-                    b.set_state(ERROR_FIELD, Expr::Flag(true))
+                    b.set_state(DIVERGED_FIELD, Expr::Flag(true))
                 });
             },
             |b| {
@@ -285,7 +285,7 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
     })?;
     let failed = Expr::State(d.fail.clone());
     let give_up = |b: &mut Block, v: Expr| {
-        b.set_state(ERROR_FIELD, Expr::Flag(true));
+        b.set_state(DIVERGED_FIELD, Expr::Flag(true));
         b.ret(v);
     };
     let illinois = prog.function(
@@ -439,7 +439,7 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
     let anchor = ode.anchor_input();
     prog.function(&ns.name("inverse"), &[("r", Ty::F64)], Some(Ty::F64), |b| {
         b.if_(local("r").is_finite().not(), |b| {
-            b.set_state(ERROR_FIELD, Expr::Flag(true))
+            b.set_state(DIVERGED_FIELD, Expr::Flag(true))
         });
         let start = select(
             Expr::State(d.started.clone()),

@@ -12,7 +12,7 @@
 
 use super::Emit;
 use crate::export::code::{lit, local, Expr, Ty};
-use crate::export::program::{mark_clip, Ns, Program, ERROR_FIELD};
+use crate::export::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
 use crate::model::operators::Orientation;
 use crate::Result;
 
@@ -39,7 +39,7 @@ impl<T: EmitCore> Emit for T {
                 let v = b.let_("v", Expr::Call(g_inv, vec![local("x")]));
                 if let Some(clipped) = clipped {
                     b.if_(Expr::State(clipped), |b| {
-                        b.set_state(ERROR_FIELD, Expr::Flag(true))
+                        b.set_state(DIVERGED_FIELD, Expr::Flag(true))
                     });
                 }
                 b.ret(lit(s) * v);

@@ -15,7 +15,7 @@
 
 use super::oriented::EmitCore;
 use crate::export::code::{call, idx, local, select, Block, Expr, Ty};
-use crate::export::program::{Ns, Program, ERROR_FIELD};
+use crate::export::program::{Ns, Program, DIVERGED_FIELD};
 use crate::export::solve;
 use crate::model::operators::preisach::{prefix_sums, Grid};
 use crate::model::operators::{Orientation, Preisach};
@@ -197,7 +197,7 @@ fn advance(op: &Preisach, ns: &Ns, prog: &mut Program, mem: &Memory) -> Result<S
                 },
                 |b| {
                     b.if_(len.clone().ge(idx(MEMORY_POINTS)), |b| {
-                        b.set_state(ERROR_FIELD, Expr::Flag(true));
+                        b.set_state(DIVERGED_FIELD, Expr::Flag(true));
                         b.ret(len.clone());
                     });
                     mem.set_p(b, &m, len.clone(), v.clone());

@@ -8,7 +8,7 @@
 
 use super::{Driver, EmitStateSpace};
 use crate::export::code::{idx, local, Block, Expr, Ty};
-use crate::export::program::{Program, ERROR_FIELD};
+use crate::export::program::{Program, DIVERGED_FIELD};
 use crate::model::greybox::simulate::dormand_prince::{A, B4, B5, C};
 use crate::Result;
 use std::ops::Not;
@@ -107,6 +107,6 @@ pub fn emit(
 
 /// Sets the error flag and leaves `advance`.
 fn fail(b: &mut Block) {
-    b.set_state(ERROR_FIELD, Expr::Flag(true));
+    b.set_state(DIVERGED_FIELD, Expr::Flag(true));
     b.ret_void();
 }

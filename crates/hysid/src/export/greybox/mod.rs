@@ -25,7 +25,7 @@ pub mod newmark;
 pub mod rk4;
 
 use super::code::{idx, local, select, Block, Expr, Ty};
-use super::program::{Ns, Program, ERROR_FIELD};
+use super::program::{Ns, Program, DIVERGED_FIELD};
 use crate::model::greybox::equation_model::EquationStateSpace;
 use crate::model::greybox::models::GreyBoxKind;
 use crate::model::greybox::simulate::{check_integrator, InputTrack};
@@ -222,7 +222,7 @@ pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Pro
 fn step(code: &dyn EmitStateSpace, d: &Driver, advance: &str, b: &mut Block) {
     let m = code.model();
     let (n, n_in) = (m.states().len(), m.inputs().len());
-    let error = |b: &mut Block| b.set_state(ERROR_FIELD, Expr::Flag(true));
+    let error = |b: &mut Block| b.set_state(DIVERGED_FIELD, Expr::Flag(true));
     for c in 0..n_in {
         b.if_(Expr::Input(c).is_finite().not(), error);
         b.set_at(&d.u_next, idx(c), Expr::Input(c));

@@ -32,7 +32,7 @@
 
 use super::{copy, Driver, EmitStateSpace};
 use crate::export::code::{call, idx, local, Block, Expr, Ty};
-use crate::export::program::{Program, ERROR_FIELD};
+use crate::export::program::{Program, DIVERGED_FIELD};
 use crate::{Error, Result};
 use std::ops::Not;
 
@@ -193,7 +193,7 @@ pub fn emit(
                     });
                 });
                 b.if_(call(&solve, vec![]).not(), |b| {
-                    b.set_state(ERROR_FIELD, Expr::Flag(true));
+                    b.set_state(DIVERGED_FIELD, Expr::Flag(true));
                     b.ret_void();
                 });
                 b.for_("i", idx(0), idx(p), |b, i| {
@@ -210,7 +210,7 @@ pub fn emit(
         b.for_("j", idx(0), idx(m), |b, j| {
             let tau = b.let_("tau", j.to_f64() / (m as f64));
             b.call(&step, vec![tau.clone(), tau + dtau]);
-            b.if_(Expr::State(ERROR_FIELD.into()), |b| b.ret_void());
+            b.if_(Expr::State(DIVERGED_FIELD.into()), |b| b.ret_void());
         });
     })
 }

@@ -5,7 +5,7 @@
 
 use super::{comment_lines, Printer, Syntax, ATOM, UNARY};
 use crate::export::code::{Math, Ty};
-use crate::export::program::{Program, CLIPPED_FIELD};
+use crate::export::program::{Program, CLIPPED_FIELD, FAULTS_FIELD};
 
 /// The C spelling, for the export `name`.
 struct C<'a> {
@@ -132,10 +132,16 @@ fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> Str
     if program.counts_clipped() {
         h.push_str(&format!(
             "/* The number of steps since {name}_init whose reference lay beyond the reachable\n\
-             \x20* range and was clipped (the library's Compensator::clipped). */\n\
+             \x20* range or whose command lay beyond the limits, and was clipped (the library's\n\
+             \x20* Compensator::clipped). */\n\
              size_t {name}_clipped(const {name}_state *s);\n\n"
         ));
     }
+    h.push_str(&format!(
+        "/* The number of bad (non-finite) input samples since {name}_init: each left the state\n\
+         \x20* unchanged and repeated the last good outputs (s->error: the last sample was bad). */\n\
+         size_t {name}_faults(const {name}_state *s);\n\n"
+    ));
     h.push_str(&format!("#endif /* {guard} */\n"));
     h
 }
@@ -210,6 +216,9 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
             "\nsize_t {name}_clipped(const {name}_state *s) {{\n    return s->{CLIPPED_FIELD};\n}}\n"
         ));
     }
+    c.push_str(&format!(
+        "\nsize_t {name}_faults(const {name}_state *s) {{\n    return s->{FAULTS_FIELD};\n}}\n"
+    ));
     let mut helpers = String::new();
     for (f, body) in MINMAX {
         let helper = format!("{name}_math_{f}");

@@ -1,5 +1,6 @@
 //! `no_std` Rust rendering: `src/lib.rs` of a crate with `pub struct Model` (the state),
-//! `Model::new`, `Model::reset`, `Model::step`, `Model::error`, the constants `N_IN`, `N_OUT`,
+//! `Model::new`, `Model::reset`, `Model::step`, `Model::error`, `Model::faults`,
+//! `Model::diverged`, the constants `N_IN`, `N_OUT`,
 //! `SAMPLE_TIME`, the tables as `const` arrays and the helpers as private methods; and its
 //! `Cargo.toml`, whose one dependency is `libm` (the math functions of `core`-only Rust).
 
@@ -147,8 +148,14 @@ pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
     p.stmts(&program.init, 2, &mut r);
     r.push_str("    }\n\n");
     r.push_str(
-        "    /// True once a step could not be computed; the outputs then hold their last\n\
-         \x20   /// values until [`Model::reset`].\n    pub fn error(&self) -> bool {\n        self.error\n    }\n\n",
+        "    /// True when the last sample was bad (not finite): the state stayed and the outputs\n\
+         \x20   /// repeated the last good ones; cleared by the next good sample.\n\
+         \x20   pub fn error(&self) -> bool {\n        self.error\n    }\n\n\
+         \x20   /// The number of bad (non-finite) samples since [`Model::reset`].\n\
+         \x20   pub fn faults(&self) -> usize {\n        self.faults\n    }\n\n\
+         \x20   /// True once a step could not be computed (a divergence, a budget or capacity\n\
+         \x20   /// overflow); the outputs then hold their last values until [`Model::reset`].\n\
+         \x20   pub fn diverged(&self) -> bool {\n        self.diverged\n    }\n\n",
     );
     if program.counts_clipped() {
         r.push_str(&format!(

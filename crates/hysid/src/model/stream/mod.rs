@@ -10,7 +10,10 @@
 //! that makes the model follow it, with what the model makes of it and whether r was out of
 //! reach (clipped to the reachable range, as [`compensate`](crate::model::compensate::compensate)
 //! clips, and counted). A fresh or [`reset`](Stepper::reset) stepper is at the model's
-//! initial state; after an error a stepper's state is undefined until it is reset.
+//! initial state; after an error (a divergence, a budget or capacity overflow: latched) a
+//! stepper's state is undefined until it is reset. A non-finite sample is not an error: it
+//! is skipped, and a compensator's command is limited, by the one rule of
+//! [`crate::model::limits`] (the library's, the exported code's and Python's).
 //!
 //! For a cascade with delay k ≥ 1 the command u_s first moves the output at s + k, so its
 //! compensator takes the reference [`preview`](Compensator::preview) = k samples ahead:
@@ -76,6 +79,7 @@ use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::compensate::Compensation;
 use crate::model::greybox::equation_model::EquationStateSpace;
 use crate::model::greybox::{models, InputInterpolation};
+use crate::model::limits::{is_bad, Limits};
 use crate::model::saved::FittedModel;
 use crate::{Error, Result};
 
@@ -85,25 +89,42 @@ pub trait Stepper: Send + std::fmt::Debug {
     fn n_inputs(&self) -> usize;
     /// The number of output channels `step` writes.
     fn n_outputs(&self) -> usize;
-    /// Back to the model's initial state.
+    /// Back to the model's initial state (and the fault count to 0).
     fn reset(&mut self);
     /// y_k for the input u_k (exactly the sample `FittedModel::simulate` gives at k), then the
-    /// state advances to k + 1. `u` holds one value per input, `y` one per output.
+    /// state advances to k + 1. `u` holds one value per input, `y` one per output. An input
+    /// with a non-finite value is a bad sample ([`crate::model::limits`]): the state stays,
+    /// `y` gets the last good outputs (0 before any) and the step counts a fault.
     fn step(&mut self, u: &[f64], y: &mut [f64]) -> Result<()>;
+    /// True when the last sample was bad (non-finite); cleared by the next good one.
+    fn error(&self) -> bool;
+    /// How many bad (non-finite) samples since the last reset.
+    fn faults(&self) -> usize;
 }
 
 /// The command that makes a model follow a reference, one sample at a time.
 pub trait Compensator: Send + std::fmt::Debug {
-    /// Back to the model's initial state (and the clipped count to 0).
+    /// Back to the model's initial state (and the clipped and fault counts to 0).
     fn reset(&mut self);
     /// How many samples ahead the reference is given: the linear block's delay k for an
     /// operator cascade (step s takes r_{s+k}), 0 otherwise.
     fn preview(&self) -> usize;
     /// The command u_k that makes the model follow the reference (clipped to the reachable
-    /// range as batch compensation does, and counted).
+    /// range as batch compensation does, then to the [`limits`](Compensator::limits), and
+    /// counted). A non-finite reference is a bad sample ([`crate::model::limits`]): the state
+    /// stays, the step repeats the last good command (the limits' midpoint, or 0, before
+    /// any) and counts a fault.
     fn step(&mut self, reference: f64) -> Result<CompensatorStep>;
     /// How many references were clipped since the last reset.
     fn clipped(&self) -> usize;
+    /// The limits of the command (none: unlimited; the default of a new compensator).
+    fn limits(&self) -> Option<Limits>;
+    /// Sets the limits of the command and resets the compensator.
+    fn set_limits(&mut self, limits: Option<Limits>);
+    /// True when the last reference was bad (non-finite); cleared by the next good one.
+    fn error(&self) -> bool;
+    /// How many bad (non-finite) references since the last reset.
+    fn faults(&self) -> usize;
 }
 
 /// A kind's step, given the sample's index (the checks and the count are [`Guarded`]'s).
@@ -142,14 +163,19 @@ impl<K: InverseKernel + ?Sized> InverseKernel for Box<K> {
     }
 }
 
-/// A kernel with the checks every stepper makes: the channel counts, finite inputs, and
-/// finite outputs (as [`FittedModel::simulate`] refuses a non-finite output), and the count k.
+/// A kernel with the checks every stepper makes: the channel counts, bad (non-finite) inputs
+/// skipped ([`crate::model::limits`]), and finite outputs (as [`FittedModel::simulate`]
+/// refuses a non-finite output), and the count k of good samples.
 #[derive(Debug)]
 struct Guarded<K> {
     kernel: K,
     k: usize,
     n_inputs: usize,
     n_outputs: usize,
+    /// The last good outputs (0 before any).
+    held: Vec<f64>,
+    bad: bool,
+    faults: usize,
 }
 
 impl<K: Kernel> Guarded<K> {
@@ -159,6 +185,9 @@ impl<K: Kernel> Guarded<K> {
             k: 0,
             n_inputs,
             n_outputs,
+            held: vec![0.0; n_outputs],
+            bad: false,
+            faults: 0,
         }
     }
 }
@@ -173,6 +202,9 @@ impl<K: Kernel> Stepper for Guarded<K> {
     fn reset(&mut self) {
         self.kernel.reset();
         self.k = 0;
+        self.held.iter_mut().for_each(|v| *v = 0.0);
+        self.bad = false;
+        self.faults = 0;
     }
     fn step(&mut self, u: &[f64], y: &mut [f64]) -> Result<()> {
         if u.len() != self.n_inputs || y.len() != self.n_outputs {
@@ -184,12 +216,11 @@ impl<K: Kernel> Stepper for Guarded<K> {
                 y.len()
             )));
         }
-        if let Some(c) = u.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                channel: format!("input {}", c + 1),
-                index: self.k,
-                value: u[c],
-            });
+        self.bad = is_bad(u);
+        if self.bad {
+            self.faults += 1;
+            y.copy_from_slice(&self.held);
+            return Ok(());
         }
         self.kernel.step(self.k, u, y)?;
         if let Some(c) = y.iter().position(|v| !v.is_finite()) {
@@ -202,18 +233,31 @@ impl<K: Kernel> Stepper for Guarded<K> {
                 ),
             });
         }
+        self.held.copy_from_slice(y);
         self.k += 1;
         Ok(())
     }
+    fn error(&self) -> bool {
+        self.bad
+    }
+    fn faults(&self) -> usize {
+        self.faults
+    }
 }
 
-/// An inverse kernel with the checks every compensator makes (a finite reference), the
-/// count k and the clipped count.
+/// An inverse kernel with the checks every compensator makes: bad (non-finite) references
+/// skipped ([`crate::model::limits`]), the command's limits, a finite command, the count k of
+/// good references and the clipped count.
 #[derive(Debug)]
 struct GuardedInverse<K> {
     kernel: K,
     k: usize,
     clipped: usize,
+    limits: Option<Limits>,
+    /// The last good step (the limits' midpoint, or 0, before any).
+    held: CompensatorStep,
+    bad: bool,
+    faults: usize,
 }
 
 impl<K: InverseKernel> GuardedInverse<K> {
@@ -222,6 +266,14 @@ impl<K: InverseKernel> GuardedInverse<K> {
             kernel,
             k: 0,
             clipped: 0,
+            limits: None,
+            held: CompensatorStep {
+                u: 0.0,
+                predicted: 0.0,
+                clipped: false,
+            },
+            bad: false,
+            faults: 0,
         }
     }
 }
@@ -231,25 +283,61 @@ impl<K: InverseKernel> Compensator for GuardedInverse<K> {
         self.kernel.reset();
         self.k = 0;
         self.clipped = 0;
+        self.held = CompensatorStep {
+            u: self.limits.map_or(0.0, |l| l.midpoint()),
+            predicted: 0.0,
+            clipped: false,
+        };
+        self.bad = false;
+        self.faults = 0;
     }
     fn preview(&self) -> usize {
         self.kernel.preview()
     }
     fn step(&mut self, reference: f64) -> Result<CompensatorStep> {
-        if !reference.is_finite() {
-            return Err(Error::NonFinite {
-                channel: "reference".into(),
-                index: self.k,
-                value: reference,
+        self.bad = is_bad(&[reference]);
+        if self.bad {
+            self.faults += 1;
+            return Ok(CompensatorStep {
+                clipped: false,
+                ..self.held
             });
         }
-        let step = self.kernel.step(self.k, reference)?;
+        let mut step = self.kernel.step(self.k, reference)?;
+        if !step.u.is_finite() {
+            return Err(Error::Diverged {
+                index: self.k,
+                reason: format!(
+                    "the command is {}; the model's inverse cannot be computed for this reference",
+                    step.u
+                ),
+            });
+        }
+        if let Some(limits) = &self.limits {
+            let (u, limited) = limits.apply(step.u);
+            step.u = u;
+            step.clipped |= limited;
+        }
         self.clipped += usize::from(step.clipped);
+        self.held = step;
         self.k += 1;
         Ok(step)
     }
     fn clipped(&self) -> usize {
         self.clipped
+    }
+    fn limits(&self) -> Option<Limits> {
+        self.limits
+    }
+    fn set_limits(&mut self, limits: Option<Limits>) {
+        self.limits = limits;
+        self.reset();
+    }
+    fn error(&self) -> bool {
+        self.bad
+    }
+    fn faults(&self) -> usize {
+        self.faults
     }
 }
 
@@ -430,7 +518,10 @@ pub fn run(stepper: &mut dyn Stepper, inputs: &[&[f64]]) -> Result<Vec<Vec<f64>>
 /// [`compensate`](crate::model::compensate::compensate) by a compensator, from its initial
 /// state (it is reset first): step s is given r_{s+p}, p its
 /// [`preview`](Compensator::preview), the last reference repeated past the record's end, as
-/// the batch does; equal to the batch.
+/// the batch does; equal to the batch ([`compensate_within`] with the compensator's
+/// [`limits`](Compensator::limits)).
+///
+/// [`compensate_within`]: crate::model::compensate::compensate_within
 pub fn compensate_stream(
     compensator: &mut dyn Compensator,
     reference: &[f64],
