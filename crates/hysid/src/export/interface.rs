@@ -197,10 +197,10 @@ pub fn comment(
          Inputs: {}. Outputs: {}.\n\
          Step semantics: a step with the input at sample k returns the output at sample k (the\n\
          {}), then advances the state to k + 1.\n\
-         Bad samples: an input that is NaN or infinite leaves the state unchanged and the step\n\
-         repeats the last good outputs{before}; the error flag then says the last sample\n\
-         was bad and clears on the next good one, the faults count keeps the total\n\
-         (docs/export.md, \"Limits and bad samples\").\n\
+         Bad samples: an input that is not finite (not a number, or infinite) leaves the\n\
+         state unchanged and the step repeats the last good outputs{before}; the error flag\n\
+         then says the last sample was bad and clears on the next good one, the faults count\n\
+         keeps the total (docs/export.md, \"Limits and bad samples\").\n\
          {limits}\
          Diverged flag: set once a step cannot be computed (the differential families'\n\
          integration beyond its sub-step budget, a Preisach memory beyond its capacity, a\n\
