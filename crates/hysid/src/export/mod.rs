@@ -48,6 +48,7 @@
 
 pub mod code;
 pub mod coleman_hodgdon;
+pub mod eval;
 pub mod families;
 pub mod fmu;
 pub mod greybox;
@@ -57,6 +58,7 @@ pub mod linear;
 pub mod output;
 pub mod program;
 pub mod render;
+pub mod sequence;
 pub mod solve;
 pub mod stmt;
 pub mod zip;
