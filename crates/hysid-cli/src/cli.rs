@@ -721,6 +721,34 @@ pub struct ExportArgs {
     /// without one exports an unlimited compensator (with a warning).
     #[arg(long, allow_hyphen_values = true, value_parser = crate::options::limits)]
     pub limits: Option<hysid::model::limits::Limits>,
+    /// The code's floating-point type: double (the library's numbers to the bit) or single
+    /// (float / f32, for single-precision FPUs such as the Cortex-M4F; within the bound its
+    /// header states, measured at export and at most 1e-4 of the output's range, else
+    /// refused). --target c or rust only.
+    #[arg(long, value_enum, default_value_t = PrecisionArg::Double)]
+    pub precision: PrecisionArg,
+    /// With --precision single: measure the bound on this CSV record instead of the test
+    /// sequence over the model file's input range (its --input columns for a model, its
+    /// --output column as the references for a compensator).
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    /// With --data: an input column of the record (repeat for several inputs); for a
+    /// model's export.
+    #[arg(long)]
+    pub input: Vec<String>,
+    /// With --data and --inverse: the record's output column, fed to the compensator as
+    /// its references.
+    #[arg(long)]
+    pub output: Option<String>,
+}
+
+/// The floating-point type of exported code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PrecisionArg {
+    /// double / f64.
+    Double,
+    /// float / f32.
+    Single,
 }
 
 /// Export targets.

@@ -5,7 +5,8 @@
 use crate::errors::guard;
 use hysid::export::fmu::{fmu, Compiler};
 use hysid::export::output::ExportDir;
-use hysid::export::{export, CCode, ExportOptions, Interface, Target};
+use hysid::export::{export, CCode, ExportOptions, Interface, Precision, Target};
+use hysid::model::limits::Limits;
 use hysid::model::saved::{FittedModel, ModelFile};
 use hysid::Error;
 use pyo3::prelude::*;
@@ -21,8 +22,10 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 
 /// Exports the model file `model_json` to `target` (`c`, `rust`, `fmu`) under `name` into
 /// the directory `out` (created; refused when it holds any file); returns the paths written.
+/// `limits` are a compensator's command limits (None: the file's input range), `precision`
+/// `double` or `single`.
 #[pyfunction]
-#[pyo3(signature = (model_json, target, name, out, inverse, ts, binary, y0=None))]
+#[pyo3(signature = (model_json, target, name, out, inverse, ts, binary, y0=None, limits=None, precision="double"))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn export_model(
     py: Python<'_>,
@@ -34,12 +37,25 @@ fn export_model(
     ts: Option<f64>,
     binary: bool,
     y0: Option<f64>,
+    limits: Option<(f64, f64)>,
+    precision: &str,
 ) -> PyResult<Vec<PathBuf>> {
     let model_json = model_json.to_string();
     let name = name.to_string();
     let target = target.to_string();
+    let precision = precision.to_string();
     crate::errors::run(py, move || {
         let target = Target::parse(&target)?;
+        let precision = Precision::parse(&precision)?;
+        let limits = limits.map(|(lo, hi)| Limits::new(lo, hi)).transpose()?;
+        if limits.is_some() && !inverse {
+            return Err(Error::invalid_option(
+                "limits",
+                format!("{limits:?}"),
+                "limits= applies to inverse=True only (a compensator's command); leave it out"
+                    .into(),
+            ));
+        }
         if let Some(ts) = ts {
             if !(ts.is_finite() && ts > 0.0) {
                 return Err(Error::invalid_option(
@@ -65,7 +81,9 @@ fn export_model(
             sample_time: ts,
             binary,
             initial_output: y0,
-            limits: None,
+            limits,
+            precision,
+            bound_record: None,
         };
         let files = export(&file, target, &name, &options)?;
         let paths = files.iter().map(|f| dir.path().join(&f.path)).collect();

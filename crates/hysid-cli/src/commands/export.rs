@@ -1,10 +1,11 @@
 //! `hysid export`: a saved model as C, no_std Rust or an FMU, in a directory of its own.
 
-use crate::cli::{ExportArgs, TargetArg};
+use crate::cli::{ExportArgs, PrecisionArg, TargetArg};
 use crate::exit::UsageError;
 use anyhow::{Context, Result};
+use hysid::data::{CsvSpec, IdData};
 use hysid::export::output::ExportDir;
-use hysid::export::{export, ExportOptions, Target};
+use hysid::export::{export, ExportOptions, Precision, Target};
 use hysid::model::saved::ModelFile;
 
 /// Registers the output directory (refused when it is or holds the model file, or holds
@@ -21,14 +22,28 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         TargetArg::Rust => Target::Rust,
         TargetArg::Fmu => Target::Fmu,
     };
-    let dir = ExportDir::new(&args.out, &[args.model.as_path()])?;
+    let precision = match args.precision {
+        PrecisionArg::Double => Precision::Double,
+        PrecisionArg::Single => Precision::Single,
+    };
+    check_precision(args, precision)?;
+    let mut inputs = vec![args.model.as_path()];
+    inputs.extend(args.data.as_deref());
+    let dir = ExportDir::new(&args.out, &inputs)?;
     let file = ModelFile::load(&args.model)?;
+    let bound_record = args
+        .data
+        .as_deref()
+        .map(|path| bound_record(path, args))
+        .transpose()?;
     let options = ExportOptions {
         inverse: args.inverse,
         sample_time: args.ts,
         binary: !args.no_binary,
         initial_output: args.y0,
         limits: args.limits,
+        precision,
+        bound_record,
     };
     if args.limits.is_some() && !args.inverse {
         return Err(UsageError(
@@ -62,4 +77,55 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         println!("  {}", args.out.join(&f.path).display());
     }
     Ok(())
+}
+
+/// The precision's options, checked before any file is read: single is for C and Rust,
+/// `--data` for single only, and its columns are those the exported step reads.
+fn check_precision(args: &ExportArgs, precision: Precision) -> Result<()> {
+    let usage = |text: &str| -> Result<()> {
+        Err(UsageError(format!("{text}; run 'hysid export --help' for the options")).into())
+    };
+    if precision.is_single() && args.target == TargetArg::Fmu {
+        return usage(
+            "--precision single applies to --target c or rust (an FMU computes in double: FMI 2.0's Real is a double)",
+        );
+    }
+    if args.data.is_some() && !precision.is_single() {
+        return usage("--data gives the record a single-precision bound is measured on; add --precision single, or leave --data out");
+    }
+    if args.data.is_none() && (!args.input.is_empty() || args.output.is_some()) {
+        return usage(
+            "--input and --output name columns of --data; give --data FILE, or leave them out",
+        );
+    }
+    if args.data.is_some() {
+        if args.inverse && args.output.is_none() {
+            return usage("with --inverse, --data needs --output COLUMN (the references fed to the compensator)");
+        }
+        if !args.inverse && args.input.is_empty() {
+            return usage("--data needs --input COLUMN (the model's inputs; repeat for several)");
+        }
+    }
+    Ok(())
+}
+
+/// The rows of `--data` the exported step is fed to measure the single-precision bound:
+/// the `--input` columns of a model, the `--output` column of a compensator.
+fn bound_record(path: &std::path::Path, args: &ExportArgs) -> Result<Vec<Vec<f64>>> {
+    let spec = CsvSpec {
+        inputs: args.input.clone(),
+        outputs: args.output.iter().cloned().collect(),
+        time: None,
+        ts: Some(1.0),
+    };
+    let data = IdData::from_file(path, &spec)
+        .with_context(|| format!("reading --data {}", path.display()))?;
+    let columns: Vec<&[f64]> = if args.inverse {
+        vec![data.output(0, 0)]
+    } else {
+        (0..args.input.len()).map(|j| data.input(0, j)).collect()
+    };
+    Ok((0..columns[0].len())
+        .map(|k| columns.iter().map(|c| c[k]).collect())
+        .collect())
 }

@@ -248,5 +248,7 @@ def export_model(
     ts: Optional[float],
     binary: bool,
     y0: Optional[float] = None,
+    limits: Optional[Tuple[float, float]] = None,
+    precision: str = "double",
 ) -> List[str]: ...
 def fmu_of_c_code(header: str, source: str, interface_json: str, binary: bool) -> bytes: ...

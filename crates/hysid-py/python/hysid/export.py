@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import TYPE_CHECKING, List, Literal, Optional
+from typing import TYPE_CHECKING, List, Literal, Optional, Tuple
 
 from . import _hysid
 
@@ -13,6 +13,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from .models import Model
 
 Target = Literal["c", "rust", "fmu"]
+Precision = Literal["double", "single"]
 
 
 def export(
@@ -25,6 +26,8 @@ def export(
     ts: Optional[float] = None,
     binary: bool = True,
     y0: Optional[float] = None,
+    limits: Optional[Tuple[float, float]] = None,
+    precision: Precision = "double",
 ) -> List[str]:
     """Writes the model as ``target`` (``"c"``: ``NAME.h`` and ``NAME.c``; ``"rust"``: the
     crate ``NAME/``; ``"fmu"``: ``NAME.fmu``) into the directory ``out``, created if missing
@@ -38,7 +41,11 @@ def export(
     its own when it has one. ``binary=False`` leaves the FMU's compiled binary out (a
     source-only FMU; the binary is built with ``$CC``, else ``cc``). ``y0`` is the measured
     initial output a Coleman–Hodgdon hysteresis saved with ``initial_output: measured``
-    starts from (required to export its forward step). Errors: ``ConfigError``
+    starts from (required to export its forward step). ``limits=(lo, hi)`` limits a
+    compensator's command (default: the input range of the data the model was fitted on, as
+    ``compensate``). ``precision="single"`` writes ``float`` / ``f32`` code for a
+    single-precision FPU (C and Rust; refused when its measured deviation from the double
+    code exceeds 1e-4 of the output's range; the header states the bound). Errors: ``ConfigError``
     for a model or request that cannot be exported (a kind without an exporter, no inverse,
     a missing sample time, no C compiler), ``ModelFileError`` for an output directory that
     holds files.
@@ -59,5 +66,21 @@ def export(
         None if ts is None else float(ts),
         bool(binary),
         None if y0 is None else float(y0),
+        None if limits is None else _limits(limits),
+        _precision(precision),
     )
     return [os.fspath(p) for p in paths]
+
+
+def _limits(limits: Tuple[float, float]) -> Tuple[float, float]:
+    """``limits`` as two floats; a TypeError for anything else."""
+    if isinstance(limits, (str, bytes)) or len(limits) != 2:
+        raise TypeError(f"limits: expected a pair (lo, hi) of numbers, got {limits!r}")
+    return (float(limits[0]), float(limits[1]))
+
+
+def _precision(precision: str) -> str:
+    """``precision`` checked: ``"double"`` or ``"single"``."""
+    if precision not in ("double", "single"):
+        raise ValueError(f"precision: expected 'double' or 'single', got {precision!r}")
+    return precision

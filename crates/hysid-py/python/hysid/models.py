@@ -20,7 +20,7 @@ from . import _hysid
 from ._fields import Fields, ReportError
 from ._hysid import ModelFileError
 from ._inputs import FloatArray, Samples, channels, choice, sample_time
-from .export import Target, export
+from .export import Precision, Target, export
 from .parameters import Parameter, ParameterTuple
 from .stream import Compensator, Stepper, compensator, stepper
 
@@ -146,10 +146,24 @@ class Model:
         ts: Optional[float] = None,
         binary: bool = True,
         y0: Optional[float] = None,
+        limits: Optional[Tuple[float, float]] = None,
+        precision: Precision = "double",
     ) -> List[str]:
         """The model as C99, a ``no_std`` Rust crate or an FMI 2.0 FMU (:mod:`hysid.export`,
-        the command line's ``hysid export``); returns the paths written."""
-        return export(self, target, name, out, inverse=inverse, ts=ts, binary=binary, y0=y0)
+        the command line's ``hysid export``; ``limits`` and ``precision`` as there); returns
+        the paths written."""
+        return export(
+            self,
+            target,
+            name,
+            out,
+            inverse=inverse,
+            ts=ts,
+            binary=binary,
+            y0=y0,
+            limits=limits,
+            precision=precision,
+        )
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Model) and self.file == other.file

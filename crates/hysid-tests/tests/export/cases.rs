@@ -215,7 +215,14 @@ fn kinds(u: &[f64]) -> Vec<Case> {
 /// where it has one), forward and inverse; then the other kinds; then the grey-box and
 /// equation-file models ([`crate::greybox`]).
 pub fn all() -> Vec<Case> {
-    let u = signal(3000, 27);
+    let mut out = all_on(&signal(3000, 27));
+    out.extend(crate::greybox::cases());
+    out
+}
+
+/// The cases of [`all`] but the grey-box ones, on the forward input `u` (the compensators'
+/// references are the models' outputs for it).
+pub fn all_on(u: &[f64]) -> Vec<Case> {
     let mut out = Vec::new();
     for op in OperatorModel::examples().expect("the registry's examples") {
         let label = op.family().name().replace('-', "_");
@@ -223,15 +230,14 @@ pub fn all() -> Vec<Case> {
             op.clone(),
             vec![f64::NAN; op.as_operator().parameters().len()],
         );
-        out.extend(cases_of(&label, &model, &u));
+        out.extend(cases_of(&label, &model, u));
         if let Some(cw) = flipped(&op) {
             let n = cw.as_operator().parameters().len();
             let model = FittedModel::operator(cw, vec![f64::NAN; n]);
-            out.extend(cases_of(&format!("{label}_cw"), &model, &u));
+            out.extend(cases_of(&format!("{label}_cw"), &model, u));
         }
     }
-    out.extend(kinds(&u));
-    out.extend(crate::greybox::cases());
+    out.extend(kinds(u));
     out
 }
 

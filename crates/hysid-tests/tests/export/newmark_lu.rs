@@ -90,7 +90,13 @@ fn the_emitted_lu_solve_is_nalgebras_to_the_bit() {
     let (mut swapped, mut singular, mut compared) = (0, 0, 0);
     for p in 1..=5 {
         let name = format!("lu{p}");
-        let (header, source) = hysid::export::render::c::render(&program(p), &name, "LU test", 1.0);
+        let (header, source) = hysid::export::render::c::render(
+            &program(p),
+            &name,
+            "LU test",
+            1.0,
+            (hysid::export::Precision::Double, 0.0),
+        );
         std::fs::write(dir.path().join(format!("{name}.h")), header).expect("write");
         std::fs::write(dir.path().join(format!("{name}.c")), source).expect("write");
         std::fs::write(dir.path().join(format!("{name}_driver.c")), driver(&name)).expect("write");

@@ -20,10 +20,11 @@
 //! `sinf`, `expf`, `powf` may differ from the host's by an ulp), which the stated bound's
 //! margin covers.
 
-use super::code::{BinOp, Expr, Function, Math, Place, Stmt, Ty};
+use super::code::{BinOp, Expr, Math, Place, Stmt, Ty};
 use super::program::Program;
 use crate::{Error, Result};
 use std::collections::HashMap;
+use std::rc::Rc;
 
 /// A floating-point type the generated code may compute in: `f64` (double) or `f32`
 /// (single).
@@ -139,39 +140,266 @@ fn bug(what: String) -> Error {
     ))
 }
 
+// The program resolved for running: every name replaced by an index (a field, a table, a
+// helper, a local's slot in its function's frame), so that a step costs no lookup.
+
+/// A resolved expression.
+enum E {
+    Lit(Value<f64>),
+    Local(usize),
+    Field(usize, Option<Box<E>>),
+    Table(usize, Box<E>),
+    Input(usize),
+    Neg(Box<E>),
+    Not(Box<E>),
+    And(Box<E>, Box<E>),
+    Or(Box<E>, Box<E>),
+    Bin(BinOp, Box<E>, Box<E>),
+    Math(Math, Vec<E>),
+    IsFinite(Box<E>),
+    ToFloat(Box<E>),
+    ToIndex(Box<E>),
+    Select(Box<E>, Box<E>, Box<E>),
+    Call(usize, Vec<E>),
+}
+
+/// Where a resolved assignment writes.
+enum P {
+    Local(usize),
+    Field(usize, Option<E>),
+    Output(usize),
+}
+
+/// A resolved statement.
+enum S {
+    Set(P, E),
+    If(E, Vec<S>, Vec<S>),
+    For(usize, E, E, Vec<S>),
+    While(E, Vec<S>),
+    Break,
+    Return(Option<E>),
+    Call(usize, Vec<E>),
+}
+
+/// A resolved helper: its body and the size of its frame (its parameters first).
+struct F {
+    body: Vec<S>,
+    slots: usize,
+}
+
+/// Resolves names while compiling one function (or the init, or the step).
+struct Resolver<'a> {
+    fields: &'a HashMap<&'a str, usize>,
+    tables: &'a HashMap<&'a str, usize>,
+    functions: &'a HashMap<&'a str, usize>,
+    scope: Vec<(&'a str, usize)>,
+    slots: usize,
+}
+
+impl<'a> Resolver<'a> {
+    fn declare(&mut self, name: &'a str) -> usize {
+        let slot = self.slots;
+        self.slots += 1;
+        self.scope.push((name, slot));
+        slot
+    }
+
+    fn local(&self, name: &str) -> Result<usize> {
+        self.scope
+            .iter()
+            .rev()
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| *s)
+            .ok_or_else(|| bug(format!("the local '{name}' is not declared")))
+    }
+
+    fn field(&self, name: &str) -> Result<usize> {
+        self.fields
+            .get(name)
+            .copied()
+            .ok_or_else(|| bug(format!("the field '{name}' does not exist")))
+    }
+
+    fn function(&self, name: &str) -> Result<usize> {
+        self.functions
+            .get(name)
+            .copied()
+            .ok_or_else(|| bug(format!("the helper '{name}' does not exist")))
+    }
+
+    fn block(&mut self, stmts: &'a [Stmt]) -> Result<Vec<S>> {
+        let mark = self.scope.len();
+        let out = stmts
+            .iter()
+            .map(|s| self.stmt(s))
+            .collect::<Result<Vec<_>>>();
+        self.scope.truncate(mark);
+        out
+    }
+
+    fn stmt(&mut self, s: &'a Stmt) -> Result<S> {
+        Ok(match s {
+            Stmt::Let { name, value, .. } => {
+                let value = self.expr(value)?;
+                S::Set(P::Local(self.declare(name)), value)
+            }
+            Stmt::Assign(place, value) => {
+                let place = match place {
+                    Place::Local(name) => P::Local(self.local(name)?),
+                    Place::State(field) => P::Field(self.field(field)?, None),
+                    Place::StateAt(field, i) => P::Field(self.field(field)?, Some(self.expr(i)?)),
+                    Place::Output(i) => P::Output(*i),
+                };
+                S::Set(place, self.expr(value)?)
+            }
+            Stmt::If(c, a, b) => S::If(self.expr(c)?, self.block(a)?, self.block(b)?),
+            Stmt::For {
+                var,
+                from,
+                to,
+                body,
+            } => {
+                let (from, to) = (self.expr(from)?, self.expr(to)?);
+                let mark = self.scope.len();
+                let slot = self.declare(var);
+                let body = self.block(body)?;
+                self.scope.truncate(mark);
+                S::For(slot, from, to, body)
+            }
+            Stmt::While(c, body) => S::While(self.expr(c)?, self.block(body)?),
+            Stmt::Break => S::Break,
+            Stmt::Return(e) => S::Return(e.as_ref().map(|e| self.expr(e)).transpose()?),
+            Stmt::Call(name, args) => S::Call(self.function(name)?, self.exprs(args)?),
+        })
+    }
+
+    fn exprs(&mut self, es: &'a [Expr]) -> Result<Vec<E>> {
+        es.iter().map(|e| self.expr(e)).collect()
+    }
+
+    fn boxed(&mut self, e: &'a Expr) -> Result<Box<E>> {
+        Ok(Box::new(self.expr(e)?))
+    }
+
+    fn expr(&mut self, e: &'a Expr) -> Result<E> {
+        Ok(match e {
+            Expr::F64(v) => E::Lit(Value::F(*v)),
+            Expr::Nan => E::Lit(Value::F(f64::NAN)),
+            Expr::Index(i) => E::Lit(Value::I(*i)),
+            Expr::Flag(b) => E::Lit(Value::B(*b)),
+            Expr::Local(name) => E::Local(self.local(name)?),
+            Expr::State(field) => E::Field(self.field(field)?, None),
+            Expr::StateAt(field, i) => E::Field(self.field(field)?, Some(self.boxed(i)?)),
+            Expr::Table(name, i) => E::Table(
+                self.tables
+                    .get(name.as_str())
+                    .copied()
+                    .ok_or_else(|| bug(format!("the table '{name}' does not exist")))?,
+                self.boxed(i)?,
+            ),
+            Expr::Input(i) => E::Input(*i),
+            Expr::Neg(a) => E::Neg(self.boxed(a)?),
+            Expr::Not(a) => E::Not(self.boxed(a)?),
+            Expr::Bin(BinOp::And, a, b) => E::And(self.boxed(a)?, self.boxed(b)?),
+            Expr::Bin(BinOp::Or, a, b) => E::Or(self.boxed(a)?, self.boxed(b)?),
+            Expr::Bin(op, a, b) => E::Bin(*op, self.boxed(a)?, self.boxed(b)?),
+            Expr::Math(f, args) => E::Math(*f, self.exprs(args)?),
+            Expr::IsFinite(a) => E::IsFinite(self.boxed(a)?),
+            Expr::ToF64(a) => E::ToFloat(self.boxed(a)?),
+            Expr::ToIndex(a) => E::ToIndex(self.boxed(a)?),
+            Expr::Select(c, a, b) => E::Select(self.boxed(c)?, self.boxed(a)?, self.boxed(b)?),
+            Expr::Call(name, args) => E::Call(self.function(name)?, self.exprs(args)?),
+        })
+    }
+}
+
+/// The resolved code of a program: its helpers, initialisation and step.
+struct Code {
+    functions: Vec<F>,
+    init: F,
+    step: F,
+}
+
 /// A program's state, running in the type `R`.
-pub struct Machine<'p, R> {
-    program: &'p Program,
-    fields: HashMap<&'p str, Vec<Value<R>>>,
-    tables: HashMap<&'p str, Vec<R>>,
-    functions: HashMap<&'p str, &'p Function>,
-    locals: Vec<(&'p str, Value<R>)>,
+pub struct Machine<R> {
+    /// Each field's length and type, for the reset.
+    shapes: Vec<(usize, Ty)>,
+    field_names: Vec<String>,
+    fields: Vec<Vec<Value<R>>>,
+    tables: Vec<Vec<R>>,
+    code: Rc<Code>,
+    /// The statements executed so far, and the most allowed ([`Machine::limit`]).
+    ops: u64,
+    budget: u64,
+    n_inputs: usize,
     inputs: Vec<R>,
     outputs: Vec<R>,
 }
 
-impl<'p, R: Real> Machine<'p, R> {
+impl<R: Real> Machine<R> {
     /// The program `program` after its initialisation (`NAME_init`, `Model::new`).
-    pub fn new(program: &'p Program) -> Result<Self> {
-        let mut m = Self {
-            program,
-            fields: HashMap::new(),
-            tables: program
-                .tables
-                .iter()
-                .map(|t| {
-                    (
-                        t.name.as_str(),
-                        t.values.iter().map(|&v| R::of(v)).collect(),
-                    )
-                })
-                .collect(),
+    pub fn new(program: &Program) -> Result<Self> {
+        let fields: HashMap<&str, usize> = program
+            .fields
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.name.as_str(), i))
+            .collect();
+        let tables: HashMap<&str, usize> = program
+            .tables
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (t.name.as_str(), i))
+            .collect();
+        let functions: HashMap<&str, usize> = program
+            .functions
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (f.name.as_str(), i))
+            .collect();
+        let compile = |params: &[(String, Ty)], body: &[Stmt]| -> Result<F> {
+            let mut r = Resolver {
+                fields: &fields,
+                tables: &tables,
+                functions: &functions,
+                scope: Vec::new(),
+                slots: 0,
+            };
+            for (name, _) in params {
+                r.declare(name);
+            }
+            let body = r.block(body)?;
+            Ok(F {
+                body,
+                slots: r.slots,
+            })
+        };
+        let code = Code {
             functions: program
                 .functions
                 .iter()
-                .map(|f| (f.name.as_str(), f))
+                .map(|f| compile(&f.params, &f.body))
+                .collect::<Result<_>>()?,
+            init: compile(&[], &program.init)?,
+            step: compile(&[], &program.step)?,
+        };
+        let mut m = Self {
+            shapes: program
+                .fields
+                .iter()
+                .map(|f| (f.len.unwrap_or(1).max(1), f.ty))
                 .collect(),
-            locals: Vec::new(),
+            field_names: program.fields.iter().map(|f| f.name.clone()).collect(),
+            fields: Vec::new(),
+            tables: program
+                .tables
+                .iter()
+                .map(|t| t.values.iter().map(|&v| R::of(v)).collect())
+                .collect(),
+            code: Rc::new(code),
+            ops: 0,
+            budget: u64::MAX,
+            n_inputs: program.n_inputs,
             inputs: vec![R::of(0.0); program.n_inputs],
             outputs: vec![R::of(0.0); program.n_outputs],
         };
@@ -182,77 +410,96 @@ impl<'p, R: Real> Machine<'p, R> {
     /// Back to the initial state.
     pub fn reset(&mut self) -> Result<()> {
         self.fields = self
-            .program
-            .fields
+            .shapes
             .iter()
-            .map(|f| {
-                (
-                    f.name.as_str(),
-                    vec![Value::zero(f.ty); f.len.unwrap_or(1).max(1)],
-                )
-            })
+            .map(|&(n, ty)| vec![Value::zero(ty); n])
             .collect();
-        self.locals.clear();
-        let init = &self.program.init;
-        self.block(init)?;
-        Ok(())
+        let code = Rc::clone(&self.code);
+        self.run_body(&code.init, Vec::new()).map(|_| ())
     }
 
     /// One step: the outputs for the inputs `u` (rounded to `R`).
     pub fn step(&mut self, u: &[f64]) -> Result<Vec<R>> {
-        if u.len() != self.program.n_inputs {
+        if u.len() != self.n_inputs {
             return Err(bug(format!(
                 "{} inputs given to a step of {}",
                 u.len(),
-                self.program.n_inputs
+                self.n_inputs
             )));
         }
-        self.inputs = u.iter().map(|&v| R::of(v)).collect();
-        self.locals.clear();
-        let step = &self.program.step;
-        self.block(step)?;
+        for (slot, &v) in self.inputs.iter_mut().zip(u) {
+            *slot = R::of(v);
+        }
+        let code = Rc::clone(&self.code);
+        self.run_body(&code.step, Vec::new())?;
         Ok(self.outputs.clone())
+    }
+
+    /// The statements executed since [`Machine::new`].
+    pub fn ops(&self) -> u64 {
+        self.ops
+    }
+
+    /// Stops the machine with an error once it has executed `budget` statements in all.
+    pub fn limit(&mut self, budget: u64) {
+        self.budget = budget;
     }
 
     /// The scalar field `name` as an index (e.g. the faults count).
     pub fn index_field(&self, name: &str) -> Option<usize> {
-        match self.fields.get(name)?.first()? {
+        let i = self.field_names.iter().position(|n| n == name)?;
+        match self.fields.get(i)?.first()? {
             Value::I(i) => Some(*i),
             _ => None,
         }
     }
 
-    /// The statements `stmts` in a scope of their own.
-    fn block(&mut self, stmts: &'p [Stmt]) -> Result<Flow<R>> {
-        let mark = self.locals.len();
-        let mut flow = Flow::Next;
-        for s in stmts {
-            flow = self.stmt(s)?;
-            if !matches!(flow, Flow::Next) {
-                break;
-            }
+    /// Runs `f` with a frame starting with `args`.
+    fn run_body(&mut self, f: &F, mut args: Vec<Value<R>>) -> Result<Option<Value<R>>> {
+        args.resize(f.slots.max(args.len()), Value::I(0));
+        let mut frame = args;
+        match self.block(&f.body, &mut frame)? {
+            Flow::Return(v) => Ok(v),
+            _ => Ok(None),
         }
-        self.locals.truncate(mark);
-        Ok(flow)
     }
 
-    fn stmt(&mut self, s: &'p Stmt) -> Result<Flow<R>> {
-        match s {
-            Stmt::Let { name, value, .. } => {
-                let v = self.expr(value)?;
-                self.locals.push((name.as_str(), v));
+    fn block(&mut self, stmts: &[S], frame: &mut [Value<R>]) -> Result<Flow<R>> {
+        for s in stmts {
+            match self.stmt(s, frame)? {
+                Flow::Next => {}
+                other => return Ok(other),
             }
-            Stmt::Assign(place, value) => {
-                let v = self.expr(value)?;
+        }
+        Ok(Flow::Next)
+    }
+
+    fn stmt(&mut self, s: &S, frame: &mut [Value<R>]) -> Result<Flow<R>> {
+        self.ops += 1;
+        if self.ops > self.budget {
+            return Err(Error::Unsupported(format!(
+                "the program ran beyond its budget of {} statements",
+                self.budget
+            )));
+        }
+        match s {
+            S::Set(place, value) => {
+                let v = self.expr(value, frame)?;
                 match place {
-                    Place::Local(name) => *self.local_mut(name)? = v,
-                    Place::State(field) => *self.field_mut(field, 0)? = v,
-                    Place::StateAt(field, i) => {
-                        let i = self.index(i)?;
-                        *self.field_mut(field, i)? = v;
+                    P::Local(slot) => frame[*slot] = v,
+                    P::Field(f, at) => {
+                        let i = match at {
+                            Some(i) => self.index(i, frame)?,
+                            None => 0,
+                        };
+                        *self
+                            .fields
+                            .get_mut(*f)
+                            .and_then(|f| f.get_mut(i))
+                            .ok_or_else(|| bug(format!("a field element [{i}] out of range")))? = v;
                     }
-                    Place::Output(i) => {
-                        let f = self.float_value(v)?;
+                    P::Output(i) => {
+                        let f = float_of(v)?;
                         *self
                             .outputs
                             .get_mut(*i)
@@ -260,190 +507,147 @@ impl<'p, R: Real> Machine<'p, R> {
                     }
                 }
             }
-            Stmt::If(c, then, otherwise) => {
-                return if self.flag(c)? {
-                    self.block(then)
+            S::If(c, then, otherwise) => {
+                return if self.flag(c, frame)? {
+                    self.block(then, frame)
                 } else {
-                    self.block(otherwise)
+                    self.block(otherwise, frame)
                 };
             }
-            Stmt::For {
-                var,
-                from,
-                to,
-                body,
-            } => {
-                let (from, to) = (self.index(from)?, self.index(to)?);
+            S::For(slot, from, to, body) => {
+                let (from, to) = (self.index(from, frame)?, self.index(to, frame)?);
                 for i in from..to {
-                    self.locals.push((var.as_str(), Value::I(i)));
-                    let flow = self.block(body)?;
-                    self.locals.pop();
-                    match flow {
+                    frame[*slot] = Value::I(i);
+                    match self.block(body, frame)? {
                         Flow::Next => {}
                         Flow::Break => break,
                         ret @ Flow::Return(_) => return Ok(ret),
                     }
                 }
             }
-            Stmt::While(c, body) => {
-                while self.flag(c)? {
-                    match self.block(body)? {
+            S::While(c, body) => {
+                while self.flag(c, frame)? {
+                    match self.block(body, frame)? {
                         Flow::Next => {}
                         Flow::Break => break,
                         ret @ Flow::Return(_) => return Ok(ret),
                     }
                 }
             }
-            Stmt::Break => return Ok(Flow::Break),
-            Stmt::Return(e) => {
-                let v = e.as_ref().map(|e| self.expr(e)).transpose()?;
+            S::Break => return Ok(Flow::Break),
+            S::Return(e) => {
+                let v = e.as_ref().map(|e| self.expr(e, frame)).transpose()?;
                 return Ok(Flow::Return(v));
             }
-            Stmt::Call(name, args) => {
-                self.call(name, args)?;
+            S::Call(f, args) => {
+                self.call(*f, args, frame)?;
             }
         }
         Ok(Flow::Next)
     }
 
-    fn local_mut(&mut self, name: &str) -> Result<&mut Value<R>> {
-        self.locals
-            .iter_mut()
-            .rev()
-            .find(|(n, _)| *n == name)
-            .map(|(_, v)| v)
-            .ok_or_else(|| bug(format!("the local '{name}' is not declared")))
-    }
-
-    fn field_mut(&mut self, name: &str, i: usize) -> Result<&mut Value<R>> {
-        self.fields
-            .get_mut(name)
-            .and_then(|f| f.get_mut(i))
-            .ok_or_else(|| bug(format!("the field '{name}[{i}]' does not exist")))
-    }
-
-    fn field(&self, name: &str, i: usize) -> Result<Value<R>> {
-        self.fields
-            .get(name)
-            .and_then(|f| f.get(i))
-            .copied()
-            .ok_or_else(|| bug(format!("the field '{name}[{i}]' does not exist")))
-    }
-
-    fn call(&mut self, name: &str, args: &'p [Expr]) -> Result<Option<Value<R>>> {
-        let f = *self
-            .functions
-            .get(name)
-            .ok_or_else(|| bug(format!("the helper '{name}' does not exist")))?;
+    fn call(&mut self, f: usize, args: &[E], frame: &mut [Value<R>]) -> Result<Option<Value<R>>> {
         let values = args
             .iter()
-            .map(|a| self.expr(a))
+            .map(|a| self.expr(a, frame))
             .collect::<Result<Vec<_>>>()?;
-        // The callee sees its parameters only: its frame starts above the caller's locals,
-        // which stay untouched below it.
-        let saved = std::mem::take(&mut self.locals);
-        for ((param, _), v) in f.params.iter().zip(values) {
-            self.locals.push((param.as_str(), v));
-        }
-        let flow = self.block(&f.body);
-        self.locals = saved;
-        match flow? {
-            Flow::Return(v) => Ok(v),
-            _ => Ok(None),
-        }
+        let code = Rc::clone(&self.code);
+        let body = code
+            .functions
+            .get(f)
+            .ok_or_else(|| bug(format!("helper {f} out of range")))?;
+        self.run_body(body, values)
     }
 
-    fn float_value(&self, v: Value<R>) -> Result<R> {
-        match v {
-            Value::F(x) => Ok(x),
-            other => Err(bug(format!("a float expected, {other:?} found"))),
-        }
+    fn float(&mut self, e: &E, frame: &mut [Value<R>]) -> Result<R> {
+        let v = self.expr(e, frame)?;
+        float_of(v)
     }
 
-    fn float(&mut self, e: &'p Expr) -> Result<R> {
-        let v = self.expr(e)?;
-        self.float_value(v)
-    }
-
-    fn index(&mut self, e: &'p Expr) -> Result<usize> {
-        match self.expr(e)? {
+    fn index(&mut self, e: &E, frame: &mut [Value<R>]) -> Result<usize> {
+        match self.expr(e, frame)? {
             Value::I(i) => Ok(i),
             other => Err(bug(format!("an index expected, {other:?} found"))),
         }
     }
 
-    fn flag(&mut self, e: &'p Expr) -> Result<bool> {
-        match self.expr(e)? {
+    fn flag(&mut self, e: &E, frame: &mut [Value<R>]) -> Result<bool> {
+        match self.expr(e, frame)? {
             Value::B(b) => Ok(b),
             other => Err(bug(format!("a flag expected, {other:?} found"))),
         }
     }
 
-    fn expr(&mut self, e: &'p Expr) -> Result<Value<R>> {
+    fn expr(&mut self, e: &E, frame: &mut [Value<R>]) -> Result<Value<R>> {
         Ok(match e {
-            Expr::F64(v) => Value::F(R::of(*v)),
-            Expr::Nan => Value::F(R::nan()),
-            Expr::Index(i) => Value::I(*i),
-            Expr::Flag(b) => Value::B(*b),
-            Expr::Local(name) => self
-                .locals
-                .iter()
-                .rev()
-                .find(|(n, _)| n == name)
-                .map(|(_, v)| *v)
-                .ok_or_else(|| bug(format!("the local '{name}' is not declared")))?,
-            Expr::State(field) => self.field(field, 0)?,
-            Expr::StateAt(field, i) => {
-                let i = self.index(i)?;
-                self.field(field, i)?
-            }
-            Expr::Table(name, i) => {
-                let i = self.index(i)?;
-                let v = self
-                    .tables
-                    .get(name.as_str())
-                    .and_then(|t| t.get(i))
+            E::Lit(Value::F(v)) => Value::F(R::of(*v)),
+            E::Lit(Value::I(i)) => Value::I(*i),
+            E::Lit(Value::B(b)) => Value::B(*b),
+            E::Local(slot) => frame[*slot],
+            E::Field(f, at) => {
+                let i = match at {
+                    Some(i) => self.index(i, frame)?,
+                    None => 0,
+                };
+                self.fields
+                    .get(*f)
+                    .and_then(|f| f.get(i))
                     .copied()
-                    .ok_or_else(|| {
-                        bug(format!("the table element '{name}[{i}]' does not exist"))
-                    })?;
-                Value::F(v)
+                    .ok_or_else(|| bug(format!("a field element [{i}] out of range")))?
             }
-            Expr::Input(i) => Value::F(
+            E::Table(t, i) => {
+                let i = self.index(i, frame)?;
+                Value::F(
+                    self.tables
+                        .get(*t)
+                        .and_then(|t| t.get(i))
+                        .copied()
+                        .ok_or_else(|| bug(format!("a table element [{i}] out of range")))?,
+                )
+            }
+            E::Input(i) => Value::F(
                 *self
                     .inputs
                     .get(*i)
                     .ok_or_else(|| bug(format!("input {i} out of range")))?,
             ),
-            Expr::Neg(a) => Value::F(-self.float(a)?),
-            Expr::Not(a) => Value::B(!self.flag(a)?),
-            Expr::Bin(BinOp::And, a, b) => Value::B(self.flag(a)? && self.flag(b)?),
-            Expr::Bin(BinOp::Or, a, b) => Value::B(self.flag(a)? || self.flag(b)?),
-            Expr::Bin(op, a, b) => {
-                let (a, b) = (self.expr(a)?, self.expr(b)?);
+            E::Neg(a) => Value::F(-self.float(a, frame)?),
+            E::Not(a) => Value::B(!self.flag(a, frame)?),
+            E::And(a, b) => Value::B(self.flag(a, frame)? && self.flag(b, frame)?),
+            E::Or(a, b) => Value::B(self.flag(a, frame)? || self.flag(b, frame)?),
+            E::Bin(op, a, b) => {
+                let (a, b) = (self.expr(a, frame)?, self.expr(b, frame)?);
                 binary(*op, a, b)?
             }
-            Expr::Math(f, args) => {
+            E::Math(f, args) => {
                 let mut xs = [R::of(0.0); 2];
                 for (slot, a) in xs.iter_mut().zip(args) {
-                    *slot = self.float(a)?;
+                    *slot = self.float(a, frame)?;
                 }
                 Value::F(R::math(*f, xs[0], xs[1]))
             }
-            Expr::IsFinite(a) => Value::B(self.float(a)?.finite()),
-            Expr::ToF64(a) => Value::F(R::of_index(self.index(a)?)),
-            Expr::ToIndex(a) => Value::I(self.float(a)?.index()),
-            Expr::Select(c, a, b) => {
-                if self.flag(c)? {
-                    self.expr(a)?
+            E::IsFinite(a) => Value::B(self.float(a, frame)?.finite()),
+            E::ToFloat(a) => Value::F(R::of_index(self.index(a, frame)?)),
+            E::ToIndex(a) => Value::I(self.float(a, frame)?.index()),
+            E::Select(c, a, b) => {
+                if self.flag(c, frame)? {
+                    self.expr(a, frame)?
                 } else {
-                    self.expr(b)?
+                    self.expr(b, frame)?
                 }
             }
-            Expr::Call(name, args) => self
-                .call(name, args)?
-                .ok_or_else(|| bug(format!("the helper '{name}' returned no value")))?,
+            E::Call(f, args) => self
+                .call(*f, args, frame)?
+                .ok_or_else(|| bug(format!("helper {f} returned no value")))?,
         })
+    }
+}
+
+/// The float in `v`, else a bug.
+fn float_of<R: Real>(v: Value<R>) -> Result<R> {
+    match v {
+        Value::F(x) => Ok(x),
+        other => Err(bug(format!("a float expected, {other:?} found"))),
     }
 }
 
@@ -497,12 +701,30 @@ fn binary<R: Real>(op: BinOp, a: Value<R>, b: Value<R>) -> Result<Value<R>> {
 /// The outputs of `program` in the type `R` on the input rows `inputs`, from its initial
 /// state.
 pub fn run<R: Real>(program: &Program, inputs: &[Vec<f64>]) -> Result<Vec<Vec<f64>>> {
+    Ok(run_counted::<R>(program, inputs, u64::MAX)?.0)
+}
+
+/// [`run`] within `budget` statements; also the statements executed.
+fn run_counted<R: Real>(
+    program: &Program,
+    inputs: &[Vec<f64>],
+    budget: u64,
+) -> Result<(Vec<Vec<f64>>, u64)> {
     let mut m = Machine::<R>::new(program)?;
-    inputs
+    m.limit(budget);
+    let out = inputs
         .iter()
         .map(|u| Ok(m.step(u)?.into_iter().map(Real::wide).collect()))
-        .collect()
+        .collect::<Result<Vec<_>>>()?;
+    Ok((out, m.ops()))
 }
+
+/// The most statements the double run of [`measure`] may execute (a few seconds).
+pub const MEASURE_WORK: u64 = 50_000_000;
+
+/// How many times the statements of the double run a float run may execute
+/// ([`measure`]).
+pub const FLOAT_WORK: u64 = 4;
 
 /// How far the single-precision program strays from the double one on a record.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -525,13 +747,34 @@ impl Deviation {
 /// rows `inputs` (each input rounded to `f32` for the single run, as a caller of the float
 /// code holds them). Samples where the double output is not finite count as infinitely far
 /// unless the single one is the same non-finite value.
+///
+/// The float run may execute at most [`FLOAT_WORK`] times the statements of the double one
+/// (plus 1000 a sample): a step whose loops stop on tolerances below the resolution of
+/// `float` runs to its iteration caps instead, and is refused with that reason.
 pub fn measure(program: &Program, inputs: &[Vec<f64>]) -> Result<Deviation> {
-    let double = run::<f64>(program, inputs)?;
+    let (double, ops) = run_counted::<f64>(program, inputs, MEASURE_WORK).map_err(|_| {
+        Error::Unsupported(format!(
+            "single precision: measuring the float code's bound would run beyond \
+             {MEASURE_WORK:e} statements of the exporter's interpreter on the {} samples of \
+             the test record (a step of many iterations: the differential families' \
+             inverses); export in double (--precision double)",
+            inputs.len()
+        ))
+    })?;
     let rounded: Vec<Vec<f64>> = inputs
         .iter()
         .map(|row| row.iter().map(|&v| v as f32 as f64).collect())
         .collect();
-    let single = run::<f32>(program, &rounded)?;
+    let budget = FLOAT_WORK * ops + 1000 * inputs.len() as u64;
+    let single = run_counted::<f32>(program, &rounded, budget)
+        .map_err(|_| {
+            Error::Unsupported(format!(
+                "single precision: the float step works more than {FLOAT_WORK} times as long \
+                 as the double one (its iterations stop on tolerances finer than float \
+                 resolution); export in double (--precision double)"
+            ))
+        })?
+        .0;
     let mut max_abs: f64 = 0.0;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for (d, s) in double.iter().zip(&single) {

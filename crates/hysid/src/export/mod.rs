@@ -56,6 +56,7 @@ pub mod interface;
 pub mod kinds;
 pub mod linear;
 pub mod output;
+pub mod precision;
 pub mod program;
 pub mod render;
 pub mod sequence;
@@ -67,6 +68,7 @@ use crate::model::limits::Limits;
 use crate::model::saved::{FittedModel, ModelFile};
 use crate::{Error, Result};
 use interface::SampleTime;
+pub use precision::Precision;
 use std::path::PathBuf;
 
 /// Where an exported model goes.
@@ -128,6 +130,14 @@ pub struct ExportOptions {
     /// [`crate::model::limits`]); None takes the model file's `input_range`, and a file
     /// without one exports an unlimited compensator ([`export_limits`] says which).
     pub limits: Option<Limits>,
+    /// The floating-point type of the code (`--precision`, [`precision`]): double (the
+    /// default) or single; the FMU is double only (FMI 2.0's `Real` is a double).
+    pub precision: Precision,
+    /// The rows fed to the exported step on which a single-precision export measures its
+    /// bound (`--data FILE`: the record's inputs for a model, its outputs as references for
+    /// a compensator); None takes the test sequence ([`sequence`]) over the file's
+    /// `input_range`.
+    pub bound_record: Option<Vec<Vec<f64>>>,
 }
 
 impl Default for ExportOptions {
@@ -138,18 +148,26 @@ impl Default for ExportOptions {
             binary: true,
             initial_output: None,
             limits: None,
+            precision: Precision::Double,
+            bound_record: None,
         }
     }
 }
 
 /// The limits an export of `file` applies to its compensator's command: `--limits`
 /// ([`ExportOptions::limits`]), else the file's `input_range`, else none (the front end
-/// warns); None for a forward export.
+/// warns); None for a forward export. In single precision they are moved inwards to the
+/// nearest floats ([`precision::single_limits`]; unchanged when that fails, and
+/// [`c_code`] then refuses the export).
 pub fn export_limits(file: &ModelFile, options: &ExportOptions) -> Option<Limits> {
     if !options.inverse {
         return None;
     }
-    options.limits.or_else(|| file.limits())
+    let limits = options.limits.or_else(|| file.limits())?;
+    Some(match options.precision {
+        Precision::Double => limits,
+        Precision::Single => precision::single_limits(limits).unwrap_or(limits),
+    })
 }
 
 /// One file of an export, its path relative to the output directory.
@@ -231,11 +249,11 @@ const KEYWORDS: &[&str] = &[
 ];
 
 /// The program, interface and opening comment of the export `name` of `file`.
-fn prepare(
-    file: &ModelFile,
-    name: &str,
-    options: &ExportOptions,
-) -> Result<(program::Program, Interface, String)> {
+/// What [`prepare`] makes: the program, its interface, the opening comment and the bound
+/// of a single-precision export in the output's units (0 in double: bit-identical).
+type Prepared = (program::Program, Interface, String, f64);
+
+fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prepared> {
     check_name(name)?;
     let given = options;
     let options = &ExportOptions {
@@ -252,15 +270,97 @@ fn prepare(
         (program.n_inputs, program.n_outputs)
     };
     let interface = interface::interface(file, name, options, sample_time, sizes);
-    let comment = interface::comment(file, &interface, given, sample_time);
-    Ok((program, interface, comment))
+    let mut comment = interface::comment(file, &interface, given, sample_time);
+    let mut bound = 0.0;
+    if options.precision.is_single() {
+        if let Some(limits) = given
+            .limits
+            .or_else(|| file.limits())
+            .filter(|_| given.inverse)
+        {
+            precision::single_limits(limits)?;
+        }
+        let measured = single_bound(file, &model, &program, options, sample_time.seconds())?;
+        comment.push('\n');
+        comment.push_str(&measured.comment());
+        bound = measured.absolute();
+    }
+    Ok((program, interface, comment, bound))
+}
+
+/// Measures the single-precision `program` of `model` (see [`precision`]) on the rows of
+/// [`ExportOptions::bound_record`], else on the test sequence over the file's input range,
+/// fed through the forward model (in double) for a compensator.
+fn single_bound(
+    file: &ModelFile,
+    model: &FittedModel,
+    program: &program::Program,
+    options: &ExportOptions,
+    ts: f64,
+) -> Result<precision::SingleBound> {
+    if let Some(rows) = &options.bound_record {
+        let width = rows.iter().map(Vec::len).find(|n| *n != program.n_inputs);
+        if rows.is_empty() || width.is_some() {
+            return Err(Error::InvalidOption {
+                option: "data".into(),
+                value: format!("{} rows", rows.len()),
+                reason: format!(
+                    "the record for the single-precision bound needs rows of {} values (the \
+                     exported step's inputs)",
+                    program.n_inputs
+                ),
+            });
+        }
+        return precision::measure(program, rows, "the record given at export (--data)");
+    }
+    let ranges = file.input_range.as_deref().ok_or_else(|| {
+        Error::Unsupported(
+            "single precision: the model file records no input_range (a file of an earlier \
+             version), over which the bound is measured; give a record with --data FILE, or \
+             refit the model"
+                .into(),
+        )
+    })?;
+    let mut rows = sequence::inputs(ranges);
+    let mut record = format!(
+        "the test sequence over the input range {}",
+        ranges
+            .iter()
+            .map(|r| format!("[{:?}, {:?}]", r[0], r[1]))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if options.inverse {
+        let forward = ExportOptions {
+            inverse: false,
+            initial_output: options.initial_output.or(Some(0.0)),
+            ..options.clone()
+        };
+        let plant = kinds::program(model, &forward, ts)?;
+        rows = eval::run::<f64>(&plant, &rows)?;
+        record.push_str(" fed through the model (the references)");
+    }
+    precision::measure(program, &rows, &record)
+}
+
+/// The language-neutral program an export of `file` prints (in `options.precision`: a
+/// single-precision export is measured, and refused, as [`c_code`] does), for running it
+/// with [`eval`].
+pub fn program(file: &ModelFile, options: &ExportOptions) -> Result<program::Program> {
+    Ok(prepare(file, "program", options)?.0)
 }
 
 /// The C99 code of the model (or, with [`ExportOptions::inverse`], of its compensator):
 /// `NAME.h` and `NAME.c` (see the module docs and `docs/export.md`).
 pub fn c_code(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<CCode> {
-    let (program, interface, comment) = prepare(file, name, options)?;
-    let (header, source) = render::c::render(&program, name, &comment, interface.sample_time);
+    let (program, interface, comment, bound) = prepare(file, name, options)?;
+    let (header, source) = render::c::render(
+        &program,
+        name,
+        &comment,
+        interface.sample_time,
+        (options.precision, bound),
+    );
     Ok(CCode {
         header,
         source,
@@ -275,8 +375,13 @@ pub fn rust_crate(
     name: &str,
     options: &ExportOptions,
 ) -> Result<Vec<GeneratedFile>> {
-    let (program, interface, comment) = prepare(file, name, options)?;
-    let lib = render::rust::lib_rs(&program, &comment, interface.sample_time);
+    let (program, interface, comment, bound) = prepare(file, name, options)?;
+    let lib = render::rust::lib_rs(
+        &program,
+        &comment,
+        interface.sample_time,
+        (options.precision, bound),
+    );
     let cargo = render::rust::cargo_toml(name, &interface.description);
     Ok(vec![
         GeneratedFile {
@@ -313,6 +418,13 @@ pub fn export(
             ])
         }
         Target::Rust => rust_crate(file, name, options),
+        Target::Fmu if options.precision.is_single() => Err(Error::invalid_option(
+            "precision",
+            "single",
+            "an FMU computes in double (FMI 2.0's Real is a double); export --target c or rust \
+             for single precision"
+                .into(),
+        )),
         Target::Fmu => fmu::fmu_files(&c_code(file, name, options)?, options),
     }
 }

@@ -257,16 +257,21 @@ impl Program {
         self.step = Block::build(body);
     }
 
-    /// Refuses a program with a non-finite literal (a model whose derived constants
-    /// overflow).
-    pub fn check(&self) -> Result<()> {
+    /// Every double constant of the program: its tables' values and its literals.
+    pub fn literals(&self) -> Vec<f64> {
         let mut values: Vec<f64> = self.tables.iter().flat_map(|t| t.values.clone()).collect();
         literals(&self.init, &mut values);
         literals(&self.step, &mut values);
         for f in &self.functions {
             literals(&f.body, &mut values);
         }
-        match values.iter().find(|v| !v.is_finite()) {
+        values
+    }
+
+    /// Refuses a program with a non-finite literal (a model whose derived constants
+    /// overflow).
+    pub fn check(&self) -> Result<()> {
+        match self.literals().iter().find(|v| !v.is_finite()) {
             Some(v) => Err(Error::InvalidModel(format!(
                 "a constant of the model is {v}; the exported code needs finite constants \
                  (refit or rescale the model)"

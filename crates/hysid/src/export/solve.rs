@@ -106,7 +106,7 @@ pub fn emit(prog: &mut Program, ns: &Ns, branch: &str) -> Result<String> {
             let step = b.var("step", span.clone());
             b.while_(fhi.clone().lt(target.clone()), |b| {
                 b.if_(
-                    local("unbounded_above").not().or(step.clone().gt(1e150)),
+                    local("unbounded_above").not().or(step.clone().gt(1e30)),
                     |b| {
                         b.set_state(&clipped, (target.clone() - fhi.clone()).gt(tol.clone()));
                         b.ret(hi.clone());
@@ -121,7 +121,7 @@ pub fn emit(prog: &mut Program, ns: &Ns, branch: &str) -> Result<String> {
             b.set("step", span);
             b.while_(flo.clone().gt(target.clone()), |b| {
                 b.if_(
-                    local("unbounded_below").not().or(step.clone().gt(1e150)),
+                    local("unbounded_below").not().or(step.clone().gt(1e30)),
                     |b| {
                         b.set_state(&clipped, (flo.clone() - target.clone()).gt(tol.clone()));
                         b.ret(lo.clone());

@@ -3,24 +3,42 @@
 //! step; in `NAME.c` the state is the parameter `state`, a name no emitter gives a local). No heap, no globals; `NAME.c` includes only `NAME.h`, `<math.h>` and `<stddef.h>`.
 //! An array field or table of length 0 is given one unused element (C has no empty arrays).
 
-use super::{comment_lines, Printer, Syntax, ATOM, UNARY};
+use super::{comment_lines, float_digits, Printer, Syntax, ATOM, UNARY};
 use crate::export::code::{Math, Ty};
+use crate::export::precision::Precision;
 use crate::export::program::{Program, CLIPPED_FIELD, FAULTS_FIELD};
 
-/// The C spelling, for the export `name`.
+/// The C spelling, for the export `name` in `precision`.
+#[derive(Clone, Copy)]
 struct C<'a> {
     name: &'a str,
+    precision: Precision,
 }
 
-fn c_type(ty: Ty) -> &'static str {
-    match ty {
-        Ty::F64 => "double",
-        Ty::Index => "size_t",
-        Ty::Flag => "int",
+impl C<'_> {
+    /// The C type of `ty`.
+    fn ty(&self, ty: Ty) -> &'static str {
+        match (ty, self.precision) {
+            (Ty::F64, Precision::Double) => "double",
+            (Ty::F64, Precision::Single) => "float",
+            (Ty::Index, _) => "size_t",
+            (Ty::Flag, _) => "int",
+        }
+    }
+
+    /// The suffix of a float literal and of a `<math.h>` function (`f` in single).
+    fn suffix(&self) -> &'static str {
+        match self.precision {
+            Precision::Double => "",
+            Precision::Single => "f",
+        }
     }
 }
 
 impl Syntax for C<'_> {
+    fn literal(&self, v: f64) -> String {
+        format!("{}{}", float_digits(v, self.precision), self.suffix())
+    }
     fn state(&self, field: &str) -> String {
         format!("state->{field}")
     }
@@ -32,8 +50,8 @@ impl Syntax for C<'_> {
             // Inline helpers (see `MINMAX`): `fmax`/`fmin` are library calls at -O2 without
             // -ffinite-math-only (three quarters of a PI step with 20 plays:
             // `bench/export_steps.sh`).
-            Math::Fmax | Math::Fmin => format!("{}_math_{}", self.name, f.name()),
-            _ => f.name().into(),
+            Math::Fmax | Math::Fmin => format!("{}_math_{}{}", self.name, f.name(), self.suffix()),
+            _ => format!("{}{}", f.name(), self.suffix()),
         }
     }
     fn call(&self, name: &str, args: &[String]) -> String {
@@ -60,13 +78,13 @@ impl Syntax for C<'_> {
         } else {
             format!("({})", x.0)
         };
-        (format!("({}){operand}", c_type(ty)), UNARY)
+        (format!("({}){operand}", self.ty(ty)), UNARY)
     }
     fn select(&self, c: String, a: String, b: String) -> (String, u8) {
         (format!("({c}) ? ({a}) : ({b})"), 0)
     }
     fn declare(&self, name: &str, ty: Ty, _mutable: bool, value: String) -> String {
-        format!("{} {name} = {value};", c_type(ty))
+        format!("{} {name} = {value};", self.ty(ty))
     }
     fn for_head(&self, var: &str, from: String, to: String) -> String {
         format!("for (size_t {var} = {from}; {var} < {to}; {var}++)")
@@ -76,11 +94,21 @@ impl Syntax for C<'_> {
     }
 }
 
-/// The two files (`NAME.h`, `NAME.c`) of `program`, each opening with `comment`.
-pub fn render(program: &Program, name: &str, comment: &str, sample_time: f64) -> (String, String) {
+/// The two files (`NAME.h`, `NAME.c`) of `program` in `numbers.0`, each opening with
+/// `comment`; `numbers.1` is the bound `NAME_BOUND` of single precision in the output's
+/// units (0 in double).
+pub fn render(
+    program: &Program,
+    name: &str,
+    comment: &str,
+    sample_time: f64,
+    numbers: (Precision, f64),
+) -> (String, String) {
+    let (precision, bound) = numbers;
+    let syntax = C { name, precision };
     (
-        header(program, name, comment, sample_time),
-        source(program, name, comment),
+        header(program, syntax, comment, sample_time, bound),
+        source(program, syntax, comment),
     )
 }
 
@@ -97,7 +125,9 @@ fn block_comment(text: &str) -> String {
     format!("/*\n{} */\n", comment_lines(text, " * "))
 }
 
-fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> String {
+fn header(program: &Program, syntax: C, comment: &str, sample_time: f64, bound: f64) -> String {
+    let name = syntax.name;
+    let real = syntax.ty(Ty::F64);
     let guard = format!("{}_H_INCLUDED", name.to_ascii_uppercase());
     let mut h = block_comment(comment);
     h.push_str(&format!(
@@ -105,8 +135,16 @@ fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> Str
     ));
     h.push_str(&format!(
         "/* The number of inputs and outputs of {name}_step, and its period in seconds. */\n\
-         #define {name}_N_INPUTS {}\n#define {name}_N_OUTPUTS {}\n#define {name}_SAMPLE_TIME {:?}\n\n",
-        program.n_inputs, program.n_outputs, sample_time
+         #define {name}_N_INPUTS {}\n#define {name}_N_OUTPUTS {}\n#define {name}_SAMPLE_TIME {}\n\n",
+        program.n_inputs,
+        program.n_outputs,
+        syntax.literal(sample_time)
+    ));
+    h.push_str(&format!(
+        "/* The largest |output - the library's double output| this code is held to, in the\n\
+         \x20* output's units: 0 in double precision (bit-identical), the measured bound in single\n\
+         \x20* (see the opening comment). A double constant, for test programs. */\n\
+         #define {name}_BOUND {bound:?}\n\n"
     ));
     h.push_str(&format!(
         "/* The model's whole state: it may live on the stack or in a static. */\n\
@@ -116,7 +154,7 @@ fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> Str
         let len = f.len.map(|n| format!("[{}]", n.max(1))).unwrap_or_default();
         h.push_str(&format!(
             "    {} {}{len}; /* {} */\n",
-            c_type(f.ty),
+            syntax.ty(f.ty),
             f.name,
             f.doc
         ));
@@ -127,7 +165,7 @@ fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> Str
          void {name}_init({name}_state *s);\n\n\
          /* One sample: reads u[0 .. {name}_N_INPUTS), writes y[0 .. {name}_N_OUTPUTS) (the\n\
          \x20* output at this sample) and advances *s to the next sample. */\n\
-         void {name}_step({name}_state *s, const double *u, double *y);\n\n"
+         void {name}_step({name}_state *s, const {real} *u, {real} *y);\n\n"
     ));
     if program.counts_clipped() {
         h.push_str(&format!(
@@ -146,20 +184,21 @@ fn header(program: &Program, name: &str, comment: &str, sample_time: f64) -> Str
     h
 }
 
-fn source(program: &Program, name: &str, comment: &str) -> String {
-    let syntax = C { name };
+fn source(program: &Program, syntax: C, comment: &str) -> String {
+    let name = syntax.name;
+    let real = syntax.ty(Ty::F64);
     let p = Printer::new(&syntax);
     let mut c = block_comment(comment);
     c.push_str(&format!(
         "#include \"{name}.h\"\n#include <math.h>\n#include <stddef.h>\n\n"
     ));
     for t in &program.tables {
-        let mut values: Vec<String> = t.values.iter().map(|v| format!("{v:?}")).collect();
+        let mut values: Vec<String> = t.values.iter().map(|v| syntax.literal(*v)).collect();
         if values.is_empty() {
-            values.push("0.0".into());
+            values.push(syntax.literal(0.0));
         }
         c.push_str(&format!(
-            "static const double {}[{}] = {{{}}};\n",
+            "static const {real} {}[{}] = {{{}}};\n",
             syntax.table(&t.name),
             values.len(),
             values.join(", ")
@@ -171,8 +210,12 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
     let tables_end = c.len();
     let signature = |f: &crate::export::code::Function| {
         let mut params = vec![format!("{name}_state *state")];
-        params.extend(f.params.iter().map(|(n, t)| format!("{} {n}", c_type(*t))));
-        let ret = f.ret.map_or("void", c_type);
+        params.extend(
+            f.params
+                .iter()
+                .map(|(n, t)| format!("{} {n}", syntax.ty(*t))),
+        );
+        let ret = f.ret.map_or("void", |t| syntax.ty(t));
         format!("static {ret} {name}_{}({})", f.name, params.join(", "))
     };
     for f in &program.functions {
@@ -192,8 +235,8 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
     c.push_str(&format!("void {name}_init({name}_state *state) {{\n"));
     for f in &program.fields {
         let zero = match f.ty {
-            Ty::F64 => "0.0",
-            Ty::Index | Ty::Flag => "0",
+            Ty::F64 => syntax.literal(0.0),
+            Ty::Index | Ty::Flag => "0".into(),
         };
         match f.len {
             Some(n) => c.push_str(&format!(
@@ -207,7 +250,7 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
     p.stmts(&program.init, 1, &mut c);
     c.push_str("}\n\n");
     c.push_str(&format!(
-        "void {name}_step({name}_state *state, const double *u, double *y) {{\n    (void)u;\n"
+        "void {name}_step({name}_state *state, const {real} *u, {real} *y) {{\n    (void)u;\n"
     ));
     p.stmts(&program.step, 1, &mut c);
     c.push_str("}\n");
@@ -221,10 +264,10 @@ fn source(program: &Program, name: &str, comment: &str) -> String {
     ));
     let mut helpers = String::new();
     for (f, body) in MINMAX {
-        let helper = format!("{name}_math_{f}");
+        let helper = format!("{name}_math_{f}{}", syntax.suffix());
         if c[tables_end..].contains(&format!("{helper}(")) {
             helpers.push_str(&format!(
-                "static double {helper}(double x, double y) {{\n    \
+                "static {real} {helper}({real} x, {real} y) {{\n    \
                  if (isnan(x)) return y;\n    if (isnan(y)) return x;\n    {body}\n}}\n\n"
             ));
         }

@@ -2,12 +2,15 @@
 //! Rust ([`rust`]). Both print expressions and statements through one printer (`Printer`)
 //! that asks a `Syntax` for the few things the two languages spell differently (state
 //! access `s->x` / `self.x`, `fabs` / `libm::fabs`, casts, the conditional expression,
-//! declarations and loops).
+//! declarations and loops). Both print in either [`Precision`]: the type `Ty::F64` is
+//! `double`/`f64` or `float`/`f32`, a literal the `f64` constant or its nearest `float`
+//! ([`float_digits`]), a math function `sin` or `sinf`.
 
 pub mod c;
 pub mod rust;
 
 use super::code::{Expr, Math, Place, Stmt, Ty};
+use super::precision::Precision;
 
 /// The precedence of an atom (a name, a literal, a call): never parenthesised.
 const ATOM: u8 = 10;
@@ -16,6 +19,8 @@ const UNARY: u8 = 8;
 
 /// What C and Rust spell differently.
 pub(crate) trait Syntax {
+    /// The literal `v` (finite; `v` rounded to the precision's type).
+    fn literal(&self, v: f64) -> String;
     /// The scalar field `field` of the state.
     fn state(&self, field: &str) -> String;
     /// The constant table `name`.
@@ -73,9 +78,8 @@ impl<'a> Printer<'a> {
         let x = self.syntax;
         match e {
             Expr::F64(v) => {
-                let s = format!("{v:?}");
                 // A negative literal is parenthesised whenever it is an operand.
-                (s, if v.is_sign_negative() { 0 } else { ATOM })
+                (x.literal(*v), if v.is_sign_negative() { 0 } else { ATOM })
             }
             Expr::Nan => (x.nan().into(), ATOM),
             Expr::Index(i) => (i.to_string(), ATOM),
@@ -197,4 +201,14 @@ pub(crate) fn comment_lines(text: &str, lead: &str) -> String {
     text.lines()
         .map(|l| format!("{lead}{l}").trim_end().to_string() + "\n")
         .collect()
+}
+
+/// The shortest decimal digits that read back to `v` in `precision`'s type (`v` first
+/// rounded to the nearest `float` in single precision); always with a `.` or an `e`, no
+/// suffix.
+pub(crate) fn float_digits(v: f64, precision: Precision) -> String {
+    match precision {
+        Precision::Double => format!("{v:?}"),
+        Precision::Single => format!("{:?}", v as f32),
+    }
 }

@@ -4,30 +4,45 @@
 //! `SAMPLE_TIME`, the tables as `const` arrays and the helpers as private methods; and its
 //! `Cargo.toml`, whose one dependency is `libm` (the math functions of `core`-only Rust).
 
-use super::{comment_lines, Printer, Syntax, ATOM};
+use super::{comment_lines, float_digits, Printer, Syntax, ATOM};
 use crate::export::code::{Math, Ty};
+use crate::export::precision::Precision;
 use crate::export::program::{Program, CLIPPED_FIELD};
 
-/// The Rust spelling.
-struct Rust;
-
-fn rust_type(ty: Ty) -> &'static str {
-    match ty {
-        Ty::F64 => "f64",
-        Ty::Index => "usize",
-        Ty::Flag => "bool",
-    }
+/// The Rust spelling in `precision`.
+#[derive(Clone, Copy)]
+struct Rust {
+    precision: Precision,
 }
 
-fn zero(ty: Ty) -> &'static str {
-    match ty {
-        Ty::F64 => "0.0",
-        Ty::Index => "0",
-        Ty::Flag => "false",
+impl Rust {
+    /// The Rust type of `ty`.
+    fn ty(&self, ty: Ty) -> &'static str {
+        match (ty, self.precision) {
+            (Ty::F64, Precision::Double) => "f64",
+            (Ty::F64, Precision::Single) => "f32",
+            (Ty::Index, _) => "usize",
+            (Ty::Flag, _) => "bool",
+        }
+    }
+
+    /// The zero of `ty`.
+    fn zero(&self, ty: Ty) -> String {
+        match ty {
+            Ty::F64 => self.literal(0.0),
+            Ty::Index => "0".into(),
+            Ty::Flag => "false".into(),
+        }
     }
 }
 
 impl Syntax for Rust {
+    fn literal(&self, v: f64) -> String {
+        match self.precision {
+            Precision::Double => float_digits(v, self.precision),
+            Precision::Single => format!("{}_f32", float_digits(v, self.precision)),
+        }
+    }
     fn state(&self, field: &str) -> String {
         format!("self.{field}")
     }
@@ -35,7 +50,10 @@ impl Syntax for Rust {
         name.into()
     }
     fn math(&self, f: Math) -> String {
-        format!("libm::{}", f.name())
+        match self.precision {
+            Precision::Double => format!("libm::{}", f.name()),
+            Precision::Single => format!("libm::{}f", f.name()),
+        }
     }
     fn call(&self, name: &str, args: &[String]) -> String {
         format!("self.{name}({})", args.join(", "))
@@ -48,7 +66,10 @@ impl Syntax for Rust {
         }
     }
     fn nan(&self) -> &'static str {
-        "f64::NAN"
+        match self.precision {
+            Precision::Double => "f64::NAN",
+            Precision::Single => "f32::NAN",
+        }
     }
     fn is_finite(&self, x: (String, u8)) -> (String, u8) {
         let receiver = if x.1 >= ATOM {
@@ -66,14 +87,14 @@ impl Syntax for Rust {
         };
         // `x as usize < y` would read as generic arguments: a cast is always parenthesised
         // inside a larger expression.
-        (format!("{operand} as {}", rust_type(ty)), 0)
+        (format!("{operand} as {}", self.ty(ty)), 0)
     }
     fn select(&self, c: String, a: String, b: String) -> (String, u8) {
         (format!("if {c} {{ {a} }} else {{ {b} }}"), 0)
     }
     fn declare(&self, name: &str, ty: Ty, mutable: bool, value: String) -> String {
         let m = if mutable { "mut " } else { "" };
-        format!("let {m}{name}: {} = {value};", rust_type(ty))
+        format!("let {m}{name}: {} = {value};", self.ty(ty))
     }
     fn for_head(&self, var: &str, from: String, to: String) -> String {
         format!("for {var} in {from}..{to}")
@@ -93,21 +114,38 @@ pub fn cargo_toml(name: &str, description: &str) -> String {
     )
 }
 
-/// `src/lib.rs` of `program`, opening with `comment` as the crate's documentation.
-pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
-    let p = Printer::new(&Rust);
+/// `src/lib.rs` of `program` in `numbers.0`, opening with `comment` as the crate's
+/// documentation; `numbers.1` is the bound `BOUND` of single precision in the output's
+/// units (0 in double).
+pub fn lib_rs(
+    program: &Program,
+    comment: &str,
+    sample_time: f64,
+    numbers: (Precision, f64),
+) -> String {
+    let (precision, bound) = numbers;
+    let syntax = Rust { precision };
+    let real = syntax.ty(Ty::F64);
+    let p = Printer::new(&syntax);
     let mut r = comment_lines(comment, "//! ");
     r.push_str("#![no_std]\n\n");
     r.push_str(&format!(
         "/// The number of inputs of [`Model::step`].\npub const N_IN: usize = {};\n\
          /// The number of outputs of [`Model::step`].\npub const N_OUT: usize = {};\n\
-         /// The period of a step in seconds.\npub const SAMPLE_TIME: f64 = {:?};\n\n",
-        program.n_inputs, program.n_outputs, sample_time
+         /// The period of a step in seconds.\npub const SAMPLE_TIME: {real} = {};\n\n",
+        program.n_inputs,
+        program.n_outputs,
+        syntax.literal(sample_time)
+    ));
+    r.push_str(&format!(
+        "/// The largest |output − the library's double output| this code is held to, in the\n\
+         /// output's units: 0 in double precision (bit-identical), the measured bound in\n\
+         /// single (see the crate's documentation).\npub const BOUND: f64 = {bound:?};\n\n"
     ));
     for t in &program.tables {
-        let values: Vec<String> = t.values.iter().map(|v| format!("{v:?}")).collect();
+        let values: Vec<String> = t.values.iter().map(|v| syntax.literal(*v)).collect();
         r.push_str(&format!(
-            "const {}: [f64; {}] = [{}];\n",
+            "const {}: [{real}; {}] = [{}];\n",
             t.name,
             t.values.len(),
             values.join(", ")
@@ -122,8 +160,8 @@ pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
     );
     for f in &program.fields {
         let ty = match f.len {
-            Some(n) => format!("[{}; {n}]", rust_type(f.ty)),
-            None => rust_type(f.ty).to_string(),
+            Some(n) => format!("[{}; {n}]", syntax.ty(f.ty)),
+            None => syntax.ty(f.ty).to_string(),
         };
         r.push_str(&format!("    /// {}\n    {}: {ty},\n", f.doc, f.name));
     }
@@ -131,8 +169,8 @@ pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
     r.push_str("impl Model {\n    /// The model in its initial state.\n    pub fn new() -> Self {\n        let mut model = Model {\n");
     for f in &program.fields {
         let value = match f.len {
-            Some(n) => format!("[{}; {n}]", zero(f.ty)),
-            None => zero(f.ty).to_string(),
+            Some(n) => format!("[{}; {n}]", syntax.zero(f.ty)),
+            None => syntax.zero(f.ty),
         };
         r.push_str(&format!("            {}: {value},\n", f.name));
     }
@@ -140,8 +178,8 @@ pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
     r.push_str("    /// Returns the model to its initial state.\n    pub fn reset(&mut self) {\n");
     for f in &program.fields {
         let value = match f.len {
-            Some(n) => format!("[{}; {n}]", zero(f.ty)),
-            None => zero(f.ty).to_string(),
+            Some(n) => format!("[{}; {n}]", syntax.zero(f.ty)),
+            None => syntax.zero(f.ty),
         };
         r.push_str(&format!("        self.{} = {value};\n", f.name));
     }
@@ -164,23 +202,24 @@ pub fn lib_rs(program: &Program, comment: &str, sample_time: f64) -> String {
              \x20   pub fn clipped(&self) -> usize {{\n        self.{CLIPPED_FIELD}\n    }}\n\n"
         ));
     }
-    r.push_str(
+    r.push_str(&format!(
         "    /// One sample: the output at this sample for the input `u`; then the state\n\
          \x20   /// advances to the next sample.\n\
-         \x20   pub fn step(&mut self, u: &[f64; N_IN]) -> [f64; N_OUT] {\n\
-         \x20       let mut y = [0.0; N_OUT];\n",
-    );
+         \x20   pub fn step(&mut self, u: &[{real}; N_IN]) -> [{real}; N_OUT] {{\n\
+         \x20       let mut y = [{}; N_OUT];\n",
+        syntax.literal(0.0)
+    ));
     p.stmts(&program.step, 2, &mut r);
     r.push_str("        y\n    }\n");
     for f in &program.functions {
         let params: Vec<String> = f
             .params
             .iter()
-            .map(|(n, t)| format!("{n}: {}", rust_type(*t)))
+            .map(|(n, t)| format!("{n}: {}", syntax.ty(*t)))
             .collect();
         let ret = f
             .ret
-            .map(|t| format!(" -> {}", rust_type(t)))
+            .map(|t| format!(" -> {}", syntax.ty(t)))
             .unwrap_or_default();
         r.push_str(&format!(
             "\n    #[allow(unused_variables)]\n    fn {}(&mut self, {}){ret} {{\n",

@@ -414,7 +414,7 @@ pub fn solve_monotone(f: impl Fn(f64) -> f64, target: f64, branch: Branch) -> (f
     let tol = 1e-12 * (1.0 + target.abs());
     let mut step = span;
     while fhi < target {
-        if !branch.unbounded_above || step > 1e150 {
+        if !branch.unbounded_above || step > 1e30 {
             return (hi, target - fhi > tol);
         }
         (lo, flo) = (hi, fhi);
@@ -424,7 +424,7 @@ pub fn solve_monotone(f: impl Fn(f64) -> f64, target: f64, branch: Branch) -> (f
     }
     step = span;
     while flo > target {
-        if !branch.unbounded_below || step > 1e150 {
+        if !branch.unbounded_below || step > 1e30 {
             return (lo, flo - target > tol);
         }
         (hi, fhi) = (lo, flo);

@@ -1,0 +1,306 @@
+//! Single precision (`--precision single`): the exporter's interpreter in double equals the
+//! library to the bit on every case (so the bound it measures compares the float code with
+//! the library's numbers); the float C of every case compiles with the embedded flags
+//! (`-Wdouble-promotion -Wconversion -Werror`) and stays within its header's `NAME_BOUND`
+//! and within 1e-4 of the range of the library's output, on the model's own data and on a
+//! fresh reference; the float Rust of a few kinds likewise.
+
+use crate::cases::{self, Case};
+use hysid::export::eval;
+use hysid::export::{c_code, program, rust_crate, ExportOptions, Precision};
+use hysid::model::compensate::compensate;
+use hysid::model::saved::FittedModel;
+use std::path::Path;
+use std::process::Command;
+
+/// The issue's bar: 1e-4 of the output's range.
+const SINGLE_BAR: f64 = 1e-4;
+
+/// The embedded engineer's flags.
+const FLAGS: [&str; 9] = [
+    "-std=c99",
+    "-O2",
+    "-Wall",
+    "-Wextra",
+    "-Werror",
+    "-pedantic",
+    "-Wdouble-promotion",
+    "-Wconversion",
+    "-Wfloat-conversion",
+];
+
+/// `case` in single precision, its bound measured on its own input (`--data`).
+fn single(case: &Case) -> Case {
+    Case {
+        name: format!("{}_f32", case.name),
+        file: case.file.clone(),
+        options: ExportOptions {
+            precision: Precision::Single,
+            bound_record: Some(case.input.iter().map(|v| vec![*v]).collect()),
+            ..case.options.clone()
+        },
+        input: case.input.clone(),
+        expected: case.expected.clone(),
+        clipped: case.clipped,
+    }
+}
+
+/// A driver reading doubles, stepping in float, printing the outputs.
+fn driver(name: &str) -> String {
+    format!(
+        "#include <stdio.h>\n#include \"{name}.h\"\n\
+         int main(int argc, char **argv) {{\n\
+         \x20   {name}_state s;\n    float u[{name}_N_INPUTS];\n    float y[{name}_N_OUTPUTS];\n\
+         \x20   double v;\n\
+         \x20   FILE *in = argc > 1 ? fopen(argv[1], \"r\") : NULL;\n\
+         \x20   if (in == NULL) {{\n        return 3;\n    }}\n\
+         \x20   {name}_init(&s);\n\
+         \x20   while (fscanf(in, \"%lf\", &v) == 1) {{\n\
+         \x20       u[0] = (float)v;\n\
+         \x20       {name}_step(&s, u, y);\n        printf(\"%.9g\\n\", (double)y[0]);\n    }}\n\
+         \x20   fclose(in);\n    if (s.diverged) {{\n        printf(\"error\\n\");\n    }}\n\
+         \x20   printf(\"bound %.17g\\n\", {name}_BOUND);\n    return 0;\n}}\n"
+    )
+}
+
+/// Compiles the float C of `case` in `dir`; returns the executable.
+fn compile(case: &Case, dir: &Path) -> std::path::PathBuf {
+    let name = &case.name;
+    let code = c_code(&case.file, name, &case.options)
+        .unwrap_or_else(|e| panic!("{name}: c_code failed: {e}"));
+    assert!(
+        code.header.contains(&format!(
+            "{name}_step({name}_state *s, const float *u, float *y)"
+        )),
+        "{name}: the float API"
+    );
+    assert!(
+        !code.source.contains("double"),
+        "{name}: a double in the float code"
+    );
+    std::fs::write(dir.join(format!("{name}.h")), &code.header).expect("write");
+    std::fs::write(dir.join(format!("{name}.c")), &code.source).expect("write");
+    std::fs::write(dir.join(format!("{name}_driver.c")), driver(name)).expect("write");
+    let exe = dir.join(name);
+    let compiled = Command::new("cc")
+        .args(FLAGS)
+        .arg("-o")
+        .arg(&exe)
+        .arg(dir.join(format!("{name}.c")))
+        .arg(dir.join(format!("{name}_driver.c")))
+        .arg("-lm")
+        .output()
+        .expect("the C compiler `cc` is needed by this test (install gcc or clang)");
+    assert!(
+        compiled.status.success(),
+        "{name}: cc failed:\n{}",
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+    exe
+}
+
+/// Runs `exe` on `input`: the outputs, the diverged flag and `NAME_BOUND`.
+fn run(exe: &Path, input: &[f64], dir: &Path, tag: &str) -> (Vec<f64>, bool, f64) {
+    let path = dir.join(format!("{tag}.in"));
+    std::fs::write(&path, cases::input_text(input)).expect("write");
+    let ran = Command::new(exe)
+        .arg(&path)
+        .output()
+        .expect("run the driver");
+    assert!(ran.status.success(), "{tag}: the driver failed");
+    let text = String::from_utf8_lossy(&ran.stdout).into_owned();
+    let bound = text
+        .lines()
+        .find_map(|l| l.strip_prefix("bound "))
+        .and_then(|b| b.trim().parse::<f64>().ok())
+        .expect("the bound line");
+    let kept: String = text
+        .lines()
+        .filter(|l| !l.starts_with("bound "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let (y, error) = cases::parse_outputs(&kept);
+    (y, error, bound)
+}
+
+/// max |a − b| over the samples.
+fn max_gap(got: &[f64], expected: &[f64]) -> f64 {
+    assert_eq!(got.len(), expected.len());
+    got.iter()
+        .zip(expected)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
+}
+
+/// The library's outputs for a fresh input: the models' outputs (or the compensators'
+/// commands) on another seeded signal, case by case (by name); the grey-box cases on their
+/// own input reversed.
+fn fresh(all: &[Case]) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let other: Vec<Case> = cases::all_on(
+        &cases::signal(3000, 99)
+            .iter()
+            .map(|v| 0.9 * v)
+            .collect::<Vec<_>>(),
+    );
+    all.iter()
+        .map(|case| {
+            if let Some(o) = other.iter().find(|o| o.name == case.name) {
+                return (o.input.clone(), o.expected.clone());
+            }
+            let model = FittedModel::from_file(&case.file).expect("a model");
+            let input: Vec<f64> = case.input.iter().rev().copied().collect();
+            let ts = case.options.sample_time.unwrap_or(1e-3);
+            let expected = if case.options.inverse {
+                compensate(&model, &input).expect("compensate").u
+            } else {
+                model.simulate(&[&input], ts, None).expect("simulate")[0].clone()
+            };
+            (input, expected)
+        })
+        .collect()
+}
+
+#[test]
+#[ignore = "every case through the interpreter (minutes): run in CI's long step, `cargo test --release -- --ignored`"]
+fn the_interpreter_in_double_equals_the_library_to_the_bit() {
+    let mut failed = Vec::new();
+    for case in cases::all() {
+        let prog = program(&case.file, &case.options)
+            .unwrap_or_else(|e| panic!("{}: program failed: {e}", case.name));
+        let rows: Vec<Vec<f64>> = case.input.iter().map(|v| vec![*v]).collect();
+        let y = eval::run::<f64>(&prog, &rows).expect("the interpreter");
+        let got: Vec<f64> = y.iter().map(|r| r[0]).collect();
+        if got.len() != case.expected.len()
+            || got
+                .iter()
+                .zip(&case.expected)
+                .any(|(a, b)| a.to_bits() != b.to_bits())
+        {
+            failed.push(format!(
+                "{} (max gap {:e})",
+                case.name,
+                max_gap(&got, &case.expected)
+            ));
+        }
+    }
+    assert!(failed.is_empty(), "not bit-identical: {failed:?}");
+}
+
+#[test]
+#[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
+fn single_c_is_within_its_bound_on_own_data_and_a_fresh_reference() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let all = cases::all();
+    let fresh = fresh(&all);
+    let mut rows = Vec::new();
+    let mut failed = Vec::new();
+    for (case, (fresh_in, fresh_out)) in all.iter().zip(&fresh) {
+        let case = single(case);
+        let exe = compile(&case, dir.path());
+        let (y, error, bound) = run(&exe, &case.input, dir.path(), &case.name);
+        assert!(!error, "{}: diverged in float", case.name);
+        let gap = max_gap(&y, &case.expected);
+        let own = cases::relative_difference(&y, &case.expected);
+        let (y2, _, _) = run(&exe, fresh_in, dir.path(), &format!("{}_fresh", case.name));
+        let other = cases::relative_difference(&y2, fresh_out);
+        rows.push(format!(
+            "{:<40} own {own:.2e}  fresh {other:.2e}  bound {bound:.2e}",
+            case.name
+        ));
+        // The measured bound is the float code against the double code on this very data;
+        // the library is the double code to the bit (the test above; c_target).
+        if !(gap <= bound && own <= SINGLE_BAR && other <= SINGLE_BAR) {
+            failed.push(case.name.clone());
+        }
+    }
+    println!("{}", rows.join("\n"));
+    assert!(
+        failed.is_empty(),
+        "beyond the bound: {failed:?}\n{}",
+        rows.join("\n")
+    );
+}
+
+#[test]
+#[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
+fn single_rust_is_within_its_bound() {
+    let picked = [
+        "pi_inverse",
+        "preisach_inverse",
+        "bouc_wen_forward",
+        "gb_bouc_wen_zoh",
+    ];
+    let all: Vec<Case> = cases::all()
+        .into_iter()
+        .filter(|c| picked.contains(&c.name.as_str()))
+        .map(|c| single(&c))
+        .collect();
+    assert_eq!(all.len(), picked.len(), "the picked cases exist");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let root = dir.path();
+    let mut manifest = String::from(
+        "[package]\nname = \"single_check\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\n\
+         [workspace]\n\n[dependencies]\n",
+    );
+    let mut main = String::from("fn main() {\n");
+    for case in &all {
+        let name = &case.name;
+        for f in rust_crate(&case.file, name, &case.options)
+            .unwrap_or_else(|e| panic!("{name}: rust_crate failed: {e}"))
+        {
+            let path = root.join("crates").join(&f.path);
+            std::fs::create_dir_all(path.parent().expect("a parent")).expect("mkdir");
+            std::fs::write(path, f.contents).expect("write");
+        }
+        std::fs::write(
+            root.join(format!("{name}.in")),
+            cases::input_text(&case.input),
+        )
+        .expect("write");
+        manifest.push_str(&format!("{name} = {{ path = \"crates/{name}\" }}\n"));
+        main.push_str(&format!(
+            "    {{\n        let text = std::fs::read_to_string(\"{name}.in\").unwrap();\n\
+             \x20       let mut m = {name}::Model::new();\n        let mut out = String::new();\n\
+             \x20       for line in text.lines() {{\n\
+             \x20           let u: f32 = line.parse::<f64>().unwrap() as f32;\n\
+             \x20           let y: [f32; {name}::N_OUT] = m.step(&[u]);\n\
+             \x20           out.push_str(&format!(\"{{:?}}\\n\", y[0] as f64));\n        }}\n\
+             \x20       out.push_str(&format!(\"bound {{:?}}\\n\", {name}::BOUND));\n\
+             \x20       std::fs::write(\"{name}.out\", out).unwrap();\n    }}\n"
+        ));
+    }
+    main.push_str("}\n");
+    std::fs::create_dir_all(root.join("src")).expect("mkdir");
+    std::fs::write(root.join("Cargo.toml"), manifest).expect("write");
+    std::fs::write(root.join("src/main.rs"), main).expect("write");
+    let built = Command::new(env!("CARGO"))
+        .args(["run", "--release", "--offline", "--quiet"])
+        .current_dir(root)
+        .env("CARGO_TARGET_DIR", root.join("target"))
+        .output()
+        .expect("cargo");
+    assert!(
+        built.status.success(),
+        "cargo run failed:\n{}",
+        String::from_utf8_lossy(&built.stderr)
+    );
+    for case in &all {
+        let text = std::fs::read_to_string(root.join(format!("{}.out", case.name))).expect("out");
+        let bound: f64 = text
+            .lines()
+            .find_map(|l| l.strip_prefix("bound "))
+            .and_then(|b| b.parse().ok())
+            .expect("bound");
+        let y: Vec<f64> = text
+            .lines()
+            .filter(|l| !l.starts_with("bound "))
+            .map(|l| l.parse().expect("a number"))
+            .collect();
+        let gap = max_gap(&y, &case.expected);
+        let relative = cases::relative_difference(&y, &case.expected);
+        assert!(
+            gap <= bound && relative <= SINGLE_BAR,
+            "{}: gap {gap:e} > bound {bound:e} or {relative:e} of the range",
+            case.name
+        );
+    }
+}
