@@ -16,5 +16,6 @@ mod model_files;
 mod nist;
 mod preprocessing;
 mod properties;
+mod report_covariance;
 mod stream;
 mod unit;

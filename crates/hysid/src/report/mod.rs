@@ -348,6 +348,79 @@ pub struct UncertaintySummary {
     pub replicates: Option<usize>,
     /// Bootstrap replicates that failed to identify.
     pub failed: Option<usize>,
+    /// The covariance of the estimates that have a standard deviation (null when the
+    /// command gives none, and in reports written before the key existed).
+    #[serde(default)]
+    pub covariance: Option<CovarianceSummary>,
+}
+
+/// The covariance matrix of the estimates with a standard deviation in the report's model
+/// (those not fixed and not held at a bound), in the model file's parameter order.
+///
+/// cov(θᵢ, θⱼ) = σᵢ σⱼ ρᵢⱼ, with σ the model file's standard deviations and ρ the
+/// correlation of the estimator's covariance: σ²(JᵀJ)⁻¹ at the estimate for a search,
+/// σ²(ΦᵀΦ)⁻¹ on the free set for a (non-negative) least-squares solve (Ljung, *System
+/// Identification*, 2nd ed., 1999, §9.3). Where σ is the estimator's own (every operator
+/// family, grey-box and operator-cascade fit) the matrix is σ²(JᵀJ)⁻¹ itself; where a
+/// standard deviation comes from elsewhere (the Coleman–Hodgdon threshold d's truncated
+/// normal, a bootstrap) its row and column are the asymptotic correlations scaled to it, so
+/// the diagonal is always σ².
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct CovarianceSummary {
+    /// The parameters of the rows and columns, in order.
+    pub parameters: Vec<String>,
+    /// The matrix, row by row (symmetric, its diagonal the squared standard deviations).
+    pub matrix: Vec<Vec<f64>>,
+}
+
+impl CovarianceSummary {
+    /// The covariance of the parameters of `model` that have a standard deviation, from the
+    /// estimator's covariance `c` (`c(i, j)`) over the parameters `names`: σᵢ σⱼ ρᵢⱼ (see
+    /// the type). None when a parameter with a standard deviation is not among `names`, or
+    /// when none has one.
+    pub fn of(
+        model: &ModelFile,
+        names: &[String],
+        c: impl Fn(usize, usize) -> f64,
+    ) -> Option<Self> {
+        let mut rows = Vec::new();
+        for p in model.parameters() {
+            if let (false, Some(s)) = (p.fixed, p.std) {
+                rows.push((p.name.clone(), names.iter().position(|n| *n == p.name)?, s));
+            }
+        }
+        if rows.is_empty() {
+            return None;
+        }
+        // The upper triangle, mirrored: a symmetric matrix to the bit.
+        let mut matrix = vec![vec![0.0; rows.len()]; rows.len()];
+        for (a, &(_, i, si)) in rows.iter().enumerate() {
+            matrix[a][a] = si * si;
+            for (b, &(_, j, sj)) in rows.iter().enumerate().skip(a + 1) {
+                let (cii, cjj) = (c(i, i), c(j, j));
+                let rho = 0.5 * (c(i, j) + c(j, i)) / (cii * cjj).sqrt();
+                let v = if cii > 0.0 && cjj > 0.0 && rho.is_finite() {
+                    si * sj * rho.clamp(-1.0, 1.0)
+                } else {
+                    0.0
+                };
+                matrix[a][b] = v;
+                matrix[b][a] = v;
+            }
+        }
+        Some(Self {
+            parameters: rows.into_iter().map(|(n, _, _)| n).collect(),
+            matrix,
+        })
+    }
+
+    /// The covariance of an output-error fit's parameters for `model` ([`Self::of`] on
+    /// σ²(JᵀJ)⁻¹ of `fit`).
+    pub fn of_output_error(model: &ModelFile, fit: &OutputErrorFit) -> Option<Self> {
+        let m = &fit.covariance.matrix;
+        Self::of(model, &fit.parameters.names(), |i, j| m[(i, j)])
+    }
 }
 
 impl UncertaintySummary {
@@ -367,6 +440,7 @@ impl UncertaintySummary {
             method: "bootstrap".into(),
             replicates: Some(replicates),
             failed: Some(failed),
+            covariance: None,
         }
     }
 
@@ -375,7 +449,14 @@ impl UncertaintySummary {
             method: method.into(),
             replicates: None,
             failed: None,
+            covariance: None,
         }
+    }
+
+    /// The summary with the estimates' covariance matrix.
+    pub fn with_covariance(mut self, covariance: Option<CovarianceSummary>) -> Self {
+        self.covariance = covariance;
+        self
     }
 }
 
@@ -465,12 +546,13 @@ impl Report {
         elapsed_s: f64,
         uncertainty: UncertaintySummary,
     ) -> Result<Self> {
+        let covariance = CovarianceSummary::of_output_error(&model, fit);
         Ok(Self {
             data: Some(DataSummary::of(data, source)),
             model: Some(model),
             fit: Some(FitSummary::of_output_error(fit, data)?),
             search: Some(SearchSummary::of(&fit.report, elapsed_s)),
-            uncertainty: Some(uncertainty),
+            uncertainty: Some(uncertainty.with_covariance(covariance)),
             ..Self::new(command)
         })
     }
@@ -523,6 +605,13 @@ impl Report {
             if !s.elapsed_s.is_finite() {
                 bad.push("search.elapsed_s".into());
             }
+        }
+        let covariance = self
+            .uncertainty
+            .as_ref()
+            .and_then(|u| u.covariance.as_ref());
+        if covariance.is_some_and(|c| c.matrix.iter().flatten().any(|v| !v.is_finite())) {
+            bad.push("uncertainty.covariance".into());
         }
         match bad.first() {
             None => Ok(()),

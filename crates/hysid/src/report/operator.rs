@@ -1,7 +1,7 @@
 //! The report of one hysteresis family fitted to a record (`hysid identify operator`, Python's
 //! `hysid.identify_operator`): the same report from both front ends.
 
-use super::UncertaintySummary;
+use super::{CovarianceSummary, UncertaintySummary};
 use super::{DataSummary, FitSummary, Report, SearchSummary, TerminationSummary};
 use crate::data::IdData;
 use crate::identify::operators::FittedOperator;
@@ -52,12 +52,18 @@ pub fn operator_report(
         ),
         estimated_model_steps: None,
     });
-    report.uncertainty = Some(if fit.iterations == 0 {
-        UncertaintySummary::least_squares()
-    } else {
-        UncertaintySummary::asymptotic()
-    });
-    report.model = Some(fit.model.to_file());
+    let model = fit.model.to_file();
+    let covariance =
+        CovarianceSummary::of(&model, &fit.parameters.names(), |i, j| fit.covariance[i][j]);
+    report.uncertainty = Some(
+        if fit.iterations == 0 {
+            UncertaintySummary::least_squares()
+        } else {
+            UncertaintySummary::asymptotic()
+        }
+        .with_covariance(covariance),
+    );
+    report.model = Some(model);
     let finite = |v: f64| v.is_finite().then_some(v);
     report.details = json!({
         "family": fitted.family.name(),

@@ -11,7 +11,7 @@
 //! Reference: M. A. Krasnosel'skii, A. V. Pokrovskii, *Systems with Hysteresis*, Springer 1989.
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
-use super::linear_support::{check_data, finish, orientation, range};
+use super::linear_support::{check_data, finish, orientation, range, unscaled, Spread};
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
     oriented, OperatorCascadeIdentification, RankOne, RANK_ONE,
@@ -19,7 +19,7 @@ use crate::identify::operator_cascade::{
 use crate::model::operators::{play, play_step, Backlash, Orientation};
 use crate::model::OperatorCascade;
 use crate::{Error, Result};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, Matrix3, Vector3};
 use std::time::Instant;
 
 /// Options of the backlash identification.
@@ -131,11 +131,16 @@ pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFi
     let n = x.len();
     let rss = rss_at(&x, &v, &theta);
     let sigma2 = rss / (n.saturating_sub(3).max(1)) as f64;
-    let std: Vec<Option<f64>> = match jtj.try_inverse() {
-        Some(inv) => (0..3)
-            .map(|i| Some((sigma2 * inv[(i, i)]).max(0.0).sqrt()))
-            .collect(),
-        None => vec![None; 3],
+    let spread = match jtj.try_inverse() {
+        Some(inv) => {
+            let c = DMatrix::from_fn(3, 3, |i, j| sigma2 * inv[(i, j)]);
+            let std: Vec<Option<f64>> = (0..3).map(|i| Some(c[(i, i)].max(0.0).sqrt())).collect();
+            Spread::mapped(&std, &c, &unscaled((0..3).map(Some)))
+        }
+        None => Spread {
+            std: vec![None; 3],
+            covariance: vec![vec![0.0; 3]; 3],
+        },
     };
     let model = Backlash::new(theta[0], theta[1].max(0.0), theta[2], o)?;
     Ok(finish(
@@ -143,7 +148,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFi
         o,
         u,
         y,
-        std,
+        spread,
         iterations,
         evaluations,
         converged,

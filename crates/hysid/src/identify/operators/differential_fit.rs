@@ -989,18 +989,20 @@ fn report_fit<F: DifferentialFamily>(
         }
     };
     let parameters = model.parameters();
-    let std = (0..parameters.len())
+    let std: Vec<Option<f64>> = (0..parameters.len())
         .map(|i| {
             let s = covariance.std[i];
             (driver.free.contains(&i) && s.is_finite()).then_some(s)
         })
         .collect();
+    let covariance = masked_covariance(&covariance.matrix, &std);
     let (n, p) = (y.len(), driver.free.len());
     let loss = metrics::mse(y, &simulated);
     Ok(OperatorFit {
         model,
         parameters,
         std,
+        covariance,
         fit_percent: metrics::fit_percent(y, &simulated),
         rmse: loss.sqrt(),
         loss,
@@ -1013,6 +1015,26 @@ fn report_fit<F: DifferentialFamily>(
         elapsed_s: started.elapsed().as_secs_f64(),
         initial_state: None,
     })
+}
+
+/// The rows of `matrix` (the parameters' covariance) as p vectors of p, zero in the rows and
+/// columns of the parameters without a standard deviation (`std[i]` None).
+pub(crate) fn masked_covariance(matrix: &DMatrix<f64>, std: &[Option<f64>]) -> Vec<Vec<f64>> {
+    let p = std.len();
+    (0..p)
+        .map(|i| {
+            (0..p)
+                .map(|j| {
+                    let both = std[i].is_some() && std[j].is_some();
+                    if both && i < matrix.nrows() && j < matrix.ncols() {
+                        matrix[(i, j)]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// Least squares of y on the columns `cols` (small dense problem): coefficients and the sum

@@ -8,6 +8,7 @@
 //! [`fit_operator`] returns the fitted model as a [`FittedModel`] (kind `operator`, or
 //! `coleman_hodgdon` for ch4/ch6), so every family saves, simulates and compensates the same way.
 
+use super::differential_fit::masked_covariance;
 use super::OperatorFit;
 use crate::data::IdData;
 use crate::identify::hysteresis::HysteresisIdentification;
@@ -426,6 +427,7 @@ fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>) -> OperatorFit<FittedModel
         model: FittedModel::operator(fit.model.into(), std).with_initial_state(fit.initial_state),
         parameters: fit.parameters,
         std: fit.std,
+        covariance: fit.covariance,
         simulated: fit.simulated,
         fit_percent: fit.fit_percent,
         rmse: fit.rmse,
@@ -451,6 +453,7 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
     let id = HysteresisIdentification::new(form);
     let fit = id.estimate(&data, &mut |_| Control::Continue)?;
     let std = fit.std();
+    let std_present: Vec<Option<f64>> = std.iter().map(|s| s.is_finite().then_some(*s)).collect();
     let simulated = simulate_switched(&fit.model, u, y[0], None);
     let parameters = ParameterSet::new(
         form.parameter_names()
@@ -470,7 +473,8 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
             std: std.clone(),
         },
         parameters,
-        std: std.iter().map(|s| s.is_finite().then_some(*s)).collect(),
+        covariance: masked_covariance(&fit.output_error.covariance.matrix, &std_present),
+        std: std_present,
         fit_percent: metrics::fit_percent(y, &simulated),
         rmse: loss.sqrt(),
         loss,

@@ -21,7 +21,8 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, range, solve_weights, threshold_grid, GramAccumulator,
+    check_data, finish, orientation, range, solve_weights, threshold_grid, unscaled,
+    GramAccumulator, Spread,
 };
 use super::OperatorFit;
 use crate::model::operators::{
@@ -158,16 +159,21 @@ pub fn fit(u: &[f64], y: &[f64], options: &GpiOptions) -> Result<OperatorFit<Gen
         reason: format!("no monotone modified PI operator fits these data ({e})"),
     })?;
     let model = GeneralizedPi::new(h, s_inv.inverse(), o);
-    let mut std = sol.std[..=m].to_vec();
-    std.extend(std::iter::repeat_n(None, m));
-    std.push(sol.std[m + 1]);
-    std.extend(std::iter::repeat_n(None, 1 + 2 * nz));
+    // (a0, w, r, c, then the dead-zone map's 1 + 2 nz, which the weights' covariance
+    // does not cover).
+    let map = unscaled(
+        (0..=m)
+            .map(Some)
+            .chain(std::iter::repeat_n(None, m))
+            .chain([Some(m + 1)])
+            .chain(std::iter::repeat_n(None, 1 + 2 * nz)),
+    );
     Ok(finish(
         model,
         o,
         u,
         y,
-        std,
+        Spread::of(&sol, &map),
         total_iterations,
         2,
         sol.converged,

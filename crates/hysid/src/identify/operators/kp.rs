@@ -35,7 +35,8 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, range, solve_weights, GramAccumulator, WeightSolution,
+    check_data, finish, orientation, range, solve_weights, unscaled, GramAccumulator, Spread,
+    WeightSolution,
 };
 use super::OperatorFit;
 use crate::model::operators::kp::KernelStates;
@@ -143,14 +144,18 @@ pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>>
             reason: format!("no KP operator fits these data ({e})"),
         }
     })?;
-    let mut std = vec![if options.reversible { sol.std[0] } else { None }];
-    std.extend_from_slice(&sol.std[first..]);
+    // (a0, the weights, c); a0 is estimated only when reversible.
+    let map = unscaled(
+        [options.reversible.then_some(0)]
+            .into_iter()
+            .chain((first..sol.x.len()).map(Some)),
+    );
     Ok(finish(
         model,
         o,
         u,
         y,
-        std,
+        Spread::of(&sol, &map),
         iterations,
         options.widths.len(),
         converged,

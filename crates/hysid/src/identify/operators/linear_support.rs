@@ -182,12 +182,61 @@ impl GramAccumulator {
     }
 }
 
-/// An NNLS solution with its standard deviations σ²(G_FF)⁻¹ on the free set F.
+/// An NNLS solution with its standard deviations and covariance σ²(G_FF)⁻¹ on the free set F.
 pub(crate) struct WeightSolution {
     pub x: Vec<f64>,
     pub std: Vec<Option<f64>>,
+    /// σ²(G_FF)⁻¹ over all of x, zero in the rows and columns outside F.
+    pub covariance: DMatrix<f64>,
     pub iterations: usize,
     pub converged: bool,
+}
+
+/// The standard deviations of a fit's parameters and their covariance (zero in the rows and
+/// columns of the parameters without a standard deviation), in the model's parameter order.
+pub(crate) struct Spread {
+    pub std: Vec<Option<f64>>,
+    pub covariance: Vec<Vec<f64>>,
+}
+
+impl Spread {
+    /// The spread of parameters θ = J x with the covariance `c` of x (none where `std[k]`
+    /// is None): parameter i is `scale · x_k` for `map[i] = Some((k, scale))`, not estimated
+    /// for None, so cov(θᵢ, θⱼ) = sᵢ sⱼ c_{kᵢkⱼ}.
+    pub fn mapped(std: &[Option<f64>], c: &DMatrix<f64>, map: &[Option<(usize, f64)>]) -> Self {
+        let live = |m: &Option<(usize, f64)>| m.filter(|&(k, _)| std[k].is_some());
+        let covariance = map
+            .iter()
+            .map(|a| {
+                map.iter()
+                    .map(|b| match (live(a), live(b)) {
+                        (Some((i, si)), Some((j, sj))) => si * sj * c[(i, j)],
+                        _ => 0.0,
+                    })
+                    .collect()
+            })
+            .collect();
+        Self {
+            std: map
+                .iter()
+                .map(|m| live(m).and_then(|(k, s)| std[k].map(|v| v * s.abs())))
+                .collect(),
+            covariance,
+        }
+    }
+
+    /// The spread of the solution's x, parameter i being `scale · x_k` for
+    /// `map[i] = Some((k, scale))` ([`Spread::mapped`]).
+    pub fn of(sol: &WeightSolution, map: &[Option<(usize, f64)>]) -> Self {
+        Self::mapped(&sol.std, &sol.covariance, map)
+    }
+}
+
+/// The map of [`Spread::of`] that takes x_k to parameter i unscaled for each `Some(k)`.
+pub(crate) fn unscaled(
+    indices: impl IntoIterator<Item = Option<usize>>,
+) -> Vec<Option<(usize, f64)>> {
+    indices.into_iter().map(|k| k.map(|k| (k, 1.0))).collect()
 }
 
 /// Solves the normal equations under x ≥ 0 (except the unconstrained variables) and the
@@ -212,14 +261,19 @@ pub(crate) fn solve_weights(
         0.0
     };
     let mut std = vec![None; sol.x.len()];
+    let mut covariance = DMatrix::zeros(sol.x.len(), sol.x.len());
     if let Some((idx, inv)) = passive_inverse(g, &sol.passive) {
         for (k, &i) in idx.iter().enumerate() {
             std[i] = Some((sigma2 * inv[(k, k)]).max(0.0).sqrt());
+            for (l, &j) in idx.iter().enumerate() {
+                covariance[(i, j)] = sigma2 * inv[(k, l)];
+            }
         }
     }
     Ok(WeightSolution {
         x: sol.x,
         std,
+        covariance,
         iterations: sol.iterations,
         converged: sol.converged,
     })
@@ -232,12 +286,13 @@ pub(crate) fn finish<M: HysteresisOperator + Core>(
     orientation: Orientation,
     u: &[f64],
     y: &[f64],
-    std: Vec<Option<f64>>,
+    spread: Spread,
     iterations: usize,
     evaluations: usize,
     converged: bool,
     start: Instant,
 ) -> OperatorFit<M> {
+    let Spread { std, covariance } = spread;
     let (simulated, _) = oriented_simulate_saturating(&model, orientation, u);
     let parameters = model.parameters();
     let estimated = std.iter().filter(|s| s.is_some()).count();
@@ -260,6 +315,7 @@ pub(crate) fn finish<M: HysteresisOperator + Core>(
         model,
         parameters,
         std,
+        covariance,
         simulated,
         iterations,
         evaluations,

@@ -14,7 +14,7 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator,
+    check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator, Spread,
 };
 use super::OperatorFit;
 use crate::identify::operator_cascade::{OperatorCascadeIdentification, RANK_ONE};
@@ -90,20 +90,19 @@ pub fn fit(u: &[f64], y: &[f64], options: &MaxwellSlipOptions) -> Result<Operato
             reason: format!("no Maxwell-slip model fits these data ({e})"),
         }
     })?;
-    let mut std = vec![if options.linear_spring {
-        sol.std[0]
-    } else {
-        None
-    }];
-    std.extend_from_slice(&sol.std[first..first + m]);
-    std.extend((0..m).map(|i| sol.std[first + i].map(|s| s * widths[i])));
-    std.push(sol.std[p - 1]);
+    // (k0, k₁…k_m, the break-away forces fᵢ = kᵢ δᵢ, c).
+    let map: Vec<Option<(usize, f64)>> = [options.linear_spring.then_some((0, 1.0))]
+        .into_iter()
+        .chain((0..m).map(|i| Some((first + i, 1.0))))
+        .chain((0..m).map(|i| Some((first + i, widths[i]))))
+        .chain([Some((p - 1, 1.0))])
+        .collect();
     Ok(finish(
         model,
         o,
         u,
         y,
-        std,
+        Spread::of(&sol, &map),
         sol.iterations,
         1,
         sol.converged,

@@ -59,6 +59,10 @@ pub struct OperatorFit<M> {
     /// Standard deviation per parameter (None where the parameter was not estimated, e.g. fixed
     /// thresholds or a weight held at the NNLS bound 0).
     pub std: Vec<Option<f64>>,
+    /// The covariance of the estimates over `parameters`, p rows of p: σ²(JᵀJ)⁻¹ of the
+    /// search (or of the least-squares solve) mapped to the model's parameters, zero in the
+    /// rows and columns of the parameters whose `std` is None; its diagonal is `std`².
+    pub covariance: Vec<Vec<f64>>,
     /// Γ\[u\] of the fitted operator on the estimation data.
     pub simulated: Vec<f64>,
     /// fit % = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖), RMSE, loss V = mean squared residual, FPE, AIC

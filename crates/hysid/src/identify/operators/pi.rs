@@ -17,7 +17,8 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator,
+    check_data, finish, orientation, solve_weights, threshold_grid, unscaled, GramAccumulator,
+    Spread,
 };
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
@@ -86,15 +87,19 @@ pub fn fit(u: &[f64], y: &[f64], options: &PiOptions) -> Result<OperatorFit<Pran
             channel: "u".into(),
             reason: format!("no monotone PI operator fits these data ({e})"),
         })?;
-    let mut std = sol.std[..=m].to_vec();
-    std.extend(std::iter::repeat_n(None, m));
-    std.push(sol.std[m + 1]);
+    // (a0, w₁…w_m, r₁…r_m, c): the thresholds are given, not estimated.
+    let map = unscaled(
+        (0..=m)
+            .map(Some)
+            .chain(std::iter::repeat_n(None, m))
+            .chain([Some(m + 1)]),
+    );
     Ok(finish(
         model,
         o,
         u,
         y,
-        std,
+        Spread::of(&sol, &map),
         sol.iterations,
         1,
         sol.converged,
