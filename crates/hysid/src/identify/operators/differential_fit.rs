@@ -1012,6 +1012,7 @@ fn report_fit<F: DifferentialFamily>(
         termination,
         elapsed_s: started.elapsed().as_secs_f64(),
         initial_state: None,
+        model_size: None,
     })
 }
 
