@@ -25,7 +25,7 @@ fn reversals(seed: u64, sweeps: usize, steps: f64) -> Vec<f64> {
     let mut at = 0.0;
     for _ in 0..sweeps {
         let target = 2.0 * rng.next() - 1.0;
-        let n = (((target - at) as f64).abs() * steps).ceil().max(1.0) as usize;
+        let n = ((target - at).abs() * steps).ceil().max(1.0) as usize;
         for k in 1..=n {
             u.push(at + (target - at) * k as f64 / n as f64);
         }
