@@ -29,9 +29,9 @@ use std::time::Instant;
 
 /// The work bound of the grid choice, in fits of the default grid 20
 /// ([`super::model_size`]): the candidates 6 … 20 cost about one such fit together on the
-/// training part, 30 about 3.4 more, so on a long record the choice is about five times one
-/// default fit and stops before 40 (which alone would be about ten).
-pub const GRID_WORK_BOUND: f64 = 4.5;
+/// training part, 30 about 3.4 more, so the default choice stays within about twice one
+/// fixed fit and stops before 30 and 40 (reached with `--grid`).
+pub const GRID_WORK_BOUND: f64 = 2.0;
 
 /// Options of the Preisach identification.
 #[derive(Clone, Debug, PartialEq)]
