@@ -22,12 +22,16 @@ pub fn family_help(lead: &str) -> String {
 pub struct FamilyArgs {
     /// PI / generalised-PI thresholds and Maxwell-slip elements: a count N in 1..=200
     /// (a uniform grid over the input range), or the thresholds themselves as a
-    /// comma-separated list r1,r2,… (strictly increasing, > 0).
-    #[arg(long, default_value = "10")]
-    pub thresholds: String,
-    /// Intervals N of the Preisach grid over the input range, 1..=100 (N(N+1)/2 cells).
-    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=100))]
-    pub grid: u32,
+    /// comma-separated list r1,r2,… (strictly increasing, > 0). Default: the count (4, 6, 8,
+    /// 10, 14, 20) and the placement (uniform, or geometric from the record's smallest
+    /// reversal) chosen by the fit % on the last 30 % of the record (`details.model_size`).
+    #[arg(long)]
+    pub thresholds: Option<String>,
+    /// Intervals N of the Preisach and KP grids over the input range, 1..=100 (N(N+1)/2
+    /// cells). Default: chosen among 6, 8, 10, 14, 20, 30, 40 by the fit % on the last 30 %
+    /// of the record, within a work bound (`details.model_size`).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub grid: Option<u32>,
     /// Smoothness penalty λ of the Preisach weights (relative to the Gram matrix). Range
     /// [0, 1e6].
     #[arg(long, default_value_t = 1e-6, value_parser = crate::options::nonnegative)]

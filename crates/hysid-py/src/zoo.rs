@@ -56,6 +56,9 @@ fn family_options(
         grid,
         lambda,
         dead_zones,
+        // Python passes its sizes (defaults 10 and 20): they fix the model as given
+        choose_thresholds: false,
+        choose_grid: false,
         ..FamilyOptions::default()
     }
 }
@@ -157,6 +160,8 @@ fn identify_operator_cascade(
                 grid,
                 loop_orientation,
                 observer: watch.observer(),
+                choose_thresholds: false,
+                choose_grid: false,
                 ..FamilyOptions::default()
             };
             let fit = id.estimate(&data, &mut watch.callback())?;

@@ -47,6 +47,8 @@ fn identification(args: &CascadeArgs) -> Result<OperatorCascadeIdentification> {
         // the record with the linear block's coefficients.
         grid: args.grid.unwrap_or(10),
         loop_orientation: args.orientation.map(Into::into),
+        choose_thresholds: false,
+        choose_grid: false,
         ..FamilyOptions::default()
     };
     Ok(id)

@@ -13,14 +13,16 @@ use std::path::Path;
 /// The recipes' options from the flags, ranges checked.
 pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
     let mut options = FamilyOptions {
-        grid: args.grid as usize,
+        grid: args.grid.map_or(20, |g| g as usize),
+        choose_grid: args.grid.is_none(),
+        choose_thresholds: args.thresholds.is_none(),
         lambda: args.lambda,
         dead_zones: args.dead_zones as usize,
         loop_orientation: args.orientation.map(Into::into),
         initial_state: args.initial_state.into(),
         ..FamilyOptions::default()
     };
-    let text = args.thresholds.trim();
+    let text = args.thresholds.as_deref().unwrap_or("10").trim();
     match text.parse::<usize>() {
         Ok(n) => options.thresholds = n,
         Err(_) => {
@@ -40,7 +42,9 @@ pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
     options.validate().with_context(|| {
         format!(
             "--thresholds {text} --grid {} --lambda {} --dead-zones {}",
-            args.grid, args.lambda, args.dead_zones
+            args.grid.map_or("chosen".to_string(), |g| g.to_string()),
+            args.lambda,
+            args.dead_zones
         )
     })?;
     Ok(options)

@@ -76,6 +76,9 @@ pub fn operator_report(
         // The state the fitted model starts from (`demagnetised` for a family whose
         // structure holds its start).
         "initial_state": fit.initial_state.map_or("demagnetised", |s| s.name()),
+        // The size chosen from the data and every candidate's held-out score (absent when
+        // the options fixed it).
+        "model_size": fit.model_size,
     });
     Ok(report)
 }

@@ -1014,6 +1014,7 @@ fn report_fit<F: DifferentialFamily>(
         termination,
         elapsed_s: started.elapsed().as_secs_f64(),
         initial_state: None,
+        model_size: None,
     })
 }
 

@@ -60,7 +60,22 @@ pub struct FamilyOptions {
     /// structure's documented state) under `estimate` and `demagnetised` and refuse a
     /// declared history for now.
     pub initial_state: InitialState,
+    /// Choose the threshold count and placement of PI, generalised PI and Maxwell-slip from
+    /// the data ([`crate::identify::operators::model_size`]: counts 4, 6, 8, 10, 14, 20,
+    /// each uniform and geometric, scored on a held-out part) instead of the `thresholds`
+    /// uniform grid (default true; ignored when `threshold_grid` is given). The command line
+    /// sets it false when `--thresholds` is given, Python when `thresholds=` is.
+    pub choose_thresholds: bool,
+    /// Choose the Preisach and KP grid from the data (intervals 6, 8, 10, 14, 20, 30, 40,
+    /// within the work bound) instead of `grid` (default true; false when `--grid` or
+    /// `grid=` is given).
+    pub choose_grid: bool,
 }
+
+/// The candidate threshold counts of [`FamilyOptions::choose_thresholds`].
+pub const THRESHOLD_CANDIDATES: [usize; 6] = [4, 6, 8, 10, 14, 20];
+/// The candidate grid sizes of [`FamilyOptions::choose_grid`].
+pub const GRID_CANDIDATES: [usize; 7] = [6, 8, 10, 14, 20, 30, 40];
 
 impl Default for FamilyOptions {
     fn default() -> Self {
@@ -74,6 +89,8 @@ impl Default for FamilyOptions {
             loop_orientation: None,
             observer: Observer::none(),
             initial_state: InitialState::Estimate,
+            choose_thresholds: true,
+            choose_grid: true,
         }
     }
 }
@@ -255,7 +272,10 @@ pub trait Identify: OperatorFamily + Into<OperatorModel> {
     ) -> Result<(OperatorCascade, &'static str)> {
         // Γ₀ = G (Γ₀ = G⁻¹ when the user gave a clockwise loop); the linear block carries
         // the sign
+        // the cascade's start keeps its fixed sizes (its refinement sees the whole record)
         let options = FamilyOptions {
+            choose_thresholds: false,
+            choose_grid: false,
             orientation: Some(match options.loop_orientation {
                 Some(LoopOrientation::Clockwise) => Orientation::CLOCKWISE,
                 _ => Orientation::COUNTER_CLOCKWISE,
@@ -439,6 +459,7 @@ fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>) -> OperatorFit<FittedModel
         termination: fit.termination,
         elapsed_s: fit.elapsed_s,
         initial_state: fit.initial_state,
+        model_size: fit.model_size,
     }
 }
 
@@ -486,5 +507,6 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
         termination: report.termination.clone(),
         elapsed_s: started.elapsed().as_secs_f64(),
         initial_state: None,
+        model_size: None,
     })
 }

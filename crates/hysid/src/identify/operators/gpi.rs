@@ -21,9 +21,10 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, range, solve_weights, threshold_grid, unscaled,
-    GramAccumulator, Spread,
+    check_data, finish, orientation, range, solve_weights, threshold_candidates, threshold_grid,
+    unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
 };
+use super::model_size::choose;
 use super::OperatorFit;
 use crate::model::operators::{
     play, validate_thresholds, DeadZones, GeneralizedPi, Orientation, PrandtlIshlinskii,
@@ -189,7 +190,38 @@ impl Identify for GeneralizedPi {
         FamilySetting::Orientation,
     ];
 
+    /// With [`FamilyOptions::choose_thresholds`] (and no explicit grid) the threshold count
+    /// and placement are chosen on a held-out part as for PI
+    /// ([`model_size`](super::model_size)).
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        let given = options.given_orientation(u, y)?;
+        if options.choose_thresholds && options.threshold_grid.is_none() {
+            let o = orientation(u, y, given)?;
+            let (x, _) = o.core_data(u, y);
+            let extra = 2 + 2 * options.dead_zones;
+            let candidates = threshold_candidates(&x, extra)?;
+            let (mut f, choice) = choose(
+                u,
+                y,
+                candidates,
+                10 + extra,
+                PLAY_WORK_BOUND,
+                |u, y, grid| {
+                    fit(
+                        u,
+                        y,
+                        &GpiOptions {
+                            grid: Some(grid.clone()),
+                            dead_zones: options.dead_zones,
+                            orientation: Some(o),
+                            ..GpiOptions::default()
+                        },
+                    )
+                },
+            )?;
+            f.model_size = Some(choice);
+            return Ok(f);
+        }
         fit(
             u,
             y,
@@ -197,7 +229,7 @@ impl Identify for GeneralizedPi {
                 thresholds: options.thresholds,
                 grid: options.threshold_grid.clone(),
                 dead_zones: options.dead_zones,
-                orientation: options.given_orientation(u, y)?,
+                orientation: given,
                 ..GpiOptions::default()
             },
         )

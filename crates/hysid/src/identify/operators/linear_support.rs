@@ -97,6 +97,90 @@ pub fn threshold_grid(x: &[f64], n: usize) -> Result<Vec<f64>> {
         .collect())
 }
 
+/// The geometric threshold placement rᵢ = r₁·(rₙ/r₁)^((i−1)/(n−1)), i = 1 … n, where the
+/// loop lives (MODELS.md §4.8): rₙ = n·R/(2(n + 1)) is the uniform grid's largest threshold
+/// (R = max x − min x) and r₁ = min(max(s/4, 10⁻³R), R/(2(n + 1))), s the smallest sweep of
+/// the input between two turning points that exceeds 10⁻³R — a play of half-width r moves
+/// once a sweep exceeds 2r, so the small plays follow the record's small reversals and a
+/// narrow loop (width ≪ R) gets plays near its width instead of a uniform grid's R/(2(n + 1))
+/// steps. n = 1 gives the uniform grid.
+#[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
+pub fn geometric_thresholds(x: &[f64], n: usize) -> Result<Vec<f64>> {
+    let uniform = threshold_grid(x, n)?;
+    if n < 2 {
+        return Ok(uniform);
+    }
+    let (lo, hi) = range(x);
+    let span = hi - lo;
+    let floor = 1e-3 * span;
+    let mut smallest = f64::INFINITY;
+    let mut anchor = x[0];
+    let mut last = x[0];
+    let mut direction = 0.0f64;
+    for &v in &x[1..] {
+        let d = v - last;
+        if d != 0.0 {
+            if direction != 0.0 && d.signum() != direction {
+                let sweep = (last - anchor).abs();
+                if sweep > floor {
+                    smallest = smallest.min(sweep);
+                }
+                anchor = last;
+            }
+            direction = d.signum();
+        }
+        last = v;
+    }
+    let first = (smallest / 4.0).max(floor).min(uniform[0]);
+    let top = uniform[n - 1];
+    if !(first > 0.0 && first < top) {
+        return Ok(uniform);
+    }
+    let ratio = (top / first).ln() / (n - 1) as f64;
+    let mut grid: Vec<f64> = (0..n).map(|i| first * (ratio * i as f64).exp()).collect();
+    grid[n - 1] = top;
+    if grid.windows(2).all(|w| w[1] > w[0]) {
+        Ok(grid)
+    } else {
+        Ok(uniform)
+    }
+}
+
+/// The work bound of the threshold-count choice, in fits of the fixed default size
+/// ([`crate::identify::operators::model_size`]): a play sum's fit is a few passes over the
+/// data, so all twelve candidates fit within it on any record.
+pub(crate) const PLAY_WORK_BOUND: f64 = 12.0;
+
+/// The candidate threshold grids of the count choice: every count of
+/// [`crate::identify::operators::family::THRESHOLD_CANDIDATES`], uniform then geometric
+/// (the geometric one only where it differs), labelled `"n uniform"` / `"n geometric"`, with
+/// `extra` parameters beside the n weights.
+pub(crate) fn threshold_candidates(
+    x: &[f64],
+    extra: usize,
+) -> Result<Vec<crate::identify::operators::model_size::Candidate<Vec<f64>>>> {
+    use crate::identify::operators::model_size::Candidate;
+    let mut out = Vec::new();
+    for &n in &crate::identify::operators::family::THRESHOLD_CANDIDATES {
+        let uniform = threshold_grid(x, n)?;
+        let geometric = geometric_thresholds(x, n)?;
+        let distinct = geometric != uniform;
+        out.push(Candidate {
+            setting: uniform,
+            label: format!("{n} uniform"),
+            parameters: n + extra,
+        });
+        if distinct {
+            out.push(Candidate {
+                setting: geometric,
+                label: format!("{n} geometric"),
+                parameters: n + extra,
+            });
+        }
+    }
+    Ok(out)
+}
+
 /// ΦᵀΦ, Φᵀy and yᵀy accumulated over blocks of rows (one regressor row per sample), the
 /// products done as matrix–matrix multiplications.
 pub(crate) struct GramAccumulator {
@@ -322,6 +406,7 @@ pub(crate) fn finish<M: HysteresisOperator + Core>(
         termination,
         elapsed_s: start.elapsed().as_secs_f64(),
         initial_state: None,
+        model_size: None,
     }
 }
 

@@ -14,8 +14,10 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, solve_weights, threshold_grid, GramAccumulator, Spread,
+    check_data, finish, orientation, solve_weights, threshold_candidates, threshold_grid,
+    GramAccumulator, Spread, PLAY_WORK_BOUND,
 };
+use super::model_size::choose;
 use super::OperatorFit;
 use crate::identify::operator_cascade::{OperatorCascadeIdentification, RANK_ONE};
 use crate::model::operators::{stop, validate_thresholds, MaxwellSlip, Orientation};
@@ -117,22 +119,53 @@ impl Identify for MaxwellSlip {
         FamilySetting::Orientation,
     ];
 
+    /// With [`FamilyOptions::choose_thresholds`] (and no explicit widths) the element count
+    /// and the widths' placement are chosen on a held-out part as for PI
+    /// ([`model_size`](super::model_size)).
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        // the stops' own loop is clockwise: a given turning sense maps the other way
+        let given = match (options.orientation, options.loop_orientation) {
+            (Some(o), _) => Some(o),
+            (None, Some(l)) => Some(Orientation::for_loop(
+                l.reversed(),
+                Orientation::trend(u, y)?,
+            )),
+            (None, None) => None,
+        };
+        if options.choose_thresholds && options.threshold_grid.is_none() {
+            let o = match given {
+                Some(o) => o,
+                None => {
+                    let d = orientation(u, y, None)?;
+                    Orientation {
+                        inverse: !d.inverse,
+                        ..d
+                    }
+                }
+            };
+            let (x, _) = o.core_data(u, y);
+            let candidates = threshold_candidates(&x, 2)?;
+            let (mut f, choice) = choose(u, y, candidates, 12, PLAY_WORK_BOUND, |u, y, w| {
+                fit(
+                    u,
+                    y,
+                    &MaxwellSlipOptions {
+                        widths: Some(w.clone()),
+                        orientation: Some(o),
+                        ..MaxwellSlipOptions::default()
+                    },
+                )
+            })?;
+            f.model_size = Some(choice);
+            return Ok(f);
+        }
         fit(
             u,
             y,
             &MaxwellSlipOptions {
                 elements: options.thresholds,
                 widths: options.threshold_grid.clone(),
-                // the stops' own loop is clockwise: a given turning sense maps the other way
-                orientation: match (options.orientation, options.loop_orientation) {
-                    (Some(o), _) => Some(o),
-                    (None, Some(l)) => Some(Orientation::for_loop(
-                        l.reversed(),
-                        Orientation::trend(u, y)?,
-                    )),
-                    (None, None) => None,
-                },
+                orientation: given,
                 ..MaxwellSlipOptions::default()
             },
         )

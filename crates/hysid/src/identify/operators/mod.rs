@@ -45,6 +45,7 @@ pub mod kp;
 #[doc(hidden)] // reached by the white-box tests in crates/hysid-tests/tests/library/unit
 pub mod linear_support;
 pub mod maxwell_slip;
+pub mod model_size;
 pub mod pi;
 pub mod preisach;
 
@@ -83,4 +84,8 @@ pub struct OperatorFit<M> {
     /// the family's neutral state; [`crate::model::operators::initial_state`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub initial_state: Option<InitialStateUsed>,
+    /// How the model size was chosen from the data (None: fixed by the options or the
+    /// family's structure; [`model_size`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model_size: Option<model_size::ModelSizeChoice>,
 }

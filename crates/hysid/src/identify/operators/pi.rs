@@ -17,9 +17,10 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, solve_weights, threshold_grid, unscaled, GramAccumulator,
-    Spread,
+    check_data, finish, orientation, solve_weights, threshold_candidates, threshold_grid,
+    unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
 };
+use super::model_size::choose;
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
     monotone_weights, OperatorCascadeIdentification, RANK_ONE,
@@ -160,14 +161,37 @@ impl Identify for PrandtlIshlinskii {
         FamilySetting::Orientation,
     ];
 
+    /// With [`FamilyOptions::choose_thresholds`] (and no explicit grid) the count and the
+    /// placement (uniform or geometric, `linear_support::geometric_thresholds`) are chosen on a held-out part
+    /// ([`model_size`](super::model_size)); otherwise the `thresholds` uniform grid or the
+    /// given one.
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
+        let given = options.given_orientation(u, y)?;
+        if options.choose_thresholds && options.threshold_grid.is_none() {
+            let o = orientation(u, y, given)?;
+            let (x, _) = o.core_data(u, y);
+            let candidates = threshold_candidates(&x, 2)?;
+            let (mut f, choice) = choose(u, y, candidates, 12, PLAY_WORK_BOUND, |u, y, grid| {
+                fit(
+                    u,
+                    y,
+                    &PiOptions {
+                        grid: Some(grid.clone()),
+                        orientation: Some(o),
+                        ..PiOptions::default()
+                    },
+                )
+            })?;
+            f.model_size = Some(choice);
+            return Ok(f);
+        }
         fit(
             u,
             y,
             &PiOptions {
                 thresholds: options.thresholds,
                 grid: options.threshold_grid.clone(),
-                orientation: options.given_orientation(u, y)?,
+                orientation: given,
                 select: None,
             },
         )

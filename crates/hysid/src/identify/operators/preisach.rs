@@ -19,12 +19,19 @@ use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, unscaled, GramAccumulator, Spread,
 };
+use super::model_size::{choose, Candidate};
 use super::OperatorFit;
 use crate::model::operators::preisach::{regressors, Grid, Memory};
 use crate::model::operators::{Orientation, Preisach};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use std::time::Instant;
+
+/// The work bound of the grid choice, in fits of the default grid 20
+/// ([`super::model_size`]): the candidates 6 … 20 cost about one such fit together on the
+/// training part, 30 about 3.4 more, so the default choice stays within about twice one
+/// fixed fit and stops before 30 and 40 (reached with `--grid`).
+pub const GRID_WORK_BOUND: f64 = 2.0;
 
 /// Options of the Preisach identification.
 #[derive(Clone, Debug, PartialEq)]
@@ -178,16 +185,34 @@ impl Identify for Preisach {
         FamilySetting::Orientation,
     ];
 
+    /// With [`FamilyOptions::choose_grid`] the grid's intervals are chosen among
+    /// [`GRID_CANDIDATES`](super::family::GRID_CANDIDATES) on a held-out part, within
+    /// [`GRID_WORK_BOUND`] fits of the default grid 20
+    /// ([`model_size`](super::model_size)); otherwise `grid` fixes them.
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
-        fit(
-            u,
-            y,
-            &PreisachOptions {
-                levels: options.grid,
-                lambda: options.lambda,
-                orientation: options.given_orientation(u, y)?,
-                ..PreisachOptions::default()
-            },
-        )
+        let given = options.given_orientation(u, y)?;
+        let settings = |levels: usize, orientation: Option<Orientation>| PreisachOptions {
+            levels,
+            lambda: options.lambda,
+            orientation,
+            ..PreisachOptions::default()
+        };
+        if options.choose_grid {
+            let o = orientation(u, y, given)?;
+            let candidates = super::family::GRID_CANDIDATES
+                .iter()
+                .map(|&n| Candidate {
+                    setting: n,
+                    label: format!("grid {n}"),
+                    parameters: n * (n + 1) / 2 + 2,
+                })
+                .collect();
+            let (mut f, choice) = choose(u, y, candidates, 212, GRID_WORK_BOUND, |u, y, &n| {
+                fit(u, y, &settings(n, Some(o)))
+            })?;
+            f.model_size = Some(choice);
+            return Ok(f);
+        }
+        fit(u, y, &settings(options.grid, given))
     }
 }

@@ -11,5 +11,6 @@ mod gpi;
 mod jiles_atherton;
 mod kp;
 mod maxwell_slip;
+mod model_size;
 mod pi;
 mod preisach;
