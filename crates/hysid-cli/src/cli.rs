@@ -721,6 +721,14 @@ pub struct ExportArgs {
     /// without one exports an unlimited compensator (with a warning).
     #[arg(long, allow_hyphen_values = true, value_parser = crate::options::limits)]
     pub limits: Option<hysid::model::limits::Limits>,
+    /// Add reference vectors and a program that checks the code against them (c: DIR/NAME_test.c
+    /// with main and NAME_test_run; rust: DIR/NAME/tests/vectors.rs); not with --target fmu.
+    #[arg(long = "test-vectors")]
+    pub test_vectors: bool,
+    /// With --test-vectors: the input range LO:HI the test sequence covers (default: the model
+    /// file's input_range; required when the file has none).
+    #[arg(long = "test-range", allow_hyphen_values = true, value_parser = crate::options::limits)]
+    pub test_range: Option<hysid::model::limits::Limits>,
 }
 
 /// Export targets.

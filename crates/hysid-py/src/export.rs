@@ -66,6 +66,7 @@ fn export_model(
             binary,
             initial_output: y0,
             limits: None,
+            ..ExportOptions::default()
         };
         let files = export(&file, target, &name, &options)?;
         let paths = files.iter().map(|f| dir.path().join(&f.path)).collect();

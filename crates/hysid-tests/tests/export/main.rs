@@ -11,3 +11,4 @@ mod greybox;
 mod hostile;
 mod newmark_lu;
 mod rust_target;
+mod vectors;
