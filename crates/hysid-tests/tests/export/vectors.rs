@@ -134,3 +134,29 @@ fn every_kinds_test_program_passes_and_fails_on_a_changed_value() {
         );
     }
 }
+
+/// Writes the C export with test vectors of every kind (one case per family and kind, forward
+/// and inverse) into the directory `$HYSID_ARM_OUT`, one subdirectory per case, for the
+/// target harness `tools/arm/run.py`; each export must succeed.
+#[test]
+#[ignore = "writes the exports for tools/arm/run.py (HYSID_ARM_OUT=DIR)"]
+fn write_the_exports_for_the_target_harness() {
+    let Some(out) = std::env::var_os("HYSID_ARM_OUT") else {
+        panic!("set HYSID_ARM_OUT to the directory to write the exports to");
+    };
+    let out = Path::new(&out);
+    let all: Vec<Case> = vector_cases()
+        .into_iter()
+        .filter(|c| !c.name.contains("_cw_") && !c.name.starts_with("ch_measured"))
+        .collect();
+    assert!(all.len() >= 20, "{} cases", all.len());
+    for case in &all {
+        let dir = out.join(&case.name);
+        std::fs::create_dir_all(&dir).expect("mkdir");
+        for f in export(&case.file, Target::C, &case.name, &with_vectors(case))
+            .unwrap_or_else(|e| panic!("{}: export failed: {e}", case.name))
+        {
+            std::fs::write(dir.join(&f.path), f.contents).expect("write");
+        }
+    }
+}
