@@ -740,6 +740,14 @@ pub struct ExportArgs {
     /// its references.
     #[arg(long)]
     pub output: Option<String>,
+    /// Add reference vectors and a program that checks the code against them (c: DIR/NAME_test.c
+    /// with main and NAME_test_run; rust: DIR/NAME/tests/vectors.rs); not with --target fmu.
+    #[arg(long = "test-vectors")]
+    pub test_vectors: bool,
+    /// With --test-vectors: the input range LO:HI the test sequence covers (default: the model
+    /// file's input_range; required when the file has none).
+    #[arg(long = "test-range", allow_hyphen_values = true, value_parser = crate::options::limits)]
+    pub test_range: Option<hysid::model::limits::Limits>,
 }
 
 /// The floating-point type of exported code.

@@ -84,6 +84,7 @@ fn export_model(
             limits,
             precision,
             bound_record: None,
+            ..ExportOptions::default()
         };
         let files = export(&file, target, &name, &options)?;
         let paths = files.iter().map(|f| dir.path().join(&f.path)).collect();

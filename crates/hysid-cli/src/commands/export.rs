@@ -17,6 +17,24 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         )
         .into());
     }
+    if args.test_vectors && args.target == TargetArg::Fmu {
+        return Err(UsageError(
+            "--test-vectors applies to --target c and rust only; leave it out; run 'hysid export --help' for the options".into(),
+        )
+        .into());
+    }
+    if args.test_range.is_some() && !args.test_vectors {
+        return Err(UsageError(
+            "--test-range applies to --test-vectors only; leave it out; run 'hysid export --help' for the options".into(),
+        )
+        .into());
+    }
+    if args.test_range.is_some_and(|r| r.lo() >= r.hi()) {
+        return Err(UsageError(
+            "--test-range needs LO < HI; run 'hysid export --help' for the options".into(),
+        )
+        .into());
+    }
     let target = match args.target {
         TargetArg::C => Target::C,
         TargetArg::Rust => Target::Rust,
@@ -44,6 +62,8 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         limits: args.limits,
         precision,
         bound_record,
+        test_vectors: args.test_vectors,
+        test_range: args.test_range,
     };
     if args.limits.is_some() && !args.inverse {
         return Err(UsageError(

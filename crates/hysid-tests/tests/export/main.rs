@@ -12,3 +12,4 @@ mod hostile;
 mod newmark_lu;
 mod rust_target;
 mod single;
+mod vectors;

@@ -62,6 +62,7 @@ pub mod render;
 pub mod sequence;
 pub mod solve;
 pub mod stmt;
+pub mod vectors;
 pub mod zip;
 
 use crate::model::limits::Limits;
@@ -138,6 +139,13 @@ pub struct ExportOptions {
     /// a compensator); None takes the test sequence ([`sequence`]) over the file's
     /// `input_range`.
     pub bound_record: Option<Vec<Vec<f64>>>,
+    /// Add reference vectors and a program that checks them (`--test-vectors`,
+    /// [`vectors`]): `NAME_test.c` for C, `NAME/tests/vectors.rs` for Rust; refused for the
+    /// FMU.
+    pub test_vectors: bool,
+    /// The input range the test vectors' sequence covers (`--test-range LO:HI`); None takes
+    /// the model file's `input_range` ([`vectors`]).
+    pub test_range: Option<Limits>,
 }
 
 impl Default for ExportOptions {
@@ -150,6 +158,8 @@ impl Default for ExportOptions {
             limits: None,
             precision: Precision::Double,
             bound_record: None,
+            test_vectors: false,
+            test_range: None,
         }
     }
 }
@@ -395,18 +405,48 @@ pub fn rust_crate(
     ])
 }
 
+/// The reference vectors of the export `name` of `file` ([`vectors`]): the test sequence (or
+/// the forward model's outputs on it, then hostile samples, for a compensator) and the
+/// library's outputs for it.
+pub fn test_vectors(
+    file: &ModelFile,
+    name: &str,
+    options: &ExportOptions,
+) -> Result<vectors::Vectors> {
+    check_name(name)?;
+    let sample_time = SampleTime::of(file, options)?;
+    vectors::vectors(file, options, sample_time.seconds())
+}
+
 /// The files of the export of `file` to `target` under the name `name`, paths relative to
-/// the output directory.
+/// the output directory; with [`ExportOptions::test_vectors`] also the test program
+/// (`NAME_test.c`, `NAME/tests/vectors.rs`).
 pub fn export(
     file: &ModelFile,
     target: Target,
     name: &str,
     options: &ExportOptions,
 ) -> Result<Vec<GeneratedFile>> {
-    match target {
+    if options.test_vectors && options.precision.is_single() {
+        return Err(Error::invalid_option(
+            "test-vectors",
+            "single",
+            "test vectors are written for the double code only so far; export them with \
+             --precision double"
+                .into(),
+        ));
+    }
+    if options.test_vectors && target == Target::Fmu {
+        return Err(Error::invalid_option(
+            "test-vectors",
+            "fmu",
+            "test vectors come with the C and Rust targets; export the C or the Rust".into(),
+        ));
+    }
+    let mut files = match target {
         Target::C => {
             let code = c_code(file, name, options)?;
-            Ok(vec![
+            vec![
                 GeneratedFile {
                     path: PathBuf::from(format!("{name}.h")),
                     contents: code.header.into_bytes(),
@@ -415,16 +455,32 @@ pub fn export(
                     path: PathBuf::from(format!("{name}.c")),
                     contents: code.source.into_bytes(),
                 },
-            ])
+            ]
         }
-        Target::Rust => rust_crate(file, name, options),
-        Target::Fmu if options.precision.is_single() => Err(Error::invalid_option(
-            "precision",
-            "single",
-            "an FMU computes in double (FMI 2.0's Real is a double); export --target c or rust \
-             for single precision"
-                .into(),
-        )),
-        Target::Fmu => fmu::fmu_files(&c_code(file, name, options)?, options),
+        Target::Rust => rust_crate(file, name, options)?,
+        Target::Fmu if options.precision.is_single() => {
+            return Err(Error::invalid_option(
+                "precision",
+                "single",
+                "an FMU computes in double (FMI 2.0's Real is a double); export --target c or \
+                 rust for single precision"
+                    .into(),
+            ))
+        }
+        Target::Fmu => fmu::fmu_files(&c_code(file, name, options)?, options)?,
+    };
+    if options.test_vectors {
+        let v = test_vectors(file, name, options)?;
+        files.push(match target {
+            Target::Rust => GeneratedFile {
+                path: PathBuf::from(name).join("tests").join("vectors.rs"),
+                contents: vectors::rust_test(name, &v).into_bytes(),
+            },
+            _ => GeneratedFile {
+                path: PathBuf::from(format!("{name}_test.c")),
+                contents: vectors::c_test(name, &v).into_bytes(),
+            },
+        });
     }
+    Ok(files)
 }

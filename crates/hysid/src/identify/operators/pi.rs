@@ -17,8 +17,8 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, solve_weights, threshold_candidates, threshold_grid,
-    unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
+    check_data, finish, orientation, solve_weights, threshold_candidates, threshold_grid, unscaled,
+    GramAccumulator, Spread, PLAY_WORK_BOUND,
 };
 use super::model_size::choose;
 use super::OperatorFit;

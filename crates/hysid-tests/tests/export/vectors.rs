@@ -1,0 +1,163 @@
+//! `--test-vectors`: the generated `NAME_test.c` compiled on the host with the contract's
+//! flags passes for every exported kind (exit 0, one PASS line), and fails when one expected
+//! value is changed — so the program can fail.
+
+use crate::cases::{self, Case};
+use hysid::export::{export, ExportOptions, Target};
+use hysid::model::limits::Limits;
+use std::path::Path;
+use std::process::Command;
+
+/// The flags of the contract.
+const FLAGS: [&str; 7] = [
+    "-std=c99",
+    "-Wall",
+    "-Wextra",
+    "-Werror",
+    "-pedantic",
+    "-Wconversion",
+    "-O2",
+];
+
+/// The options of `case` with test vectors over the test signal's range, ±1.
+fn with_vectors(case: &Case) -> ExportOptions {
+    ExportOptions {
+        test_vectors: true,
+        test_range: Some(Limits::new(-1.0, 1.0).expect("limits")),
+        ..case.options.clone()
+    }
+}
+
+/// Writes the C export of `case` with its test program into `dir`, `corrupt` changing the
+/// first expected value; compiles and runs it: (exit code, stdout).
+fn run(case: &Case, dir: &Path, corrupt: bool) -> (i32, String) {
+    let name = &case.name;
+    let files = export(&case.file, Target::C, name, &with_vectors(case))
+        .unwrap_or_else(|e| panic!("{name}: export failed: {e}"));
+    assert_eq!(files.len(), 3, "{name}: NAME.h, NAME.c and NAME_test.c");
+    for f in &files {
+        let mut text = String::from_utf8(f.contents.clone()).expect("text");
+        if corrupt && f.path.to_string_lossy().ends_with("_test.c") {
+            let table = format!("{name}_test_y[");
+            let at = text.find(&table).expect("the expected table");
+            let line = at + text[at..].find('\n').expect("a line") + 1;
+            let end = line + text[line..].find(',').expect("a value");
+            text.replace_range(end..end, " + 0.5");
+        }
+        std::fs::write(dir.join(&f.path), text).expect("write");
+    }
+    let exe = dir.join(name);
+    let compiled = Command::new("cc")
+        .args(FLAGS)
+        .arg("-o")
+        .arg(&exe)
+        .arg(dir.join(format!("{name}.c")))
+        .arg(dir.join(format!("{name}_test.c")))
+        .arg("-lm")
+        .output()
+        .expect("the C compiler `cc` is needed by this test (install gcc or clang)");
+    assert!(
+        compiled.status.success(),
+        "{name}: cc failed:\n{}",
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+    let ran = Command::new(&exe).output().expect("run the test program");
+    (
+        ran.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&ran.stdout).into_owned(),
+    )
+}
+
+/// The cases of one input (the test program's sequence), forward and inverse, without the
+/// references beyond reach (the vectors make their own).
+fn vector_cases() -> Vec<Case> {
+    cases::all()
+        .into_iter()
+        .filter(|c| !c.name.ends_with("_beyond"))
+        .filter(|c| {
+            hysid::export::test_vectors(&c.file, &c.name, &with_vectors(c))
+                .is_ok_and(|v| v.inputs.first().is_some_and(|u| u.len() == 1))
+        })
+        .collect()
+}
+
+#[test]
+fn the_pi_test_program_passes_and_fails_on_a_changed_value() {
+    let all = cases::all();
+    let dir = tempfile::tempdir().expect("temp dir");
+    for name in ["pi_forward", "pi_inverse"] {
+        let case = all.iter().find(|c| c.name == name).expect("the PI case");
+        let (code, out) = run(case, dir.path(), false);
+        assert_eq!(code, 0, "{name}: {out}");
+        assert!(out.starts_with(&format!("{name}: PASS (")), "{out}");
+        let (code, out) = run(case, dir.path(), true);
+        assert_eq!(code, 1, "{name}: a changed expected value passed: {out}");
+        assert!(
+            out.starts_with(&format!("{name}: FAIL (1 failed checks")),
+            "{out}"
+        );
+    }
+}
+
+#[test]
+fn a_compensators_vectors_hold_hostile_samples_and_the_limits() {
+    let case = cases::all()
+        .into_iter()
+        .find(|c| c.name == "pi_inverse")
+        .expect("the PI compensator");
+    let mut options = with_vectors(&case);
+    options.limits = Some(Limits::new(-0.5, 0.5).expect("limits"));
+    let v = hysid::export::test_vectors(&case.file, "pi", &options).expect("vectors");
+    let bad = v.inputs.iter().filter(|u| !u[0].is_finite()).count();
+    assert_eq!(bad, 3 + 7);
+    assert_eq!(v.faults, bad);
+    assert!(v.inputs.iter().any(|u| u[0].abs() >= 10.0));
+    assert!(v.outputs.iter().all(|y| (-0.5..=0.5).contains(&y[0])));
+    assert!(v.clipped.is_some_and(|n| n > 0));
+    assert_eq!(v.bound, 0.0);
+}
+
+#[test]
+#[ignore = "generated code (compiled with cc): run in CI's long step, `cargo test --release -- --ignored`"]
+fn every_kinds_test_program_passes_and_fails_on_a_changed_value() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let all = vector_cases();
+    assert!(all.len() >= 40, "{} cases", all.len());
+    for case in &all {
+        let (code, out) = run(case, dir.path(), false);
+        assert_eq!(code, 0, "{}: {out}", case.name);
+        let (code, out) = run(case, dir.path(), true);
+        assert_eq!(
+            code, 1,
+            "{}: a changed expected value passed: {out}",
+            case.name
+        );
+    }
+}
+
+/// Writes the C export with test vectors of every kind (one case per family and kind, forward
+/// and inverse) into the directory `$HYSID_ARM_OUT` (a temporary one when unset), one
+/// subdirectory per case, for the target harness `tools/arm/run.py`; each export must succeed
+/// and hold the three files.
+#[test]
+#[ignore = "generated code for tools/arm/run.py (HYSID_ARM_OUT=DIR): run in CI's long step, `cargo test --release -- --ignored`"]
+fn write_the_exports_for_the_target_harness() {
+    let temp = tempfile::tempdir().expect("temp dir");
+    let out = std::env::var_os("HYSID_ARM_OUT").map_or(temp.path().to_path_buf(), Into::into);
+    let out = out.as_path();
+    let all: Vec<Case> = vector_cases()
+        .into_iter()
+        .filter(|c| !c.name.contains("_cw_") && !c.name.starts_with("ch_measured"))
+        .collect();
+    assert!(all.len() >= 20, "{} cases", all.len());
+    for case in &all {
+        let dir = out.join(&case.name);
+        std::fs::create_dir_all(&dir).expect("mkdir");
+        for f in export(&case.file, Target::C, &case.name, &with_vectors(case))
+            .unwrap_or_else(|e| panic!("{}: export failed: {e}", case.name))
+        {
+            std::fs::write(dir.join(&f.path), f.contents).expect("write");
+        }
+        assert!(dir.join(format!("{}_test.c", case.name)).is_file());
+    }
+}
