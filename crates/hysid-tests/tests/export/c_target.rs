@@ -37,6 +37,26 @@ pub fn driver(name: &str, inverse: bool) -> String {
     )
 }
 
+/// Compiles the C files `sources` of `dir` with `flags` (and `-lm`) into the executable
+/// `dir/name`; a compiler error fails the test with its output.
+pub fn compile(dir: &Path, name: &str, flags: &[&str], sources: &[&str]) -> std::path::PathBuf {
+    let exe = dir.join(name);
+    let compiled = Command::new("cc")
+        .args(flags)
+        .arg("-o")
+        .arg(&exe)
+        .args(sources.iter().map(|s| dir.join(s)))
+        .arg("-lm")
+        .output()
+        .expect("the C compiler `cc` is needed by this test (install gcc or clang)");
+    assert!(
+        compiled.status.success(),
+        "{name}: cc failed:\n{}",
+        String::from_utf8_lossy(&compiled.stderr)
+    );
+    exe
+}
+
 /// Compiles and runs the C of `case` in `dir`: the outputs, the diverged flag and, for a
 /// compensator, its clipped count.
 pub fn run(case: &Case, dir: &Path) -> (Vec<f64>, bool, Option<usize>) {
@@ -62,20 +82,11 @@ pub fn run_text(case: &Case, dir: &Path) -> String {
         cases::input_text(&case.input),
     )
     .expect("write");
-    let exe = dir.join(name);
-    let compiled = Command::new("cc")
-        .args(FLAGS)
-        .arg("-o")
-        .arg(&exe)
-        .arg(dir.join(format!("{name}.c")))
-        .arg(dir.join(format!("{name}_driver.c")))
-        .arg("-lm")
-        .output()
-        .expect("the C compiler `cc` is needed by this test (install gcc or clang)");
-    assert!(
-        compiled.status.success(),
-        "{name}: cc failed:\n{}",
-        String::from_utf8_lossy(&compiled.stderr)
+    let exe = compile(
+        dir,
+        name,
+        &FLAGS,
+        &[&format!("{name}.c"), &format!("{name}_driver.c")],
     );
     let ran = Command::new(&exe)
         .arg(dir.join(format!("{name}.in")))

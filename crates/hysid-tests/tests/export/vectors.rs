@@ -46,20 +46,11 @@ fn run(case: &Case, dir: &Path, corrupt: bool) -> (i32, String) {
         }
         std::fs::write(dir.join(&f.path), text).expect("write");
     }
-    let exe = dir.join(name);
-    let compiled = Command::new("cc")
-        .args(FLAGS)
-        .arg("-o")
-        .arg(&exe)
-        .arg(dir.join(format!("{name}.c")))
-        .arg(dir.join(format!("{name}_test.c")))
-        .arg("-lm")
-        .output()
-        .expect("the C compiler `cc` is needed by this test (install gcc or clang)");
-    assert!(
-        compiled.status.success(),
-        "{name}: cc failed:\n{}",
-        String::from_utf8_lossy(&compiled.stderr)
+    let exe = crate::c_target::compile(
+        dir,
+        name,
+        &FLAGS,
+        &[&format!("{name}.c"), &format!("{name}_test.c")],
     );
     let ran = Command::new(&exe).output().expect("run the test program");
     (

@@ -38,7 +38,7 @@
 //! of operations ([`greybox::newmark`]); a `band_limited` model is refused
 //! ([`Error::UnsupportedKind`]). See `docs/export.md`.
 //!
-//! How it is built: a language-neutral program ([`code`], [`program`]) that the renderers
+//! How it is built: a language-neutral program ([`code`], [`mod@program`]) that the renderers
 //! ([`render`]) print as C or Rust; each model kind ([`kinds`]) and each operator family,
 //! through the family registry ([`families`]), supplies its step once, transliterating the
 //! library's computation in its order of operations; the emitters know models, the renderers

@@ -4,7 +4,7 @@
 //! access `s->x` / `self.x`, `fabs` / `libm::fabs`, casts, the conditional expression,
 //! declarations and loops). Both print in either [`Precision`]: the type `Ty::F64` is
 //! `double`/`f64` or `float`/`f32`, a literal the `f64` constant or its nearest `float`
-//! ([`float_digits`]), a math function `sin` or `sinf`.
+//! (`float_digits`), a math function `sin` or `sinf`.
 
 pub mod c;
 pub mod rust;
