@@ -339,24 +339,9 @@ pub struct Machine<R> {
 impl<R: Real> Machine<R> {
     /// The program `program` after its initialisation (`NAME_init`, `Model::new`).
     pub fn new(program: &Program) -> Result<Self> {
-        let fields: HashMap<&str, usize> = program
-            .fields
-            .iter()
-            .enumerate()
-            .map(|(i, f)| (f.name.as_str(), i))
-            .collect();
-        let tables: HashMap<&str, usize> = program
-            .tables
-            .iter()
-            .enumerate()
-            .map(|(i, t)| (t.name.as_str(), i))
-            .collect();
-        let functions: HashMap<&str, usize> = program
-            .functions
-            .iter()
-            .enumerate()
-            .map(|(i, f)| (f.name.as_str(), i))
-            .collect();
+        let fields = index_by_name(&program.fields, |f| &f.name);
+        let tables = index_by_name(&program.tables, |t| &t.name);
+        let functions = index_by_name(&program.functions, |f| &f.name);
         let compile = |params: &[(String, Ty)], body: &[Stmt]| -> Result<F> {
             let mut r = Resolver {
                 fields: &fields,
@@ -641,6 +626,15 @@ impl<R: Real> Machine<R> {
                 .ok_or_else(|| bug(format!("helper {f} returned no value")))?,
         })
     }
+}
+
+/// Each item's position, by its name.
+fn index_by_name<T>(items: &[T], name: impl Fn(&T) -> &String) -> HashMap<&str, usize> {
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| (name(item).as_str(), i))
+        .collect()
 }
 
 /// The float in `v`, else a bug.
