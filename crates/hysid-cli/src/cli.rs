@@ -354,9 +354,11 @@ pub struct SearchArgs {
     /// Seed of the random starts.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Maximum iterations of the final fit (Gunnar et al. 2006 use 30). Range 1..=100000.
-    #[arg(long, default_value_t = 100, value_parser = crate::options::count::<1, 100_000>)]
-    pub max_iterations: usize,
+    /// Maximum iterations of the final fit, a hard cap (Gunnar et al. 2006 use 30). Range
+    /// 1..=100000. Not given: 100, and a fit still improving at 100 goes on to at most 1000
+    /// (docs/numerics.md §1).
+    #[arg(long, value_parser = crate::options::count::<1, 100_000>)]
+    pub max_iterations: Option<usize>,
     /// Stop when the expected relative improvement falls below this (Gunnar et al. 2006:
     /// 1e-4, i.e. 0.01 %) and the Gauss–Newton step is below 1e-7·√(X/1e-10) of every
     /// parameter (so a stop means a minimum; docs/numerics.md §1). Range [1e-15, 1).

@@ -60,12 +60,21 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     if let Some(eq) = &equations {
         initial = InitialStates::of_equations(eq, data.n_experiments(), &initial.estimated);
     }
+    let default_lm = GreyBoxEstimation::default().lm;
     let estimation = GreyBoxEstimation {
         simulation: simulation(&args.simulation),
         lm: LmConfig {
-            max_iterations: args.search.max_iterations,
+            // A given --max-iterations is a hard cap.
+            max_iterations: args
+                .search
+                .max_iterations
+                .unwrap_or(default_lm.max_iterations),
+            extra_iterations: match args.search.max_iterations {
+                Some(_) => 0,
+                None => default_lm.extra_iterations,
+            },
             improvement_tolerance: args.search.tolerance,
-            ..GreyBoxEstimation::default().lm
+            ..default_lm
         },
         starts: args.search.starts.max(1),
         seed: args.search.seed,

@@ -15,6 +15,16 @@ use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::native::Evaluator;
 use hysid::model::greybox::StateSpaceModel;
 use hysid::numerics::{Control, DampingScale, LmConfig, Termination};
+
+/// The cases that the extension past 100 iterations and the restarts certify
+/// ([`LmConfig::extra_iterations`], [`LmConfig::restarts`]).
+pub const EXTENDED: [(&str, usize); 5] = [
+    ("MGH17", 1),
+    ("BoxBOD", 1),
+    ("MGH10", 2),
+    ("Bennett5", 1),
+    ("Bennett5", 2),
+];
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -31,20 +41,13 @@ pub const PARAMETER_DIGITS: f64 = 6.0;
 /// Correct digits every standard deviation must reach.
 pub const STD_DIGITS: f64 = 3.0;
 
-/// The cases the engine does not certify yet, each a (problem, start) pair, with what stops
-/// it: a far start that ends at another stationary point (BoxBOD from start 1, as MINPACK's
-/// does) or that needs more than the default 100 iterations (MGH17 from start 1, MGH10 and
-/// Bennett5 from both starts). The test fails if one of them starts to pass (take it off
-/// the list, and the table in `docs/numerics.md` §1.1 says so) or if any other case falls
-/// below six digits.
-pub const SHORT: [(&str, usize); 6] = [
-    ("MGH17", 1),
-    ("BoxBOD", 1),
-    ("MGH10", 1),
-    ("MGH10", 2),
-    ("Bennett5", 1),
-    ("Bennett5", 2),
-];
+/// The cases the engine does not certify yet, each a (problem, start) pair: MGH10 from its
+/// far start, which the search takes, with b1 → 10⁻⁵⁰, to a point of S ≈ 1.49·10⁶ (the
+/// certified S is 87.9) where the improvement and parameter tests pass, and which the plateau
+/// test of the restarts does not recognise (no column of J has vanished). The test fails if
+/// it starts to pass (take it off the list, and the table in `docs/numerics.md` §1.1 says
+/// so) or if any other case falls below six digits.
+pub const SHORT: [(&str, usize); 1] = [("MGH10", 1)];
 
 /// What a NIST `.dat` file certifies.
 #[derive(Clone, Debug)]
@@ -302,7 +305,7 @@ fn improvement_rule_alone_stops_nelson_short() {
 }
 
 /// Marquardt's scaling by the current diag(JᵀJ) leaves MGH09 and Eckerle4 from their far
-/// starts short at 100 iterations; MINPACK's running maximum, the grey-box default
+/// starts short at 100 iterations (without the extension past them and the restarts); MINPACK's running maximum, the grey-box default
 /// ([`DampingScale::RunningMax`]), certifies both (the test above).
 #[test]
 fn current_scaling_leaves_mgh09_and_eckerle4_short() {
@@ -310,6 +313,8 @@ fn current_scaling_leaves_mgh09_and_eckerle4_short() {
         let estimation = GreyBoxEstimation {
             lm: LmConfig {
                 damping_scale: DampingScale::Current,
+                extra_iterations: 0,
+                restarts: 0,
                 ..GreyBoxEstimation::default().lm
             },
             ..GreyBoxEstimation::default()
@@ -319,5 +324,36 @@ fn current_scaling_leaves_mgh09_and_eckerle4_short() {
         assert!(digits < 5.0, "{name}: {digits}");
         let got = fit(name, 1);
         assert!(worst_lre(&got.values, &certified(name).values) >= PARAMETER_DIGITS);
+    }
+}
+
+/// Without the extension past 100 iterations and the restarts (the engine before them) the
+/// five cases of [`EXTENDED`] stay short: MGH17 from start 1, MGH10 from start 2 and Bennett5
+/// from both at the iteration limit, BoxBOD from start 1 on its plateau (b2 ≈ 115, S =
+/// 9771.5) called converged; with them (the test above) all five are certified.
+#[test]
+fn without_extension_and_restarts_five_cases_stay_short() {
+    for (name, k) in EXTENDED {
+        let estimation = GreyBoxEstimation {
+            lm: LmConfig {
+                extra_iterations: 0,
+                restarts: 0,
+                ..GreyBoxEstimation::default().lm
+            },
+            ..GreyBoxEstimation::default()
+        };
+        let got = fit_with(name, k, estimation);
+        let digits = worst_lre(&got.values, &certified(name).values);
+        assert!(digits < 5.0, "{name} start {k}: {digits}");
+        let expected_stop = match name {
+            "BoxBOD" => got.termination.converged(),
+            _ => matches!(got.termination, Termination::MaxIterations),
+        };
+        assert!(expected_stop, "{name} start {k}: {}", got.termination);
+        assert!(
+            got.iterations <= 100,
+            "{name} start {k}: {}",
+            got.iterations
+        );
     }
 }

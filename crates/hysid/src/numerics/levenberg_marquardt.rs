@@ -27,6 +27,32 @@
 //! "relative improvement below tolerance". `docs/numerics.md` §1.1 certifies the engine on
 //! NIST's reference problems.
 //!
+//! **Past the iteration limit** ([`LmConfig::extra_iterations`], 0 by default, 900 in the
+//! grey-box fits): a search that reaches `max_iterations` while still making progress goes
+//! on, for at most `extra_iterations` more, as long as the last k = [`PROGRESS_WINDOW`]
+//! accepted iterations lowered S by more than the relative ε_p = [`PROGRESS_DECREASE`],
+//!
+//! ```text
+//! S(θ_{n−k}) − S(θ_n) > ε_p · S(θ_n),
+//! ```
+//!
+//! and it stops as [`Termination::MaxIterations`] once they do not. A long curved valley
+//! (NIST's MGH10, Bennett5) is crawled through at a steady rate that this test sees; a
+//! search that has stalled is not kept going. A search that stops before the limit is
+//! untouched: its iterates are those without the extension, bit for bit.
+//!
+//! **Restarts** ([`LmConfig::restarts`], 0 by default, 2 in the grey-box fits): a search
+//! that ended off a minimum — at the iteration limit, or "converged" on a plateau where a
+//! free parameter's column of J has vanished, diag(JᵀJ)ⱼ < [`PLATEAU_COLUMN`]·maxₚₐₜₕ
+//! diag(JᵀJ)ⱼ (the parameter no longer acts on the residuals: a saturated exponential,
+//! NIST's BoxBOD from its far start, b2 ≈ 115) — searches again from θ₀ with the initial
+//! damping λ₀·Rᵏ, R = [`RESTART_DAMPING`], for restart k. A large λ makes the first steps
+//! short gradient steps in the metric D (Marquardt 1963: δ → −(λD)⁻¹Jᵀr as λ → ∞), which
+//! follow the valley instead of leaping over it onto the plateau; Nielsen's rule then lowers
+//! λ by up to 3 per accepted step. The run with the lower S is kept. Both rules act only
+//! with the parameter test (`parameter_tolerance` finite), so the improvement rule
+//! ([`LmConfig::improvement_rule`]) keeps its bits.
+//!
 //! **Diverging trials**: a trial point whose residuals cannot be computed (the simulation blows
 //! up or errors) counts as a failed step (λ grows) and is reported in
 //! [`LmReport::rejected_trials`]; it never aborts the fit.
@@ -190,7 +216,33 @@ pub struct LmConfig {
     pub fd_step: f64,
     /// The scale D of the damping term λ·D.
     pub damping_scale: DampingScale,
+    /// Iterations past `max_iterations` that a search still making progress may take (0:
+    /// `max_iterations` is a hard cap). Past the cap the search goes on only while the last
+    /// [`PROGRESS_WINDOW`] iterations lowered S by more than the relative
+    /// [`PROGRESS_DECREASE`]; it stops as [`Termination::MaxIterations`] once they do not.
+    /// Only the rule with the parameter test (`parameter_tolerance` finite) extends.
+    pub extra_iterations: usize,
+    /// Restarts of a search that ended without reaching a minimum — at the iteration limit,
+    /// or on a plateau where a free parameter's column of J has vanished (below
+    /// [`PLATEAU_COLUMN`] of the largest it had on the path, so the parameter no longer acts
+    /// on the residuals). Each restart searches again from the start with the damping
+    /// [`RESTART_DAMPING`]ᵏ·λ₀ for restart k (ever more cautious first steps), and the run
+    /// with the lower S is kept.
+    /// Only the rule with the parameter test restarts; 0 never does.
+    pub restarts: usize,
 }
+
+/// Iterations over which the progress test past `max_iterations` looks back
+/// ([`LmConfig::extra_iterations`]).
+pub const PROGRESS_WINDOW: usize = 10;
+/// The relative decrease of S over [`PROGRESS_WINDOW`] iterations below which a search past
+/// `max_iterations` has stagnated ([`LmConfig::extra_iterations`]).
+pub const PROGRESS_DECREASE: f64 = 1e-9;
+/// A free parameter whose diag(JᵀJ) is below this fraction of the largest it had on the
+/// search's path has stopped acting on the residuals ([`LmConfig::restarts`]).
+pub const PLATEAU_COLUMN: f64 = 1e-20;
+/// The factor on λ₀ of each restart over the run before it ([`LmConfig::restarts`]).
+pub const RESTART_DAMPING: f64 = 1e4;
 
 /// The scale D of the damping term λ·D of [`LmConfig`] (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -214,6 +266,8 @@ impl Default for LmConfig {
             initial_damping: 1e-3,
             fd_step: 1e-7,
             damping_scale: DampingScale::Current,
+            extra_iterations: 0,
+            restarts: 0,
         }
     }
 }
@@ -373,7 +427,40 @@ pub fn minimize(
 ) -> Result<LmReport> {
     let start = Instant::now();
     let mut state = State::new(problem, theta0, free, lower, upper, config)?;
-    let termination = state.run(callback)?;
+    let mut termination = state.run(callback)?;
+    let mut factor = 1.0;
+    for _ in 0..config.restarts {
+        if !config.parameter_tolerance.is_finite() || !state.needs_restart(&termination) {
+            break;
+        }
+        factor *= RESTART_DAMPING;
+        let restart_config = LmConfig {
+            initial_damping: config.initial_damping * factor,
+            ..config.clone()
+        };
+        let mut again = State::new(problem, theta0, free, lower, upper, &restart_config)?;
+        again.iterations = state.iterations;
+        again.first = state.iterations;
+        again.fevals += state.fevals;
+        again.plain_evals += state.plain_evals;
+        again.sensitivity_evals += state.sensitivity_evals;
+        again.rejected = state.rejected;
+        again.history = std::mem::take(&mut state.history);
+        let again_termination = again.run(callback)?;
+        if again.system.cost < state.system.cost {
+            termination = again_termination;
+            std::mem::swap(&mut state.theta, &mut again.theta);
+            state.system = again.system;
+            state.scale = again.scale;
+            state.largest = again.largest;
+        }
+        state.iterations = again.iterations;
+        state.fevals = again.fevals;
+        state.plain_evals = again.plain_evals;
+        state.sensitivity_evals = again.sensitivity_evals;
+        state.rejected = again.rejected;
+        state.history = again.history;
+    }
     Ok(state.into_report(termination, start.elapsed().as_secs_f64()))
 }
 
@@ -410,6 +497,11 @@ struct State<'a> {
     refining: bool,
     /// D of the damping term, per free parameter ([`LmConfig::damping_scale`]).
     scale: Vec<f64>,
+    /// The largest diag(JᵀJ) of the accepted points, per free parameter
+    /// ([`LmConfig::restarts`]).
+    largest: Vec<f64>,
+    /// Iterations of the runs before this one ([`LmConfig::restarts`]).
+    first: usize,
 }
 
 /// Gauss–Newton steps at most at an exact fit ([`State::polish`]).
@@ -471,6 +563,8 @@ impl<'a> State<'a> {
             history: Vec::new(),
             refining: false,
             scale: Vec::new(),
+            largest: Vec::new(),
+            first: 0,
         };
         state.system = match analytic {
             Some(system) => {
@@ -490,6 +584,7 @@ impl<'a> State<'a> {
         };
         state.initial_cost = state.system.cost;
         state.scale = state.system.jtj.diagonal().iter().copied().collect();
+        state.largest = state.scale.clone();
         // D = diag(JᵀJ) carries the scale, so λ itself is dimensionless.
         state.lambda = config.initial_damping;
         Ok(state)
@@ -523,7 +618,7 @@ impl<'a> State<'a> {
                 }
                 self.refining = true;
             }
-            if self.iterations >= self.config.max_iterations {
+            if self.iterations - self.first >= self.config.max_iterations && !self.may_go_on() {
                 return Ok(Termination::MaxIterations);
             }
             self.iterations += 1;
@@ -597,6 +692,36 @@ impl<'a> State<'a> {
                 return;
             }
         }
+    }
+
+    /// Past `max_iterations`: true while the search may take another iteration
+    /// ([`LmConfig::extra_iterations`]).
+    fn may_go_on(&self) -> bool {
+        if !self.config.parameter_tolerance.is_finite()
+            || self.iterations - self.first
+                >= self.config.max_iterations + self.config.extra_iterations
+        {
+            return false;
+        }
+        let n = self.history.len();
+        if n < self.first + PROGRESS_WINDOW + 1 {
+            return false;
+        }
+        let before = self.history[n - 1 - PROGRESS_WINDOW].cost;
+        let now = self.history[n - 1].cost;
+        (before - now) > PROGRESS_DECREASE * now
+    }
+
+    /// True when a search that ended with `termination` is not at a minimum
+    /// ([`LmConfig::restarts`]).
+    fn needs_restart(&self, termination: &Termination) -> bool {
+        if matches!(termination, Termination::MaxIterations) {
+            return true;
+        }
+        termination.converged()
+            && !matches!(termination, Termination::ZeroResidual)
+            && (0..self.free.len())
+                .any(|k| self.system.jtj[(k, k)] < PLATEAU_COLUMN * self.largest[k])
     }
 
     /// τ of [`LmConfig::parameter_tolerance`].
@@ -718,6 +843,9 @@ impl<'a> State<'a> {
     /// D after a new point's normal equations ([`DampingScale`]).
     fn update_scale(&mut self) {
         let diagonal = self.system.jtj.diagonal();
+        for (d, &now) in self.largest.iter_mut().zip(diagonal.iter()) {
+            *d = d.max(now);
+        }
         for (d, &now) in self.scale.iter_mut().zip(diagonal.iter()) {
             *d = match self.config.damping_scale {
                 DampingScale::Current => now,

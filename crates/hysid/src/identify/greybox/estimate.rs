@@ -48,6 +48,10 @@ impl Default for GreyBoxEstimation {
             // (docs/numerics.md §1.1).
             lm: LmConfig {
                 damping_scale: DampingScale::RunningMax,
+                // Past 100 iterations a search still improving goes on (to 1000), and one
+                // that ends off a minimum restarts: MGH17, BoxBOD, MGH10 and Bennett5.
+                extra_iterations: 900,
+                restarts: 2,
                 ..LmConfig::default()
             },
             output_weights: None,
@@ -235,6 +239,8 @@ impl GreyBoxEstimation {
         let estimator = OutputError {
             config: LmConfig {
                 max_iterations: self.screening_iterations,
+                extra_iterations: 0,
+                restarts: 0,
                 ..self.lm.clone()
             },
             output_weights: self.output_weights.clone(),
