@@ -357,3 +357,67 @@ fn without_extension_and_restarts_five_cases_stay_short() {
         );
     }
 }
+
+/// The extension and the restarts act only where a search would stop off a minimum: every
+/// case outside [`EXTENDED`] and [`SHORT`] is fitted to the same bits, in the same number of
+/// iterations, with them as without them.
+#[test]
+fn extension_and_restarts_leave_the_other_cases_bit_for_bit() {
+    let without = GreyBoxEstimation {
+        lm: LmConfig {
+            extra_iterations: 0,
+            restarts: 0,
+            ..GreyBoxEstimation::default().lm
+        },
+        ..GreyBoxEstimation::default()
+    };
+    let mut compared = 0;
+    for name in PROBLEMS {
+        for k in [1, 2] {
+            if EXTENDED.contains(&(name, k)) || SHORT.contains(&(name, k)) {
+                continue;
+            }
+            let with = fit(name, k);
+            let plain = fit_with(name, k, without.clone());
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&with.values), bits(&plain.values), "{name} start {k}");
+            assert_eq!(bits(&with.std), bits(&plain.std), "{name} start {k}");
+            assert_eq!(with.iterations, plain.iterations, "{name} start {k}");
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, 48);
+}
+
+/// The improvement rule (the Bouc–Wen benchmark's and the cascade's) neither extends nor
+/// restarts: Nelson from start 1, which it stops short, and MGH10 from start 2, which it
+/// leaves at the iteration limit, are fitted to the same bits with the two rules asked for.
+#[test]
+fn improvement_rule_neither_extends_nor_restarts() {
+    for (name, k) in [("Nelson", 1), ("MGH10", 2)] {
+        let plain = fit_with(
+            name,
+            k,
+            GreyBoxEstimation {
+                lm: LmConfig::improvement_rule(),
+                ..GreyBoxEstimation::default()
+            },
+        );
+        let asked = fit_with(
+            name,
+            k,
+            GreyBoxEstimation {
+                lm: LmConfig {
+                    extra_iterations: 900,
+                    restarts: 2,
+                    ..LmConfig::improvement_rule()
+                },
+                ..GreyBoxEstimation::default()
+            },
+        );
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&plain.values), bits(&asked.values), "{name} start {k}");
+        assert_eq!(plain.iterations, asked.iterations, "{name} start {k}");
+        assert!(plain.iterations <= 100, "{name} start {k}");
+    }
+}

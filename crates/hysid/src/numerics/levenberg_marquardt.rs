@@ -42,7 +42,8 @@
 //! untouched: its iterates are those without the extension, bit for bit.
 //!
 //! **Restarts** ([`LmConfig::restarts`], 0 by default, 2 in the grey-box fits): a search
-//! that ended off a minimum — at the iteration limit, or "converged" on a plateau where a
+//! that ended off a minimum — at the limit after stagnating past `max_iterations` (never at
+//! a hard cap: `extra_iterations` = 0), or "converged" on a plateau where a
 //! free parameter's column of J has vanished, diag(JᵀJ)ⱼ < [`PLATEAU_COLUMN`]·maxₚₐₜₕ
 //! diag(JᵀJ)ⱼ (the parameter no longer acts on the residuals: a saturated exponential,
 //! NIST's BoxBOD from its far start, b2 ≈ 115) — searches again from θ₀ with the initial
@@ -61,6 +62,20 @@
 //! (models with analytic sensitivities stream them without storing J, which keeps 10⁶-sample
 //! fits in a few MB). Otherwise J is built by forward finite differences, one column per free
 //! parameter, in parallel (rayon).
+//!
+//! Not in the engine: geodesic acceleration (Transtrum & Sethna 2012), which needs Jᵀ times
+//! the second directional derivative of the residuals, not available from a problem that
+//! streams JᵀJ and Jᵀr; NIST's MGH10 from its far start is the one reference case it leaves
+//! short (`docs/numerics.md` §1.1).
+//!
+//! References: D. W. Marquardt, "An algorithm for least-squares estimation of nonlinear
+//! parameters", SIAM J. Applied Mathematics 11(2), 1963; J. J. Moré, "The Levenberg–Marquardt
+//! algorithm: implementation and theory", Lecture Notes in Mathematics 630, Springer, 1978;
+//! H. B. Nielsen, "Damping parameter in Marquardt's method", IMM-REP-1999-05, DTU, 1999;
+//! J. E. Dennis, R. B. Schnabel, *Numerical Methods for Unconstrained Optimization and
+//! Nonlinear Equations*, Prentice Hall, 1983, §7.2; M. K. Transtrum, J. P. Sethna,
+//! "Improvements to the Levenberg–Marquardt algorithm for nonlinear least-squares
+//! minimization", arXiv:1201.5885, 2012.
 //!
 //! # Why not the `levenberg-marquardt` crate
 //! It needs the whole Jacobian in memory and offers no bounds, per-iteration callback or
@@ -222,8 +237,9 @@ pub struct LmConfig {
     /// [`PROGRESS_DECREASE`]; it stops as [`Termination::MaxIterations`] once they do not.
     /// Only the rule with the parameter test (`parameter_tolerance` finite) extends.
     pub extra_iterations: usize,
-    /// Restarts of a search that ended without reaching a minimum — at the iteration limit,
-    /// or on a plateau where a free parameter's column of J has vanished (below
+    /// Restarts of a search that ended without reaching a minimum — at the iteration limit
+    /// after stagnating past `max_iterations` (only with `extra_iterations` > 0: a hard cap
+    /// is not restarted), or on a plateau where a free parameter's column of J has vanished (below
     /// [`PLATEAU_COLUMN`] of the largest it had on the path, so the parameter no longer acts
     /// on the residuals). Each restart searches again from the start with the damping
     /// [`RESTART_DAMPING`]ᵏ·λ₀ for restart k (ever more cautious first steps), and the run
@@ -716,7 +732,8 @@ impl<'a> State<'a> {
     /// ([`LmConfig::restarts`]).
     fn needs_restart(&self, termination: &Termination) -> bool {
         if matches!(termination, Termination::MaxIterations) {
-            return true;
+            // Stagnated past the limit; a search held to a hard cap is not restarted.
+            return self.config.extra_iterations > 0;
         }
         termination.converged()
             && !matches!(termination, Termination::ZeroResidual)
