@@ -207,7 +207,8 @@ pub enum Control {
 /// Settings of the engine.
 #[derive(Clone, Debug)]
 pub struct LmConfig {
-    /// Maximum number of iterations (Jacobian evaluations).
+    /// Maximum number of iterations (Jacobian evaluations) of a run, unless the search is
+    /// still progressing there ([`extra_iterations`](Self::extra_iterations)).
     pub max_iterations: usize,
     /// Stop when the relative decrease of S that the next step predicts, or both the actual
     /// and the predicted decrease of an accepted step, fall below this (Gunnar et al. 2006
