@@ -3,7 +3,8 @@
 //! the library's numbers); the float C of every case compiles with the embedded flags
 //! (`-Wdouble-promotion -Wconversion -Werror`) and stays within its header's `NAME_BOUND`
 //! and within 1e-4 of the range of the library's output, on the model's own data and on a
-//! fresh reference; the float Rust of a few kinds likewise.
+//! fresh reference; every case exports but the listed refusals ([`REFUSED`], each with its
+//! reason); the float Rust of a few kinds, forward and inverse, likewise.
 
 use crate::cases::{self, Case};
 use hysid::export::eval;
@@ -15,6 +16,40 @@ use std::process::Command;
 
 /// The issue's bar: 1e-4 of the output's range.
 const SINGLE_BAR: f64 = 1e-4;
+
+/// The cases refused in single precision, each with its reason (docs/export.md, "Single
+/// precision"); every other case must export. A refusal that disappears, or a new one, fails
+/// the test.
+const REFUSED: [(&str, &str); 10] = [
+    // Saturating models: beyond the saturation the output is flat in the command, the
+    // command is not determined by the output, and the float and double solves settle on
+    // different commands of the same output (d far above 1e-4 of the command's range).
+    ("maxwell_slip_saturating_inverse_f32", "above the bound"),
+    (
+        "cascade_maxwell_slip_saturating_inverse_f32",
+        "above the bound",
+    ),
+    ("preisach_saturating_inverse_f32", "above the bound"),
+    ("preisach_saturating_beyond_f32", "above the bound"),
+    // The Dahl operator saturates too: references beyond its reach.
+    ("dahl_beyond_f32", "above the bound"),
+    // The operator cascade with backlash: the dead band, where the output is flat in the
+    // command (open: not analysed further).
+    ("cascade_backlash_inverse_f32", "above the bound"),
+    ("cascade_backlash_beyond_f32", "above the bound"),
+    // The grey-box Newmark model with a non-uniform sample time (open: 5e-2 with the float
+    // corrector tolerances).
+    ("gb_bouc_wen_newmark_nu_f32", "above the bound"),
+    // Differential inverses on 3000 references beyond reach: every sample brackets in vain
+    // over the whole span, beyond the measurement's work (5e7 statements) in double.
+    ("jiles_atherton_beyond_f32", "beyond 5e7 statements"),
+    ("cascade_dahl_beyond_f32", "beyond 5e7 statements"),
+];
+
+/// The models with an integrator (a rigid body's position), whose float error grows with
+/// the record's path: the bound measured on one record is exceeded on the fresh one (by a
+/// factor of about 2), which is held to the bar only.
+const INTEGRATING: [&str; 2] = ["gb_rigid_body_zoh_f32", "gb_rigid_body_linear_f32"];
 
 /// The embedded engineer's flags.
 const FLAGS: [&str; 9] = [
@@ -140,7 +175,9 @@ fn max_gap(got: &[f64], expected: &[f64]) -> f64 {
 
 /// The library's outputs for a fresh input: the models' outputs (or the compensators'
 /// commands) on another seeded signal, case by case (by name); the grey-box cases on their
-/// own input reversed.
+/// own input reversed. A forward case that starts from a measured output given at export
+/// (`initial_output`, the Coleman–Hodgdon hysteresis saved with `initial_output: measured`)
+/// is simulated from that same output: the exported code starts there whatever its input.
 fn fresh(all: &[Case]) -> Vec<(Vec<f64>, Vec<f64>)> {
     let other: Vec<Case> = cases::all_on(
         &cases::signal(3000, 99)
@@ -151,6 +188,12 @@ fn fresh(all: &[Case]) -> Vec<(Vec<f64>, Vec<f64>)> {
     all.iter()
         .map(|case| {
             if let Some(o) = other.iter().find(|o| o.name == case.name) {
+                if let (Some(y0), false) = (case.options.initial_output, case.options.inverse) {
+                    let model = FittedModel::from_file(&case.file).expect("a model");
+                    let ts = case.options.sample_time.unwrap_or(1e-3);
+                    let y = model.simulate(&[&o.input], ts, Some(y0)).expect("simulate");
+                    return (o.input.clone(), y[0].clone());
+                }
                 return (o.input.clone(), o.expected.clone());
             }
             let model = FittedModel::from_file(&case.file).expect("a model");
@@ -203,13 +246,20 @@ fn single_c_is_within_its_bound_on_own_data_and_a_fresh_reference() {
     let mut passed = 0;
     for (case, (fresh_in, fresh_out)) in all.iter().zip(&fresh) {
         let case = single(case);
+        let started = std::time::Instant::now();
         let exe = match compile(&case, dir.path()) {
             Ok(exe) => exe,
             Err(reason) => {
-                rows.push(format!("{:<40} refused: {reason}", case.name));
+                let expected = REFUSED.iter().find(|(name, _)| *name == case.name);
+                match expected {
+                    Some((_, why)) if reason.contains(why) => {}
+                    _ => failed.push(format!("{} refused: {reason}", case.name)),
+                }
+                rows.push(format!("{:<44} refused: {reason}", case.name));
                 continue;
             }
         };
+        let seconds = started.elapsed().as_secs_f64();
         passed += 1;
         let (y, error, bound) = run(&exe, &case.input, dir.path(), &case.name);
         assert!(!error, "{}: diverged in float", case.name);
@@ -217,20 +267,24 @@ fn single_c_is_within_its_bound_on_own_data_and_a_fresh_reference() {
         let own = cases::relative_difference(&y, &case.expected);
         let (y2, _, _) = run(&exe, fresh_in, dir.path(), &format!("{}_fresh", case.name));
         let other = cases::relative_difference(&y2, fresh_out);
+        let fresh_gap = max_gap(&y2, fresh_out);
         rows.push(format!(
-            "{:<40} own {own:.2e}  fresh {other:.2e}  bound {bound:.2e}",
+            "{:<44} own {own:.2e}  fresh {other:.2e} of the range; |y - library| {gap:.2e} \
+             and {fresh_gap:.2e} within the bound {bound:.2e}; export {seconds:.1} s",
             case.name
         ));
-        // The measured bound is the float code against the double code on this very data;
-        // the library is the double code to the bit (the test above; c_target).
-        // Known open case: the Coleman–Hodgdon forward step from the measured y(0) exceeds
-        // its stated bound (closing note of stop 46); checked against 1e-4 only.
-        let bound = if case.name == "ch_measured_forward_f32" {
+        // The measured bound is the float code against the double code on the own data;
+        // the library is the double code to the bit (the test above; c_target). The fresh
+        // reference was not measured: the bound's margin must cover it.
+        let fresh_bound = if INTEGRATING.contains(&case.name.as_str()) {
             f64::INFINITY
         } else {
             bound
         };
-        if !(gap <= bound && own <= SINGLE_BAR && other <= SINGLE_BAR) {
+        if REFUSED.iter().any(|(name, _)| *name == case.name) {
+            failed.push(format!("{}: exported, but listed as refused", case.name));
+        }
+        if !(gap <= bound && fresh_gap <= fresh_bound && own <= SINGLE_BAR && other <= SINGLE_BAR) {
             failed.push(case.name.clone());
         }
     }
@@ -240,19 +294,8 @@ fn single_c_is_within_its_bound_on_own_data_and_a_fresh_reference() {
         "beyond the bound: {failed:?}\n{}",
         rows.join("\n")
     );
-    // Every forward operator family and kind is exported in single precision.
-    for case in all.iter().filter(|c| c.name.ends_with("_forward")) {
-        let row = rows
-            .iter()
-            .find(|r| r.starts_with(&format!("{}_f32 ", case.name)))
-            .expect("a row per case");
-        assert!(!row.contains("refused"), "a forward model refused: {row}");
-    }
-    assert!(
-        passed > all.len() / 2,
-        "{passed} of {} in single precision",
-        all.len()
-    );
+    // Every case but the listed refusals was exported (checked above, case by case).
+    assert_eq!(passed + REFUSED.len(), all.len(), "{passed} exported");
 }
 
 #[test]
@@ -260,8 +303,11 @@ fn single_c_is_within_its_bound_on_own_data_and_a_fresh_reference() {
 fn single_rust_is_within_its_bound() {
     let picked = [
         "pi_forward",
+        "pi_inverse",
         "preisach_forward",
+        "preisach_inverse",
         "bouc_wen_forward",
+        "bouc_wen_inverse",
         "gb_bouc_wen_zoh",
     ];
     let all: Vec<Case> = cases::all()

@@ -156,6 +156,11 @@ impl Math {
 pub enum Expr {
     /// A double literal (finite; checked when the program is rendered).
     F64(f64),
+    /// A constant that depends on the code's floating-point type ([`typed`]): the first
+    /// value in double precision (printed exactly as [`Expr::F64`] would print it, so the
+    /// double code is unchanged), the second in single precision. For tolerances tied to the
+    /// type's resolution, such as the machine epsilon ([`epsilon`]).
+    Typed(f64, f64),
     /// Not a number (`NAN` / `f64::NAN`).
     Nan,
     /// An index literal.
@@ -207,6 +212,26 @@ impl From<usize> for Expr {
 /// A double literal.
 pub fn lit(v: f64) -> Expr {
     Expr::F64(v)
+}
+
+/// A constant of the code's floating-point type: `double` in double precision, `single` in
+/// single precision ([`Expr::Typed`]).
+pub fn typed(double: f64, single: f64) -> Expr {
+    Expr::Typed(double, single)
+}
+
+/// The machine epsilon ε of the code's floating-point type, the gap between 1 and the next
+/// larger number: 2⁻⁵² = `DBL_EPSILON` (`f64::EPSILON`) in double, 2⁻²³ = `FLT_EPSILON`
+/// (`f32::EPSILON`) in single (IEEE 754-2008, binary64 and binary32). A stopping test such
+/// as |b − a| ≤ 2ε·|a| that is reachable in double is then reachable in float too.
+pub fn epsilon() -> Expr {
+    typed(f64::EPSILON, f32::EPSILON as f64)
+}
+
+/// The smallest positive normal number of the code's type: `DBL_MIN` (2⁻¹⁰²²) in double,
+/// `FLT_MIN` (2⁻¹²⁶) in single (`f64::MIN_POSITIVE` would round to 0 in `float`).
+pub fn min_positive() -> Expr {
+    typed(f64::MIN_POSITIVE, f32::MIN_POSITIVE as f64)
 }
 
 /// An index literal.
@@ -339,6 +364,7 @@ impl Expr {
     pub(crate) fn literals(&self, out: &mut Vec<f64>) {
         match self {
             Expr::F64(v) => out.push(*v),
+            Expr::Typed(d, s) => out.extend([*d, *s]),
             Expr::Nan
             | Expr::Index(_)
             | Expr::Flag(_)

@@ -4,11 +4,12 @@
 //! even piecewise-constant g, in the library's order of operations.
 //!
 //! The forward step errors (the error flag) where α·|Δx| > 1 + 1e-12, as the library's rate
-//! check refuses the record. A model that starts from the measured output
+//! check refuses the record (1 + 4ε in single precision, and the clipping tolerances those of
+//! `float`: [`typed`]). A model that starts from the measured output
 //! (`initial_output: measured`) has no forward stream (a stream has no measured output);
 //! its compensator starts from the first reference, as `hysid compensate` does.
 
-use super::code::{call, local, select, Expr, Ty};
+use super::code::{call, local, select, typed, Expr, Ty};
 use super::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
 use super::solve;
 use crate::model::coleman_hodgdon::InitialOutput;
@@ -78,7 +79,9 @@ pub fn forward(ch: &ColemanHodgdon, v0: f64, ns: &Ns, prog: &mut Program) -> Res
             Expr::State(rec.started.clone()),
             |b| {
                 let rate = alpha * (v.clone() - x.clone()).abs();
-                b.if_(rate.gt(1.0 + 1e-12), |b| {
+                // 1 + 4 float ε in single precision (1 + 1e-12 rounds to 1 in float).
+                let limit = typed(1.0 + 1e-12, 1.0 + 4.0 * f32::EPSILON as f64);
+                b.if_(rate.gt(limit), |b| {
                     b.set_state(DIVERGED_FIELD, Expr::Flag(true))
                 });
                 b.set_state(
@@ -161,7 +164,7 @@ pub fn inverse(
                     // recursion need not be monotone on every branch).
                     let missed = (y_s.clone() - r.clone())
                         .abs()
-                        .gt(1e-9 * (1.0 + r.clone().abs()));
+                        .gt(typed(1e-9, 1e-5) * (1.0 + r.clone().abs()));
                     mark_clip(b, Expr::State(ns.sub("r").name("clipped")).or(missed));
                 },
                 |b| {
@@ -186,7 +189,7 @@ pub fn inverse(
                     // The first reference counts as clipped when the start misses it.
                     let missed = (y0.clone() - r.clone())
                         .abs()
-                        .gt(1e-12 * (1.0 + r.clone().abs()));
+                        .gt(typed(1e-12, 16.0 * f32::EPSILON as f64) * (1.0 + r.clone().abs()));
                     mark_clip(b, missed);
                     b.set_state(&rec.y, y0);
                     b.set_state(&rec.started, Expr::Flag(true));

@@ -38,6 +38,8 @@ pub trait Real:
     + std::ops::Div<Output = Self>
     + std::ops::Neg<Output = Self>
 {
+    /// True for `f32`: selects the single-precision value of an [`Expr::Typed`] constant.
+    const SINGLE: bool;
     /// The literal `v` in this type (rounded to nearest).
     fn of(v: f64) -> Self;
     /// The value as an `f64` (exact).
@@ -55,8 +57,9 @@ pub trait Real:
 }
 
 macro_rules! real {
-    ($t:ty) => {
+    ($t:ty, $single:expr) => {
         impl Real for $t {
+            const SINGLE: bool = $single;
             fn of(v: f64) -> Self {
                 v as $t
             }
@@ -103,8 +106,8 @@ macro_rules! real {
         }
     };
 }
-real!(f32);
-real!(f64);
+real!(f32, true);
+real!(f64, false);
 
 /// A value of the program: a float, an index or a flag.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -194,6 +197,8 @@ struct Resolver<'a> {
     functions: &'a HashMap<&'a str, usize>,
     scope: Vec<(&'a str, usize)>,
     slots: usize,
+    /// The code is single precision ([`Expr::Typed`] takes its second value).
+    single: bool,
 }
 
 impl<'a> Resolver<'a> {
@@ -284,6 +289,7 @@ impl<'a> Resolver<'a> {
     fn expr(&mut self, e: &'a Expr) -> Result<E> {
         Ok(match e {
             Expr::F64(v) => E::Lit(Value::F(*v)),
+            Expr::Typed(d, s) => E::Lit(Value::F(if self.single { *s } else { *d })),
             Expr::Nan => E::Lit(Value::F(f64::NAN)),
             Expr::Index(i) => E::Lit(Value::I(*i)),
             Expr::Flag(b) => E::Lit(Value::B(*b)),
@@ -349,6 +355,7 @@ impl<R: Real> Machine<R> {
                 functions: &functions,
                 scope: Vec::new(),
                 slots: 0,
+                single: R::SINGLE,
             };
             for (name, _) in params {
                 r.declare(name);

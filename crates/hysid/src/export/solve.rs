@@ -2,9 +2,11 @@
 //! that needs it: a transliteration of `model::operators::solve_monotone` (bracketing by
 //! doubling steps, then the Illinois variant of regula falsi, at most 300 iterations), with
 //! the same constants and the same order of operations, so the generated inverse picks the
-//! library's root to the bit.
+//! library's root to the bit. In single precision the tolerances tied to the resolution of
+//! the type are those of `float` ([`typed`], [`epsilon`]): the same stopping rules, reached
+//! after as many iterations as in double.
 
-use super::code::{idx, lit, local, Expr, Ty};
+use super::code::{epsilon, idx, lit, local, typed, Expr, Ty};
 use super::program::{Ns, Program};
 use crate::Result;
 use std::ops::Not;
@@ -41,9 +43,15 @@ pub fn emit(prog: &mut Program, ns: &Ns, branch: &str) -> Result<String> {
             b.if_(fhi.clone().eq(0.0), |b| b.ret(hi.clone()));
             let side = b.var("side", 0.0);
             b.for_("_iteration", idx(0), idx(300), |b, _| {
+                // ε of the code's type: in float the double ε is never reached, and every
+                // solve would run to the cap (the smallest width: 1e-300 rounds to 0 in
+                // float, the smallest normal float instead).
                 let width = lit(2.0)
-                    * lit(f64::EPSILON)
-                    * lo.clone().abs().max(hi.clone().abs()).max(1e-300);
+                    * epsilon()
+                    * lo.clone()
+                        .abs()
+                        .max(hi.clone().abs())
+                        .max(typed(1e-300, f32::MIN_POSITIVE as f64));
                 b.if_((hi.clone() - lo.clone()).le(width), |b| b.break_());
                 let m = b.var(
                     "m",
@@ -102,7 +110,13 @@ pub fn emit(prog: &mut Program, ns: &Ns, branch: &str) -> Result<String> {
             let hi = b.var("hi", local("center") + span.clone());
             let flo = b.var("flo", f(lo.clone()));
             let fhi = b.var("fhi", f(hi.clone()));
-            let tol = b.let_("tol", 1e-12 * (1.0 + target.clone().abs()));
+            // A target counts as clipped beyond 1e-12 of its size in double, 16 float ε
+            // (about 1.9e-6) in single, where the saturation level itself is only known
+            // to the float resolution.
+            let tol = b.let_(
+                "tol",
+                typed(1e-12, 16.0 * f32::EPSILON as f64) * (1.0 + target.clone().abs()),
+            );
             let step = b.var("step", span.clone());
             b.while_(fhi.clone().lt(target.clone()), |b| {
                 b.if_(

@@ -11,7 +11,9 @@
 //! is not finite (the library's `Diverged` error), and a non-finite input, set the error
 //! flag: the outputs then hold their last values until the next init.
 
-use crate::export::code::{call, idx, lit, local, select, Block, Expr, Ty};
+use crate::export::code::{
+    call, epsilon, idx, lit, local, min_positive, select, typed, Block, Expr, Ty,
+};
 use crate::export::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
 use crate::model::operators::differential::{InputOde, TOLERANCE};
 use crate::Result;
@@ -19,6 +21,18 @@ use std::ops::Not;
 
 /// The sub-steps one sample interval may take.
 pub const SUBSTEP_BUDGET: usize = 100_000;
+
+/// The integration's relative tolerance in single precision (the library's [`TOLERANCE`],
+/// 1e-10, in double): 10⁻⁶, about 8 `float` ulps. The error estimate of a Dormand–Prince
+/// step is a difference of slopes that each carry a rounding error of about ε·|k|, so a
+/// tolerance below float resolution is never met and every step shrinks to its floor; at
+/// 10⁻⁶ the float code takes about as many sub-steps as the double one, and its error,
+/// a few 10⁻⁶ of the state's scale, stays well inside the single-precision bar of 10⁻⁴.
+pub const SINGLE_TOLERANCE: f64 = 1e-6;
+
+/// The inverse's output tolerance in single precision (1e-13 of |r| + |y| in double): 10⁻⁶,
+/// the integration's tolerance, below which the float branch is noise.
+pub const SINGLE_YTOL: f64 = 1e-6;
 
 /// What a differential family supplies: its equations as helpers.
 pub trait EmitOde: InputOde {
@@ -137,7 +151,9 @@ fn driver<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Result<D
         },
     )?;
     let h_max = ode.max_substep().abs().max(f64::MIN_POSITIVE);
-    let atol = TOLERANCE * ode.state_scale().abs().max(f64::MIN_POSITIVE);
+    let scale = ode.state_scale().abs().max(f64::MIN_POSITIVE);
+    let atol = typed(TOLERANCE * scale, SINGLE_TOLERANCE * scale);
+    let rtol = typed(TOLERANCE, SINGLE_TOLERANCE);
     let fail_c = fail.clone();
     let advance = prog.function(
         &ns.name("advance"),
@@ -178,13 +194,14 @@ fn driver<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Result<D
                         .not()
                         .or(err.clone().is_finite().not()),
                     |b| {
-                        b.if_(step.clone().le(1e-14 * (u.clone().abs() + h_max)), failed);
+                        let floor = typed(1e-14, 10.0 * f32::EPSILON as f64);
+                        b.if_(step.clone().le(floor * (u.clone().abs() + h_max)), failed);
                         b.set("h", step.clone() * 0.25);
                     },
                     |b| {
                         let tol = b.let_(
                             "tol",
-                            atol + TOLERANCE * x.clone().abs().max(x_new.clone().abs()),
+                            atol.clone() + rtol.clone() * x.clone().abs().max(x_new.clone().abs()),
                         );
                         b.if_(err.clone().le(tol.clone()), |b| {
                             let moved = u.clone() + step.clone() * direction.clone();
@@ -197,7 +214,9 @@ fn driver<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Result<D
                             select((err.clone() * 6000.0).le(tol), 5.0, power.clamp(0.2, 5.0)),
                         );
                         b.set("h", (step.clone() * factor).min(h_max));
-                        b.if_(h.clone().le(1e-15 * (u.clone().abs() + h_max)), failed);
+                        // Below ε·|u| a step would not move u at all.
+                        let floor = typed(1e-15, f32::EPSILON as f64);
+                        b.if_(h.clone().le(floor * (u.clone().abs() + h_max)), failed);
                     },
                 );
             });
@@ -328,7 +347,7 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
                 b.if_(failed.clone(), |b| give_up(b, v.clone()));
                 b.set_state(&sol_x, Expr::State(br_x.clone()));
                 let gv = b.let_("gv", yv - r.clone());
-                let width = lit(4.0) * lit(f64::EPSILON) * v.clone().abs().max(f64::MIN_POSITIVE);
+                let width = lit(4.0) * epsilon() * v.clone().abs().max(min_positive());
                 b.if_(
                     gv.clone()
                         .abs()
@@ -356,6 +375,9 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
         },
     )?;
     let span = ode.inversion_span().abs();
+    // The probe of the branch's direction and the first bracketing step are the same in
+    // both precisions, so that the float code tries the same inputs (rounded) and finds the
+    // same bracket; a trial below float resolution only repeats the start.
     let probe = 1e-6 * ode.max_substep().abs();
     let solve = prog.function(
         &ns.name("solve_sample"),
@@ -369,7 +391,8 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
             let g0 = b.let_("g0", y0.clone() - r.clone());
             let ytol = b.let_(
                 "ytol",
-                1e-13 * (r.clone().abs() + y0.clone().abs()).max(f64::MIN_POSITIVE),
+                typed(1e-13, SINGLE_YTOL)
+                    * (r.clone().abs() + y0.clone().abs()).max(min_positive()),
             );
             b.if_(g0.clone().abs().le(ytol.clone()), |b| b.ret(start.clone()));
             let (best_v, best_x, best_y) = (

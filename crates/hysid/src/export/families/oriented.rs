@@ -11,7 +11,7 @@
 //! record) sets the error flag.
 
 use super::Emit;
-use crate::export::code::{lit, local, Expr, Ty};
+use crate::export::code::{lit, local, typed, Expr, Ty};
 use crate::export::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
 use crate::model::operators::Orientation;
 use crate::Result;
@@ -83,7 +83,10 @@ impl<T: EmitCore> Emit for T {
             let u = b.let_("u", Expr::Call(g, vec![rho.clone()]));
             let y = b.let_("y", Expr::Call(g_inv, vec![u.clone()]));
             b.set_state(&scale, Expr::State(scale.clone()).max(rho.clone().abs()));
-            mark_clip(b, (y - rho).abs().gt(1e-9 * Expr::State(scale.clone())));
+            // (1e-5 in single precision, about 80 float ulps, as the float solves meet ρ
+            // only to their resolution.)
+            let tol = typed(1e-9, 1e-5);
+            mark_clip(b, (y - rho).abs().gt(tol * Expr::State(scale.clone())));
             b.ret(u);
         })
     }

@@ -31,7 +31,7 @@
 //! the model's state count.
 
 use super::{copy, Driver, EmitStateSpace};
-use crate::export::code::{call, idx, local, Block, Expr, Ty};
+use crate::export::code::{call, idx, local, typed, Block, Expr, Ty};
 use crate::export::program::{Program, DIVERGED_FIELD};
 use crate::{Error, Result};
 use std::ops::Not;
@@ -44,6 +44,17 @@ const TOLERANCE: f64 = 1e-13;
 const RELATIVE_STEP: f64 = 1e-7;
 /// The floor of a difference step relative to the scale.
 const STEP_FLOOR: f64 = 1e-6;
+/// The residual tolerance in single precision: 4·10⁻⁶, about 32 `float` ulps (1e-13 is
+/// below float resolution: the corrector would never converge and run its 50 iterations).
+const SINGLE_TOLERANCE: f64 = 4e-6;
+/// The relative difference step in single precision: √ε of `float` ≈ 3.5·10⁻⁴, the
+/// standard forward-difference step (Dennis & Schnabel, *Numerical Methods for
+/// Unconstrained Optimization and Nonlinear Equations*, 1983, §5.4); 1e-7 is about one float
+/// ulp, and the differences would be rounding noise.
+const SINGLE_RELATIVE_STEP: f64 = 3.4526698e-4;
+/// The floor of a difference step relative to the scale in single precision: 1 (the step is
+/// √ε of max(|z|, scale), so that the difference of the rates stays above their rounding).
+const SINGLE_STEP_FLOOR: f64 = 1.0;
 /// β of the position update (average acceleration).
 const BETA: f64 = 0.25;
 /// γ of the velocity update.
@@ -167,7 +178,8 @@ pub fn emit(
                 });
                 let converged = b.local("converged", Ty::Flag, true, Expr::Flag(true));
                 b.for_("i", idx(0), idx(p), |b, i| {
-                    let within = at(&g, i).abs().le(TOLERANCE * scale.clone());
+                    let tol = typed(TOLERANCE, SINGLE_TOLERANCE);
+                    let within = at(&g, i).abs().le(tol * scale.clone());
                     b.if_(within.not(), |b| b.set("converged", Expr::Flag(false)));
                 });
                 b.if_(converged, |b| b.break_());
@@ -179,7 +191,9 @@ pub fn emit(
                 });
                 b.for_("c", idx(0), idx(p), |b, c| {
                     let zc = at(&z, c.clone()).abs();
-                    let dz = b.let_("dz", RELATIVE_STEP * zc.max(STEP_FLOOR * scale.clone()));
+                    let step = typed(RELATIVE_STEP, SINGLE_RELATIVE_STEP);
+                    let floor = typed(STEP_FLOOR, SINGLE_STEP_FLOOR);
+                    let dz = b.let_("dz", step * zc.max(floor * scale.clone()));
                     copy(b, &trial, &z, p);
                     b.set_at(&trial, c.clone(), at(&trial, c.clone()) + dz.clone());
                     b.call(&state_of, vec![]);

@@ -39,6 +39,9 @@ impl Syntax for C<'_> {
     fn literal(&self, v: f64) -> String {
         format!("{}{}", float_digits(v, self.precision), self.suffix())
     }
+    fn single(&self) -> bool {
+        self.precision.is_single()
+    }
     fn state(&self, field: &str) -> String {
         format!("state->{field}")
     }

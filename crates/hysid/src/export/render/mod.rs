@@ -21,6 +21,8 @@ const UNARY: u8 = 8;
 pub(crate) trait Syntax {
     /// The literal `v` (finite; `v` rounded to the precision's type).
     fn literal(&self, v: f64) -> String;
+    /// True when the code is single precision (selects [`Expr::Typed`]'s second value).
+    fn single(&self) -> bool;
     /// The scalar field `field` of the state.
     fn state(&self, field: &str) -> String;
     /// The constant table `name`.
@@ -80,6 +82,10 @@ impl<'a> Printer<'a> {
             Expr::F64(v) => {
                 // A negative literal is parenthesised whenever it is an operand.
                 (x.literal(*v), if v.is_sign_negative() { 0 } else { ATOM })
+            }
+            Expr::Typed(d, s) => {
+                let v = if x.single() { *s } else { *d };
+                (x.literal(v), if v.is_sign_negative() { 0 } else { ATOM })
             }
             Expr::Nan => (x.nan().into(), ATOM),
             Expr::Index(i) => (i.to_string(), ATOM),

@@ -43,6 +43,9 @@ impl Syntax for Rust {
             Precision::Single => format!("{}_f32", float_digits(v, self.precision)),
         }
     }
+    fn single(&self) -> bool {
+        self.precision.is_single()
+    }
     fn state(&self, field: &str) -> String {
         format!("self.{field}")
     }
