@@ -266,3 +266,19 @@ def test_every_family_fills_the_figures_and_marks_its_bounds(noisy_play, family)
         # An NNLS weight held at 0 is at its bound: no weight without a σ off a bound.
         if re.fullmatch(r"(a|w|k|W|mu)\d[\d_]*", p.name) and p.name != "a0" and not p.fixed and p.value == 0.0:
             assert p.at_bound, p
+
+
+def test_models_fitted_from_python_carry_their_sample_time_and_columns(fits):
+    """Every recipe's model holds the ts it was fitted with and its channels' names, so
+    that an export (an FMU needs its sample time) works from it."""
+    assert fits["greybox_fit"][0].model.sample_time == 0.05
+    assert fits["greybox_fit"][0].model.columns == (["u"], ["y"])
+    for name in ("identify_operator", "compare", "identify_cascade"):
+        model = fits[name][0].model
+        assert model.sample_time == 1.0 and model.columns == (["u"], ["y"]), name
+    u, y = play_record()
+    r = hysid.identify_operator(u, y, family="pi", ts=0.002, names=("voltage", "stroke"))
+    assert r.model.sample_time == 0.002 and r.model.columns == (["voltage"], ["stroke"])
+    builtin = hysid.greybox_fit("rigid-body", u, y, ts=0.01, fix=["Fc"], substeps=1)
+    assert builtin.model.sample_time == 0.01
+    assert hysid.Model({k: v for k, v in r.model.file.items() if k != "sample_time"}).sample_time is None
