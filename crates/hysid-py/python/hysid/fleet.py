@@ -133,16 +133,20 @@ def identify_many(
     if client is not None:
         results = _gather(client, fit, records)
     else:
-        cluster = LocalCluster(  # type: ignore[no-untyped-call]
+        # Called through Any: dask's own annotations differ between versions (untyped in
+        # some, typed in others), so neither a `type: ignore` nor its absence suits all.
+        make_cluster: Any = LocalCluster
+        make_client: Any = Client
+        cluster = make_cluster(
             n_workers=n_workers or os.cpu_count() or 1,
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
         )
-        own = Client(cluster)  # type: ignore[no-untyped-call]
+        own = make_client(cluster)
         try:
             results = _gather(own, fit, records)
         finally:
-            own.close()  # type: ignore[no-untyped-call]
+            own.close()
             cluster.close()
     return FleetResult(list(results), time.perf_counter() - clock)

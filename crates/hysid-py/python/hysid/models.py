@@ -89,6 +89,24 @@ class Model:
         self._callback_simulation = None if user is None else _callback_simulation(fields)
 
     @property
+    def sample_time(self) -> Optional[float]:
+        """The sample time in seconds of the data the model was fitted on (the model
+        file's ``sample_time``: every recipe's fit from Python writes its ``ts``); None in a
+        file without one."""
+        value = self.file.get("sample_time")
+        return None if value is None else float(value)
+
+    @property
+    def columns(self) -> Optional[Tuple[List[str], List[str]]]:
+        """The names of the input and output channels the model was fitted on (the model
+        file's ``columns``, which name an export's inputs and outputs): ``(inputs,
+        outputs)``; None in a file without them."""
+        cols = self.file.get("columns")
+        if not isinstance(cols, dict):
+            return None
+        return [str(n) for n in cols.get("inputs", [])], [str(n) for n in cols.get("outputs", [])]
+
+    @property
     def parameters(self) -> Dict[str, Parameter]:
         """The parameters by name (copies: changing one leaves the model as it is)."""
         return {p.name: copy.copy(p) for p in self._parameters}

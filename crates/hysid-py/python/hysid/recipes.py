@@ -280,14 +280,15 @@ def greybox_fit(
             text = _hysid.greybox_fit_equations(
                 user.equations, u, y, ts, params, *args, check.threads(threads), limit, tell, chosen_evaluator
             )
-            return _finished(FitResult(json.loads(text), data=fitted), limit, "greybox_fit")
+            report = _greybox_labelled(json.loads(text), ts, user.input_names, user.output_names)
+            return _finished(FitResult(report, data=fitted), limit, "greybox_fit")
         if limit is not None or tell is not None:
             raise ConfigError(
                 "time_limit and progress are not available for a model written as Python functions (its "
                 "callbacks run on the fit's thread); write it as equations (GreyBoxModel.from_equations)"
             )
         text = _hysid.greybox_fit_user(user._spec(), u, y, ts, *args)
-        return FitResult(json.loads(text), user, fitted)
+        return FitResult(_greybox_labelled(json.loads(text), ts, [], []), user, fitted)
     if not isinstance(model, str):
         raise TypeError(f"model: give a built-in model name or a hysid.GreyBoxModel, got {type(model).__name__}")
     defaults, _, _ = _hysid.model_parameters(model)
@@ -296,7 +297,8 @@ def greybox_fit(
     text = _hysid.greybox_fit(
         model, u, y, ts, [p.as_tuple() for p in chosen], *args, check.threads(threads), limit, tell
     )
-    return _finished(FitResult(json.loads(text), data=fitted), limit, "greybox_fit")
+    report = _greybox_labelled(json.loads(text), ts, [], [])
+    return _finished(FitResult(report, data=fitted), limit, "greybox_fit")
 
 
 #: Sampling frequency of the Bouc–Wen benchmark records [Hz].
@@ -405,6 +407,21 @@ def rigid_body_ls(
         tell,
     )
     return _finished(FitResult(json.loads(text)), limit, "rigid_body_ls")
+
+
+def _greybox_labelled(
+    report: Dict[str, Any], ts: float, inputs: Sequence[str], outputs: Sequence[str]
+) -> Dict[str, Any]:
+    """The grey-box report with its model file carrying the fit's sample time and, for an
+    equation model, its input and output names as ``columns`` (what the command line's
+    model files hold), where the library left them out: so that every export works from the
+    model."""
+    model = report.get("model")
+    if isinstance(model, dict):
+        model.setdefault("sample_time", ts)
+        if inputs and outputs:
+            model.setdefault("columns", {"inputs": list(inputs), "outputs": list(outputs)})
+    return report
 
 
 def _joined(channels: List[check.FloatArray]) -> check.FloatArray:

@@ -83,7 +83,11 @@ class Result:
     source, samples, fit_percent, rmse, e_rms), ``warnings``, ``details`` (the command's
     own part of the report), ``model`` (:class:`Model`), ``elapsed_s``, and ``data`` (the
     :class:`Record` fitted, kept by the recipes of one input and one output). Figures a
-    command does not produce are None.
+    command does not produce are None. As lmfit's ``ModelResult``: ``nfev`` (the criterion
+    evaluations), ``free_parameters`` (the names estimated with a σ), ``covariance`` and
+    ``correlation`` (numpy arrays over ``free_parameters``, in that order), ``best_fit``
+    (the model's output on ``data``) and ``residuals`` (y − best_fit, the
+    system-identification sign), and each :class:`Parameter`'s ``at_bound``.
 
     ``report()`` returns the report as a dict; ``fit_report()`` a text table of the
     parameters with σ, the fit and the termination; ``to_dataframe()`` the parameter table
@@ -138,6 +142,7 @@ class Result:
         self.nfev = None if search is None else search.get("evaluations", int)
         uncertainty = f.object("uncertainty")
         self.uncertainty = None if uncertainty is None else uncertainty.get("method", str)
+        self._covariance = _covariance(uncertainty, self.parameters)
         self.validation = [_validation_entry(v) for v in f.objects("validation")]
         self.warnings = [str(w) for w in f.get("warnings", list)]
         self.details = f.raw("details")
@@ -151,6 +156,25 @@ class Result:
         """The names of the parameters that were estimated and have a standard deviation
         (neither fixed nor at a bound), in the model's order."""
         return tuple(n for n, p in self.parameters.items() if not p.fixed and p.std is not None)
+
+    @property
+    def covariance(self) -> Optional[FloatArray]:
+        """The covariance matrix of the estimates over :attr:`free_parameters`, in that
+        order (the report's ``uncertainty.covariance``, ``docs/report.md`` §1.4: σ²(JᵀJ)⁻¹
+        at the estimate, or σ²(ΦᵀΦ)⁻¹ on the free set of a least-squares solve; its
+        diagonal the squared ``std``); a copy. None when the report holds none: a report
+        without standard deviations, or one written before the key existed."""
+        return None if self._covariance is None else self._covariance.copy()
+
+    @property
+    def correlation(self) -> Optional[FloatArray]:
+        """The correlation matrix of the estimates over :attr:`free_parameters`:
+        C_ij / √(C_ii C_jj) of :attr:`covariance` (unit diagonal, symmetric); None when
+        :attr:`covariance` is None. An estimate with a zero variance correlates 0 with the
+        others."""
+        if self._covariance is None:
+            return None
+        return _correlation(self._covariance)
 
     @property
     def best_fit(self) -> Optional[FloatArray]:
@@ -182,36 +206,66 @@ class Result:
         """The report as JSON text."""
         return json.dumps(self._report, indent=2)
 
-    def fit_report(self, *, max_parameters: int = 40) -> str:
-        """The fit as a text table (as lmfit's ``fit_report``): the figures, how the
-        search ended, then one line per parameter (at most ``max_parameters``) with its
-        value, σ and σ relative to the value."""
+    def fit_report(self, *, max_parameters: int = 40, min_correl: float = 0.1) -> str:
+        """The fit as a text table (as lmfit's ``fit_report``): the figures (fit %, RMSE,
+        AIC, FPE, the function evaluations, the free parameters), how the search ended, then
+        one line per parameter (at most ``max_parameters``) with its value, σ and σ relative
+        to the value, ``(fixed)`` or ``(at bound)``, and last the ``[[Correlations]]``: the
+        pairs of free parameters correlated more than ``min_correl`` in magnitude, the
+        strongest first, as ``C(a, b) = +0.9000``."""
+        points = None if self.data is None else int(np.asarray(self.data.y).shape[0])
+        lines = [f"[[Fit: {self.command}]]"]
+        if self.termination:
+            state = "converged" if self.converged else "NOT converged"
+            lines.append(f"    {'termination':<15}= {self.termination} ({state}, {self.iterations} iterations)")
+        if self.uncertainty:
+            lines.append(f"    {'uncertainty':<15}= {self.uncertainty}")
+        if self.elapsed_s is not None:
+            lines.append(f"    {'time':<15}= {self.elapsed_s:.4g} s")
+        # lmfit's [[Fit Statistics]], with the system-identification figures: AIC
+        # (N ln V + 2p + N (ln 2π + 1), MATLAB's) and Akaike's FPE V (1 + p/N)/(1 − p/N).
         figures = [
+            ("# fcn evals", "" if self.nfev is None else str(self.nfev)),
+            ("# data points", "" if points is None else str(points)),
+            ("# variables", str(len(self.free_parameters))),
             ("fit %", _num(self.fit_percent, ".4f")),
             ("RMSE", _num(self.rmse, ".6e")),
             ("AIC", _num(self.aic, ".2f")),
             ("FPE", _num(self.fpe, ".6e")),
-            ("# fcn evals", "" if self.nfev is None else str(self.nfev)),
-            ("# variables", str(len(self.free_parameters))),
         ]
-        lines = [f"[[Fit: {self.command}]]"]
-        lines += [f"    {name:<12}= {value}" for name, value in figures if value]
-        if self.termination:
-            state = "converged" if self.converged else "NOT converged"
-            lines.append(f"    {'termination':<12}= {self.termination} ({state}, {self.iterations} iterations)")
-        if self.uncertainty:
-            lines.append(f"    {'uncertainty':<12}= {self.uncertainty}")
-        if self.elapsed_s is not None:
-            lines.append(f"    {'time':<12}= {self.elapsed_s:.4g} s")
+        lines.append("[[Fit Statistics]]")
+        lines += [f"    {name:<15}= {value}" for name, value in figures if value]
         for v in self.validation:
-            lines.append(f"    {'validation':<12}= {v['source']}: fit {v['fit_percent']:.4f} %, RMSE {v['rmse']:.6e}")
+            lines.append(f"    {'validation':<15}= {v['source']}: fit {v['fit_percent']:.4f} %, RMSE {v['rmse']:.6e}")
         lines.append("[[Parameters]]")
         width = max((len(n) for n in self.parameters), default=0)
         for p in list(self.parameters.values())[:max_parameters]:
             lines.append(f"    {p.name + ':':<{width + 1}} {_parameter_line(p)}")
         if len(self.parameters) > max_parameters:
             lines.append(f"    … {len(self.parameters) - max_parameters} more (see .parameters)")
+        pairs = self.correlations(min_correl=min_correl)
+        if pairs:
+            lines.append(f"[[Correlations]] (unreported correlations are < {min_correl:.3f})")
+            width = max(len(f"C({a}, {b})") for a, b, _ in pairs)
+            lines += [f"    {f'C({a}, {b})':<{width}} = {c:+.4f}" for a, b, c in pairs]
         return "\n".join(lines)
+
+    def correlations(self, *, min_correl: float = 0.1) -> List[Tuple[str, str, float]]:
+        """The pairs of :attr:`free_parameters` whose correlation exceeds ``min_correl``
+        in magnitude, as ``(name, name, correlation)``, the strongest first (the pairs
+        ``fit_report()`` shows under ``[[Correlations]]``, as lmfit's); empty without a
+        :attr:`correlation`."""
+        corr = self.correlation
+        if corr is None:
+            return []
+        names = self.free_parameters
+        pairs = [
+            (names[i], names[j], float(corr[i, j]))
+            for i in range(len(names))
+            for j in range(i + 1, len(names))
+            if abs(corr[i, j]) > min_correl
+        ]
+        return sorted(pairs, key=lambda t: -abs(t[2]))
 
     def to_dataframe(self) -> Any:
         """The parameters as a pandas DataFrame (columns value, std, unit, fixed, lower,
@@ -307,6 +361,44 @@ def _figure(fit: Optional[Fields], details: Optional[Fields], key: str) -> Optio
     if value is None and details is not None:
         value = details.absent_or(key, float)
     return value
+
+
+def _covariance(uncertainty: Optional[Fields], parameters: Dict[str, Parameter]) -> Optional[FloatArray]:
+    """The report's ``uncertainty.covariance`` as a matrix over the free parameters (those
+    neither fixed nor without a standard deviation, in the model's order), rows and columns
+    mapped by name; None when the report has none. A matrix that is not square, names a
+    parameter twice, or does not cover exactly the free parameters is a :class:`ReportError`."""
+    raw = None if uncertainty is None else uncertainty.absent_or("covariance", dict)
+    if raw is None:
+        return None
+    c = Fields(raw, "report.uncertainty.covariance")
+    names = c.get("parameters", list)
+    rows = c.get("matrix", list)
+    where = "report.uncertainty.covariance"
+    if not all(isinstance(n, str) for n in names) or len(set(names)) != len(names):
+        raise ReportError(f"{where}.parameters: expected distinct names")
+    free = [n for n, p in parameters.items() if not p.fixed and p.std is not None]
+    if sorted(names) != sorted(free):
+        raise ReportError(f"{where}.parameters: {names} are not the free parameters {free} (those with a std)")
+    try:
+        matrix = np.array(rows, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ReportError(f"{where}.matrix: expected rows of numbers ({e})") from None
+    if matrix.shape != (len(names), len(names)):
+        raise ReportError(f"{where}.matrix: expected {len(names)} rows of {len(names)}, got shape {matrix.shape}")
+    order = [names.index(n) for n in free]
+    return np.ascontiguousarray(matrix[np.ix_(order, order)])
+
+
+def _correlation(c: FloatArray) -> FloatArray:
+    """C_ij / √(C_ii C_jj), 1 on the diagonal, 0 where a variance is 0."""
+    d = np.sqrt(np.clip(np.diag(c), 0.0, None))
+    scale = np.outer(d, d)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.where(scale > 0, c / np.where(scale > 0, scale, 1.0), 0.0)
+    r = np.clip(0.5 * (r + r.T), -1.0, 1.0)
+    np.fill_diagonal(r, 1.0)
+    return np.asarray(r, dtype=np.float64)
 
 
 def _num(v: Optional[float], spec: str) -> str:

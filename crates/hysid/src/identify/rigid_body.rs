@@ -72,6 +72,9 @@ pub struct RigidBodyEstimate {
     pub values: Vec<f64>,
     /// Standard deviations.
     pub std: Vec<f64>,
+    /// The covariance σ²(WᵀW)⁻¹ of the estimates, rows in the order of `names` (its
+    /// diagonal the squared `std`; empty when not computed).
+    pub covariance: Vec<Vec<f64>>,
     /// Relative standard deviations, 100·σ/|θ| [%].
     pub relative_std_percent: Vec<f64>,
     /// ‖g·u − Wθ̂‖/‖g·u‖ on the estimation record [%].
@@ -109,6 +112,9 @@ impl RigidBodyLs {
         let ls: LsSolution = least_squares(&w, &force, &name_refs)?;
         let values: Vec<f64> = ls.theta.iter().copied().collect();
         let std = ls.std();
+        let covariance = (0..values.len())
+            .map(|i| (0..values.len()).map(|j| ls.covariance[(i, j)]).collect())
+            .collect();
         if let Some((name, value)) = names.iter().zip(&values).find(|(_, v)| !v.is_finite()) {
             return Err(Error::NonFiniteResult {
                 key: name.clone(),
@@ -128,6 +134,7 @@ impl RigidBodyLs {
             names,
             values,
             std,
+            covariance,
         })
     }
 

@@ -5,6 +5,8 @@ use super::{CovarianceSummary, UncertaintySummary};
 use super::{DataSummary, FitSummary, Report, SearchSummary, TerminationSummary};
 use crate::data::IdData;
 use crate::identify::operators::FittedOperator;
+use crate::model::operators::Family;
+use crate::model::saved::{ModelFile, SavedModel};
 use crate::Result;
 use serde_json::json;
 
@@ -52,7 +54,8 @@ pub fn operator_report(
         ),
         estimated_model_steps: None,
     });
-    let model = fit.model.to_file();
+    let mut model = fit.model.to_file();
+    nnls_bounds(&mut model, fitted.family);
     let covariance =
         CovarianceSummary::of(&model, &fit.parameters.names(), |i, j| fit.covariance[i][j]);
     report.uncertainty = Some(
@@ -81,4 +84,27 @@ pub fn operator_report(
         "model_size": fit.model_size,
     });
     Ok(report)
+}
+
+/// The fitted model file with the bounds its fit held: the weights a₁…aₙ of a PI or GPI
+/// operator are the non-negative least-squares solution (aᵢ ≥ 0, `identify::operators::pi`,
+/// `gpi`), so their records say `lower: 0` (the model itself admits a negative weight while
+/// every partial sum a₀ + … + aᵢ stays non-negative, as an operator cascade fits it). A
+/// weight at 0 is then a parameter on its bound, without a standard deviation.
+fn nnls_bounds(model: &mut ModelFile, family: Family) {
+    if !matches!(family, Family::Pi | Family::Gpi) {
+        return;
+    }
+    if let SavedModel::Operator { parameters, .. } = &mut model.model {
+        for p in parameters.iter_mut() {
+            let weight = p
+                .name
+                .strip_prefix('a')
+                .and_then(|i| i.parse::<usize>().ok())
+                .is_some_and(|i| i >= 1);
+            if weight && !p.fixed && p.lower.is_none() && p.value >= 0.0 {
+                p.lower = Some(0.0);
+            }
+        }
+    }
 }

@@ -12,11 +12,13 @@
 //! holds the same per validation record; `details` hold the relative standard deviations,
 //! the relative error per record, the condition numbers and the settings.
 
-use super::{DataSummary, FitSummary, Report, SearchSummary, UncertaintySummary, ValidationEntry};
+use super::{CovarianceSummary, DataSummary, FitSummary, Report, SearchSummary};
+use super::{UncertaintySummary, ValidationEntry};
 use crate::identify::rigid_body::{RigidBodyEstimate, RigidBodyLs};
 use crate::model::greybox::models::RigidBody;
 use crate::model::greybox::{Simulation, StateSpaceModel};
 use crate::model::saved::FittedModel;
+use crate::numerics::metrics;
 use crate::Result;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
@@ -95,7 +97,28 @@ pub fn rigid_body_report(
 ) -> Result<Report> {
     let model = rigid_body_model(estimate, ls);
     let (u, u_hat) = estimation.prediction(&model)?;
-    let fit = FitSummary::of(&[estimation.source.to_string()], &[&u], &[&u_hat])?;
+    let mut fit = FitSummary::of(&[estimation.source.to_string()], &[&u], &[&u_hat])?;
+    // AIC and FPE of the prediction scored in `fit` (its N samples, loss V its mean squared
+    // error), with p the estimated parameters, as every output-error fit gives them.
+    let (n, p) = (u.len(), estimate.values.len());
+    let loss = metrics::mse(&u, &u_hat);
+    let finite = |v: f64| v.is_finite().then_some(v);
+    fit.aic = finite(metrics::aic(loss, n, p));
+    fit.fpe = finite(metrics::fpe(loss, n, p));
+    let file = model.to_file();
+    // The regression's covariance over the model's names (its inertia column is `M`).
+    let names: Vec<String> = (0..estimate.names.len())
+        .map(|k| {
+            if k == 0 {
+                "M".into()
+            } else {
+                estimate.names[k].clone()
+            }
+        })
+        .collect();
+    let covariance = (estimate.covariance.len() == names.len())
+        .then(|| CovarianceSummary::of(&file, &names, |i, j| estimate.covariance[i][j]))
+        .flatten();
     let mut records = vec![json!({
         "file": estimation.source,
         "role": "estimation",
@@ -119,10 +142,10 @@ pub fn rigid_body_report(
         validation: entries,
         details: details(estimate, ls, records, settings),
         ..Report::new("rigid-body ls").with_model(
-            Some(model.to_file()),
+            Some(file),
             Some(fit),
             Some(SearchSummary::direct(elapsed_s)),
-            Some(UncertaintySummary::least_squares()),
+            Some(UncertaintySummary::least_squares().with_covariance(covariance)),
         )
     })
 }

@@ -9,6 +9,7 @@ fn estimate() -> RigidBodyEstimate {
         names: vec!["M".into(), "Fv".into(), "Fc".into()],
         values: vec![1.5, 20.0, 3.0],
         std: vec![0.01, 0.2, 0.03],
+        covariance: Vec::new(),
         relative_std_percent: vec![0.67, 1.0, 1.0],
         relative_error_percent: 2.5,
         condition_number: 4.0,
