@@ -38,28 +38,30 @@ fn families() -> Vec<(&'static str, &'static str)> {
 }
 
 /// The recipes' options as Python passes them: `threshold_grid` empty means the uniform
-/// grid of `thresholds` thresholds.
+/// grid of `thresholds` thresholds; `None` sizes are chosen from the data, as the command
+/// line does without `--thresholds`/`--grid` (a given size fixes the model as given).
 fn family_options(
-    thresholds: usize,
+    thresholds: Option<usize>,
     threshold_grid: Vec<f64>,
-    grid: usize,
+    grid: Option<usize>,
     lambda: f64,
     dead_zones: usize,
 ) -> FamilyOptions {
+    let defaults = FamilyOptions::default();
+    let choose_thresholds = thresholds.is_none() && threshold_grid.is_empty();
     FamilyOptions {
         thresholds: if threshold_grid.is_empty() {
-            thresholds
+            thresholds.unwrap_or(defaults.thresholds)
         } else {
             threshold_grid.len()
         },
         threshold_grid: (!threshold_grid.is_empty()).then_some(threshold_grid),
-        grid,
+        grid: grid.unwrap_or(defaults.grid),
         lambda,
         dead_zones,
-        // Python passes its sizes (defaults 10 and 20): they fix the model as given
-        choose_thresholds: false,
-        choose_grid: false,
-        ..FamilyOptions::default()
+        choose_thresholds,
+        choose_grid: grid.is_none(),
+        ..defaults
     }
 }
 
@@ -80,9 +82,9 @@ fn identify_operator(
     y: PyReadonlyArray1<'_, f64>,
     family: &str,
     ts: f64,
-    thresholds: usize,
+    thresholds: Option<usize>,
     threshold_grid: Vec<f64>,
-    grid: usize,
+    grid: Option<usize>,
     lambda_: f64,
     dead_zones: usize,
     threads: usize,
@@ -197,9 +199,9 @@ fn compare<'py>(
     y_val: Option<PyReadonlyArray1<'py, f64>>,
     families: Vec<String>,
     ts: f64,
-    thresholds: usize,
+    thresholds: Option<usize>,
     threshold_grid: Vec<f64>,
-    grid: usize,
+    grid: Option<usize>,
     lambda_: f64,
     dead_zones: usize,
     threads: usize,

@@ -40,17 +40,23 @@ def _orientation(value: Optional[str]) -> Optional[str]:
 class _FamilyOptions(NamedTuple):
     """The families' options as the extension module takes them."""
 
-    thresholds: int
+    thresholds: Optional[int]
     threshold_grid: List[float]
-    grid: int
+    grid: Optional[int]
     lambda_: float
     dead_zones: int
 
 
 def _family_options(
-    thresholds: Union[int, Sequence[float]], grid: int, lambda_: float, dead_zones: int
+    thresholds: Union[int, Sequence[float], None], grid: Optional[int], lambda_: float, dead_zones: int
 ) -> _FamilyOptions:
-    if isinstance(thresholds, (int, np.integer)) and not isinstance(thresholds, bool):
+    """None for ``thresholds`` or ``grid``: chosen from the data, as the command line does
+    without ``--thresholds``/``--grid``."""
+    count: Optional[int]
+    values: List[float]
+    if thresholds is None:
+        count, values = None, []
+    elif isinstance(thresholds, (int, np.integer)) and not isinstance(thresholds, bool):
         count, values = check.count(thresholds, "thresholds"), []
     elif isinstance(thresholds, (bool, float, np.floating, str)):
         raise TypeError(
@@ -63,7 +69,8 @@ def _family_options(
     lam = float(lambda_)
     if not (math.isfinite(lam) and lam >= 0.0):
         raise ConfigError(f"lambda_={lambda_!r}: the Preisach smoothness must be finite and >= 0")
-    return _FamilyOptions(count, values, check.count(grid, "grid"), lam, check.count(dead_zones, "dead_zones"))
+    grid_count = None if grid is None else check.count(grid, "grid")
+    return _FamilyOptions(count, values, grid_count, lam, check.count(dead_zones, "dead_zones"))
 
 
 def _family(name: Any, what: str = "family") -> str:
@@ -79,8 +86,8 @@ def identify_operator(
     *,
     family: FamilyName,
     ts: float = 1.0,
-    thresholds: Union[int, Sequence[float]] = 10,
-    grid: int = 20,
+    thresholds: Union[int, Sequence[float], None] = None,
+    grid: Optional[int] = None,
     lambda_: float = 1e-6,
     dead_zones: int = 4,
     orientation: Optional[LoopOrientation] = None,
@@ -97,7 +104,9 @@ def identify_operator(
     ``family``: one of :data:`FAMILIES` (``"pi"``, ``"preisach"``, ``"bouc-wen"``, …; see
     ``docs/zoo.md``). ``thresholds``: PI/GPI thresholds and Maxwell-slip elements, a count
     (a uniform grid over the input range) or the thresholds themselves (strictly increasing,
-    > 0). ``grid``: Preisach intervals; ``lambda_``: Preisach smoothness; ``dead_zones``: GPI
+    > 0); None (the default) chooses the count and placement from the data (held-out
+    validation within a work bound, ``docs/zoo.md``), as the command line does without
+    ``--thresholds``. ``grid``: Preisach/KP intervals, None (the default) likewise chosen; ``lambda_``: Preisach smoothness; ``dead_zones``: GPI
     dead zones per side. ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
     ``orientation``: the loop's turning sense in the (u, y) plane, ``"ccw"``
     (counter-clockwise: the output lags the input, as a piezo stack or a magnet's B(H)) or
@@ -132,8 +141,8 @@ def compare(
     validate: Union[RecordLike, Tuple[Samples, Samples], None] = None,
     families: Union[AllFamilies, Sequence[FamilyName]] = "all",
     ts: float = 1.0,
-    thresholds: Union[int, Sequence[float]] = 10,
-    grid: int = 20,
+    thresholds: Union[int, Sequence[float], None] = None,
+    grid: Optional[int] = None,
     lambda_: float = 1e-6,
     dead_zones: int = 4,
     orientation: Optional[LoopOrientation] = None,
