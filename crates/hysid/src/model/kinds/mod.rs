@@ -4,8 +4,8 @@
 //! A kind is one module of this directory: the keys of its model file (`File`, a serde struct
 //! whose required keys are required by the type and which refuses any other key), how a file
 //! becomes a fitted model, checking every value ([`ModelKind::fitted`]), and how a fitted model
-//! is saved again (a `saved` function the module's [`FittedModel`] arm of
-//! [`FittedModel::to_file`] calls). The list generates:
+//! is saved again (the module's `saved`, which [`FittedModel::to_file`] calls). The list
+//! generates:
 //!
 //! * [`SavedModel`], the enum of every kind's file tagged by `kind` (its serde form and its
 //!   JSON Schema, `docs/schema/hysid.model.v1.json`), with the user's own grey-box model
