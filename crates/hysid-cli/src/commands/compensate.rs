@@ -43,7 +43,7 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
     let ranges = c.clipped_ranges();
     let file = model.to_file();
     let family = match &file.model {
-        SavedModel::Operator { family, .. } => family.as_str(),
+        SavedModel::Operator(op) => op.family.as_str(),
         other => other.kind(),
     };
     println!(

@@ -520,10 +520,10 @@ fn saved_equation_models_round_trip() {
     assert!(a[0].iter().zip(truth).all(|(x, y)| (x - y).abs() < 1e-12));
     // A corrupted text is reported with its line and column.
     let mut file = fitted.to_file();
-    let SavedModel::Equations { equations, .. } = &mut file.model else {
+    let SavedModel::Equations(saved) = &mut file.model else {
         panic!("not an equations model: {}", file.kind())
     };
-    *equations = model.source().replace("c*v", "cc*v");
+    saved.equations = model.source().replace("c*v", "cc*v");
     let e = FittedModel::from_file(&file).unwrap_err().to_string();
     assert!(
         e.contains("line ") && e.contains("unknown name 'cc'"),

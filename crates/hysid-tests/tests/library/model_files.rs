@@ -5,6 +5,7 @@
 //! copies are refused with one line naming the kind and the key.
 
 use hysid::data::{CsvSpec, IdData};
+use hysid::model::kinds::coleman_hodgdon::ColemanHodgdonFile;
 use hysid::model::saved::{FittedModel, ModelFile, SavedModel, MODEL_KINDS};
 use hysid::report::simulate_report;
 use serde_json::{json, Value};
@@ -351,10 +352,10 @@ fn keys_written_out_as_null_read_as_left_out() {
         serde_json::from_value(with(&ch, "initial_output", Some(Value::Null))).unwrap();
     assert!(matches!(
         file.model,
-        SavedModel::ColemanHodgdon {
+        SavedModel::ColemanHodgdon(ColemanHodgdonFile {
             initial_output: None,
             ..
-        }
+        })
     ));
     FittedModel::from_file(&file).unwrap();
 }

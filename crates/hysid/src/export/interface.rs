@@ -82,18 +82,19 @@ impl SampleTime {
 /// cascade.
 pub fn model_name(file: &ModelFile) -> String {
     match &file.model {
-        SavedModel::Operator { family, .. } => format!("operator ({family})"),
-        SavedModel::OperatorCascade { operator, .. } => {
-            let family = operator
+        SavedModel::Operator(op) => format!("operator ({})", op.family),
+        SavedModel::OperatorCascade(cascade) => {
+            let family = cascade
+                .operator
                 .get("family")
                 .and_then(|f| f.as_str())
                 .unwrap_or("?");
             format!("operator_cascade ({family})")
         }
-        SavedModel::ColemanHodgdon { hysteresis, .. }
-        | SavedModel::ChCascade { hysteresis, .. } => {
-            format!("{} ({})", file.kind(), hysteresis.short_name())
+        SavedModel::ColemanHodgdon(ch) => {
+            format!("{} ({})", file.kind(), ch.hysteresis.short_name())
         }
+        SavedModel::ChCascade(ch) => format!("{} ({})", file.kind(), ch.hysteresis.short_name()),
         _ => file.kind().to_string(),
     }
 }

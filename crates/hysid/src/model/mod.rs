@@ -13,13 +13,15 @@
 //!   their integrators and forward sensitivities.
 //! * [`record_filters`]: the processing a fit applied to its records (pre-filter,
 //!   inverse-dynamics preprocessing), saved with the model.
-//! * [`saved`]: fitted models and the saved-model file.
+//! * [`saved`]: fitted models and the saved-model file; [`kinds`]: the registry of its kinds,
+//!   one module per kind.
 //! * [`stream`]: every model one sample at a time ([`stream::Stepper`], [`stream::Compensator`]).
 
 mod cascade;
 pub mod coleman_hodgdon;
 pub mod compensate;
 pub mod greybox;
+pub mod kinds;
 pub mod limits;
 mod linear;
 pub mod operator_cascade;
@@ -27,7 +29,6 @@ pub mod operators;
 mod parameters;
 pub mod record_filters;
 pub mod saved;
-mod saved_equations;
 pub mod stream;
 
 pub use cascade::{CascadeOutput, HysteresisCascade};

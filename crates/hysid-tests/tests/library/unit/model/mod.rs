@@ -3,6 +3,7 @@
 mod coleman_hodgdon;
 mod compensate;
 mod greybox;
+mod kinds;
 mod linear;
 mod operator_cascade;
 mod operators;

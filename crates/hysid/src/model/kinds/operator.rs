@@ -1,0 +1,73 @@
+//! Kind `operator`: a hysteresis operator of one family of the registry
+//! ([`FittedModel::Operator`]).
+
+use super::{records, ModelKind, Records};
+use crate::model::operators::{InitialStateUsed, OperatorModel};
+use crate::model::saved::{FittedModel, ParameterRecord, SavedModel};
+use crate::Result;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The kind of a saved hysteresis operator.
+pub const OPERATOR_KIND: &str = "operator";
+
+/// The kind `operator` in the registry ([`super::ModelKind`]).
+pub struct OperatorKind;
+
+/// The keys of an `operator` model file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OperatorFile {
+    /// The family's parameters, named as in the literature.
+    pub parameters: Vec<ParameterRecord>,
+    /// The family's name, one of the registry's operator families (`pi`, `preisach`,
+    /// `kp`, …: `hysid::model::operators::Family`).
+    pub family: String,
+    /// The operator's full structure: thresholds, weights, grids, orientation and
+    /// initial state, as the family defines them. Checked on reading.
+    pub operator: serde_json::Value,
+    /// The initial state the operator starts from (`demagnetised`, `descending`,
+    /// `ascending`, `estimated`: `hysid::model::operators::InitialStateUsed`); a declared
+    /// history is re-applied at every record's first input. Absent: the structure's own
+    /// state, as before the field existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_state: Option<InitialStateUsed>,
+}
+
+impl ModelKind for OperatorKind {
+    type File = OperatorFile;
+
+    fn parameters(file: &OperatorFile) -> &[ParameterRecord] {
+        &file.parameters
+    }
+
+    fn fitted(file: &OperatorFile) -> Result<FittedModel> {
+        let records = Records {
+            kind: OPERATOR_KIND,
+            list: &file.parameters,
+        };
+        let model = OperatorModel::from_structure(&file.family, &file.operator)?;
+        let names = model.as_operator().parameters();
+        let mut std = Vec::with_capacity(names.len());
+        for p in names.iter() {
+            std.push(records.get(&p.name)?.std_or_nan());
+        }
+        Ok(FittedModel::operator(model, std).with_initial_state(file.initial_state))
+    }
+}
+
+/// The saved form of [`FittedModel::Operator`].
+pub(crate) fn saved(
+    family: &str,
+    model: &OperatorModel,
+    std: &[f64],
+    initial_state: Option<InitialStateUsed>,
+) -> SavedModel {
+    SavedModel::Operator(OperatorFile {
+        parameters: records(&model.as_operator().parameters(), std),
+        family: family.to_string(),
+        // As for the operator cascade: a failure would only leave the structure null.
+        operator: model.structure().unwrap_or_default(),
+        initial_state,
+    })
+}

@@ -1,0 +1,509 @@
+//! The fitted model ([`FittedModel`]): what an estimator returns and `hysid simulate` loads,
+//! able to simulate and predict, saved by [`FittedModel::to_file`] and read back by
+//! [`FittedModel::from_file`] through the registry of kinds ([`crate::model::kinds`]).
+
+use super::{check_inverse_dynamics, check_prefilter, ModelFile, MODEL_SCHEMA};
+use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
+use crate::model::greybox::equation_model::EquationStateSpace;
+use crate::model::greybox::models;
+use crate::model::greybox::native::Evaluator;
+use crate::model::greybox::Simulation;
+use crate::model::kinds::grey_box::simulate_outputs;
+use crate::model::kinds::operator_cascade;
+use crate::model::kinds::{ch_cascade, coleman_hodgdon, equations, grey_box, operator};
+use crate::model::operators::initial_state;
+use crate::model::operators::{InitialStateUsed, OperatorModel};
+use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
+use crate::model::{ColemanHodgdon, HysteresisCascade, OperatorCascade, ParameterSet};
+use crate::{Error, Result};
+use std::path::Path;
+
+/// A fitted model that can simulate.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FittedModel {
+    /// The hysteresis alone.
+    Hysteresis {
+        /// The model.
+        model: ColemanHodgdon,
+        /// Where its output starts.
+        initial: InitialOutput,
+        /// Standard deviations in [`crate::model::ChForm::parameter_names`] order.
+        std: Vec<f64>,
+    },
+    /// The cascade.
+    Cascade {
+        /// The model.
+        model: HysteresisCascade,
+        /// Standard deviations in [`HysteresisCascade::params`] order.
+        std: Vec<f64>,
+    },
+    /// A built-in grey-box model.
+    GreyBox {
+        /// Its kind (`bouc_wen`, `rigid_body`).
+        kind: String,
+        /// Its parameters (values, units, bounds, fixed flags).
+        parameters: ParameterSet,
+        /// Their standard deviations.
+        std: Vec<f64>,
+        /// How it is simulated.
+        simulation: Simulation,
+        /// Its initial state.
+        initial_state: Vec<f64>,
+    },
+    /// Any hysteresis operator followed by a linear block.
+    OperatorCascade {
+        /// The model.
+        model: OperatorCascade,
+        /// Standard deviations in [`OperatorCascade::parameters`] order (NaN where not
+        /// estimated).
+        std: Vec<f64>,
+    },
+    /// A grey-box model written as equations (`hysid-equations`).
+    Equations {
+        /// The equation file's text.
+        equations: String,
+        /// Its parameters (values, units, bounds, fixed flags) in the file's order.
+        parameters: ParameterSet,
+        /// Their standard deviations.
+        std: Vec<f64>,
+        /// How it is simulated.
+        simulation: Simulation,
+        /// Its initial state.
+        initial_state: Vec<f64>,
+        /// Which code runs its tapes when it is simulated (not saved: a setting of the run,
+        /// [`FittedModel::with_evaluator`]; [`Evaluator::Auto`] when read from a file).
+        evaluator: Evaluator,
+    },
+    /// A hysteresis operator of one of the families of [`crate::model::operators`].
+    Operator {
+        /// The family's name (`pi`, `preisach`, …; equal to `model.family()`).
+        family: &'static str,
+        /// The operator.
+        model: OperatorModel,
+        /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
+        std: Vec<f64>,
+        /// The initial state it starts from (None: as its structure holds it).
+        initial_state: Option<InitialStateUsed>,
+    },
+    /// A model fitted to pre-filtered records: it filters every record (inputs and measured
+    /// output alike) before it simulates.
+    Prefiltered {
+        /// The model as fitted to the filtered records.
+        model: Box<FittedModel>,
+        /// The filter.
+        prefilter: Prefilter,
+    },
+    /// A rigid body (a [`FittedModel::GreyBox`] of kind `rigid_body`) fitted by inverse
+    /// dynamics: it predicts the drive signal from the measured position (see
+    /// [`InverseDynamics`]).
+    InverseDynamics {
+        /// The rigid body.
+        model: Box<FittedModel>,
+        /// The preprocessing of the fit.
+        preprocessing: InverseDynamics,
+    },
+}
+
+/// One record as a model's fit sees it: the inputs the model is driven by (filtered,
+/// decimated where the fit did so), its outputs, and the measured output processed alike.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    /// The inputs as the model sees them.
+    pub inputs: Vec<Vec<f64>>,
+    /// The model's outputs (simulated, or predicted by inverse dynamics).
+    pub outputs: Vec<Vec<f64>>,
+    /// The measured counterpart of output 0, processed as the fit processed it.
+    pub measured: Option<Vec<f64>>,
+}
+
+impl FittedModel {
+    /// Simulates the model's outputs for the input channels `inputs` sampled every `ts`;
+    /// `y0` is the measured initial output (used by a hysteresis with
+    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges
+    /// (an output that is NaN or ±∞, e.g. an unstable linear block, is
+    /// [`Error::Diverged`], never returned).
+    pub fn simulate(&self, inputs: &[&[f64]], ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let outputs = self.simulate_unchecked(inputs, ts, y0)?;
+        for (channel, y) in outputs.iter().enumerate() {
+            if let Some(index) = y.iter().position(|v| !v.is_finite()) {
+                return Err(Error::Diverged {
+                    index,
+                    reason: format!(
+                        "output {} is {}; the model is unstable or its parameters are out of range for this input",
+                        channel + 1,
+                        y[index]
+                    ),
+                });
+            }
+        }
+        Ok(outputs)
+    }
+
+    fn simulate_unchecked(
+        &self,
+        inputs: &[&[f64]],
+        ts: f64,
+        y0: Option<f64>,
+    ) -> Result<Vec<Vec<f64>>> {
+        let first = || {
+            inputs
+                .first()
+                .copied()
+                .ok_or_else(|| Error::ModelMismatch("no input channel given".into()))
+        };
+        match self {
+            FittedModel::Hysteresis { model, initial, .. } => {
+                let x = first()?;
+                model.check_rate(x)?;
+                let v0 = match initial {
+                    InitialOutput::Measured => y0.ok_or_else(|| {
+                        Error::ModelMismatch(
+                            "this hysteresis starts from the measured output; give the measured output"
+                                .into(),
+                        )
+                    })?,
+                    InitialOutput::Zero => 0.0,
+                };
+                Ok(vec![simulate_switched(model, x, v0, None)])
+            }
+            FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::Prefiltered { model, prefilter } => {
+                let filtered = inputs
+                    .iter()
+                    .map(|x| prefilter.apply(x, ts))
+                    .collect::<Result<Vec<_>>>()?;
+                model.simulate_unchecked(&slices(&filtered), ts, y0)
+            }
+            FittedModel::InverseDynamics { preprocessing, .. } => Ok(vec![
+                preprocessing.predict(&self.rigid_body()?, first()?, ts)?.1,
+            ]),
+            FittedModel::OperatorCascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
+            FittedModel::Operator {
+                model,
+                initial_state,
+                ..
+            } => Ok(vec![initial_state::simulate(
+                model.as_operator(),
+                *initial_state,
+                first()?,
+            )?]),
+            FittedModel::GreyBox {
+                kind,
+                parameters,
+                simulation,
+                initial_state,
+                ..
+            } => {
+                let model = models::by_kind(kind)?;
+                let theta = parameters.values();
+                simulate_outputs(
+                    model.as_ref(),
+                    &theta,
+                    initial_state,
+                    inputs,
+                    ts,
+                    simulation,
+                )
+            }
+            FittedModel::Equations {
+                equations,
+                parameters,
+                simulation,
+                initial_state,
+                evaluator,
+                ..
+            } => {
+                let model =
+                    EquationStateSpace::parse(equations, "saved model")?.with_evaluator(*evaluator);
+                simulate_outputs(
+                    &model,
+                    &parameters.values(),
+                    initial_state,
+                    inputs,
+                    ts,
+                    simulation,
+                )
+            }
+        }
+    }
+
+    /// The model's outputs for the inputs `inputs` sampled every `ts`, and the measured output
+    /// `measured` processed as the fit processed it: filtered for a
+    /// [`FittedModel::Prefiltered`], decimated and trimmed for a
+    /// [`FittedModel::InverseDynamics`] (whose input is the position and whose output the
+    /// predicted drive signal); as they are for every other model. fit % of
+    /// `outputs[0]` against `measured` is the fit the model's report states.
+    pub fn predict(
+        &self,
+        inputs: &[&[f64]],
+        measured: Option<&[f64]>,
+        ts: f64,
+    ) -> Result<Prediction> {
+        match self {
+            FittedModel::Prefiltered { model, prefilter } => {
+                let filtered = inputs
+                    .iter()
+                    .map(|x| prefilter.apply(x, ts))
+                    .collect::<Result<Vec<_>>>()?;
+                let measured = measured.map(|y| prefilter.apply(y, ts)).transpose()?;
+                model.predict(&slices(&filtered), measured.as_deref(), ts)
+            }
+            FittedModel::InverseDynamics { preprocessing, .. } => {
+                let q = inputs.first().copied().unwrap_or_default();
+                if let Some(u) = measured.filter(|u| u.len() != q.len()) {
+                    return Err(Error::InvalidData(format!(
+                        "the position has {} samples, the drive signal {}",
+                        q.len(),
+                        u.len()
+                    )));
+                }
+                let (position, predicted) = preprocessing.predict(&self.rigid_body()?, q, ts)?;
+                if let Some(index) = predicted.iter().position(|v| !v.is_finite()) {
+                    return Err(Error::Diverged {
+                        index,
+                        reason:
+                            "the predicted drive signal is not finite; scale the position data down"
+                                .into(),
+                    });
+                }
+                Ok(Prediction {
+                    inputs: vec![position],
+                    outputs: vec![predicted],
+                    measured: measured.map(|u| preprocessing.reduce(u)).transpose()?,
+                })
+            }
+            _ => Ok(Prediction {
+                outputs: self.simulate(inputs, ts, measured.and_then(|y| y.first().copied()))?,
+                inputs: inputs.iter().map(|x| x.to_vec()).collect(),
+                measured: measured.map(<[f64]>::to_vec),
+            }),
+        }
+    }
+
+    /// `model` fitted to records filtered by `prefilter` (unchanged when there is none).
+    pub fn prefiltered(model: FittedModel, prefilter: Option<Prefilter>) -> Self {
+        match prefilter {
+            Some(prefilter) => FittedModel::Prefiltered {
+                model: Box::new(model),
+                prefilter,
+            },
+            None => model,
+        }
+    }
+
+    /// The rigid body's values of an inverse-dynamics model (M, Fv, Fc, offset, gain).
+    fn rigid_body(&self) -> Result<RigidBodyValues> {
+        let inner = match self {
+            FittedModel::InverseDynamics { model, .. } => model.as_ref(),
+            other => other,
+        };
+        let parameters = match inner {
+            FittedModel::GreyBox {
+                kind, parameters, ..
+            } if kind == "rigid_body" => parameters,
+            other => {
+                return Err(Error::UnsupportedKind {
+                    kind: other.to_file().kind().to_string(),
+                    operation: "inverse dynamics (a rigid_body model)".into(),
+                })
+            }
+        };
+        let value = |name: &str| parameters.iter().find(|p| p.name == name).map(|p| p.value);
+        match (
+            value("M"),
+            value("Fv"),
+            value("Fc"),
+            value("offset"),
+            value("gain"),
+        ) {
+            (Some(inertia), Some(fv), Some(fc), Some(offset), Some(gain)) => Ok(RigidBodyValues {
+                inertia,
+                fv,
+                fc,
+                offset,
+                gain,
+            }),
+            _ => Err(Error::InvalidModel(
+                "a rigid body needs the parameters M, Fv, Fc, offset and gain".into(),
+            )),
+        }
+    }
+
+    /// A built-in-style grey-box fit ([`FittedModel::GreyBox`]) of the equation model with
+    /// file text `equations`, as [`FittedModel::Equations`]; other variants unchanged.
+    pub fn with_equations(self, equations: &str) -> Self {
+        match self {
+            FittedModel::GreyBox {
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                ..
+            } => FittedModel::Equations {
+                equations: equations.to_string(),
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                evaluator: Evaluator::Auto,
+            },
+            other => other,
+        }
+    }
+
+    /// The same model with its equation tapes run by `evaluator` (an equation model, also
+    /// inside a pre-filtered one); other models unchanged.
+    pub fn with_evaluator(self, evaluator: Evaluator) -> Self {
+        match self {
+            FittedModel::Equations {
+                equations,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                ..
+            } => FittedModel::Equations {
+                equations,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                evaluator,
+            },
+            FittedModel::Prefiltered { model, prefilter } => FittedModel::Prefiltered {
+                model: Box::new(model.with_evaluator(evaluator)),
+                prefilter,
+            },
+            other => other,
+        }
+    }
+
+    /// The model file of this model (each kind saved by its module of
+    /// [`crate::model::kinds`]).
+    pub fn to_file(&self) -> ModelFile {
+        let model = match self {
+            FittedModel::Hysteresis {
+                model,
+                initial,
+                std,
+            } => coleman_hodgdon::saved(model, *initial, std),
+            FittedModel::Cascade { model, std } => ch_cascade::saved(model, std),
+            FittedModel::OperatorCascade { model, std } => operator_cascade::saved(model, std),
+            FittedModel::GreyBox {
+                kind,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+            } => grey_box::saved(kind, parameters, std, simulation, initial_state),
+            FittedModel::Equations {
+                equations,
+                parameters,
+                std,
+                simulation,
+                initial_state,
+                ..
+            } => equations::saved(equations, parameters, std, simulation, initial_state),
+            FittedModel::Operator {
+                family,
+                model,
+                std,
+                initial_state,
+            } => operator::saved(family, model, std, *initial_state),
+            FittedModel::Prefiltered { model, prefilter } => {
+                return ModelFile {
+                    prefilter: Some(*prefilter),
+                    ..model.to_file()
+                }
+            }
+            FittedModel::InverseDynamics {
+                model,
+                preprocessing,
+            } => {
+                return ModelFile {
+                    inverse_dynamics: Some(*preprocessing),
+                    ..model.to_file()
+                }
+            }
+        };
+        ModelFile::new(model)
+    }
+
+    /// The fitted model of an operator with standard deviations `std` (NaN: none).
+    pub fn operator(model: OperatorModel, std: Vec<f64>) -> Self {
+        FittedModel::Operator {
+            family: model.family().name(),
+            model,
+            std,
+            initial_state: None,
+        }
+    }
+
+    /// The same model starting from `state` (an operator; other kinds are returned as they
+    /// are).
+    pub fn with_initial_state(self, state: Option<InitialStateUsed>) -> Self {
+        match self {
+            FittedModel::Operator {
+                family, model, std, ..
+            } => FittedModel::Operator {
+                family,
+                model,
+                std,
+                initial_state: state,
+            },
+            other => other,
+        }
+    }
+
+    /// Rebuilds a fitted model from a model file, checking every value.
+    pub fn from_file(file: &ModelFile) -> Result<Self> {
+        if file.schema != MODEL_SCHEMA {
+            return Err(Error::InvalidModel(format!(
+                "schema '{}' is not {MODEL_SCHEMA}; save the model again with this version",
+                file.schema
+            )));
+        }
+        if let Some(p) = file.parameters().iter().find(|p| !p.value.is_finite()) {
+            return Err(Error::InvalidModel(format!(
+                "parameter '{}' has no finite value",
+                p.name
+            )));
+        }
+        if let Some(prefilter) = file.prefilter {
+            check_prefilter(&prefilter)?;
+            let inner = ModelFile {
+                prefilter: None,
+                ..file.clone()
+            };
+            return Ok(Self::prefiltered(Self::from_file(&inner)?, Some(prefilter)));
+        }
+        if let Some(preprocessing) = file.inverse_dynamics {
+            check_inverse_dynamics(&preprocessing)?;
+            let inner = ModelFile {
+                inverse_dynamics: None,
+                ..file.clone()
+            };
+            let model = FittedModel::InverseDynamics {
+                model: Box::new(Self::from_file(&inner)?),
+                preprocessing,
+            };
+            model.rigid_body()?;
+            return Ok(model);
+        }
+        file.model.fitted()
+    }
+
+    /// Reads a model file, or the `model` object of a report.
+    pub fn load(path: &Path) -> Result<Self> {
+        let file = ModelFile::read(path)?;
+        Self::from_file(&file).map_err(|e| Error::ModelFile {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+    }
+}
+
+/// The slices of `signals`.
+fn slices(signals: &[Vec<f64>]) -> Vec<&[f64]> {
+    signals.iter().map(Vec::as_slice).collect()
+}
