@@ -95,8 +95,8 @@ fn nnls_bounds(model: &mut ModelFile, family: Family) {
     if !matches!(family, Family::Pi | Family::Gpi) {
         return;
     }
-    if let SavedModel::Operator { parameters, .. } = &mut model.model {
-        for p in parameters.iter_mut() {
+    if let SavedModel::Operator(operator) = &mut model.model {
+        for p in operator.parameters.iter_mut() {
             let weight = p
                 .name
                 .strip_prefix('a')
