@@ -49,20 +49,23 @@ impl Default for MaxwellSlipOptions {
     }
 }
 
+/// The orientation detected from the data, for the stop operators: their own loop is
+/// clockwise (the force leads the displacement), so a detected clockwise loop is the direct
+/// form and a counter-clockwise one the inverse.
+fn detected_orientation(u: &[f64], y: &[f64]) -> Result<Orientation> {
+    let d = orientation(u, y, None)?;
+    Ok(Orientation {
+        inverse: !d.inverse,
+        ..d
+    })
+}
+
 /// Fits Maxwell-slip elements to displacement `u` and force `y`.
 pub fn fit(u: &[f64], y: &[f64], options: &MaxwellSlipOptions) -> Result<OperatorFit<MaxwellSlip>> {
     let start = Instant::now();
-    // the stop operators' own loop is clockwise (the force leads the displacement): a
-    // detected clockwise loop is the direct form, a counter-clockwise one the inverse
     let o = match options.orientation {
         Some(o) => o,
-        None => {
-            let d = orientation(u, y, None)?;
-            Orientation {
-                inverse: !d.inverse,
-                ..d
-            }
-        }
+        None => detected_orientation(u, y)?,
     };
     let (x, v) = o.core_data(u, y);
     let widths = match &options.widths {
@@ -135,13 +138,7 @@ impl Identify for MaxwellSlip {
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = match given {
                 Some(o) => o,
-                None => {
-                    let d = orientation(u, y, None)?;
-                    Orientation {
-                        inverse: !d.inverse,
-                        ..d
-                    }
-                }
+                None => detected_orientation(u, y)?,
             };
             let (x, _) = o.core_data(u, y);
             let candidates = threshold_candidates(&x, 2)?;

@@ -69,6 +69,31 @@ fn needed(p: usize) -> usize {
     (2 * p).max(p + 10)
 }
 
+/// The Preisach-plane families' (Preisach, KP) choice of their grid: the candidates
+/// [`GRID_CANDIDATES`](super::family::GRID_CANDIDATES), each with its n(n+1)/2 cells, offset
+/// and slope, chosen by [`choose`] within `bound` fits of the default grid 20; `fit` fits
+/// the grid of n intervals. The choice is recorded in the fit's `model_size`.
+pub(crate) fn choose_grid<M, F>(u: &[f64], y: &[f64], bound: f64, fit: F) -> Result<OperatorFit<M>>
+where
+    M: HysteresisOperator,
+    F: Fn(&[f64], &[f64], usize) -> Result<OperatorFit<M>>,
+{
+    let parameters = |n: usize| n * (n + 1) / 2 + 2;
+    let candidates = super::family::GRID_CANDIDATES
+        .iter()
+        .map(|&n| Candidate {
+            setting: n,
+            label: format!("grid {n}"),
+            parameters: parameters(n),
+        })
+        .collect();
+    let (mut f, choice) = choose(u, y, candidates, parameters(20), bound, |u, y, &n| {
+        fit(u, y, n)
+    })?;
+    f.model_size = Some(choice);
+    Ok(f)
+}
+
 /// Chooses among `candidates` (smallest first) by the held-out fit % within `bound` default
 /// fits of `default_parameters` parameters, and refits the winner on the whole record.
 pub(crate) fn choose<M, C, F>(

@@ -19,7 +19,7 @@ use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, finish, orientation, range, solve_weights, unscaled, GramAccumulator, Spread,
 };
-use super::model_size::{choose, Candidate};
+use super::model_size::choose_grid;
 use super::OperatorFit;
 use crate::model::operators::preisach::{regressors, Grid, Memory};
 use crate::model::operators::{Orientation, Preisach};
@@ -199,19 +199,9 @@ impl Identify for Preisach {
         };
         if options.choose_grid {
             let o = orientation(u, y, given)?;
-            let candidates = super::family::GRID_CANDIDATES
-                .iter()
-                .map(|&n| Candidate {
-                    setting: n,
-                    label: format!("grid {n}"),
-                    parameters: n * (n + 1) / 2 + 2,
-                })
-                .collect();
-            let (mut f, choice) = choose(u, y, candidates, 212, GRID_WORK_BOUND, |u, y, &n| {
+            return choose_grid(u, y, GRID_WORK_BOUND, |u, y, n| {
                 fit(u, y, &settings(n, Some(o)))
-            })?;
-            f.model_size = Some(choice);
-            return Ok(f);
+            });
         }
         fit(u, y, &settings(options.grid, given))
     }
