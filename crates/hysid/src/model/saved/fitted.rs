@@ -353,28 +353,17 @@ impl FittedModel {
 
     /// The same model with its equation tapes run by `evaluator` (an equation model, also
     /// inside a pre-filtered one); other models unchanged.
-    pub fn with_evaluator(self, evaluator: Evaluator) -> Self {
+    pub fn with_evaluator(mut self, evaluator: Evaluator) -> Self {
+        self.set_evaluator(evaluator);
+        self
+    }
+
+    /// [`Self::with_evaluator`] in place.
+    fn set_evaluator(&mut self, evaluator: Evaluator) {
         match self {
-            FittedModel::Equations {
-                equations,
-                parameters,
-                std,
-                simulation,
-                initial_state,
-                ..
-            } => FittedModel::Equations {
-                equations,
-                parameters,
-                std,
-                simulation,
-                initial_state,
-                evaluator,
-            },
-            FittedModel::Prefiltered { model, prefilter } => FittedModel::Prefiltered {
-                model: Box::new(model.with_evaluator(evaluator)),
-                prefilter,
-            },
-            other => other,
+            FittedModel::Equations { evaluator: e, .. } => *e = evaluator,
+            FittedModel::Prefiltered { model, .. } => model.set_evaluator(evaluator),
+            _ => {}
         }
     }
 
