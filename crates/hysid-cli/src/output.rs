@@ -173,10 +173,9 @@ pub fn write_model(out: &Staged, file: &ModelFile) -> Result<()> {
     write_text(out, &text).context("writing the model file")
 }
 
-/// Writes the plots into `dir`, a staged directory or a directory inside one.
+/// Writes the plots into `dir`, a staged directory (which exists: registering it created
+/// it, and it is never recreated here, so that an interrupt's removal is final).
 pub fn write_figures(dir: &Path, figures: &[Svg]) -> Result<()> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create directory {}", dir.display()))?;
     for f in figures {
         let path = dir.join(&f.name);
         std::fs::write(&path, &f.svg)
@@ -185,7 +184,9 @@ pub fn write_figures(dir: &Path, figures: &[Svg]) -> Result<()> {
     Ok(())
 }
 
-/// Writes `text` to the temporary of `out`.
+/// Writes `text` to the temporary of `out` (created through the library, so that an
+/// interrupt never leaves it behind: [`hysid::io::atomic::create`]).
 pub fn write_text(out: &Staged, text: &str) -> Result<()> {
-    std::fs::write(&out.tmp, text).with_context(|| format!("cannot write {}", out.target.display()))
+    hysid::io::atomic::write(&out.tmp, text)
+        .with_context(|| format!("cannot write {}", out.target.display()))
 }

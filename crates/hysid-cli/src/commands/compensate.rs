@@ -1,6 +1,6 @@
 //! `hysid compensate`: the input that makes a fitted hysteresis model follow a reference.
 
-use super::zoo::{signals, write_text};
+use super::zoo::signals;
 use crate::cli_zoo::CompensateArgs;
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
@@ -104,7 +104,8 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
         )?;
     }
     if let Some(path) = &json_tmp {
-        write_text(path, &report.to_json()?)?;
+        hysid::io::atomic::write(path, report.to_json()?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
     files.commit()?;
     println!("  compensating input: {}", args.csv.display());

@@ -106,12 +106,8 @@ pub fn signals(path: &Path, title: &str, y_label: &str, series: &[(&str, &[f64])
     plot(path, &figure)
 }
 
-/// Renders `figure` as SVG into the staged output `path`.
+/// Renders `figure` as SVG into `path`, a file inside a staged plot directory.
 fn plot(path: &Path, figure: &Figure) -> Result<()> {
-    write_text(path, &render(figure)?)
-}
-
-/// Writes `text` to the staged output `path`.
-pub fn write_text(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))
+    std::fs::write(path, render(figure)?)
+        .with_context(|| format!("cannot write {}", path.display()))
 }

@@ -218,7 +218,7 @@ fn sigterm_child() {
     let mut outputs = OutputSet::new(&[]).unwrap();
     let tmp = outputs.file(&dir.join("report.json")).unwrap();
     let plots = outputs.dir(&dir.join("plots")).unwrap();
-    fs::write(&tmp, "new").unwrap();
+    hysid::io::atomic::write(&tmp, "new").unwrap();
     fs::write(plots.join("new.svg"), "new").unwrap();
     fs::write(dir.join("ready"), "").unwrap();
     std::thread::sleep(std::time::Duration::from_secs(60));
@@ -277,6 +277,103 @@ fn sigterm_removes_the_temporaries_and_keeps_the_previous_outputs() {
         "old"
     );
     assert!(listing(&dir.path().join("plots")).is_empty());
+}
+
+/// Run as a child process by the next test: registers, creates, writes and drops or
+/// commits output sets in a tight loop — a file, a directory with a file and a CSV inside
+/// it — with a handler that removes the temporaries and exits with 130.
+#[test]
+#[ignore = "helper: run only as the child of the interrupt-at-any-moment test"]
+fn churning_child() {
+    let Ok(dir) = std::env::var("HYSID_CHURN_DIR") else {
+        return;
+    };
+    ctrlc::set_handler(|| {
+        hysid::io::atomic::remove_live_temporaries();
+        std::process::exit(130);
+    })
+    .unwrap();
+    let dir = Path::new(&dir);
+    fs::write(dir.join("ready"), "").unwrap();
+    for k in 0.. {
+        let mut outputs = OutputSet::new(&[]).unwrap();
+        let tmp = outputs.file(&dir.join("report.json")).unwrap();
+        let plots = outputs.dir(&dir.join("plots")).unwrap();
+        hysid::io::atomic::write(&tmp, "new").unwrap();
+        fs::write(plots.join("a.svg"), "new").unwrap();
+        hysid::data::write_csv(&plots.join("b.csv"), &["x"], &[&[1.0]]).unwrap();
+        if k % 2 == 0 {
+            outputs.commit().unwrap();
+        }
+    }
+}
+
+/// A program whose handler calls `remove_live_temporaries` leaves no temporary whatever
+/// the moment of the signal — also between a registration and the creation of its
+/// temporary, which the library does under the handler's lock (`OutputSet::dir`,
+/// `atomic::create`). Forty signals at seeded moments into a child that does nothing but
+/// register and write outputs.
+#[cfg(unix)]
+#[test]
+fn a_signal_at_any_moment_leaves_no_temporary() {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(41);
+    for round in 0..40 {
+        let dir = tempfile::tempdir().unwrap();
+        let mut child = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--ignored",
+                "--exact",
+                "atomic_outputs::churning_child",
+                "--nocapture",
+            ])
+            .env("HYSID_CHURN_DIR", dir.path())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let ready = dir.path().join("ready");
+        for _ in 0..3000 {
+            if ready.exists() {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        assert!(ready.exists(), "the child never got ready");
+        let moment = rng.random_range(0.0..0.05);
+        std::thread::sleep(std::time::Duration::from_secs_f64(moment));
+        let status = std::process::Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let exit = child.wait().unwrap();
+        assert_eq!(exit.code(), Some(130), "round {round}: {exit}");
+        let mut left = Vec::new();
+        let mut pending = vec![dir.path().to_path_buf()];
+        while let Some(d) = pending.pop() {
+            for entry in fs::read_dir(&d).unwrap().flatten() {
+                let name = entry.file_name().to_string_lossy().into_owned();
+                if name.contains("hysid-tmp") || name.contains("hysid-probe") {
+                    left.push(name);
+                }
+                if entry.path().is_dir() {
+                    pending.push(entry.path());
+                }
+            }
+        }
+        assert!(left.is_empty(), "round {round}: temporaries left: {left:?}");
+    }
+}
+
+/// A temporary is created only through its registration: any other path is refused.
+#[test]
+fn only_a_registered_temporary_is_created() {
+    let dir = tempfile::tempdir().unwrap();
+    let stray = dir.path().join(".x.hysid-tmp-0-0");
+    let e = hysid::io::atomic::create(&stray).unwrap_err();
+    assert!(e.to_string().contains("not a registered temporary"), "{e}");
+    assert!(!stray.exists());
 }
 
 /// Signals belong to the program: an output set installs no handler, so a program without

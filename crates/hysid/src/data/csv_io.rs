@@ -217,7 +217,7 @@ pub fn write_csv(path: &Path, headers: &[&str], columns: &[&[f64]]) -> Result<()
     };
     let mut output = OutputSet::new(&[])?;
     let temp = output.file(path)?;
-    let file = File::create(&temp).map_err(io_error)?;
+    let file = crate::io::atomic::create(&temp)?;
     write_table(file, headers, columns).map_err(io_error)?;
     output.commit()
 }

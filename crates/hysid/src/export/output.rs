@@ -66,9 +66,18 @@ impl ExportDir {
                     file.path.display()
                 )));
             }
+            // The directories below the staged one, one by one: the staged directory itself
+            // is never recreated, so that an interrupt's removal of it is final.
             let path = self.staged.join(&file.path);
-            if let Some(parent) = path.parent() {
-                std::fs::create_dir_all(parent).map_err(|source| io(parent, source))?;
+            let mut parent = self.staged.clone();
+            for part in file.path.parent().into_iter().flat_map(Path::components) {
+                parent.push(part);
+                match std::fs::create_dir(&parent) {
+                    Err(e) if e.kind() != std::io::ErrorKind::AlreadyExists => {
+                        return Err(io(&parent, e));
+                    }
+                    _ => {}
+                }
             }
             std::fs::write(&path, &file.contents).map_err(|source| io(&path, source))?;
         }

@@ -15,7 +15,9 @@
 //!    cannot be created and removed;
 //! 2. each output is written to a temporary in its destination directory — a file to
 //!    `.NAME.hysid-tmp-PID-N`, a directory output to a sibling directory of that form — whose
-//!    path registration returns;
+//!    path registration returns. A temporary file is created through [`create`] or
+//!    [`write`], under the same lock as a signal handler's removal (below), so that no
+//!    interrupt can leave one behind;
 //! 3. [`OutputSet::commit`] puts every temporary in place, each by one atomic replacement
 //!    (a file renamed over the previous one, a directory swapped with it), and only then
 //!    deletes the previous outputs; if a replacement fails the previous outputs are put
@@ -132,7 +134,7 @@ struct Output {
 /// std::fs::create_dir_all(&dir).unwrap();
 /// let mut outputs = OutputSet::new(&[])?;
 /// let report = outputs.file(&dir.join("report.json"))?;
-/// std::fs::write(&report, b"{}").unwrap(); // the run writes its temporary…
+/// hysid::io::atomic::write(&report, b"{}")?; // the run writes its temporary…
 /// outputs.commit()?; // …and the report appears only now
 /// assert!(dir.join("report.json").is_file());
 /// # std::fs::remove_dir_all(&dir).unwrap();
@@ -212,7 +214,7 @@ impl OutputSet {
         let id = self.check_new(path, Kind::File)?;
         probe(path, parent)?;
         let staged = temporary_beside(path);
-        self.push(Kind::File, path, id, staged.clone());
+        self.push(&mut lock_live(), Kind::File, path, id, staged.clone());
         Ok(staged)
     }
 
@@ -233,9 +235,12 @@ impl OutputSet {
         let id = self.check_new(path, Kind::Dir)?;
         probe(path, &parent)?;
         let staged = temporary_beside(path);
-        // Registered before it exists, so that a signal handler's removal never misses it.
-        self.push(Kind::Dir, path, id, staged.clone());
+        // Registered and created under one lock, so that a signal handler's removal runs
+        // wholly before (and the process ends before the directory exists) or wholly after.
+        let mut live = lock_live();
+        self.push(&mut live, Kind::Dir, path, id, staged.clone());
         fs::create_dir(&staged).map_err(|source| io(&staged, source))?;
+        drop(live);
         Ok(staged)
     }
 
@@ -283,14 +288,23 @@ impl OutputSet {
             }
         }
         self.committed = true;
+        // The previous copies take the temporaries' places in the registry until they are
+        // removed: an interrupt during their removal removes them too (the new outputs
+        // are in place by now), so none is left under a temporary name.
         live.retain(|(set, _)| *set != self.id);
+        let previous: Vec<PathBuf> = replaced
+            .into_iter()
+            .filter_map(|done| match done {
+                Replaced::Previous(old) => Some(old),
+                Replaced::New => None,
+            })
+            .collect();
+        live.extend(previous.iter().map(|old| (self.id, old.clone())));
         drop(live);
-        for done in replaced {
-            // The new outputs are in place; a leftover previous copy is only untidy.
-            if let Replaced::Previous(old) = done {
-                remove_any(&old);
-            }
+        for old in &previous {
+            remove_any(old);
         }
+        unregister(self.id);
         Ok(())
     }
 
@@ -370,8 +384,16 @@ impl OutputSet {
         Ok(())
     }
 
-    fn push(&mut self, kind: Kind, target: &Path, id: Identity, staged: PathBuf) {
-        lock_live().push((self.id, staged.clone()));
+    /// Registers `staged` in the locked registry `live` and the output in the set.
+    fn push(
+        &mut self,
+        live: &mut Vec<(usize, PathBuf)>,
+        kind: Kind,
+        target: &Path,
+        id: Identity,
+        staged: PathBuf,
+    ) {
+        live.push((self.id, staged.clone()));
         let held = match kind {
             Kind::Dir => held_inodes(target),
             Kind::File => Vec::new(),
@@ -392,10 +414,11 @@ impl Drop for OutputSet {
         if self.committed {
             return;
         }
-        unregister(self.id);
+        // Removed while still registered: an interrupt meanwhile removes them too.
         for output in &self.outputs {
             remove_any(&output.staged);
         }
+        unregister(self.id);
         for dir in self.created.iter().rev() {
             // Only if still empty: something else may have been put there meanwhile.
             let _ = fs::remove_dir(dir);
@@ -561,7 +584,8 @@ fn lock_live() -> std::sync::MutexGuard<'static, Vec<(usize, PathBuf)>> {
 /// meanwhile: a file written into a temporary directory while it is being removed keeps
 /// the directory alive, so the removal is repeated until every temporary is gone (at most
 /// a hundred rounds a millisecond apart). No new temporary can appear meanwhile:
-/// registering one takes the same lock, which is held from here on. Nor can a commit put
+/// registering one, creating a directory one ([`OutputSet::dir`]) or a file one ([`create`])
+/// takes the same lock, which is held from here on. Nor can a commit put
 /// one in place meanwhile: [`OutputSet::commit`] holds the lock through its replacements.
 pub fn remove_live_temporaries() {
     let live = lock_live();
@@ -579,6 +603,37 @@ pub fn remove_live_temporaries() {
     }
     // Held until the process ends (see above).
     std::mem::forget(live);
+}
+
+/// Creates (or truncates) the registered temporary file `staged` — a path returned by
+/// [`OutputSet::file`] — for writing.
+///
+/// The file is created under the registry's lock, as [`OutputSet::dir`] creates its
+/// directory: a signal handler's [`remove_live_temporaries`] then runs wholly before (it
+/// keeps the lock until the process ends, so this call waits for the end) or wholly after
+/// (and removes the file). Creating the temporary any other way (`fs::write`,
+/// `File::create`) could recreate it between the handler's removal and the process's end.
+/// Files *inside* a temporary directory need none of this: once the directory is removed
+/// they cannot be created. Refused: a path that is not a live temporary of this process.
+pub fn create(staged: &Path) -> Result<fs::File> {
+    let live = lock_live();
+    if !live.iter().any(|(_, path)| path == staged) {
+        return Err(Error::InvalidOutput(format!(
+            "{} is not a registered temporary; register the output with OutputSet::file first",
+            staged.display()
+        )));
+    }
+    let file = fs::File::create(staged).map_err(|source| io(staged, source))?;
+    drop(live);
+    Ok(file)
+}
+
+/// Writes `contents` to the registered temporary file `staged` ([`create`], then the bytes).
+pub fn write(staged: &Path, contents: impl AsRef<[u8]>) -> Result<()> {
+    use std::io::Write;
+    create(staged)?
+        .write_all(contents.as_ref())
+        .map_err(|source| io(staged, source))
 }
 
 /// Rounds of [`remove_live_temporaries`] at most.
@@ -647,6 +702,9 @@ fn lexical_target(path: &Path) -> Option<PathBuf> {
 fn probe(path: &Path, dir: &Path) -> Result<()> {
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     let probe = dir.join(format!(".hysid-probe-{}-{n}", std::process::id()));
+    // Under the registry's lock: a signal handler's removal ([`remove_live_temporaries`])
+    // holds it until the process ends, so the probe is never left behind by an interrupt.
+    let _live = lock_live();
     let created = fs::OpenOptions::new()
         .write(true)
         .create_new(true)
