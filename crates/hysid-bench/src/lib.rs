@@ -11,6 +11,7 @@
 use hysid::model::greybox::models;
 use hysid::model::greybox::{InputInterpolation, Integrator, Simulation};
 use hysid::model::operators::{OperatorModel, Orientation, PrandtlIshlinskii, Preisach};
+use hysid::model::saved::FittedGreyBox;
 use hysid::model::saved::FittedModel;
 
 /// Samples of [`stream_input`] per period (the library bench's batch).
@@ -52,7 +53,7 @@ pub fn stream_models() -> Vec<(String, FittedModel)> {
     let bouc_wen = models::by_kind("bouc_wen").unwrap();
     let parameters = bouc_wen.parameters();
     let p = parameters.len();
-    let grey_box = FittedModel::GreyBox {
+    let grey_box = FittedModel::GreyBox(FittedGreyBox {
         kind: "bouc_wen".into(),
         parameters,
         std: vec![f64::NAN; p],
@@ -61,7 +62,7 @@ pub fn stream_models() -> Vec<(String, FittedModel)> {
             interpolation: InputInterpolation::ZeroOrderHold,
         },
         initial_state: vec![0.0; bouc_wen.states().len()],
-    };
+    });
     let mut out = vec![
         ("pi_20_plays".to_string(), operator(OperatorModel::Pi(pi))),
         (

@@ -17,6 +17,7 @@ use hysid::identify::greybox::InitialStates;
 use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::native::Evaluator;
 use hysid::model::greybox::StateSpaceModel;
+use hysid::model::saved::FittedEquations;
 use hysid::model::saved::FittedModel;
 use hysid::{Error, Result};
 use numpy::PyReadonlyArray1;
@@ -101,14 +102,14 @@ fn equation_model_file(
                 given: x0.len(),
             });
         }
-        let file = FittedModel::Equations {
+        let file = FittedModel::Equations(FittedEquations {
             equations: text.to_string(),
             std: vec![f64::NAN; parameters.len()],
             parameters,
             simulation: simulation(integrator, substeps, interpolation)?,
             initial_state: x0,
             evaluator: hysid::model::greybox::native::Evaluator::Auto,
-        }
+        })
         .to_file();
         serde_json::to_string(&file).map_err(|e| Error::Serialization(format!("model: {e}")))
     })

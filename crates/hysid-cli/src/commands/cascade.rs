@@ -5,6 +5,7 @@ use crate::cli::UncertaintyArg;
 use crate::report::{figures, Report, Row};
 use hysid::identify::cascade::CascadeFit;
 use hysid::identify::Uncertainty;
+use hysid::model::saved::FittedCascade;
 use hysid::model::saved::FittedModel;
 
 /// True for the Coleman–Hodgdon forms (`ch4`, `ch6`) of the paper-1 pipeline; every other
@@ -23,10 +24,10 @@ pub fn uncertainty(arg: UncertaintyArg, replicates: usize) -> Uncertainty {
 
 /// The fitted model with the reported standard deviations.
 pub fn fitted(fit: &CascadeFit) -> FittedModel {
-    FittedModel::Cascade {
+    FittedModel::Cascade(FittedCascade {
         model: fit.model.clone(),
         std: fit.std(),
-    }
+    })
 }
 
 /// Table rows: estimate ± std, with the truth and the initial values when known.

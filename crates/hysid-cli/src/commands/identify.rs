@@ -9,6 +9,7 @@ use anyhow::Result;
 use hysid::data::{Channel, CsvSpec, Experiment, IdData};
 use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::hysteresis::{HysteresisIdentification, InitialOutput};
+use hysid::model::saved::FittedHysteresis;
 use hysid::model::saved::FittedModel;
 use hysid::model::ChForm;
 use hysid::report::plot::{cascade_figures, hysteresis_figures};
@@ -198,11 +199,11 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
         );
     }
     out.figures(|| hysteresis_figures(&fit, &data))?;
-    let fitted = FittedModel::Hysteresis {
+    let fitted = FittedModel::Hysteresis(FittedHysteresis {
         model: fit.model.clone(),
         initial: id.initial,
         std,
-    };
+    });
     out.finish(Some(&report), Some(&fitted))
 }
 

@@ -2,6 +2,7 @@
 
 use crate::cases;
 use hysid::export::{c_code, export, ExportOptions, Target};
+use hysid::model::saved::{FittedCascade, FittedGreyBox, FittedOperatorCascade};
 
 #[test]
 fn an_invalid_name_is_refused() {
@@ -70,10 +71,10 @@ fn a_rate_independent_operator_exports_without_a_sample_time_and_a_cascade_does_
     )
     .expect("cascade");
     let n = cascade.parameters().len();
-    let file = hysid::model::saved::FittedModel::OperatorCascade {
+    let file = hysid::model::saved::FittedModel::OperatorCascade(FittedOperatorCascade {
         model: cascade,
         std: vec![f64::NAN; n],
-    }
+    })
     .to_file();
     let e = c_code(&file, "stage", &ExportOptions::default()).expect_err("no sample time");
     assert!(
@@ -95,10 +96,10 @@ fn a_compensator_is_refused_for_a_model_without_an_inverse_and_a_non_minimum_pha
     let block = hysid::model::LinearBlock::new(vec![-0.5], vec![1.0, 2.0], 1).expect("block");
     let cascade = hysid::model::OperatorCascade::new(op, block).expect("cascade");
     let n = cascade.parameters().len();
-    let file = hysid::model::saved::FittedModel::OperatorCascade {
+    let file = hysid::model::saved::FittedModel::OperatorCascade(FittedOperatorCascade {
         model: cascade,
         std: vec![f64::NAN; n],
-    }
+    })
     .to_file();
     let options = ExportOptions {
         inverse: true,
@@ -110,10 +111,10 @@ fn a_compensator_is_refused_for_a_model_without_an_inverse_and_a_non_minimum_pha
     let ch = hysid::model::ColemanHodgdon::general(2.0, 1.0, 0.3, 0.4, 0.1, 0.5).expect("ch");
     let cascade = hysid::model::HysteresisCascade::new(ch, cases::block()).expect("cascade");
     let n = cascade.params().len();
-    let file = hysid::model::saved::FittedModel::Cascade {
+    let file = hysid::model::saved::FittedModel::Cascade(FittedCascade {
         model: cascade,
         std: vec![f64::NAN; n],
-    }
+    })
     .to_file();
     let e = c_code(&file, "stage", &options).expect_err("no inverse");
     assert!(e.to_string().contains("not invertible"), "{e}");
@@ -126,13 +127,13 @@ fn bouc_wen(simulation: hysid::model::greybox::Simulation) -> hysid::model::save
     use hysid::model::greybox::models::GreyBoxKind;
     let model = GreyBoxKind::BoucWen.model();
     let parameters = model.parameters();
-    hysid::model::saved::FittedModel::GreyBox {
+    hysid::model::saved::FittedModel::GreyBox(FittedGreyBox {
         kind: "bouc_wen".into(),
         std: vec![f64::NAN; parameters.len()],
         parameters,
         simulation,
         initial_state: vec![0.0; 3],
-    }
+    })
     .to_file()
 }
 

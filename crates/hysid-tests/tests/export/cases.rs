@@ -5,6 +5,7 @@ use hysid::model::coleman_hodgdon::InitialOutput;
 use hysid::model::compensate::compensate;
 use hysid::model::operators::{MaxwellSlip, OperatorModel, Orientation, Preisach};
 use hysid::model::saved::{Columns, FittedModel, ModelFile};
+use hysid::model::saved::{FittedCascade, FittedHysteresis, FittedOperatorCascade};
 use hysid::model::{ColemanHodgdon, HysteresisCascade, LinearBlock, OperatorCascade};
 use rand::rngs::Xoshiro256PlusPlus;
 use rand::{RngExt, SeedableRng};
@@ -62,7 +63,7 @@ fn file_of(model: &FittedModel) -> ModelFile {
 /// reference `preview` samples ahead: the linear block's delay of an operator cascade).
 fn cases_of(label: &str, model: &FittedModel, input: &[f64]) -> Vec<Case> {
     let preview = match model {
-        FittedModel::OperatorCascade { model, .. } => model.linear.delay(),
+        FittedModel::OperatorCascade(FittedOperatorCascade { model, .. }) => model.linear.delay(),
         _ => 0,
     };
     let file = file_of(model);
@@ -143,10 +144,10 @@ fn kinds(u: &[f64]) -> Vec<Case> {
         let label = format!("cascade_{}", op.family().name().replace('-', "_"));
         let cascade = OperatorCascade::new(op, block()).expect("a cascade");
         let n = cascade.parameters().len();
-        let model = FittedModel::OperatorCascade {
+        let model = FittedModel::OperatorCascade(FittedOperatorCascade {
             model: cascade,
             std: vec![f64::NAN; n],
-        };
+        });
         out.extend(cases_of(&label, &model, u));
     }
     // Maxwell-slip without a linear spring saturates: the PI inverse is the per-sample solve.
@@ -172,10 +173,10 @@ fn kinds(u: &[f64]) -> Vec<Case> {
     out.extend(cases_of("preisach_saturating", &model, u));
     let cascade = OperatorCascade::new(saturating.into(), block()).expect("a cascade");
     let n = cascade.parameters().len();
-    let model = FittedModel::OperatorCascade {
+    let model = FittedModel::OperatorCascade(FittedOperatorCascade {
         model: cascade,
         std: vec![f64::NAN; n],
-    };
+    });
     out.extend(cases_of("cascade_maxwell_slip_saturating", &model, u));
     let ch = hysteresis();
     let n = ch.params().len();
@@ -183,11 +184,11 @@ fn kinds(u: &[f64]) -> Vec<Case> {
         ("ch", InitialOutput::Zero),
         ("ch_measured", InitialOutput::Measured),
     ] {
-        let model = FittedModel::Hysteresis {
+        let model = FittedModel::Hysteresis(FittedHysteresis {
             model: ch.clone(),
             initial,
             std: vec![f64::NAN; n],
-        };
+        });
         let mut cases = cases_of(label, &model, u);
         if initial == InitialOutput::Measured {
             // The forward step starts from the measured y(0) given at export (`--y0`), the
@@ -202,10 +203,10 @@ fn kinds(u: &[f64]) -> Vec<Case> {
     let n = cascade.params().len();
     out.extend(cases_of(
         "ch_cascade",
-        &FittedModel::Cascade {
+        &FittedModel::Cascade(FittedCascade {
             model: cascade,
             std: vec![f64::NAN; n],
-        },
+        }),
         u,
     ));
     out

@@ -10,6 +10,7 @@ use hysid::model::greybox::equation_model::EquationStateSpace;
 use hysid::model::greybox::models::GreyBoxKind;
 use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
 use hysid::model::saved::FittedModel;
+use hysid::model::saved::{FittedEquations, FittedGreyBox};
 use hysid::model::ParameterSet;
 
 /// An equation file that reads the time t (and a `sin`, an `abs`).
@@ -61,26 +62,26 @@ fn built_in(kind: GreyBoxKind, values: &[(&str, f64)], simulation: Simulation) -
         theta[i] = *v;
     }
     parameters.set_values(&theta);
-    FittedModel::GreyBox {
+    FittedModel::GreyBox(FittedGreyBox {
         kind: kind.name().into(),
         std: no_std(parameters.len()),
         parameters,
         simulation,
         initial_state: vec![0.0; model.states().len()],
-    }
+    })
 }
 
 /// An equation file with its own parameter values and initial state.
 pub fn equations(text: &str, simulation: Simulation) -> FittedModel {
     let model = EquationStateSpace::parse(text, "test").expect("a valid equation file");
-    FittedModel::Equations {
+    FittedModel::Equations(FittedEquations {
         equations: text.into(),
         parameters: model.parameters(),
         std: no_std(model.parameters().len()),
         simulation,
         initial_state: model.initial_values(),
         evaluator: hysid::model::greybox::native::Evaluator::Auto,
-    }
+    })
 }
 
 fn scaled(u: &[f64], scale: f64) -> Vec<f64> {

@@ -11,6 +11,7 @@ use hysid::model::greybox::models::{ActuatorFixed, BoucWen};
 use hysid::model::greybox::native::Evaluator;
 use hysid::model::greybox::simulate::{simulate, InputTrack};
 use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::saved::FittedEquations;
 use hysid::model::saved::{FittedModel, SavedModel};
 use hysid::model::ParameterSet;
 use hysid::numerics::signal::{gaussian_noise, multisine};
@@ -460,7 +461,7 @@ fn cascaded_tanks_validation_rmse() {
     .unwrap();
     let values = fit.fit.parameters.values();
     let p = model.parameters().len();
-    let fitted = FittedModel::Equations {
+    let fitted = FittedModel::Equations(FittedEquations {
         equations: model.source().to_string(),
         parameters: {
             let mut ps = model.parameters();
@@ -471,7 +472,7 @@ fn cascaded_tanks_validation_rmse() {
         simulation,
         initial_state: values[p..p + 2].to_vec(),
         evaluator: hysid::model::greybox::native::Evaluator::Auto,
-    };
+    });
     let y = fitted
         .simulate(&[val.experiment(0).input(0)], val.ts(), None)
         .unwrap();
@@ -494,7 +495,7 @@ fn cascaded_tanks_validation_rmse() {
 #[test]
 fn saved_equation_models_round_trip() {
     let model = example("duffing");
-    let fitted = FittedModel::Equations {
+    let fitted = FittedModel::Equations(FittedEquations {
         equations: model.source().to_string(),
         parameters: {
             let mut ps = model.parameters();
@@ -505,7 +506,7 @@ fn saved_equation_models_round_trip() {
         simulation: rk4(4, InputInterpolation::ZeroOrderHold),
         initial_state: vec![0.0, 0.0],
         evaluator: hysid::model::greybox::native::Evaluator::Auto,
-    };
+    });
     let json = serde_json::to_string(&fitted.to_file()).unwrap();
     assert!(json.contains("\"kind\":\"equations\"") && json.contains("\"equations\":\"#"));
     let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
@@ -588,7 +589,7 @@ fn discrete_backlash_round_trip() {
     for (e, t) in got.iter().zip(BACKLASH) {
         assert!(((e - t) / t).abs() < 1e-8, "{got:?}");
     }
-    let fitted = FittedModel::Equations {
+    let fitted = FittedModel::Equations(FittedEquations {
         equations: model.source().to_string(),
         parameters: {
             let mut ps = model.parameters();
@@ -599,7 +600,7 @@ fn discrete_backlash_round_trip() {
         simulation: rk4(1, InputInterpolation::ZeroOrderHold),
         initial_state: vec![0.0, 0.0],
         evaluator: hysid::model::greybox::native::Evaluator::Auto,
-    };
+    });
     let json = serde_json::to_string(&fitted.to_file()).unwrap();
     let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
     let y = back.simulate(&[u], data.ts(), None).unwrap();

@@ -9,6 +9,7 @@
 use hysid::data::{CsvSpec, IdData};
 use hysid::model::greybox::models;
 use hysid::model::saved::FittedModel;
+use hysid::model::saved::{FittedCascade, FittedGreyBox, FittedHysteresis};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 use std::io::Read;
@@ -341,26 +342,26 @@ fn valid_models() -> Vec<serde_json::Value> {
         ColemanHodgdon::from_params(ChForm::General6, &[0.3, 1.0, 0.5, 3.0, 0.2, 0.1]).unwrap();
     let linear = LinearBlock::new(vec![-0.6, 0.2], vec![1.0, 0.5], 1).unwrap();
     let mut fitted = vec![
-        FittedModel::Hysteresis {
+        FittedModel::Hysteresis(FittedHysteresis {
             model: ch4,
             initial: InitialOutput::Zero,
             std: vec![0.01; 4],
-        },
-        FittedModel::Cascade {
+        }),
+        FittedModel::Cascade(FittedCascade {
             model: HysteresisCascade::new(ch6, linear).unwrap(),
             std: vec![0.01; 9],
-        },
+        }),
     ];
     for kind in ["bouc_wen", "rigid_body"] {
         let model = models::by_kind(kind).unwrap();
         let parameters = model.parameters();
-        fitted.push(FittedModel::GreyBox {
+        fitted.push(FittedModel::GreyBox(FittedGreyBox {
             kind: kind.into(),
             std: vec![0.01; parameters.len()],
             parameters,
             simulation: Simulation::default(),
             initial_state: vec![0.0; model.states().len()],
-        });
+        }));
     }
     fitted
         .iter()

@@ -6,6 +6,7 @@
 
 use hysid::data::{CsvSpec, IdData};
 use hysid::model::kinds::coleman_hodgdon::ColemanHodgdonFile;
+use hysid::model::saved::FittedGreyBox;
 use hysid::model::saved::{FittedModel, ModelFile, SavedModel, MODEL_KINDS};
 use hysid::report::simulate_report;
 use serde_json::{json, Value};
@@ -404,13 +405,13 @@ fn a_grey_box_model_of_the_user_is_written_under_its_own_kind_and_not_read_back(
     // A model of the user's own (e.g. Python callbacks) under the kind it gives itself.
     let model = GreyBoxKind::RigidBody.model();
     let parameters = model.parameters();
-    let fitted = FittedModel::GreyBox {
+    let fitted = FittedModel::GreyBox(FittedGreyBox {
         kind: "python".into(),
         std: vec![f64::NAN; parameters.len()],
         parameters,
         simulation: Simulation::default(),
         initial_state: vec![0.0; model.states().len()],
-    };
+    });
     let file = fitted.to_file();
     assert_eq!(file.kind(), "python");
     let value = serde_json::to_value(&file).unwrap();
@@ -434,23 +435,23 @@ fn a_grey_box_model_of_the_user_is_written_under_its_own_kind_and_not_read_back(
     let e = refusal(&value);
     assert!(e.contains("unknown model kind 'python'"), "{e}");
     // The same model under its built-in kind is a rigid_body file.
-    let FittedModel::GreyBox {
+    let FittedModel::GreyBox(FittedGreyBox {
         parameters,
         std,
         simulation,
         initial_state,
         ..
-    } = fitted
+    }) = fitted
     else {
         unreachable!()
     };
-    let builtin = FittedModel::GreyBox {
+    let builtin = FittedModel::GreyBox(FittedGreyBox {
         kind: "rigid_body".into(),
         parameters,
         std,
         simulation,
         initial_state,
-    };
+    });
     assert!(matches!(builtin.to_file().model, SavedModel::RigidBody(_)));
 }
 

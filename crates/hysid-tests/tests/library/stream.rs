@@ -11,6 +11,9 @@ use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpa
 use hysid::model::limits::Limits;
 use hysid::model::operators::OperatorModel;
 use hysid::model::saved::FittedModel;
+use hysid::model::saved::{
+    FittedCascade, FittedEquations, FittedGreyBox, FittedHysteresis, FittedOperatorCascade,
+};
 use hysid::model::stream::{compensate_stream, run, Stepper};
 use hysid::model::{ColemanHodgdon, HysteresisCascade, LinearBlock, OperatorCascade};
 use rand::rngs::Xoshiro256PlusPlus;
@@ -149,10 +152,10 @@ fn operator_cascades_stream_and_compensate_as_the_batch() {
     for (name, model, u) in operators() {
         let cascade = OperatorCascade::new(model, linear(0.4)).unwrap();
         let n = cascade.parameters().len();
-        let fitted = FittedModel::OperatorCascade {
+        let fitted = FittedModel::OperatorCascade(FittedOperatorCascade {
             model: cascade.clone(),
             std: no_std(n),
-        };
+        });
         assert_streams(&fitted, &[&u], 1.0, None, &format!("{name} cascade"));
         let r = cascade.simulate(&u).unwrap().y;
         assert_compensates(&fitted, &r, &format!("{name} cascade"));
@@ -164,10 +167,10 @@ fn a_non_minimum_phase_cascade_has_no_compensator_and_says_so_as_the_batch_does(
     let model = OperatorModel::examples().unwrap().remove(0);
     let cascade = OperatorCascade::new(model, linear(1.5)).unwrap();
     let n = cascade.parameters().len();
-    let fitted = FittedModel::OperatorCascade {
+    let fitted = FittedModel::OperatorCascade(FittedOperatorCascade {
         model: cascade,
         std: no_std(n),
-    };
+    });
     let stream = fitted.compensator(1.0).unwrap_err().to_string();
     let batch = compensate(&fitted, &[0.0, 0.1]).unwrap_err().to_string();
     assert_eq!(stream, batch);
@@ -189,11 +192,11 @@ fn coleman_hodgdon_hysteresis_and_cascades_stream_as_the_batch() {
     let x = signal(800, 2.0, 11);
     for ch in coleman_hodgdon() {
         for initial in [InitialOutput::Measured, InitialOutput::Zero] {
-            let fitted = FittedModel::Hysteresis {
+            let fitted = FittedModel::Hysteresis(FittedHysteresis {
                 model: ch.clone(),
                 initial,
                 std: no_std(ch.params().len()),
-            };
+            });
             let what = format!("{:?} {initial:?}", ch.form());
             assert_streams(&fitted, &[&x], 1.0, Some(0.25), &what);
             let y = fitted.simulate(&[&x], 1.0, Some(0.25)).unwrap().remove(0);
@@ -202,10 +205,10 @@ fn coleman_hodgdon_hysteresis_and_cascades_stream_as_the_batch() {
             assert_compensates(&fitted, &far, &format!("{what}, far reference"));
         }
         let cascade = HysteresisCascade::new(ch.clone(), linear(0.4)).unwrap();
-        let fitted = FittedModel::Cascade {
+        let fitted = FittedModel::Cascade(FittedCascade {
             std: no_std(cascade.params().len()),
             model: cascade,
-        };
+        });
         assert_streams(&fitted, &[&x], 1.0, None, "ch cascade");
         // A step faster than the rate limit 1/α: the same error, at the same sample.
         let fast: Vec<f64> = x.iter().map(|v| 10.0 * v).collect();
@@ -258,13 +261,13 @@ fn built_in_grey_box_models_stream_as_they_simulate() {
         let inputs = channels(model.inputs().len(), 1.0);
         let slices: Vec<&[f64]> = inputs.iter().map(Vec::as_slice).collect();
         for simulation in simulations() {
-            let fitted = FittedModel::GreyBox {
+            let fitted = FittedModel::GreyBox(FittedGreyBox {
                 kind: kind.name().to_string(),
                 std: no_std(parameters.len()),
                 parameters: parameters.clone(),
                 simulation,
                 initial_state: vec![0.0; model.states().len()],
-            };
+            });
             let what = format!("{} {simulation:?}", kind.name());
             match fitted.stepper(1e-3, None) {
                 Ok(_) => assert_streams(&fitted, &slices, 1e-3, None, &what),
@@ -304,14 +307,14 @@ fn equation_models_stream_as_they_simulate() {
         let inputs = channels(model.inputs().len(), 1.0);
         let slices: Vec<&[f64]> = inputs.iter().map(Vec::as_slice).collect();
         for simulation in simulations() {
-            let fitted = FittedModel::Equations {
+            let fitted = FittedModel::Equations(FittedEquations {
                 equations: text.clone(),
                 parameters: model.parameters(),
                 std: no_std(model.parameters().len()),
                 simulation,
                 initial_state: model.initial_values(),
                 evaluator: hysid::model::greybox::native::Evaluator::Auto,
-            };
+            });
             let what = format!("{} {simulation:?}", model.name());
             match fitted.stepper(1e-2, None) {
                 Ok(_) => assert_streams(&fitted, &slices, 1e-2, None, &what),
@@ -331,7 +334,7 @@ fn equation_models_stream_as_they_simulate() {
 fn band_limited_interpolation_is_reported_as_differing() {
     let kind = GreyBoxKind::BoucWen;
     let model = kind.model();
-    let fitted = FittedModel::GreyBox {
+    let fitted = FittedModel::GreyBox(FittedGreyBox {
         kind: kind.name().into(),
         std: no_std(model.parameters().len()),
         parameters: model.parameters(),
@@ -340,7 +343,7 @@ fn band_limited_interpolation_is_reported_as_differing() {
             interpolation: InputInterpolation::BandLimited,
         },
         initial_state: vec![0.0; model.states().len()],
-    };
+    });
     let why = fitted.streaming_differs().unwrap();
     assert!(why.contains("band-limited") && !why.contains('\n'), "{why}");
     // It still streams (with linear interpolation).
@@ -351,13 +354,13 @@ fn band_limited_interpolation_is_reported_as_differing() {
 fn kinds_that_cannot_stream_or_invert_say_so_in_one_line() {
     let kind = GreyBoxKind::RigidBody;
     let model = kind.model();
-    let rigid = FittedModel::GreyBox {
+    let rigid = FittedModel::GreyBox(FittedGreyBox {
         kind: kind.name().into(),
         std: no_std(model.parameters().len()),
         parameters: model.parameters(),
         simulation: Simulation::default(),
         initial_state: vec![0.0; model.states().len()],
-    };
+    });
     let err = rigid.compensator(1.0).unwrap_err().to_string();
     assert!(
         err.contains("not invertible") && !err.contains('\n'),

@@ -17,6 +17,7 @@
 //! Reference: J.-P. Noël, M. Schoukens, "Hysteretic benchmark with a dynamic nonlinearity",
 //! Workshop on Nonlinear System Identification Benchmarks, 2016.
 
+use crate::model::saved::FittedGreyBox;
 use std::sync::Arc;
 
 use crate::data::{CsvSpec, IdData};
@@ -268,7 +269,7 @@ pub fn generate(signal: TestSignal, noise: f64, seed: u64) -> Result<GeneratedRe
         }
     };
     let input = IdData::input_only(1.0 / (FS * UP as f64), "u", u_fine)?;
-    let model = FittedModel::GreyBox {
+    let model = FittedModel::GreyBox(FittedGreyBox {
         kind: "bouc_wen".into(),
         parameters: BoucWen.parameters(),
         std: vec![0.0; 7],
@@ -277,7 +278,7 @@ pub fn generate(signal: TestSignal, noise: f64, seed: u64) -> Result<GeneratedRe
             interpolation: InputInterpolation::Linear,
         },
         initial_state: vec![0.0; 3],
-    };
+    });
     let y_fine = model
         .simulate(&[input.experiment(0).input(0)], input.ts(), None)?
         .remove(0);

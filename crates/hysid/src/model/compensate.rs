@@ -24,7 +24,6 @@
 
 use crate::model::limits::Limits;
 use crate::model::saved::FittedModel;
-use crate::model::stream::compensate_stream;
 use crate::numerics::metrics;
 use crate::{Error, Result};
 use serde::Serialize;
@@ -92,19 +91,13 @@ pub(crate) fn check_reference(reference: &[f64]) -> Result<()> {
 
 /// The error for a model kind [`compensate`] does not invert.
 pub(crate) fn not_invertible(model: &FittedModel) -> Error {
-    Error::NotInvertible {
-        kind: model.to_file().kind().to_string(),
-        reason: "compensation inverts hysteresis operators, the Coleman–Hodgdon \
-                 hysteresis alone and operator cascades with a minimum-phase linear \
-                 block; identify one of those"
-            .into(),
-    }
+    crate::model::kinds::not_invertible(model.to_file().kind())
 }
 
 /// [`compensate`] with the command limited to `limits` ([`crate::model::limits`]): each
 /// command beyond them is set to the nearer limit and its sample counted as clipped (the
 /// predicted output stays the model's output for the unlimited command); None: unlimited.
-/// Equal to the stream ([`compensate_stream`] of a compensator with the same limits).
+/// Equal to the stream ([`compensate_stream`](crate::model::stream::compensate_stream) of a compensator with the same limits).
 pub fn compensate_within(
     model: &FittedModel,
     reference: &[f64],
@@ -128,30 +121,8 @@ pub fn compensate_within(
 /// The input that makes `model` follow `reference` (see the module doc), unlimited.
 pub fn compensate(model: &FittedModel, reference: &[f64]) -> Result<Compensation> {
     check_reference(reference)?;
-    let mut settled_from = 0;
-    let (u, predicted, clipped) = match model {
-        FittedModel::Operator { model, .. } => {
-            let inv = model.as_operator().invert(reference)?;
-            (inv.u, inv.predicted, inv.clipped)
-        }
-        FittedModel::Hysteresis { .. } => {
-            // The per-sample solve of the module doc, one step of the stream at a time.
-            let stream = compensate_stream(model.compensator(0.0)?.as_mut(), reference)?;
-            (stream.u, stream.predicted, stream.clipped)
-        }
-        FittedModel::OperatorCascade { model, .. } => {
-            // The linear block is inverted (minimum-phase B only) and the operator after it.
-            let inv = model.compensate(reference)?;
-            settled_from = inv.delay;
-            (inv.u, inv.predicted, inv.clipped)
-        }
-        other => return Err(not_invertible(other)),
-    };
-    Ok(Compensation {
-        reference: reference.to_vec(),
-        u,
-        predicted,
-        clipped,
-        settled_from,
-    })
+    match model.as_kind() {
+        Some(kind) => kind.compensate(reference),
+        None => Err(not_invertible(model)),
+    }
 }

@@ -7,6 +7,7 @@ use super::{DataSummary, Report, SearchSummary, UncertaintySummary, ValidationEn
 use crate::identify::actuator::{tables::MODELS, ActuatorIdentification, PARAMETERS};
 use crate::model::greybox::models::ActuatorFixed;
 use crate::model::greybox::{Simulation, StateSpaceModel};
+use crate::model::saved::FittedGreyBox;
 use crate::model::saved::FittedModel;
 use crate::{Error, Result};
 use serde_json::json;
@@ -120,13 +121,13 @@ fn step2(id: &ActuatorIdentification, simulation: Simulation) -> Report {
     std[2] = id.step1.std.get(2).copied().unwrap_or(f64::NAN);
     std[3..].copy_from_slice(&id.step2.std);
     let m0 = FittedModel::prefiltered(
-        FittedModel::GreyBox {
+        FittedModel::GreyBox(FittedGreyBox {
             kind: "actuator_fixed".into(),
             parameters,
             std,
             simulation,
             initial_state: vec![0.0; 3],
-        },
+        }),
         id.prefilter,
     );
     Report {

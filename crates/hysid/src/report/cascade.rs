@@ -14,6 +14,7 @@ use crate::identify::cascade::CascadeFit;
 use crate::identify::hysteresis::{HysteresisFit, InitialOutput};
 use crate::identify::operator_cascade::OperatorCascadeFit;
 use crate::model::saved::FittedModel;
+use crate::model::saved::{FittedCascade, FittedHysteresis, FittedOperatorCascade};
 use crate::Result;
 use serde_json::{json, Value};
 
@@ -50,10 +51,10 @@ pub fn cascade_report(
         Some(b) => UncertaintySummary::bootstrap(b.replicates.len(), b.failed),
         None => UncertaintySummary::asymptotic(),
     };
-    let model = FittedModel::Cascade {
+    let model = FittedModel::Cascade(FittedCascade {
         model: fit.model.clone(),
         std: fit.std(),
-    };
+    });
     Ok(Report::of_output_error(
         command,
         data,
@@ -75,11 +76,11 @@ pub fn hysteresis_report(
     initial: InitialOutput,
 ) -> Result<Report> {
     let oe = &fit.output_error;
-    let model = FittedModel::Hysteresis {
+    let model = FittedModel::Hysteresis(FittedHysteresis {
         model: fit.model.clone(),
         initial,
         std: fit.std(),
-    };
+    });
     let details = json!({
         "admissibility": fit.model.admissibility(),
         "threshold": fit.threshold,
@@ -112,10 +113,10 @@ pub(super) fn merged(mut details: Value, extra: Value) -> Value {
 /// The fitted model of an operator cascade (any hysteresis operator followed by a linear
 /// block, `docs/models/operator-cascade.md`) with its asymptotic standard deviations.
 pub fn operator_cascade_model(fit: &OperatorCascadeFit) -> FittedModel {
-    FittedModel::OperatorCascade {
+    FittedModel::OperatorCascade(FittedOperatorCascade {
         model: fit.model.clone(),
         std: fit.output_error.std().to_vec(),
-    }
+    })
 }
 
 /// The report of `identify cascade` with an operator family (`family`) on `data` (read

@@ -17,6 +17,7 @@ use super::{UncertaintySummary, ValidationEntry};
 use crate::identify::rigid_body::{RigidBodyEstimate, RigidBodyLs};
 use crate::model::greybox::models::RigidBody;
 use crate::model::greybox::{Simulation, StateSpaceModel};
+use crate::model::saved::FittedGreyBox;
 use crate::model::saved::FittedModel;
 use crate::numerics::metrics;
 use crate::Result;
@@ -50,13 +51,13 @@ pub fn rigid_body_model(estimate: &RigidBodyEstimate, ls: &RigidBodyLs) -> Fitte
         }
     }
     FittedModel::InverseDynamics {
-        model: Box::new(FittedModel::GreyBox {
+        model: Box::new(FittedModel::GreyBox(FittedGreyBox {
             kind: "rigid_body".into(),
             parameters,
             std,
             simulation: Simulation::default(),
             initial_state: vec![0.0; RigidBody.states().len()],
-        }),
+        })),
         preprocessing: ls.preprocessing(),
     }
 }

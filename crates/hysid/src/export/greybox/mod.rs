@@ -16,7 +16,7 @@
 //! corrector solves with a fixed-size LU with partial pivoting in nalgebra's order of
 //! operations, a singular Newton matrix setting the error flag); a discrete-time model runs
 //! its recursion. A `band_limited` model is refused: its stream differs from its simulation
-//! ([`FittedModel::streaming_differs`]).
+//! ([`FittedModel::streaming_differs`](crate::model::saved::FittedModel::streaming_differs)).
 
 pub mod dopri;
 pub mod equations;
@@ -30,7 +30,7 @@ use crate::model::greybox::equation_model::EquationStateSpace;
 use crate::model::greybox::models::GreyBoxKind;
 use crate::model::greybox::simulate::{check_integrator, InputTrack};
 use crate::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
-use crate::model::saved::FittedModel;
+use crate::model::saved::{FittedEquations, FittedGreyBox, FittedKind};
 use crate::{Error, Result};
 use std::ops::Not;
 
@@ -120,57 +120,54 @@ struct Exported<'a> {
     x0: &'a [f64],
 }
 
-/// The grey-box or equation model `model` as code, or None for another kind.
-fn emitter(model: &FittedModel) -> Result<Option<Exported<'_>>> {
-    Ok(match model {
-        FittedModel::GreyBox {
-            kind,
-            parameters,
-            simulation,
-            initial_state,
-            ..
-        } => {
-            let kind = GreyBoxKind::parse(kind)
-                .ok_or_else(|| Error::InvalidModel(format!("unknown grey-box model '{kind}'")))?;
-            Some(Exported {
-                code: Box::new(models::BuiltIn::new(kind, parameters.values())),
-                simulation: *simulation,
-                x0: initial_state,
-            })
-        }
-        FittedModel::Equations {
-            equations,
-            parameters,
-            simulation,
-            initial_state,
-            ..
-        } => {
-            let parsed = EquationStateSpace::parse(equations, "saved model")?;
-            Some(Exported {
-                code: Box::new(equations::Equations::new(parsed, parameters.values())),
-                simulation: *simulation,
-                x0: initial_state,
-            })
-        }
-        _ => None,
-    })
+impl<'a> Exported<'a> {
+    /// The built-in grey-box model `model` as code.
+    fn grey_box(model: &'a FittedGreyBox) -> Result<Self> {
+        let kind = GreyBoxKind::parse(&model.kind).ok_or_else(|| {
+            Error::InvalidModel(format!("unknown grey-box model '{}'", model.kind))
+        })?;
+        Ok(Self {
+            code: Box::new(models::BuiltIn::new(kind, model.parameters.values())),
+            simulation: model.simulation,
+            x0: &model.initial_state,
+        })
+    }
+
+    /// The equation model `model` as code.
+    fn equations(model: &'a FittedEquations) -> Result<Self> {
+        let parsed = EquationStateSpace::parse(&model.equations, "saved model")?;
+        Ok(Self {
+            code: Box::new(equations::Equations::new(parsed, model.parameters.values())),
+            simulation: model.simulation,
+            x0: &model.initial_state,
+        })
+    }
 }
 
-/// The streaming program of a grey-box or equation model sampled every `ts` seconds, or
-/// None for another kind. Refused: the compensator (no grey-box model is invertible), a
-/// `band_limited` model, and the integrators the library refuses for the model.
-pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Program>> {
-    let Some(Exported {
+/// The streaming program of the built-in grey-box model `model` sampled every `ts` seconds
+/// (refused: the compensator, a `band_limited` model, an integrator the library refuses).
+pub fn grey_box_program(model: &FittedGreyBox, inverse: bool, ts: f64) -> Result<Program> {
+    program(Exported::grey_box(model)?, model, inverse, ts)
+}
+
+/// The streaming program of the equation model `model` sampled every `ts` seconds (refused:
+/// the compensator, a `band_limited` model, an integrator the library refuses).
+pub fn equations_program(model: &FittedEquations, inverse: bool, ts: f64) -> Result<Program> {
+    program(Exported::equations(model)?, model, inverse, ts)
+}
+
+/// The streaming program of a grey-box or equation model (`exported`, the code of `model`)
+/// sampled every `ts` seconds. Refused: the compensator (no grey-box model is invertible),
+/// a `band_limited` model, and the integrators the library refuses for the model.
+fn program(exported: Exported, model: &dyn FittedKind, inverse: bool, ts: f64) -> Result<Program> {
+    let Exported {
         code,
         simulation,
         x0,
-    }) = emitter(model)?
-    else {
-        return Ok(None);
-    };
-    let kind = || model.to_file().kind().to_string();
+    } = exported;
+    let kind = || model.saved().kind().to_string();
     if inverse {
-        return Err(crate::model::compensate::not_invertible(model));
+        return Err(crate::model::kinds::not_invertible(&kind()));
     }
     if let Some(why) = model.streaming_differs() {
         return Err(Error::UnsupportedKind {
@@ -215,7 +212,7 @@ pub fn program(model: &FittedModel, inverse: bool, ts: f64) -> Result<Option<Pro
         }
     });
     prog.fallible_step(|b| step(code.as_ref(), &d, &advance, b))?;
-    Ok(Some(prog))
+    Ok(prog)
 }
 
 /// The step: integrate the last interval (from the second step on), then y = h(x, u).

@@ -10,6 +10,7 @@ use crate::data::IdData;
 use crate::identify::multistart::{best_of, draw_starts, StartOutcome};
 use crate::identify::{OutputError, OutputErrorFit};
 use crate::model::greybox::{InputInterpolation, Simulation, StateSpaceModel};
+use crate::model::saved::FittedGreyBox;
 use crate::model::saved::FittedModel;
 use crate::model::ParameterSet;
 use crate::numerics::{Control, DampingScale, IterationRecord, LmConfig, Observer};
@@ -98,13 +99,13 @@ impl GreyBoxFit {
         let n = model.states().len();
         let all = &self.fit.parameters;
         let values = all.values();
-        FittedModel::GreyBox {
+        FittedModel::GreyBox(FittedGreyBox {
             kind: model.kind().to_string(),
             parameters: all.leading(p),
             std: self.fit.std()[..p].to_vec(),
             simulation,
             initial_state: values[p..p + n].to_vec(),
-        }
+        })
     }
 
     /// The fitted initial states of the `experiments` experiments, fixed (for

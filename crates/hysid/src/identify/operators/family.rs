@@ -19,6 +19,7 @@ use crate::model::operators::{
     InitialState, LoopOrientation, OperatorFamily, OperatorModel, Orientation,
 };
 use crate::model::saved::FittedModel;
+use crate::model::saved::{FittedHysteresis, FittedHysteresisOperator};
 use crate::model::OperatorCascade;
 use crate::model::{ChForm, Parameter, ParameterSet};
 use crate::numerics::levenberg_marquardt::Control;
@@ -368,7 +369,7 @@ pub fn fit_operator(
         operator => by_family::fit(operator, u, y, options)?,
     };
     let operator = match &fit.model {
-        FittedModel::Operator { model, .. } => Some(model),
+        FittedModel::Operator(FittedHysteresisOperator { model, .. }) => Some(model),
         _ => None,
     };
     let orientation = OrientationUsed::of(family, operator, options, false);
@@ -488,11 +489,11 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
     let loss = metrics::mse(y, &simulated);
     let report = &fit.output_error.report;
     Ok(OperatorFit {
-        model: FittedModel::Hysteresis {
+        model: FittedModel::Hysteresis(FittedHysteresis {
             model: fit.model.clone(),
             initial: InitialOutput::Measured,
             std: std.clone(),
-        },
+        }),
         parameters,
         covariance: masked_covariance(&fit.output_error.covariance.matrix, &std_present),
         std: std_present,

@@ -2,8 +2,9 @@
 //! [`FittedModel::Cascade`]).
 
 use super::coleman_hodgdon::{hysteresis_from_records, hysteresis_records};
-use super::{ModelKind, Records};
+use super::{first, FittedKind, ModelKind, Records};
 use crate::model::saved::{FittedModel, ParameterRecord, SavedModel};
+use crate::model::stream::{self, Stepper};
 use crate::model::{ChForm, HysteresisCascade, LinearBlock, Parameter};
 use crate::{Error, Result};
 use schemars::JsonSchema;
@@ -52,35 +53,53 @@ impl ModelKind for ChCascadeKind {
         )?;
         std.extend(b.iter().skip(1).map(ParameterRecord::std_or_nan));
         std.extend(a.iter().map(ParameterRecord::std_or_nan));
-        Ok(FittedModel::Cascade {
+        Ok(FittedModel::Cascade(FittedCascade {
             model: HysteresisCascade::new(hysteresis, linear)?,
             std,
-        })
+        }))
     }
 }
 
-/// The saved form of [`FittedModel::Cascade`].
-pub(crate) fn saved(model: &HysteresisCascade, std: &[f64]) -> SavedModel {
-    let nh = model.hysteresis.form().n_params();
-    let nb = model.linear.nb();
-    let mut records = hysteresis_records(&model.hysteresis, &std[..nh]);
-    records.push(ParameterRecord::of(
-        &Parameter::new("b1", 1.0).fixed(true),
-        f64::NAN,
-    ));
-    let b = model.linear.b()[1..].iter().zip(&std[nh..nh + nb - 1]);
-    records
-        .extend(b.enumerate().map(|(j, (v, s))| {
+/// A fitted Coleman–Hodgdon cascade ([`FittedModel::Cascade`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedCascade {
+    /// The model.
+    pub model: HysteresisCascade,
+    /// Standard deviations in [`HysteresisCascade::params`] order.
+    pub std: Vec<f64>,
+}
+
+/// The recursion from 0, then the linear block; no compensator (as `hysid compensate`).
+impl FittedKind for FittedCascade {
+    fn saved(&self) -> SavedModel {
+        let (model, std) = (&self.model, &self.std);
+        let nh = model.hysteresis.form().n_params();
+        let nb = model.linear.nb();
+        let mut records = hysteresis_records(&model.hysteresis, &std[..nh]);
+        records.push(ParameterRecord::of(
+            &Parameter::new("b1", 1.0).fixed(true),
+            f64::NAN,
+        ));
+        let b = model.linear.b()[1..].iter().zip(&std[nh..nh + nb - 1]);
+        records.extend(b.enumerate().map(|(j, (v, s))| {
             ParameterRecord::of(&Parameter::new(format!("b{}", j + 2), *v), *s)
         }));
-    let a = model.linear.a().iter().zip(&std[nh + nb - 1..]);
-    records
-        .extend(a.enumerate().map(|(i, (v, s))| {
+        let a = model.linear.a().iter().zip(&std[nh + nb - 1..]);
+        records.extend(a.enumerate().map(|(i, (v, s))| {
             ParameterRecord::of(&Parameter::new(format!("a{}", i + 1), *v), *s)
         }));
-    SavedModel::ChCascade(ChCascadeFile {
-        parameters: records,
-        hysteresis: model.hysteresis.form(),
-        delay: model.linear.delay(),
-    })
+        SavedModel::ChCascade(ChCascadeFile {
+            parameters: records,
+            hysteresis: model.hysteresis.form(),
+            delay: model.linear.delay(),
+        })
+    }
+
+    fn simulate(&self, inputs: &[&[f64]], _ts: f64, _y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        Ok(vec![self.model.simulate(first(inputs)?)?.y])
+    }
+
+    fn stepper(&self, _ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
+        Ok(stream::ch_cascade_stepper(&self.model))
+    }
 }

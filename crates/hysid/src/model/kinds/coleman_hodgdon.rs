@@ -1,11 +1,13 @@
 //! Kind `coleman_hodgdon`: the Coleman–Hodgdon hysteresis alone
 //! ([`FittedModel::Hysteresis`]).
 
-use super::{ModelKind, Records};
-use crate::model::coleman_hodgdon::InitialOutput;
+use super::{first, FittedKind, ModelKind, Records};
+use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
+use crate::model::compensate::Compensation;
 use crate::model::saved::{FittedModel, ParameterRecord, SavedModel};
+use crate::model::stream::{self, compensate_stream, Compensator, Stepper};
 use crate::model::{ChForm, ColemanHodgdon, Parameter};
-use crate::Result;
+use crate::{Error, Result};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -38,21 +40,78 @@ impl ModelKind for ColemanHodgdonKind {
             list: &file.parameters,
         };
         let (model, std) = hysteresis_from_records(file.hysteresis, &records)?;
-        Ok(FittedModel::Hysteresis {
+        Ok(FittedModel::Hysteresis(FittedHysteresis {
             model,
             initial: file.initial_output.unwrap_or(InitialOutput::Measured),
             std,
-        })
+        }))
     }
 }
 
-/// The saved form of [`FittedModel::Hysteresis`].
-pub(crate) fn saved(model: &ColemanHodgdon, initial: InitialOutput, std: &[f64]) -> SavedModel {
-    SavedModel::ColemanHodgdon(ColemanHodgdonFile {
-        parameters: hysteresis_records(model, std),
-        hysteresis: model.form(),
-        initial_output: Some(initial),
-    })
+/// A fitted Coleman–Hodgdon hysteresis ([`FittedModel::Hysteresis`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedHysteresis {
+    /// The model.
+    pub model: ColemanHodgdon,
+    /// Where its output starts.
+    pub initial: InitialOutput,
+    /// Standard deviations in [`crate::model::ChForm::parameter_names`] order.
+    pub std: Vec<f64>,
+}
+
+impl FittedHysteresis {
+    /// The output the recursion starts from: 0, or the measured `y0`.
+    fn start(&self, y0: Option<f64>) -> Result<f64> {
+        match self.initial {
+            InitialOutput::Measured => y0.ok_or_else(|| {
+                Error::ModelMismatch(
+                    "this hysteresis starts from the measured output; give the measured output"
+                        .into(),
+                )
+            }),
+            InitialOutput::Zero => Ok(0.0),
+        }
+    }
+}
+
+/// The recursion of [`crate::model::coleman_hodgdon`] from its start; the compensator is the
+/// per-sample solve, and the batch compensation runs it one step at a time.
+impl FittedKind for FittedHysteresis {
+    fn saved(&self) -> SavedModel {
+        SavedModel::ColemanHodgdon(ColemanHodgdonFile {
+            parameters: hysteresis_records(&self.model, &self.std),
+            hysteresis: self.model.form(),
+            initial_output: Some(self.initial),
+        })
+    }
+
+    fn simulate(&self, inputs: &[&[f64]], _ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let x = first(inputs)?;
+        self.model.check_rate(x)?;
+        Ok(vec![simulate_switched(
+            &self.model,
+            x,
+            self.start(y0)?,
+            None,
+        )])
+    }
+
+    fn stepper(&self, _ts: f64, y0: Option<f64>) -> Result<Box<dyn Stepper>> {
+        Ok(stream::hysteresis_stepper(&self.model, self.start(y0)?))
+    }
+
+    fn compensator(&self) -> Result<Box<dyn Compensator>> {
+        Ok(stream::hysteresis_compensator(&self.model, self.initial))
+    }
+
+    fn compensate(&self, reference: &[f64]) -> Result<Compensation> {
+        // The per-sample solve of `model::compensate`, one step of the stream at a time.
+        let stream = compensate_stream(self.compensator()?.as_mut(), reference)?;
+        Ok(Compensation {
+            settled_from: 0,
+            ..stream
+        })
+    }
 }
 
 /// The Coleman–Hodgdon hysteresis of form `form` from its records, and their standard

@@ -2,11 +2,13 @@
 //! [`FittedModel::Equations`]). The file's text travels in the `equations` key, so a saved fit
 //! is self-contained.
 
-use super::{records, ModelKind};
+use super::grey_box::{simulate_outputs, streamed_differently};
+use super::{records, FittedKind, ModelKind};
 use crate::model::greybox::equation_model::EquationStateSpace;
 use crate::model::greybox::native::Evaluator;
 use crate::model::greybox::{Simulation, StateSpaceModel};
 use crate::model::saved::{FittedModel, ParameterRecord, SavedModel, SimulationSpec};
+use crate::model::stream::{self, Stepper};
 use crate::model::ParameterSet;
 use crate::{Error, Result};
 use schemars::JsonSchema;
@@ -76,29 +78,83 @@ impl ModelKind for EquationsKind {
             .simulation
             .as_ref()
             .map_or(Ok(Simulation::default()), SimulationSpec::simulation)?;
-        Ok(FittedModel::Equations {
+        Ok(FittedModel::Equations(FittedEquations {
             equations: text.to_string(),
             parameters,
             std,
             simulation,
             initial_state,
             evaluator: Evaluator::Auto,
-        })
+        }))
     }
 }
 
-/// The saved form of [`FittedModel::Equations`].
-pub(crate) fn saved(
-    equations: &str,
-    parameters: &ParameterSet,
-    std: &[f64],
-    simulation: &Simulation,
-    initial_state: &[f64],
-) -> SavedModel {
-    SavedModel::Equations(EquationsFile {
-        parameters: records(parameters, std),
-        simulation: Some(SimulationSpec::of(simulation)),
-        initial_state: Some(initial_state.to_vec()),
-        equations: equations.to_string(),
-    })
+/// A fitted equation model ([`FittedModel::Equations`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedEquations {
+    /// The equation file's text.
+    pub equations: String,
+    /// Its parameters (values, units, bounds, fixed flags) in the file's order.
+    pub parameters: ParameterSet,
+    /// Their standard deviations.
+    pub std: Vec<f64>,
+    /// How it is simulated.
+    pub simulation: Simulation,
+    /// Its initial state.
+    pub initial_state: Vec<f64>,
+    /// Which code runs its tapes when it is simulated (not saved: a setting of the run,
+    /// [`FittedModel::with_evaluator`]; [`Evaluator::Auto`] when read from a file).
+    pub evaluator: Evaluator,
+}
+
+impl FittedEquations {
+    /// The text compiled, its tapes run by the chosen evaluator.
+    fn model(&self) -> Result<EquationStateSpace> {
+        Ok(EquationStateSpace::parse(&self.equations, "saved model")?
+            .with_evaluator(self.evaluator))
+    }
+}
+
+/// The equations integrated as a grey-box model ([`crate::model::greybox`]), in batch and
+/// one interval at a time; not invertible.
+impl FittedKind for FittedEquations {
+    fn saved(&self) -> SavedModel {
+        SavedModel::Equations(EquationsFile {
+            parameters: records(&self.parameters, &self.std),
+            simulation: Some(SimulationSpec::of(&self.simulation)),
+            initial_state: Some(self.initial_state.clone()),
+            equations: self.equations.clone(),
+        })
+    }
+
+    fn simulate(&self, inputs: &[&[f64]], ts: f64, _y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let theta = self.parameters.values();
+        simulate_outputs(
+            &self.model()?,
+            &theta,
+            &self.initial_state,
+            inputs,
+            ts,
+            &self.simulation,
+        )
+    }
+
+    fn stepper(&self, ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
+        let theta = self.parameters.values();
+        stream::grey_box(
+            Box::new(self.model()?),
+            theta,
+            &self.initial_state,
+            &self.simulation,
+            ts,
+        )
+    }
+
+    fn streaming_differs(&self) -> Option<String> {
+        streamed_differently(&self.simulation)
+    }
+
+    fn set_evaluator(&mut self, evaluator: Evaluator) {
+        self.evaluator = evaluator;
+    }
 }

@@ -2,11 +2,13 @@
 //! models ([`GreyBoxKind`], [`FittedModel::GreyBox`]), one file form for the four, and the
 //! user's own grey-box model, written under its own kind ([`SavedModel::UserGreyBox`]).
 
-use super::{records, ModelKind, Records};
-use crate::model::greybox::models::GreyBoxKind;
+use super::{records, FittedKind, ModelKind, Records};
+use crate::model::greybox::models::{self, GreyBoxKind};
 use crate::model::greybox::simulate::{simulate, InputTrack};
+use crate::model::greybox::InputInterpolation;
 use crate::model::greybox::{Simulation, StateSpaceModel};
 use crate::model::saved::{FittedModel, ParameterRecord, SavedModel, SimulationSpec};
+use crate::model::stream::{self, Stepper};
 use crate::model::ParameterSet;
 use crate::{Error, Result};
 use schemars::JsonSchema;
@@ -127,42 +129,95 @@ fn fitted(kind: GreyBoxKind, file: &GreyBoxFile) -> Result<FittedModel> {
         .simulation
         .as_ref()
         .map_or(Ok(Simulation::default()), SimulationSpec::simulation)?;
-    Ok(FittedModel::GreyBox {
+    Ok(FittedModel::GreyBox(FittedGreyBox {
         kind: name.to_string(),
         parameters,
         std,
         simulation,
         initial_state,
-    })
+    }))
 }
 
-/// The saved form of [`FittedModel::GreyBox`]: a built-in kind's file, or the user's model
-/// under its own kind.
-pub(crate) fn saved(
-    kind: &str,
-    parameters: &ParameterSet,
-    std: &[f64],
-    simulation: &Simulation,
-    initial_state: &[f64],
-) -> SavedModel {
-    let parameters = records(parameters, std);
-    let simulation = SimulationSpec::of(simulation);
-    match GreyBoxKind::parse(kind).filter(|k| k.name() == kind) {
-        Some(kind) => SavedModel::grey_box(
-            kind,
-            GreyBoxFile {
+/// A fitted built-in grey-box model ([`FittedModel::GreyBox`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedGreyBox {
+    /// Its kind (`bouc_wen`, `rigid_body`, …; or the kind a user's own model gives itself).
+    pub kind: String,
+    /// Its parameters (values, units, bounds, fixed flags).
+    pub parameters: ParameterSet,
+    /// Their standard deviations.
+    pub std: Vec<f64>,
+    /// How it is simulated.
+    pub simulation: Simulation,
+    /// Its initial state.
+    pub initial_state: Vec<f64>,
+}
+
+/// The built-in model integrated ([`crate::model::greybox`]), in batch and one interval at
+/// a time; not invertible. Saved as a built-in kind's file, or as the user's model under
+/// its own kind.
+impl FittedKind for FittedGreyBox {
+    fn saved(&self) -> SavedModel {
+        let parameters = records(&self.parameters, &self.std);
+        let simulation = SimulationSpec::of(&self.simulation);
+        let initial_state = self.initial_state.clone();
+        match GreyBoxKind::parse(&self.kind).filter(|k| k.name() == self.kind) {
+            Some(kind) => SavedModel::grey_box(
+                kind,
+                GreyBoxFile {
+                    parameters,
+                    simulation: Some(simulation),
+                    initial_state: Some(initial_state),
+                },
+            ),
+            None => SavedModel::UserGreyBox {
+                kind: self.kind.clone(),
                 parameters,
-                simulation: Some(simulation),
-                initial_state: Some(initial_state.to_vec()),
+                simulation,
+                initial_state,
             },
-        ),
-        None => SavedModel::UserGreyBox {
-            kind: kind.to_string(),
-            parameters,
-            simulation,
-            initial_state: initial_state.to_vec(),
-        },
+        }
     }
+
+    fn simulate(&self, inputs: &[&[f64]], ts: f64, _y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let model = models::by_kind(&self.kind)?;
+        let theta = self.parameters.values();
+        simulate_outputs(
+            model.as_ref(),
+            &theta,
+            &self.initial_state,
+            inputs,
+            ts,
+            &self.simulation,
+        )
+    }
+
+    fn stepper(&self, ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
+        let model = models::by_kind(&self.kind)?;
+        stream::grey_box(
+            model,
+            self.parameters.values(),
+            &self.initial_state,
+            &self.simulation,
+            ts,
+        )
+    }
+
+    fn streaming_differs(&self) -> Option<String> {
+        streamed_differently(&self.simulation)
+    }
+}
+
+/// Why a grey-box or equation model simulated by `simulation` streams differently from its
+/// batch simulation: band-limited input interpolation, which reads the whole record's
+/// spectrum, is streamed with linear interpolation; None for the other interpolations.
+pub(crate) fn streamed_differently(simulation: &Simulation) -> Option<String> {
+    (simulation.interpolation == InputInterpolation::BandLimited).then(|| {
+        "the model was saved with band-limited input interpolation, which reads the \
+         whole record's spectrum; one sample at a time it is streamed with linear \
+         interpolation between the samples, so its outputs differ from `simulate`'s"
+            .into()
+    })
 }
 
 /// The outputs of `model` simulated from `x0` with parameters `theta` for the input

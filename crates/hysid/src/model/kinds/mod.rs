@@ -15,8 +15,15 @@
 //!   that the error names the path of the bad key (`"parameters"[2]."value"`), and the
 //!   dispatch from a file to its fitted model ([`SavedModel::fitted`]).
 //!
-//! A new kind is its module here and one line of `model_kinds!` (see `docs/architecture.md`,
-//! "A new model kind").
+//! The run-time half has its own list, `fitted_kinds!`: a fitted model of each kind is a
+//! struct of its module (`FittedHysteresisOperator`, `FittedHysteresis`, …) implementing
+//! [`FittedKind`] — how it simulates, steps one sample at a time, compensates and is saved —
+//! and the list generates the [`FittedModel`] enum (one variant per struct, besides the two
+//! record-processing wrappers), its dispatch ([`FittedModel::as_kind`]) and, in the export
+//! layer, the dispatch to each kind's program (`export::kinds`).
+//!
+//! A new kind is its module here, one line of `model_kinds!`, one of `fitted_kinds!` and its
+//! export program (see `docs/architecture.md`, "A new model kind").
 
 pub mod ch_cascade;
 pub mod coleman_hodgdon;
@@ -25,7 +32,10 @@ pub mod grey_box;
 pub mod operator;
 pub mod operator_cascade;
 
+use crate::model::compensate::Compensation;
+use crate::model::greybox::native::Evaluator;
 use crate::model::saved::{FittedModel, ParameterRecord, SimulationSpec};
+use crate::model::stream::{Compensator, Stepper};
 use crate::{Error, Result};
 use schemars::JsonSchema;
 use serde::de::DeserializeOwned;
@@ -44,6 +54,92 @@ pub trait ModelKind {
     /// schema tag and the record processing, are checked by [`FittedModel::from_file`]).
     fn fitted(file: &Self::File) -> Result<FittedModel>;
 }
+
+/// What a fitted model of one kind does at run time. Each kind's module implements it for
+/// its `Fitted…` struct, which `fitted_kinds!` makes a variant of [`FittedModel`]; the
+/// methods of [`FittedModel`] dispatch to it (after the record processing of a wrapper).
+pub trait FittedKind {
+    /// The model of its model file (the kind's [`SavedModel`] variant).
+    fn saved(&self) -> SavedModel;
+
+    /// The outputs for the input channels `inputs` sampled every `ts`; `y0` is the measured
+    /// initial output (see [`FittedModel::simulate`], which also refuses a non-finite one).
+    fn simulate(&self, inputs: &[&[f64]], ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>>;
+
+    /// The model one sample at a time, `ts` and `y0` as for [`FittedKind::simulate`]
+    /// ([`FittedModel::stepper`]).
+    fn stepper(&self, ts: f64, y0: Option<f64>) -> Result<Box<dyn Stepper>>;
+
+    /// Its compensator one sample at a time ([`FittedModel::compensator`]); by default none
+    /// ([`Error::NotInvertible`]).
+    fn compensator(&self) -> Result<Box<dyn Compensator>> {
+        Err(not_invertible(self.saved().kind()))
+    }
+
+    /// The input that makes it follow `reference`, unlimited
+    /// ([`crate::model::compensate::compensate`], which checks the reference first); by
+    /// default none ([`Error::NotInvertible`]).
+    fn compensate(&self, reference: &[f64]) -> Result<Compensation> {
+        let _ = reference;
+        Err(not_invertible(self.saved().kind()))
+    }
+
+    /// Why its one-sample step differs from its batch simulation, if it does
+    /// ([`FittedModel::streaming_differs`]); by default they agree.
+    fn streaming_differs(&self) -> Option<String> {
+        None
+    }
+
+    /// Runs its equation tapes by `evaluator` ([`FittedModel::with_evaluator`]); by default
+    /// it has none.
+    fn set_evaluator(&mut self, evaluator: Evaluator) {
+        let _ = evaluator;
+    }
+}
+
+/// The refusal to compensate a model of kind `kind`.
+pub(crate) fn not_invertible(kind: &str) -> Error {
+    Error::NotInvertible {
+        kind: kind.to_string(),
+        reason: "compensation inverts hysteresis operators, the Coleman–Hodgdon \
+                 hysteresis alone and operator cascades with a minimum-phase linear \
+                 block; identify one of those"
+            .into(),
+    }
+}
+
+/// The first input channel of `inputs` (the only one of a single-input kind).
+pub(crate) fn first<'a>(inputs: &[&'a [f64]]) -> Result<&'a [f64]> {
+    inputs
+        .first()
+        .copied()
+        .ok_or_else(|| Error::ModelMismatch("no input channel given".into()))
+}
+
+/// The one list of fitted model kinds: calls `$callback! { Variant => Type, … }` with each
+/// [`FittedModel`] variant (its doc comment first) and the struct it holds, which implements
+/// [`FittedKind`]. The two record-processing wrappers (`Prefiltered`, `InverseDynamics`) are
+/// not kinds and are not listed. Adding a kind is adding its line here (and in
+/// `model_kinds!` for its file).
+macro_rules! fitted_kinds {
+    ($callback:ident) => {
+        $callback! {
+            /// The Coleman–Hodgdon hysteresis alone.
+            Hysteresis => $crate::model::kinds::coleman_hodgdon::FittedHysteresis,
+            /// The Coleman–Hodgdon cascade.
+            Cascade => $crate::model::kinds::ch_cascade::FittedCascade,
+            /// A built-in grey-box model.
+            GreyBox => $crate::model::kinds::grey_box::FittedGreyBox,
+            /// Any hysteresis operator followed by a linear block.
+            OperatorCascade => $crate::model::kinds::operator_cascade::FittedOperatorCascade,
+            /// A grey-box model written as equations (`hysid-equations`).
+            Equations => $crate::model::kinds::equations::FittedEquations,
+            /// A hysteresis operator of one of the families of [`crate::model::operators`].
+            Operator => $crate::model::kinds::operator::FittedHysteresisOperator,
+        }
+    };
+}
+pub(crate) use fitted_kinds;
 
 /// The one list of model kinds: calls `$callback! { Variant = "kind" => KindType, … }` with
 /// each kind's [`SavedModel`] variant (its doc comment first), the `kind` key naming it and

@@ -1,9 +1,11 @@
 //! Kind `operator`: a hysteresis operator of one family of the registry
 //! ([`FittedModel::Operator`]).
 
-use super::{records, ModelKind, Records};
-use crate::model::operators::{InitialStateUsed, OperatorModel};
+use super::{first, records, FittedKind, ModelKind, Records};
+use crate::model::compensate::Compensation;
+use crate::model::operators::{initial_state, InitialStateUsed, OperatorModel};
 use crate::model::saved::{FittedModel, ParameterRecord, SavedModel};
+use crate::model::stream::{Compensator, Stepper};
 use crate::Result;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -56,18 +58,55 @@ impl ModelKind for OperatorKind {
     }
 }
 
-/// The saved form of [`FittedModel::Operator`].
-pub(crate) fn saved(
-    family: &str,
-    model: &OperatorModel,
-    std: &[f64],
-    initial_state: Option<InitialStateUsed>,
-) -> SavedModel {
-    SavedModel::Operator(OperatorFile {
-        parameters: records(&model.as_operator().parameters(), std),
-        family: family.to_string(),
-        // As for the operator cascade: a failure would only leave the structure null.
-        operator: model.structure().unwrap_or_default(),
-        initial_state,
-    })
+/// A fitted hysteresis operator ([`FittedModel::Operator`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedHysteresisOperator {
+    /// The family's name (`pi`, `preisach`, …; equal to `model.family()`).
+    pub family: &'static str,
+    /// The operator.
+    pub model: OperatorModel,
+    /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
+    pub std: Vec<f64>,
+    /// The initial state it starts from (None: as its structure holds it).
+    pub initial_state: Option<InitialStateUsed>,
+}
+
+/// The family's own simulation from the declared initial state, its step and its inverse
+/// (the registry's operators, [`crate::model::operators`]).
+impl FittedKind for FittedHysteresisOperator {
+    fn saved(&self) -> SavedModel {
+        let model = &self.model;
+        SavedModel::Operator(OperatorFile {
+            parameters: records(&model.as_operator().parameters(), &self.std),
+            family: self.family.to_string(),
+            // As for the operator cascade: a failure would only leave the structure null.
+            operator: model.structure().unwrap_or_default(),
+            initial_state: self.initial_state,
+        })
+    }
+
+    fn simulate(&self, inputs: &[&[f64]], _ts: f64, _y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        let operator = self.model.as_operator();
+        let y = initial_state::simulate(operator, self.initial_state, first(inputs)?)?;
+        Ok(vec![y])
+    }
+
+    fn stepper(&self, _ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
+        self.model.stepper()
+    }
+
+    fn compensator(&self) -> Result<Box<dyn Compensator>> {
+        self.model.compensator()
+    }
+
+    fn compensate(&self, reference: &[f64]) -> Result<Compensation> {
+        let inv = self.model.as_operator().invert(reference)?;
+        Ok(Compensation {
+            reference: reference.to_vec(),
+            u: inv.u,
+            predicted: inv.predicted,
+            clipped: inv.clipped,
+            settled_from: 0,
+        })
+    }
 }

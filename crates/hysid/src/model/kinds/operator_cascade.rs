@@ -1,8 +1,10 @@
 //! Kind `operator_cascade`: a hysteresis operator of the registry followed by a linear block
 //! ([`FittedModel::OperatorCascade`]).
 
-use super::{records, ModelKind, Records};
+use super::{first, records, FittedKind, ModelKind, Records};
+use crate::model::compensate::Compensation;
 use crate::model::saved::{FittedModel, ParameterRecord, SavedModel};
+use crate::model::stream::{self, Compensator, Stepper};
 use crate::model::{LinearBlock, OperatorCascade, OperatorModel};
 use crate::{Error, Result};
 use schemars::JsonSchema;
@@ -66,20 +68,56 @@ impl ModelKind for OperatorCascadeKind {
             values.push(e.value);
             std.push(e.std_or_nan());
         }
-        Ok(FittedModel::OperatorCascade {
+        Ok(FittedModel::OperatorCascade(FittedOperatorCascade {
             model: template.with_values(&values)?,
             std,
-        })
+        }))
     }
 }
 
-/// The saved form of [`FittedModel::OperatorCascade`].
-pub(crate) fn saved(model: &OperatorCascade, std: &[f64]) -> SavedModel {
-    SavedModel::OperatorCascade(OperatorCascadeFile {
-        parameters: records(&model.parameters(), std),
-        delay: model.linear.delay(),
-        // The structure of a constructed operator is always representable; a failure would
-        // only leave it null, and reading the file back then says so.
-        operator: serde_json::to_value(&model.operator).unwrap_or_default(),
-    })
+/// A fitted operator cascade ([`FittedModel::OperatorCascade`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedOperatorCascade {
+    /// The model.
+    pub model: OperatorCascade,
+    /// Standard deviations in [`OperatorCascade::parameters`] order (NaN where not
+    /// estimated).
+    pub std: Vec<f64>,
+}
+
+/// The operator, then the linear block; compensated by the block's inverse (minimum-phase B
+/// only, the reference k samples ahead), then the operator's inverse.
+impl FittedKind for FittedOperatorCascade {
+    fn saved(&self) -> SavedModel {
+        SavedModel::OperatorCascade(OperatorCascadeFile {
+            parameters: records(&self.model.parameters(), &self.std),
+            delay: self.model.linear.delay(),
+            // The structure of a constructed operator is always representable; a failure
+            // would only leave it null, and reading the file back then says so.
+            operator: serde_json::to_value(&self.model.operator).unwrap_or_default(),
+        })
+    }
+
+    fn simulate(&self, inputs: &[&[f64]], _ts: f64, _y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
+        Ok(vec![self.model.simulate(first(inputs)?)?.y])
+    }
+
+    fn stepper(&self, _ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
+        stream::operator_cascade_stepper(&self.model)
+    }
+
+    fn compensator(&self) -> Result<Box<dyn Compensator>> {
+        stream::operator_cascade_compensator(&self.model)
+    }
+
+    fn compensate(&self, reference: &[f64]) -> Result<Compensation> {
+        let inv = self.model.compensate(reference)?;
+        Ok(Compensation {
+            reference: reference.to_vec(),
+            u: inv.u,
+            predicted: inv.predicted,
+            clipped: inv.clipped,
+            settled_from: inv.delay,
+        })
+    }
 }

@@ -3,88 +3,26 @@
 //! [`FittedModel::from_file`] through the registry of kinds ([`crate::model::kinds`]).
 
 use super::{check_inverse_dynamics, check_prefilter, ModelFile, MODEL_SCHEMA};
-use crate::model::coleman_hodgdon::{simulate_switched, InitialOutput};
-use crate::model::greybox::equation_model::EquationStateSpace;
-use crate::model::greybox::models;
 use crate::model::greybox::native::Evaluator;
-use crate::model::greybox::Simulation;
-use crate::model::kinds::grey_box::simulate_outputs;
-use crate::model::kinds::operator_cascade;
-use crate::model::kinds::{ch_cascade, coleman_hodgdon, equations, grey_box, operator};
-use crate::model::operators::initial_state;
+use crate::model::kinds::equations::FittedEquations;
+use crate::model::kinds::grey_box::FittedGreyBox;
+use crate::model::kinds::operator::FittedHysteresisOperator;
+use crate::model::kinds::{self, fitted_kinds, FittedKind};
 use crate::model::operators::{InitialStateUsed, OperatorModel};
 use crate::model::record_filters::{InverseDynamics, Prefilter, RigidBodyValues};
-use crate::model::{ColemanHodgdon, HysteresisCascade, OperatorCascade, ParameterSet};
 use crate::{Error, Result};
 use std::path::Path;
 
-/// A fitted model that can simulate.
-#[derive(Clone, Debug, PartialEq)]
-pub enum FittedModel {
-    /// The hysteresis alone.
-    Hysteresis {
-        /// The model.
-        model: ColemanHodgdon,
-        /// Where its output starts.
-        initial: InitialOutput,
-        /// Standard deviations in [`crate::model::ChForm::parameter_names`] order.
-        std: Vec<f64>,
-    },
-    /// The cascade.
-    Cascade {
-        /// The model.
-        model: HysteresisCascade,
-        /// Standard deviations in [`HysteresisCascade::params`] order.
-        std: Vec<f64>,
-    },
-    /// A built-in grey-box model.
-    GreyBox {
-        /// Its kind (`bouc_wen`, `rigid_body`).
-        kind: String,
-        /// Its parameters (values, units, bounds, fixed flags).
-        parameters: ParameterSet,
-        /// Their standard deviations.
-        std: Vec<f64>,
-        /// How it is simulated.
-        simulation: Simulation,
-        /// Its initial state.
-        initial_state: Vec<f64>,
-    },
-    /// Any hysteresis operator followed by a linear block.
-    OperatorCascade {
-        /// The model.
-        model: OperatorCascade,
-        /// Standard deviations in [`OperatorCascade::parameters`] order (NaN where not
-        /// estimated).
-        std: Vec<f64>,
-    },
-    /// A grey-box model written as equations (`hysid-equations`).
-    Equations {
-        /// The equation file's text.
-        equations: String,
-        /// Its parameters (values, units, bounds, fixed flags) in the file's order.
-        parameters: ParameterSet,
-        /// Their standard deviations.
-        std: Vec<f64>,
-        /// How it is simulated.
-        simulation: Simulation,
-        /// Its initial state.
-        initial_state: Vec<f64>,
-        /// Which code runs its tapes when it is simulated (not saved: a setting of the run,
-        /// [`FittedModel::with_evaluator`]; [`Evaluator::Auto`] when read from a file).
-        evaluator: Evaluator,
-    },
-    /// A hysteresis operator of one of the families of [`crate::model::operators`].
-    Operator {
-        /// The family's name (`pi`, `preisach`, …; equal to `model.family()`).
-        family: &'static str,
-        /// The operator.
-        model: OperatorModel,
-        /// Standard deviations in `model.as_operator().parameters()` order (NaN: none).
-        std: Vec<f64>,
-        /// The initial state it starts from (None: as its structure holds it).
-        initial_state: Option<InitialStateUsed>,
-    },
+/// Generates [`FittedModel`] and its dispatch to each kind ([`FittedModel::as_kind`]) from
+/// the list of fitted kinds ([`crate::model::kinds`]).
+macro_rules! define_fitted_model {
+    ($($(#[$doc:meta])* $variant:ident => $fitted:ty),* $(,)?) => {
+        /// A fitted model that can simulate: a model of one kind (a struct of its module of
+        /// [`crate::model::kinds`], implementing [`FittedKind`]), or one of them behind the
+        /// processing its records had in the fit.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum FittedModel {
+            $($(#[$doc])* $variant($fitted),)*
     /// A model fitted to pre-filtered records: it filters every record (inputs and measured
     /// output alike) before it simulates.
     Prefiltered {
@@ -102,7 +40,47 @@ pub enum FittedModel {
         /// The preprocessing of the fit.
         preprocessing: InverseDynamics,
     },
+        }
+
+        impl FittedModel {
+            /// What this is: a model of one kind, or one behind its record processing.
+            fn view(&self) -> View<'_> {
+                match self {
+                    $(FittedModel::$variant(m) => View::Kind(m),)*
+                    FittedModel::Prefiltered { model, prefilter } => {
+                        View::Prefiltered(model, prefilter)
+                    }
+                    FittedModel::InverseDynamics {
+                        model,
+                        preprocessing,
+                    } => View::InverseDynamics(model, preprocessing),
+                }
+            }
+
+            /// The model of one kind this is, None for the record-processing wrappers
+            /// ([`FittedModel::Prefiltered`], [`FittedModel::InverseDynamics`]).
+            fn as_kind_mut(&mut self) -> Option<&mut dyn FittedKind> {
+                match self {
+                    $(FittedModel::$variant(m) => Some(m),)*
+                    FittedModel::Prefiltered { .. } | FittedModel::InverseDynamics { .. } => None,
+                }
+            }
+        }
+    };
 }
+
+/// A [`FittedModel`] seen as a model of one kind or as one of the wrappers with its inner
+/// model: the one match every method dispatches on.
+pub(crate) enum View<'a> {
+    /// A model of one kind.
+    Kind(&'a dyn FittedKind),
+    /// [`FittedModel::Prefiltered`]: the inner model and the filter.
+    Prefiltered(&'a FittedModel, &'a Prefilter),
+    /// [`FittedModel::InverseDynamics`]: the rigid body and the preprocessing.
+    InverseDynamics(&'a FittedModel, &'a InverseDynamics),
+}
+
+fitted_kinds!(define_fitted_model);
 
 /// One record as a model's fit sees it: the inputs the model is driven by (filtered,
 /// decimated where the fit did so), its outputs, and the measured output processed alike.
@@ -119,7 +97,7 @@ pub struct Prediction {
 impl FittedModel {
     /// Simulates the model's outputs for the input channels `inputs` sampled every `ts`;
     /// `y0` is the measured initial output (used by a hysteresis with
-    /// [`InitialOutput::Measured`]). Errors when α·|Δx| > 1 or the simulation diverges
+    /// [`InitialOutput::Measured`](crate::model::coleman_hodgdon::InitialOutput::Measured)). Errors when α·|Δx| > 1 or the simulation diverges
     /// (an output that is NaN or ±∞, e.g. an unstable linear block, is
     /// [`Error::Diverged`], never returned).
     pub fn simulate(&self, inputs: &[&[f64]], ts: f64, y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
@@ -145,85 +123,29 @@ impl FittedModel {
         ts: f64,
         y0: Option<f64>,
     ) -> Result<Vec<Vec<f64>>> {
-        let first = || {
-            inputs
-                .first()
-                .copied()
-                .ok_or_else(|| Error::ModelMismatch("no input channel given".into()))
-        };
-        match self {
-            FittedModel::Hysteresis { model, initial, .. } => {
-                let x = first()?;
-                model.check_rate(x)?;
-                let v0 = match initial {
-                    InitialOutput::Measured => y0.ok_or_else(|| {
-                        Error::ModelMismatch(
-                            "this hysteresis starts from the measured output; give the measured output"
-                                .into(),
-                        )
-                    })?,
-                    InitialOutput::Zero => 0.0,
-                };
-                Ok(vec![simulate_switched(model, x, v0, None)])
-            }
-            FittedModel::Cascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
-            FittedModel::Prefiltered { model, prefilter } => {
+        match self.view() {
+            View::Kind(kind) => kind.simulate(inputs, ts, y0),
+            View::Prefiltered(model, prefilter) => {
                 let filtered = inputs
                     .iter()
                     .map(|x| prefilter.apply(x, ts))
                     .collect::<Result<Vec<_>>>()?;
                 model.simulate_unchecked(&slices(&filtered), ts, y0)
             }
-            FittedModel::InverseDynamics { preprocessing, .. } => Ok(vec![
-                preprocessing.predict(&self.rigid_body()?, first()?, ts)?.1,
+            View::InverseDynamics(_, preprocessing) => Ok(vec![
+                preprocessing
+                    .predict(&self.rigid_body()?, kinds::first(inputs)?, ts)?
+                    .1,
             ]),
-            FittedModel::OperatorCascade { model, .. } => Ok(vec![model.simulate(first()?)?.y]),
-            FittedModel::Operator {
-                model,
-                initial_state,
-                ..
-            } => Ok(vec![initial_state::simulate(
-                model.as_operator(),
-                *initial_state,
-                first()?,
-            )?]),
-            FittedModel::GreyBox {
-                kind,
-                parameters,
-                simulation,
-                initial_state,
-                ..
-            } => {
-                let model = models::by_kind(kind)?;
-                let theta = parameters.values();
-                simulate_outputs(
-                    model.as_ref(),
-                    &theta,
-                    initial_state,
-                    inputs,
-                    ts,
-                    simulation,
-                )
-            }
-            FittedModel::Equations {
-                equations,
-                parameters,
-                simulation,
-                initial_state,
-                evaluator,
-                ..
-            } => {
-                let model =
-                    EquationStateSpace::parse(equations, "saved model")?.with_evaluator(*evaluator);
-                simulate_outputs(
-                    &model,
-                    &parameters.values(),
-                    initial_state,
-                    inputs,
-                    ts,
-                    simulation,
-                )
-            }
+        }
+    }
+
+    /// The model of one kind this is, None for the record-processing wrappers
+    /// ([`FittedModel::Prefiltered`], [`FittedModel::InverseDynamics`]).
+    pub fn as_kind(&self) -> Option<&dyn FittedKind> {
+        match self.view() {
+            View::Kind(kind) => Some(kind),
+            View::Prefiltered(..) | View::InverseDynamics(..) => None,
         }
     }
 
@@ -298,9 +220,9 @@ impl FittedModel {
             other => other,
         };
         let parameters = match inner {
-            FittedModel::GreyBox {
+            FittedModel::GreyBox(FittedGreyBox {
                 kind, parameters, ..
-            } if kind == "rigid_body" => parameters,
+            }) if kind == "rigid_body" => parameters,
             other => {
                 return Err(Error::UnsupportedKind {
                     kind: other.to_file().kind().to_string(),
@@ -333,20 +255,20 @@ impl FittedModel {
     /// file text `equations`, as [`FittedModel::Equations`]; other variants unchanged.
     pub fn with_equations(self, equations: &str) -> Self {
         match self {
-            FittedModel::GreyBox {
+            FittedModel::GreyBox(FittedGreyBox {
                 parameters,
                 std,
                 simulation,
                 initial_state,
                 ..
-            } => FittedModel::Equations {
+            }) => FittedModel::Equations(FittedEquations {
                 equations: equations.to_string(),
                 parameters,
                 std,
                 simulation,
                 initial_state,
                 evaluator: Evaluator::Auto,
-            },
+            }),
             other => other,
         }
     }
@@ -361,85 +283,50 @@ impl FittedModel {
     /// [`Self::with_evaluator`] in place.
     fn set_evaluator(&mut self, evaluator: Evaluator) {
         match self {
-            FittedModel::Equations { evaluator: e, .. } => *e = evaluator,
             FittedModel::Prefiltered { model, .. } => model.set_evaluator(evaluator),
-            _ => {}
+            FittedModel::InverseDynamics { .. } => {}
+            kind => {
+                if let Some(kind) = kind.as_kind_mut() {
+                    kind.set_evaluator(evaluator)
+                }
+            }
         }
     }
 
     /// The model file of this model (each kind saved by its module of
     /// [`crate::model::kinds`]).
     pub fn to_file(&self) -> ModelFile {
-        let model = match self {
-            FittedModel::Hysteresis {
-                model,
-                initial,
-                std,
-            } => coleman_hodgdon::saved(model, *initial, std),
-            FittedModel::Cascade { model, std } => ch_cascade::saved(model, std),
-            FittedModel::OperatorCascade { model, std } => operator_cascade::saved(model, std),
-            FittedModel::GreyBox {
-                kind,
-                parameters,
-                std,
-                simulation,
-                initial_state,
-            } => grey_box::saved(kind, parameters, std, simulation, initial_state),
-            FittedModel::Equations {
-                equations,
-                parameters,
-                std,
-                simulation,
-                initial_state,
-                ..
-            } => equations::saved(equations, parameters, std, simulation, initial_state),
-            FittedModel::Operator {
-                family,
-                model,
-                std,
-                initial_state,
-            } => operator::saved(family, model, std, *initial_state),
-            FittedModel::Prefiltered { model, prefilter } => {
-                return ModelFile {
-                    prefilter: Some(*prefilter),
-                    ..model.to_file()
-                }
-            }
-            FittedModel::InverseDynamics {
-                model,
-                preprocessing,
-            } => {
-                return ModelFile {
-                    inverse_dynamics: Some(*preprocessing),
-                    ..model.to_file()
-                }
-            }
-        };
-        ModelFile::new(model)
+        match self.view() {
+            View::Kind(kind) => ModelFile::new(kind.saved()),
+            View::Prefiltered(model, prefilter) => ModelFile {
+                prefilter: Some(*prefilter),
+                ..model.to_file()
+            },
+            View::InverseDynamics(model, preprocessing) => ModelFile {
+                inverse_dynamics: Some(*preprocessing),
+                ..model.to_file()
+            },
+        }
     }
 
     /// The fitted model of an operator with standard deviations `std` (NaN: none).
     pub fn operator(model: OperatorModel, std: Vec<f64>) -> Self {
-        FittedModel::Operator {
+        FittedModel::Operator(FittedHysteresisOperator {
             family: model.family().name(),
             model,
             std,
             initial_state: None,
-        }
+        })
     }
 
     /// The same model starting from `state` (an operator; other kinds are returned as they
     /// are).
     pub fn with_initial_state(self, state: Option<InitialStateUsed>) -> Self {
         match self {
-            FittedModel::Operator {
-                family, model, std, ..
-            } => FittedModel::Operator {
-                family,
-                model,
-                std,
+            FittedModel::Operator(op) => FittedModel::Operator(FittedHysteresisOperator {
                 initial_state: state,
-            },
+                ..op
+            }),
             other => other,
         }
     }

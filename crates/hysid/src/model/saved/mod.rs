@@ -48,10 +48,16 @@ mod fitted;
 mod read;
 mod simulation;
 
+pub use crate::model::kinds::ch_cascade::FittedCascade;
+pub use crate::model::kinds::coleman_hodgdon::FittedHysteresis;
+pub use crate::model::kinds::equations::FittedEquations;
+pub use crate::model::kinds::grey_box::FittedGreyBox;
 pub use crate::model::kinds::grey_box::GreyBoxFile;
+pub use crate::model::kinds::operator::FittedHysteresisOperator;
 pub use crate::model::kinds::operator::OPERATOR_KIND;
+pub use crate::model::kinds::operator_cascade::FittedOperatorCascade;
 pub use crate::model::kinds::operator_cascade::OPERATOR_CASCADE_KIND;
-pub use crate::model::kinds::{SavedModel, MODEL_KINDS};
+pub use crate::model::kinds::{FittedKind, SavedModel, MODEL_KINDS};
 pub use fitted::{FittedModel, Prediction};
 pub use read::MAX_FILTER_ORDER;
 pub(crate) use read::{check_inverse_dynamics, check_prefilter};

@@ -77,10 +77,9 @@ pub use crate::model::operators::CompensatorStep;
 
 use crate::model::coleman_hodgdon::InitialOutput;
 use crate::model::compensate::Compensation;
-use crate::model::greybox::equation_model::EquationStateSpace;
-use crate::model::greybox::{models, InputInterpolation};
 use crate::model::limits::{is_bad, Limits};
 use crate::model::saved::FittedModel;
+use crate::model::{ColemanHodgdon, HysteresisCascade, OperatorCascade};
 use crate::{Error, Result};
 
 /// One sample in, one sample out, from the model's saved initial state.
@@ -346,65 +345,9 @@ impl FittedModel {
     /// they mean for [`FittedModel::simulate`] (`ts` is used by grey-box models; `y0` by a
     /// Coleman–Hodgdon hysteresis that starts from the measured output).
     pub fn stepper(&self, ts: f64, y0: Option<f64>) -> Result<Box<dyn Stepper>> {
-        let single =
-            |kernel: Box<dyn Kernel>| -> Box<dyn Stepper> { Box::new(Guarded::new(kernel, 1, 1)) };
-        match self {
-            FittedModel::Operator { model, .. } => model.stepper(),
-            FittedModel::Hysteresis { model, initial, .. } => {
-                let v0 = match initial {
-                    InitialOutput::Measured => y0.ok_or_else(|| {
-                        Error::ModelMismatch(
-                            "this hysteresis starts from the measured output; give the measured output"
-                                .into(),
-                        )
-                    })?,
-                    InitialOutput::Zero => 0.0,
-                };
-                Ok(single(Box::new(coleman_hodgdon::HysteresisStream::new(
-                    model.clone(),
-                    v0,
-                ))))
-            }
-            FittedModel::Cascade { model, .. } => {
-                Ok(single(Box::new(cascade::ChCascadeStream::new(model))))
-            }
-            FittedModel::OperatorCascade { model, .. } => Ok(single(Box::new(
-                cascade::OperatorCascadeStream::new(model)?,
-            ))),
-            FittedModel::GreyBox {
-                kind,
-                parameters,
-                simulation,
-                initial_state,
-                ..
-            } => grey_box(
-                models::by_kind(kind)?,
-                parameters.values(),
-                initial_state,
-                simulation,
-                ts,
-            ),
-            FittedModel::Equations {
-                equations,
-                parameters,
-                simulation,
-                initial_state,
-                evaluator,
-                ..
-            } => {
-                let model =
-                    EquationStateSpace::parse(equations, "saved model")?.with_evaluator(*evaluator);
-                grey_box(
-                    Box::new(model),
-                    parameters.values(),
-                    initial_state,
-                    simulation,
-                    ts,
-                )
-            }
-            FittedModel::Prefiltered { .. } | FittedModel::InverseDynamics { .. } => {
-                Err(self.not_causal())
-            }
+        match self.as_kind() {
+            Some(kind) => kind.stepper(ts, y0),
+            None => Err(self.not_causal()),
         }
     }
 
@@ -413,18 +356,9 @@ impl FittedModel {
     /// the sample time, as for [`FittedModel::stepper`] (every kind with an inverse is
     /// discrete-time today, so none reads it).
     pub fn compensator(&self, _ts: f64) -> Result<Box<dyn Compensator>> {
-        match self {
-            FittedModel::Operator { model, .. } => model.compensator(),
-            FittedModel::Hysteresis { model, initial, .. } => Ok(Box::new(GuardedInverse::new(
-                coleman_hodgdon::HysteresisInverse::new(model.clone(), *initial),
-            ))),
-            FittedModel::OperatorCascade { model, .. } => Ok(Box::new(GuardedInverse::new(
-                cascade::OperatorCascadeInverse::new(model)?,
-            ))),
-            FittedModel::Prefiltered { .. } | FittedModel::InverseDynamics { .. } => {
-                Err(self.not_causal())
-            }
-            other => Err(crate::model::compensate::not_invertible(other)),
+        match self.as_kind() {
+            Some(kind) => kind.compensator(),
+            None => Err(self.not_causal()),
         }
     }
 
@@ -432,21 +366,13 @@ impl FittedModel {
     /// grey-box or equation model saved with `band_limited` input interpolation (streamed
     /// with linear interpolation); None when they agree.
     pub fn streaming_differs(&self) -> Option<String> {
-        match self {
-            FittedModel::GreyBox { simulation, .. } | FittedModel::Equations { simulation, .. }
-                if simulation.interpolation == InputInterpolation::BandLimited =>
-            {
-                Some(
-                    "the model was saved with band-limited input interpolation, which reads the \
-                     whole record's spectrum; one sample at a time it is streamed with linear \
-                     interpolation between the samples, so its outputs differ from `simulate`'s"
-                        .into(),
-                )
-            }
-            FittedModel::Prefiltered { model, .. } | FittedModel::InverseDynamics { model, .. } => {
-                model.streaming_differs()
-            }
-            _ => None,
+        match (self, self.as_kind()) {
+            (_, Some(kind)) => kind.streaming_differs(),
+            (
+                FittedModel::Prefiltered { model, .. } | FittedModel::InverseDynamics { model, .. },
+                None,
+            ) => model.streaming_differs(),
+            (_, None) => None,
         }
     }
 
@@ -470,8 +396,43 @@ impl FittedModel {
     }
 }
 
+/// The stepper of the Coleman–Hodgdon hysteresis `model` starting from the output `v0`.
+pub(crate) fn hysteresis_stepper(model: &ColemanHodgdon, v0: f64) -> Box<dyn Stepper> {
+    let kernel = coleman_hodgdon::HysteresisStream::new(model.clone(), v0);
+    Box::new(Guarded::new(kernel, 1, 1))
+}
+
+/// The compensator of the Coleman–Hodgdon hysteresis `model` (its per-sample solve).
+pub(crate) fn hysteresis_compensator(
+    model: &ColemanHodgdon,
+    initial: InitialOutput,
+) -> Box<dyn Compensator> {
+    Box::new(GuardedInverse::new(
+        coleman_hodgdon::HysteresisInverse::new(model.clone(), initial),
+    ))
+}
+
+/// The stepper of the Coleman–Hodgdon cascade `model`.
+pub(crate) fn ch_cascade_stepper(model: &HysteresisCascade) -> Box<dyn Stepper> {
+    Box::new(Guarded::new(cascade::ChCascadeStream::new(model), 1, 1))
+}
+
+/// The stepper of the operator cascade `model`.
+pub(crate) fn operator_cascade_stepper(model: &OperatorCascade) -> Result<Box<dyn Stepper>> {
+    let kernel = cascade::OperatorCascadeStream::new(model)?;
+    Ok(Box::new(Guarded::new(kernel, 1, 1)))
+}
+
+/// The compensator of the operator cascade `model` (refused unless B is minimum phase).
+pub(crate) fn operator_cascade_compensator(
+    model: &OperatorCascade,
+) -> Result<Box<dyn Compensator>> {
+    let kernel = cascade::OperatorCascadeInverse::new(model)?;
+    Ok(Box::new(GuardedInverse::new(kernel)))
+}
+
 /// The grey-box stepper of `model` with values `theta`.
-fn grey_box(
+pub(crate) fn grey_box(
     model: Box<dyn crate::model::greybox::StateSpaceModel>,
     theta: Vec<f64>,
     initial_state: &[f64],

@@ -4,6 +4,7 @@ use hysid::data::IdData;
 use hysid::identify::bouc_wen_benchmark::*;
 use hysid::model::greybox::models::BoucWen;
 use hysid::model::greybox::{InputInterpolation, Integrator, Simulation, StateSpaceModel};
+use hysid::model::saved::FittedGreyBox;
 use hysid::model::saved::FittedModel;
 use hysid::numerics::metrics;
 
@@ -38,7 +39,7 @@ fn generated_records_are_seeded_and_carry_the_asked_noise() {
 #[test]
 fn the_generating_model_scores_zero_on_its_own_noise_free_record() {
     let record = generate(TestSignal::Sweep { samples: 3000 }, 0.0, 3).unwrap();
-    let nominal = FittedModel::GreyBox {
+    let nominal = FittedModel::GreyBox(FittedGreyBox {
         kind: "bouc_wen".into(),
         parameters: BoucWen.parameters(),
         std: vec![0.0; 7],
@@ -47,7 +48,7 @@ fn the_generating_model_scores_zero_on_its_own_noise_free_record() {
             interpolation: InputInterpolation::Linear,
         },
         initial_state: vec![0.0; 3],
-    };
+    });
     let data = IdData::siso(1.0 / FS, "u_N", record.u, "y_m", record.y.clone()).unwrap();
     let test = score(&nominal, "sweep", &data, false).unwrap();
     // At 750 Hz without the 15 kHz substeps the simulation differs from the record by the

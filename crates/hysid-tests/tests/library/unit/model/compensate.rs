@@ -4,6 +4,7 @@ use hysid::model::coleman_hodgdon::InitialOutput;
 use hysid::model::compensate::*;
 use hysid::model::operators::{OperatorModel, Orientation, PrandtlIshlinskii};
 use hysid::model::saved::FittedModel;
+use hysid::model::saved::{FittedCascade, FittedHysteresis};
 use hysid::model::ColemanHodgdon;
 use hysid::Error;
 
@@ -37,11 +38,11 @@ fn pi_compensation_tracks_to_1e9() {
 #[test]
 fn coleman_hodgdon_compensation_and_clipping() {
     let ch = ColemanHodgdon::saturated(0.5, 1.0, 0.3, 3.0).unwrap();
-    let model = FittedModel::Hysteresis {
+    let model = FittedModel::Hysteresis(FittedHysteresis {
         model: ch,
         initial: InitialOutput::Measured,
         std: vec![f64::NAN; 4],
-    };
+    });
     let r = reference(800, 1.5);
     let c = compensate(&model, &r).unwrap();
     let (_, max) = c.tracking_error();
@@ -60,7 +61,7 @@ fn coleman_hodgdon_compensation_and_clipping() {
 fn a_cascade_is_not_invertible() {
     let truth = hysid::experiments::voros::CascadeExample::example2().truth;
     let std = vec![f64::NAN; truth.params().len()];
-    let model = FittedModel::Cascade { model: truth, std };
+    let model = FittedModel::Cascade(FittedCascade { model: truth, std });
     let e = compensate(&model, &[0.0, 1.0]).unwrap_err();
     assert!(matches!(e, Error::NotInvertible { .. }));
     assert!(e

@@ -4,6 +4,7 @@
 
 use hysid::model::greybox::models::GreyBoxKind;
 use hysid::model::kinds::{ch_cascade, coleman_hodgdon, ModelKind};
+use hysid::model::saved::FittedHysteresis;
 use hysid::model::saved::{FittedModel, ModelFile, SavedModel, MODEL_KINDS};
 use hysid::model::ChForm;
 use hysid::report::model_schema;
@@ -64,7 +65,10 @@ fn a_kind_reads_and_writes_its_own_file() {
     };
     assert_eq!(file.hysteresis, ChForm::Saturated4);
     let fitted = coleman_hodgdon::ColemanHodgdonKind::fitted(file).unwrap();
-    assert!(matches!(fitted, FittedModel::Hysteresis { .. }));
+    assert!(matches!(
+        fitted,
+        FittedModel::Hysteresis(FittedHysteresis { .. })
+    ));
     assert_eq!(fitted.to_file().model.kind(), "coleman_hodgdon");
     let value = serde_json::to_value(&model).unwrap();
     assert_eq!(value["kind"], "coleman_hodgdon");

@@ -3,6 +3,7 @@
 use hysid::experiments::voros::CascadeExample;
 use hysid::model::coleman_hodgdon::InitialOutput;
 use hysid::model::saved::*;
+use hysid::model::saved::{FittedCascade, FittedHysteresis, FittedOperatorCascade};
 use hysid::model::{ColemanHodgdon, LinearBlock};
 use hysid::model::{OperatorCascade, OperatorModel};
 
@@ -12,7 +13,7 @@ fn cascade_round_trips_through_json() {
     let std: Vec<f64> = (0..truth.params().len())
         .map(|i| 0.01 * (i + 1) as f64)
         .collect();
-    let fitted = FittedModel::Cascade { model: truth, std };
+    let fitted = FittedModel::Cascade(FittedCascade { model: truth, std });
     let json = serde_json::to_string(&fitted.to_file()).unwrap();
     assert!(
         json.contains("\"kind\":\"ch_cascade\"")
@@ -33,7 +34,7 @@ fn operator_cascade_round_trips_through_json() {
     let std: Vec<f64> = (0..model.parameters().len())
         .map(|i| 0.01 * i as f64)
         .collect();
-    let fitted = FittedModel::OperatorCascade { model, std };
+    let fitted = FittedModel::OperatorCascade(FittedOperatorCascade { model, std });
     let json = serde_json::to_string(&fitted.to_file()).unwrap();
     assert!(
         json.contains("\"kind\":\"operator_cascade\"") && json.contains("\"family\":\"preisach\"")
@@ -60,15 +61,15 @@ fn operator_cascade_round_trips_through_json() {
 #[test]
 fn unknown_std_is_null() {
     let model = ColemanHodgdon::saturated(0.3, 1.0, 0.5, 3.0).unwrap();
-    let fitted = FittedModel::Hysteresis {
+    let fitted = FittedModel::Hysteresis(FittedHysteresis {
         model,
         initial: InitialOutput::Zero,
         std: vec![f64::NAN, 0.1, 0.1, 0.1],
-    };
+    });
     let json = serde_json::to_string(&fitted.to_file()).unwrap();
     assert!(json.contains("\"std\":null"), "{json}");
     let back = FittedModel::from_file(&serde_json::from_str(&json).unwrap()).unwrap();
-    let FittedModel::Hysteresis { std, .. } = back else {
+    let FittedModel::Hysteresis(FittedHysteresis { std, .. }) = back else {
         panic!()
     };
     assert!(std[0].is_nan());

@@ -3,6 +3,7 @@
 use hysid::identify::operators::family::*;
 use hysid::model::operators::{HysteresisOperator, PrandtlIshlinskii};
 use hysid::model::operators::{OperatorModel, Orientation};
+use hysid::model::saved::FittedHysteresisOperator;
 use hysid::model::saved::FittedModel;
 
 #[test]
@@ -60,10 +61,10 @@ fn pi_through_the_registry() {
         ..FamilyOptions::default()
     };
     let fitted = fit_operator(Family::Pi, &u, &y, &options).unwrap();
-    let FittedModel::Operator {
+    let FittedModel::Operator(FittedHysteresisOperator {
         model: OperatorModel::Pi(pi),
         ..
-    } = &fitted.fit.model
+    }) = &fitted.fit.model
     else {
         panic!("not a PI model")
     };

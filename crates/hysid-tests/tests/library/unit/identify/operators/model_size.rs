@@ -3,6 +3,7 @@
 
 use hysid::identify::operators::{fit_operator, Family, FamilyOptions, FittedOperator};
 use hysid::model::operators::{play, HysteresisOperator, Orientation, Preisach};
+use hysid::model::saved::FittedHysteresisOperator;
 use hysid::model::saved::FittedModel;
 use hysid::numerics::metrics;
 
@@ -55,7 +56,9 @@ fn smooth_plant() -> Preisach {
 /// The fitted operator simulated on `u` from its saved state.
 fn simulate(fitted: &FittedOperator, u: &[f64]) -> Vec<f64> {
     match &fitted.fit.model {
-        FittedModel::Operator { model, .. } => model.as_operator().simulate(u).unwrap(),
+        FittedModel::Operator(FittedHysteresisOperator { model, .. }) => {
+            model.as_operator().simulate(u).unwrap()
+        }
         other => panic!("not an operator: {other:?}"),
     }
 }
