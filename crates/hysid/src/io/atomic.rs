@@ -16,7 +16,7 @@
 //! 2. each output is written to a temporary in its destination directory — a file to
 //!    `.NAME.hysid-tmp-PID-N`, a directory output to a sibling directory of that form — whose
 //!    path registration returns. A temporary file is created through [`create`] or
-//!    [`write`], under the same lock as a signal handler's removal (below), so that no
+//!    [`write()`], under the same lock as a signal handler's removal (below), so that no
 //!    interrupt can leave one behind;
 //! 3. [`OutputSet::commit`] puts every temporary in place, each by one atomic replacement
 //!    (a file renamed over the previous one, a directory swapped with it), and only then
