@@ -5,7 +5,7 @@
 use hysid::model::greybox::models::GreyBoxKind;
 use hysid::model::kinds::{ch_cascade, coleman_hodgdon, ModelKind};
 use hysid::model::saved::FittedHysteresis;
-use hysid::model::saved::{FittedKind, FittedModel, ModelFile, SavedModel, MODEL_KINDS};
+use hysid::model::saved::{FittedModel, ModelFile, SavedModel, MODEL_KINDS};
 use hysid::model::ChForm;
 use hysid::report::model_schema;
 use serde_json::json;
