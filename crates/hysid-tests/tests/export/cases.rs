@@ -14,6 +14,7 @@ use rand::{RngExt, SeedableRng};
 pub const BAR: f64 = 1e-12;
 
 /// One export to check.
+#[derive(Clone)]
 pub struct Case {
     /// The export name (also the label in the table).
     pub name: String,

@@ -101,3 +101,108 @@ fn generated_rust_equals_the_library() {
     cases::check("Rust", &results);
     cases::check_clipped("Rust", &all, &clipped);
 }
+
+/// The target the embedded build is checked on: the Cortex-M4F/M7 one when the toolchain
+/// has it (`rustup target add thumbv7em-none-eabihf`, as CI does), else the host.
+fn embedded_target() -> Option<&'static str> {
+    let installed = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+        .unwrap_or_default();
+    installed
+        .lines()
+        .any(|l| l.trim() == "thumbv7em-none-eabihf")
+        .then_some("thumbv7em-none-eabihf")
+}
+
+#[test]
+#[ignore = "generated code (compiled with cargo for thumbv7em): run in CI's long step, `cargo test --release -- --ignored`"]
+fn generated_rust_builds_for_cortex_m_without_std_alloc_or_a_panic_path() {
+    // Every case in double and, where the kind exports it, in single precision.
+    let mut all = Vec::new();
+    for case in cases::all() {
+        let mut single = case.clone();
+        single.name = format!("{}_f32", case.name);
+        single.options.precision = hysid::export::Precision::Single;
+        all.push(case);
+        if rust_crate(&single.file, &single.name, &single.options).is_ok() {
+            all.push(single);
+        }
+    }
+    let dir = tempfile::tempdir().expect("temp dir");
+    let root = dir.path();
+    let mut manifest = String::from(
+        "[package]\nname = \"embedded_check\"\nversion = \"0.1.0\"\nedition = \"2021\"\n\n\
+         [workspace]\n\n[dependencies]\n",
+    );
+    // A no_std library that links every crate: it builds only if none needs std.
+    let mut lib = String::from("#![no_std]\n");
+    for case in &all {
+        manifest.push_str(&write_crate(case, root));
+        lib.push_str(&format!(
+            "pub use {}::Model as {};\n",
+            case.name,
+            case.name.to_uppercase()
+        ));
+    }
+    std::fs::create_dir_all(root.join("src")).expect("mkdir");
+    std::fs::write(root.join("Cargo.toml"), manifest).expect("write");
+    std::fs::write(root.join("src/lib.rs"), lib).expect("write");
+    let target = embedded_target();
+    // Clippy holds the crates to their `deny(clippy::indexing_slicing)`; the build gives
+    // their object code.
+    for command in ["clippy", "build"] {
+        let mut args = vec![command, "--release", "--offline", "--quiet"];
+        if let Some(t) = target {
+            args.extend(["--target", t]);
+        }
+        let built = Command::new(env!("CARGO"))
+            .args(&args)
+            .current_dir(root)
+            .env("CARGO_TARGET_DIR", root.join("target"))
+            .env_remove("RUSTFLAGS")
+            .output()
+            .expect("run cargo");
+        assert!(
+            built.status.success(),
+            "cargo {command} of the generated crates for {target:?} failed:\n{}",
+            String::from_utf8_lossy(&built.stderr)
+        );
+    }
+    // No symbol of a panic, an allocator or std in any crate's object code.
+    let deps = root
+        .join("target")
+        .join(target.unwrap_or(""))
+        .join("release/deps");
+    let mut checked = 0;
+    for case in &all {
+        let prefix = format!("lib{}-", case.name);
+        let rlib = std::fs::read_dir(&deps)
+            .expect("the deps directory")
+            .flatten()
+            .map(|e| e.path())
+            .find(|p| {
+                let name = p.file_name().unwrap().to_string_lossy().into_owned();
+                name.starts_with(&prefix) && name.ends_with(".rlib")
+            })
+            .unwrap_or_else(|| panic!("no rlib of {}", case.name));
+        let nm = Command::new("nm")
+            .args(["-C", "--undefined-only"])
+            .arg(&rlib)
+            .output()
+            .expect("run nm");
+        let symbols = String::from_utf8_lossy(&nm.stdout);
+        for bad in ["panic", "alloc", "std::"] {
+            let found: Vec<&str> = symbols.lines().filter(|l| l.contains(bad)).collect();
+            assert!(
+                found.is_empty(),
+                "{}: {bad} in its object: {found:?}",
+                case.name
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked > 50, "only {checked} crates checked");
+}

@@ -47,6 +47,17 @@ pub(crate) trait Syntax {
     fn for_head(&self, var: &str, from: String, to: String) -> String;
     /// The head of `if`/`while` with a printed condition (`if (c)` / `if c`).
     fn cond_head(&self, keyword: &str, c: String) -> String;
+    /// Element `i` (printed) of the printed array `array`; `constant` when `i` is a literal
+    /// (which the compiler checks against the array's length). By default `array[i]`.
+    fn element(&self, array: String, i: String, constant: bool) -> String {
+        let _ = constant;
+        format!("{array}[{i}]")
+    }
+    /// The statement storing the printed `value` in element `i` of `array` (see
+    /// [`Syntax::element`]). By default `array[i] = value;`.
+    fn store(&self, array: String, i: String, constant: bool, value: String) -> String {
+        format!("{} = {value};", self.element(array, i, constant))
+    }
 }
 
 /// Prints expressions and statements in one language.
@@ -92,8 +103,10 @@ impl<'a> Printer<'a> {
             Expr::Flag(b) => (x.flag(*b).into(), ATOM),
             Expr::Local(name) => (name.clone(), ATOM),
             Expr::State(field) => (x.state(field), ATOM),
-            Expr::StateAt(field, i) => (format!("{}[{}]", x.state(field), self.top(i)), ATOM),
-            Expr::Table(name, i) => (format!("{}[{}]", x.table(name), self.top(i)), ATOM),
+            Expr::StateAt(field, i) => {
+                (x.element(x.state(field), self.top(i), is_literal(i)), ATOM)
+            }
+            Expr::Table(name, i) => (x.element(x.table(name), self.top(i), is_literal(i)), ATOM),
             Expr::Input(i) => (format!("u[{i}]"), ATOM),
             Expr::Neg(a) => (format!("-{}", self.operand(a, UNARY + 1)), UNARY),
             Expr::Not(a) => (format!("!{}", self.operand(a, UNARY + 1)), UNARY),
@@ -148,13 +161,16 @@ impl<'a> Printer<'a> {
                 value,
             } => Self::line(depth, &x.declare(name, *ty, *mutable, self.top(value)), out),
             Stmt::Assign(place, value) => {
-                let target = match place {
-                    Place::Local(name) => name.clone(),
-                    Place::State(field) => x.state(field),
-                    Place::StateAt(field, i) => format!("{}[{}]", x.state(field), self.top(i)),
-                    Place::Output(i) => format!("y[{i}]"),
+                let value = self.top(value);
+                let line = match place {
+                    Place::Local(name) => format!("{name} = {value};"),
+                    Place::State(field) => format!("{} = {value};", x.state(field)),
+                    Place::StateAt(field, i) => {
+                        x.store(x.state(field), self.top(i), is_literal(i), value)
+                    }
+                    Place::Output(i) => format!("y[{i}] = {value};"),
                 };
-                Self::line(depth, &format!("{target} = {};", self.top(value)), out);
+                Self::line(depth, &line, out);
             }
             Stmt::If(c, then, otherwise) => {
                 Self::line(
@@ -200,6 +216,11 @@ impl<'a> Printer<'a> {
             }
         }
     }
+}
+
+/// True when the index `i` is a literal.
+fn is_literal(i: &Expr) -> bool {
+    matches!(i, Expr::Index(_))
 }
 
 /// `text` as comment lines with the prefix `lead` (`" * "`, `"//! "`), one per line.

@@ -105,6 +105,26 @@ impl Syntax for Rust {
     fn cond_head(&self, keyword: &str, c: String) -> String {
         format!("{keyword} {c}")
     }
+    /// A computed index reads through `get`: no bounds-check panic can be reached (an
+    /// index past the end, which the program never forms, would read 0). A literal index
+    /// is checked by the compiler.
+    fn element(&self, array: String, i: String, constant: bool) -> String {
+        match constant {
+            true => format!("{array}[{i}]"),
+            false => format!("{array}.get({i}).copied().unwrap_or_default()"),
+        }
+    }
+    /// A computed index writes through `get_mut` (an index past the end would store
+    /// nothing), for the reason of [`Syntax::element`].
+    fn store(&self, array: String, i: String, constant: bool, value: String) -> String {
+        match constant {
+            true => format!("{array}[{i}] = {value};"),
+            // The value first, in a block of its own: it may read the same array.
+            false => format!(
+                "{{ let stored = {value}; if let Some(slot) = {array}.get_mut({i}) {{ *slot = stored; }} }}"
+            ),
+        }
+    }
 }
 
 /// `Cargo.toml` of the crate `name`.
@@ -131,7 +151,8 @@ pub fn lib_rs(
     let real = syntax.ty(Ty::F64);
     let p = Printer::new(&syntax);
     let mut r = comment_lines(comment, "//! ");
-    r.push_str("#![no_std]\n\n");
+    // Generated code: clippy's style lints do not apply; indexing that could panic does.
+    r.push_str("#![no_std]\n#![allow(clippy::all)]\n#![deny(clippy::indexing_slicing)]\n\n");
     r.push_str(&format!(
         "/// The number of inputs of [`Model::step`].\npub const N_IN: usize = {};\n\
          /// The number of outputs of [`Model::step`].\npub const N_OUT: usize = {};\n\
