@@ -1,8 +1,9 @@
 //! Hostile input (NaN, ±∞, ±10 times the range; alone and in bursts) to every exported
-//! compensator and forward model: the library's streams and the generated C obey the rule of
+//! compensator and forward model: the library's streams, the generated C and the generated
+//! Rust obey the rule of
 //! `hysid::model::limits` — commands finite and within the limits, the error flag and the
 //! fault count as specified, and after a bad sample the outputs those of the same sequence
-//! without it — and the C equals the library to the bit.
+//! without it — and the C and the Rust equal the library to the bit.
 
 use crate::c_target;
 use crate::cases::{self, Case};
@@ -220,5 +221,77 @@ fn generated_c_is_safe_on_hostile_input_and_equals_the_library() {
             "{name}: faults"
         );
         assert_eq!(cases::parse_clipped(&text), run.clipped, "{name}: clipped");
+    }
+}
+
+#[test]
+#[ignore = "generated code (compiled with cargo): run in CI's long step, `cargo test --release -- --ignored`"]
+fn generated_rust_is_safe_on_hostile_input_and_follows_the_library() {
+    // The Rust is held to the library within its bar (its `libm` differs from the
+    // platform's `pow` by an ulp: `cases::RUST_EXCEPTIONS`), and to itself to the bit: the
+    // good samples of a hostile run are those of its run without the bad samples.
+    let all = hostile_cases();
+    let clean: Vec<Case> = all
+        .iter()
+        .map(|c| Case {
+            name: format!("{}_clean", c.name),
+            input: without_bad(&c.input),
+            ..c.clone()
+        })
+        .collect();
+    let both: Vec<Case> = all.iter().chain(&clean).cloned().collect();
+    let texts = crate::rust_target::run_texts(&both);
+    let (hostile_texts, clean_texts) = texts.split_at(all.len());
+    for ((case, text), clean_text) in all.iter().zip(hostile_texts).zip(clean_texts) {
+        let run = check_library(case);
+        let name = &case.name;
+        let (y, diverged) = cases::parse_outputs(text);
+        assert!(!diverged, "{name}: the Rust diverged");
+        assert!(
+            y.iter().all(|v| v.is_finite()),
+            "{name}: a non-finite output"
+        );
+        if let Some(limits) = case.options.limits.filter(|_| case.options.inverse) {
+            assert!(
+                y.iter().all(|u| limits.lo() <= *u && *u <= limits.hi()),
+                "{name}: a command beyond the limits"
+            );
+        }
+        assert_eq!(
+            cases::parse_faults(text),
+            Some(run.faults),
+            "{name}: faults"
+        );
+        assert_eq!(cases::parse_clipped(text), run.clipped, "{name}: clipped");
+        let bad: Vec<bool> = case.input.iter().map(|v| !v.is_finite()).collect();
+        let good: Vec<u64> = y
+            .iter()
+            .zip(&bad)
+            .filter(|(_, b)| !**b)
+            .map(|(v, _)| v.to_bits())
+            .collect();
+        let (clean_y, _) = cases::parse_outputs(clean_text);
+        let clean_bits: Vec<u64> = clean_y.iter().map(|v| v.to_bits()).collect();
+        assert_eq!(
+            good, clean_bits,
+            "{name}: a bad sample changed what followed"
+        );
+        let d = cases::relative_difference(&y, &run.y);
+        println!("  {name:<40} {d:.3e}");
+        let bar = hostile_rust_bar(case);
+        assert!(d <= bar, "{name}: {d:e} from the library (bar {bar:e})");
+    }
+}
+
+/// The Rust's bar on a hostile case: its own ([`cases::bar`]) for a forward model; for a
+/// compensator that of the references beyond reach (`bouc_wen_beyond` in
+/// [`cases::RUST_EXCEPTIONS`]), which the spikes of ±10 times the range are: the per-sample
+/// solve searches the closest output of a `pow`-based branch, and the `libm` crate's ulp
+/// moves the best point found.
+fn hostile_rust_bar(case: &Case) -> f64 {
+    let own = cases::bar("Rust", case.name.trim_end_matches("_hostile"));
+    match case.options.inverse {
+        true => own.max(cases::bar("Rust", "bouc_wen_beyond")),
+        false => own,
     }
 }

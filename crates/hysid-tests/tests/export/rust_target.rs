@@ -23,10 +23,10 @@ fn write_crate(case: &Case, dir: &Path) -> String {
     format!("{name} = {{ path = \"crates/{name}\" }}\n")
 }
 
-#[test]
-#[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
-fn generated_rust_equals_the_library() {
-    let all = cases::all();
+/// Builds the crates of `cases` into one program, runs each on its input and returns what
+/// each printed: its outputs, a line `error` when diverged, `faults N` and, for a
+/// compensator, `clipped N` (the format of [`cases::parse_outputs`]).
+pub fn run_texts(cases: &[Case]) -> Vec<String> {
     let dir = tempfile::tempdir().expect("temp dir");
     let root = dir.path();
     let mut manifest = String::from(
@@ -41,10 +41,11 @@ fn generated_rust_equals_the_library() {
          \x20           let y = m.step(&[line.parse::<f64>().unwrap()]);\n\
          \x20           out.push_str(&format!(\"{:?}\\n\", y[0]));\n        }\n\
          \x20       if m.diverged() {\n            out.push_str(\"error\\n\");\n        }\n\
+         \x20       out.push_str(&format!(\"faults {}\\n\", m.faults()));\n\
          \x20       $(out.push_str(&format!(\"clipped {}\\n\", m.$clipped()));)?\n\
          \x20       std::fs::write(format!(\"{}.out\", $name), out).unwrap();\n    }};\n}\n\nfn main() {\n",
     );
-    for case in &all {
+    for case in cases {
         manifest.push_str(&write_crate(case, root));
         let clipped = if case.options.inverse {
             ", clipped"
@@ -83,14 +84,24 @@ fn generated_rust_equals_the_library() {
         "the check program failed: {}",
         String::from_utf8_lossy(&ran.stderr)
     );
+    cases
+        .iter()
+        .map(|case| std::fs::read_to_string(root.join(format!("{}.out", case.name))).expect("read"))
+        .collect()
+}
+
+#[test]
+#[ignore = "generated code (compiled with cc and cargo): run in CI's long step, `cargo test --release -- --ignored`"]
+fn generated_rust_equals_the_library() {
+    let all = cases::all();
+    let texts = run_texts(&all);
     let mut clipped = Vec::new();
     let results: Vec<(String, f64, bool)> = all
         .iter()
-        .map(|case| {
-            let text =
-                std::fs::read_to_string(root.join(format!("{}.out", case.name))).expect("read");
-            clipped.push(cases::parse_clipped(&text));
-            let (y, error) = cases::parse_outputs(&text);
+        .zip(&texts)
+        .map(|(case, text)| {
+            clipped.push(cases::parse_clipped(text));
+            let (y, error) = cases::parse_outputs(text);
             (
                 case.name.clone(),
                 cases::relative_difference(&y, &case.expected),
