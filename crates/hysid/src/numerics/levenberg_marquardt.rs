@@ -50,7 +50,16 @@
 //! damping λ₀·Rᵏ, R = [`RESTART_DAMPING`], for restart k. A large λ makes the first steps
 //! short gradient steps in the metric D (Marquardt 1963: δ → −(λD)⁻¹Jᵀr as λ → ∞), which
 //! follow the valley instead of leaping over it onto the plateau; Nielsen's rule then lowers
-//! λ by up to 3 per accepted step. The run with the lower S is kept. Both rules act only
+//! λ by up to 3 per accepted step. The run with the lower S is kept.
+//!
+//! **Evaporated parameters** (with the restarts): a search that "converged" after moving a
+//! free parameter by a factor beyond 1/[`EVAPORATION`] from its start, either way, has let it
+//! evaporate to the edge of the model manifold (Transtrum, Machta & Sethna 2011: the typical
+//! failure of Levenberg–Marquardt on sloppy models; NIST's MGH10 from its far start, b1 →
+//! 10⁻⁵⁰ at S ≈ 1.49·10⁶, where the plateau test sees nothing because b1's column grows).
+//! It searches again from θ₀ with each evaporated parameter fenced to
+//! [θ₀ⱼ·f, θ₀ⱼ/f], f = [`EVAPORATION_FENCE`], then from where the fenced search ended with
+//! the fence off; the run with the lowest S is kept. Both rules act only
 //! with the parameter test (`parameter_tolerance` finite), so the improvement rule
 //! ([`LmConfig::improvement_rule`]) keeps its bits.
 //!
@@ -65,8 +74,8 @@
 //!
 //! Not in the engine: geodesic acceleration (Transtrum & Sethna 2012), which needs Jᵀ times
 //! the second directional derivative of the residuals, not available from a problem that
-//! streams JᵀJ and Jᵀr; NIST's MGH10 from its far start is the one reference case it leaves
-//! short (`docs/numerics.md` §1.1).
+//! streams JᵀJ and Jᵀr. Every NIST reference case is certified without it
+//! (`docs/numerics.md` §1.1).
 //!
 //! References: D. W. Marquardt, "An algorithm for least-squares estimation of nonlinear
 //! parameters", SIAM J. Applied Mathematics 11(2), 1963; J. J. Moré, "The Levenberg–Marquardt
@@ -76,6 +85,8 @@
 //! Nonlinear Equations*, Prentice Hall, 1983, §7.2; M. K. Transtrum, J. P. Sethna,
 //! "Improvements to the Levenberg–Marquardt algorithm for nonlinear least-squares
 //! minimization", arXiv:1201.5885, 2012.
+//! M. K. Transtrum, B. B. Machta, J. P. Sethna, "Geometry of nonlinear least squares with
+//! applications to sloppy models and optimization", Physical Review E 83, 036701, 2011.
 //!
 //! # Why not the `levenberg-marquardt` crate
 //! It needs the whole Jacobian in memory and offers no bounds, per-iteration callback or
@@ -244,7 +255,9 @@ pub struct LmConfig {
     /// [`PLATEAU_COLUMN`] of the largest it had on the path, so the parameter no longer acts
     /// on the residuals). Each restart searches again from the start with the damping
     /// [`RESTART_DAMPING`]ᵏ·λ₀ for restart k (ever more cautious first steps), and the run
-    /// with the lower S is kept.
+    /// with the lower S is kept. A converged search that has moved a free parameter beyond
+    /// 1/[`EVAPORATION`] times its start searches again with it fenced
+    /// ([`EVAPORATION_FENCE`]), then free (the module doc).
     /// Only the rule with the parameter test restarts; 0 never does.
     pub restarts: usize,
 }
@@ -260,6 +273,12 @@ pub const PROGRESS_DECREASE: f64 = 1e-9;
 pub const PLATEAU_COLUMN: f64 = 1e-20;
 /// The factor on λ₀ of each restart over the run before it ([`LmConfig::restarts`]).
 pub const RESTART_DAMPING: f64 = 1e4;
+/// A free parameter that a converged search has moved from its start by more than the factor
+/// 1/`EVAPORATION` (either way) has evaporated ([`LmConfig::restarts`]).
+pub const EVAPORATION: f64 = 1e-20;
+/// The fence of an evaporated parameter's second search: [θ₀ⱼ·f, θ₀ⱼ/f] for f =
+/// `EVAPORATION_FENCE` ([`LmConfig::restarts`]).
+pub const EVAPORATION_FENCE: f64 = 1e-3;
 
 /// The scale D of the damping term λ·D of [`LmConfig`] (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -445,9 +464,10 @@ pub fn minimize(
     let start = Instant::now();
     let mut state = State::new(problem, theta0, free, lower, upper, config)?;
     let mut termination = state.run(callback)?;
+    let restarting = config.restarts > 0 && config.parameter_tolerance.is_finite();
     let mut factor = 1.0;
     for _ in 0..config.restarts {
-        if !config.parameter_tolerance.is_finite() || !state.needs_restart(&termination) {
+        if !restarting || !state.needs_restart(&termination) {
             break;
         }
         factor *= RESTART_DAMPING;
@@ -455,28 +475,32 @@ pub fn minimize(
             initial_damping: config.initial_damping * factor,
             ..config.clone()
         };
-        let mut again = State::new(problem, theta0, free, lower, upper, &restart_config)?;
-        again.iterations = state.iterations;
-        again.first = state.iterations;
-        again.fevals += state.fevals;
-        again.plain_evals += state.plain_evals;
-        again.sensitivity_evals += state.sensitivity_evals;
-        again.rejected = state.rejected;
-        again.history = std::mem::take(&mut state.history);
+        let mut again = state.follow_up(theta0, lower, upper, &restart_config)?;
         let again_termination = again.run(callback)?;
-        if again.system.cost < state.system.cost {
-            termination = again_termination;
-            std::mem::swap(&mut state.theta, &mut again.theta);
-            state.system = again.system;
-            state.scale = again.scale;
-            state.largest = again.largest;
+        state.adopt(again, again_termination, &mut termination);
+    }
+    let evaporated = match restarting && termination.converged() {
+        true => state.evaporated(theta0),
+        false => Vec::new(),
+    };
+    if !evaporated.is_empty() {
+        // Fenced from θ₀, then free from where the fence left the search.
+        let (mut fenced_lower, mut fenced_upper) = (lower.to_vec(), upper.to_vec());
+        for &j in &evaporated {
+            let (a, b) = (theta0[j] * EVAPORATION_FENCE, theta0[j] / EVAPORATION_FENCE);
+            fenced_lower[j] = fenced_lower[j].max(a.min(b));
+            fenced_upper[j] = fenced_upper[j].min(a.max(b));
         }
-        state.iterations = again.iterations;
-        state.fevals = again.fevals;
-        state.plain_evals = again.plain_evals;
-        state.sensitivity_evals = again.sensitivity_evals;
-        state.rejected = again.rejected;
-        state.history = again.history;
+        let mut fenced = state.follow_up(theta0, &fenced_lower, &fenced_upper, config)?;
+        let fenced_termination = fenced.run(callback)?;
+        let from = fenced.theta.clone();
+        let mut freed = fenced.follow_up(&from, lower, upper, config)?;
+        let mut freed_termination = freed.run(callback)?;
+        if fenced.system.cost < freed.system.cost {
+            // The free run cannot end above its start; kept for the counters' sake.
+            freed.adopt(fenced, fenced_termination, &mut freed_termination);
+        }
+        state.adopt(freed, freed_termination, &mut termination);
     }
     Ok(state.into_report(termination, start.elapsed().as_secs_f64()))
 }
@@ -709,6 +733,67 @@ impl<'a> State<'a> {
                 return;
             }
         }
+    }
+
+    /// A new search from `theta0` in the box [lower, upper] under `config` that carries on
+    /// this one's counters and history ([`LmConfig::restarts`]).
+    fn follow_up<'b>(
+        &mut self,
+        theta0: &[f64],
+        lower: &[f64],
+        upper: &[f64],
+        config: &'b LmConfig,
+    ) -> Result<State<'b>>
+    where
+        'a: 'b,
+    {
+        let mut again = State::new(self.problem, theta0, &self.free, lower, upper, config)?;
+        again.iterations = self.iterations;
+        again.first = self.iterations;
+        again.fevals += self.fevals;
+        again.plain_evals += self.plain_evals;
+        again.sensitivity_evals += self.sensitivity_evals;
+        again.rejected = self.rejected;
+        again.history = std::mem::take(&mut self.history);
+        Ok(again)
+    }
+
+    /// Takes the counters and history of `again`, a [`State::follow_up`] of this search that
+    /// ended with `again_termination`, and its point too where its S is lower.
+    fn adopt(
+        &mut self,
+        mut again: State<'_>,
+        again_termination: Termination,
+        termination: &mut Termination,
+    ) {
+        if again.system.cost < self.system.cost {
+            *termination = again_termination;
+            std::mem::swap(&mut self.theta, &mut again.theta);
+            self.system = again.system;
+            self.scale = again.scale;
+            self.largest = again.largest;
+        }
+        self.iterations = again.iterations;
+        self.fevals = again.fevals;
+        self.plain_evals = again.plain_evals;
+        self.sensitivity_evals = again.sensitivity_evals;
+        self.rejected = again.rejected;
+        self.history = again.history;
+    }
+
+    /// The free parameters that the search has moved from their start by a factor beyond
+    /// 1/[`EVAPORATION`] either way (or to zero) ([`LmConfig::restarts`]).
+    fn evaporated(&self, theta0: &[f64]) -> Vec<usize> {
+        self.free
+            .iter()
+            .copied()
+            .filter(|&j| {
+                let (from, to) = (theta0[j].abs(), self.theta[j].abs());
+                from > 0.0
+                    && from.is_finite()
+                    && !(to > from * EVAPORATION && to * EVAPORATION < from)
+            })
+            .collect()
     }
 
     /// Past `max_iterations`: true while the search may take another iteration
