@@ -706,7 +706,10 @@ pub struct ExportArgs {
     #[arg(long)]
     pub inverse: bool,
     /// Sample time [s] of the exported step, required when the model file has none (files
-    /// of earlier versions); must equal the file's when it has one. Range (0, 1e12].
+    /// of earlier versions). Another than the file's re-steps a continuous-time grey-box or
+    /// equation model (sub-steps no longer than the fitted model's; the header states the
+    /// integration error's estimate); for any other model it must equal the file's.
+    /// Range (0, 1e12].
     #[arg(long, value_parser = crate::options::positive)]
     pub ts: Option<f64>,
     /// With --target fmu: leave the binary out (a source-only FMU; no C compiler needed).

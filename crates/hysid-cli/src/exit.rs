@@ -97,7 +97,7 @@ pub fn classify(error: &anyhow::Error) -> ExitClass {
 
 /// The command-line flag of a library setting ([`Error::InvalidOption`]'s `option`), where
 /// the CLI has one.
-const FLAGS: [(&str, &str); 15] = [
+const FLAGS: [(&str, &str); 16] = [
     ("cutoff_hz", "--cutoff"),
     ("starts", "--starts"),
     ("start_factor", "--start-factor"),
@@ -106,6 +106,7 @@ const FLAGS: [(&str, &str); 15] = [
     ("levels", "--grid"),
     ("lambda", "--lambda"),
     ("family", "--family"),
+    ("families", "--families"),
     ("hysteresis", "--hysteresis"),
     ("model", "--model"),
     ("substeps", "--substeps"),

@@ -5,7 +5,7 @@ use super::zoo::{family_options, load, loops};
 use crate::cli_zoo::CompareArgs;
 use crate::output::Outputs;
 use crate::progress::FitProgress;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use hysid::identify::operators::{
     compare, CompareOptions, CompareRow, Comparison, Family, FamilyOptions,
 };
@@ -14,7 +14,7 @@ use std::path::Path;
 
 /// Fits the families, prints the ranked table, writes the report, best model and plot.
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let families = Family::parse_list(&args.families).context("--families")?;
+    let families = Family::parse_list(&args.families)?;
     let progress = FitProgress::new("comparing families");
     let options = CompareOptions {
         families,

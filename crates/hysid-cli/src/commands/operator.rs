@@ -14,7 +14,7 @@ const PRINTED_PARAMETERS: usize = 16;
 
 /// Fits the family, prints the parameters and fit, writes the report, model and plots.
 pub fn run(args: &OperatorArgs) -> Result<()> {
-    let family = Family::parse(&args.family).context("--family")?;
+    let family = Family::parse(&args.family)?;
     let mut options = family_options(&args.options)?;
     if options.loop_orientation.is_some()
         && !family.settings().contains(&FamilySetting::Orientation)

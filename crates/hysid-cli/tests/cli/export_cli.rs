@@ -218,3 +218,81 @@ fn every_model_file_exports_as_an_fmu_or_is_refused_with_its_error() {
         assert_eq!(tree(tmp.path()).len(), 3, "{:?}", tree(tmp.path()));
     }
 }
+
+/// `--ts` other than the file's (#39 item 7): a continuous-time grey-box model is re-stepped
+/// and its header says so, with the estimate of the integration error; an operator, whose
+/// step is its sample, is refused in one line, nothing written.
+#[test]
+fn another_ts_re_steps_a_continuous_time_model_and_is_refused_for_an_operator() {
+    let tmp = TempDir::new().unwrap();
+    let record = fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../data/bouc-wen/train_multisine_5periods.csv"),
+    )
+    .unwrap();
+    let data = tmp.path().join("bw.csv");
+    let head: Vec<&str> = record.lines().take(1501).collect();
+    fs::write(&data, head.join("\n") + "\n").unwrap();
+    let model = tmp.path().join("bw.model.json");
+    hysid()
+        .args([
+            "-q", "greybox", "fit", "--model", "bouc-wen", "--input", "u_N",
+        ])
+        .args([
+            "--output",
+            "y_m",
+            "--max-iterations",
+            "1",
+            "--substeps",
+            "4",
+        ])
+        .args(["--interpolation", "linear", "--data"])
+        .arg(&data)
+        .arg("--model-out")
+        .arg(&model)
+        .assert()
+        .success();
+    let out = tmp.path().join("c");
+    hysid()
+        .args([
+            "-q", "export", "--target", "c", "--name", "bw", "--ts", "0.0005",
+        ])
+        .arg("--model")
+        .arg(&model)
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let header = fs::read_to_string(out.join("bw.h")).unwrap();
+    assert!(
+        header.contains("Sample time: 0.0005 s (given at export; the model was fitted at")
+            && header.contains("sub-steps half as long by at most"),
+        "{header}"
+    );
+    let operator = tmp.path().join("pi.model.json");
+    hysid()
+        .args([
+            "-q", "identify", "operator", "--family", "pi", "--input", "u_N",
+        ])
+        .args(["--output", "y_m", "--data"])
+        .arg(&data)
+        .arg("--model-out")
+        .arg(&operator)
+        .assert()
+        .success();
+    let refused = tmp.path().join("pi");
+    let err = fails_with(
+        hysid()
+            .args(["export", "--target", "c", "--name", "pi", "--ts", "0.0005"])
+            .arg("--model")
+            .arg(&operator)
+            .arg("--out")
+            .arg(&refused),
+        1,
+    );
+    assert!(
+        err.lines().count() == 1 && err.contains("runs at the rate it was fitted at"),
+        "{err}"
+    );
+    assert!(!refused.exists());
+}

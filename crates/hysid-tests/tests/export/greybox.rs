@@ -166,7 +166,135 @@ pub fn cases() -> Vec<Case> {
     let timed = equations(TIMED, adaptive);
     out.push(case("eq_timed_adaptive", &timed, u.clone(), 1e-2));
     out.extend(newmark_cases(&u));
+    out.extend(resampled_cases(&u));
     out
+}
+
+/// A model fitted every `fitted` seconds exported at `ts` (`--ts` other than the file's):
+/// the export's model is the library's [`FittedModel::resampled`], and the code must equal
+/// its simulation at `ts`.
+fn resampled_case(label: &str, model: &FittedModel, input: Vec<f64>, fitted: f64, ts: f64) -> Case {
+    let stepped = model
+        .resampled(fitted, ts)
+        .unwrap_or_else(|| panic!("{label}: a continuous-time model is re-stepped"));
+    let mut case = case(label, &stepped, input, ts);
+    case.file = model.to_file();
+    case.file.sample_time = Some(fitted);
+    case
+}
+
+/// The re-stepped cases (#39 item 7): RK4 at a third and at 2.5 times the fitted sample
+/// time (2 and 10 sub-steps for the fitted 4), Newmark at twice it, and the equation file
+/// that reads t.
+fn resampled_cases(u: &[f64]) -> Vec<Case> {
+    let rk4 = Simulation {
+        integrator: RK4,
+        interpolation: InputInterpolation::Linear,
+    };
+    let bw = built_in(GreyBoxKind::BoucWen, &[], rk4);
+    let fitted = 1.0 / 750.0;
+    let mut out = vec![
+        resampled_case(
+            "gb_bouc_wen_at_third",
+            &bw,
+            scaled(u, 120.0),
+            fitted,
+            fitted / 3.0,
+        ),
+        resampled_case(
+            "gb_bouc_wen_at_2_5",
+            &bw,
+            scaled(u, 120.0),
+            fitted,
+            2.5 * fitted,
+        ),
+        resampled_case(
+            "eq_timed_at_half",
+            &equations(TIMED, rk4),
+            u.to_vec(),
+            1e-2,
+            5e-3,
+        ),
+    ];
+    let newmark = Simulation {
+        integrator: Integrator::Newmark { substeps: 1 },
+        interpolation: InputInterpolation::Linear,
+    };
+    let bw = built_in(GreyBoxKind::BoucWen, &[], newmark);
+    out.push(resampled_case(
+        "gb_bouc_wen_newmark_at_double",
+        &bw,
+        scaled(u, 120.0),
+        fitted,
+        2.0 * fitted,
+    ));
+    out
+}
+
+/// The sub-steps of a re-stepped model are no longer than the fitted model's and as few as
+/// that allows, so its integration error is no larger: on a smooth input u(t) sampled at
+/// the fitted rate and at a third and 2.5 times its period, the error of each model against
+/// the same model integrated with 64 sub-steps per sample (its reference) — the fitted
+/// model's at its rate, the re-stepped one's at the new rate. The error grows with the
+/// sub-step h (as h⁴ for RK4) and with the length of the record, which is the same here:
+/// at a third of the period h′ = 2h/3, at 2.5 times it h′ = h. And the refusal for a
+/// discrete-time model.
+#[test]
+fn a_continuous_time_model_is_re_stepped_for_another_sample_time() {
+    let rk4 = |substeps| Simulation {
+        integrator: Integrator::Rk4 { substeps },
+        interpolation: InputInterpolation::Linear,
+    };
+    for (n, from, to, expected) in [
+        (4, 3.0, 1.0, 2),
+        (4, 1.0, 2.5, 10),
+        (4, 1.0, 2.0, 8),
+        (10, 1.0, 0.01, 1),
+        (3, 0.3, 0.1, 1),
+    ] {
+        let got = rk4(n).resampled(from, to).integrator;
+        assert_eq!(
+            got,
+            Integrator::Rk4 { substeps: expected },
+            "{n} {from} {to}"
+        );
+    }
+    let fitted = 1.0 / 750.0;
+    let duration = 4.0;
+    let smooth = |t: f64| {
+        let w = 2.0 * std::f64::consts::PI;
+        80.0 * (w * 7.0 * t).sin() + 40.0 * (w * 23.0 * t).sin()
+    };
+    // The largest error of `model` at `ts` against itself with 64 sub-steps.
+    let error = |model: &FittedModel, ts: f64| {
+        let n = (duration / ts).round() as usize;
+        let u: Vec<f64> = (0..n).map(|k| smooth(k as f64 * ts)).collect();
+        let y = model.simulate(&[&u], ts, None).unwrap().remove(0);
+        let reference = built_in(GreyBoxKind::BoucWen, &[], rk4(64));
+        let r = reference.simulate(&[&u], ts, None).unwrap().remove(0);
+        let range = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let worst = y
+            .iter()
+            .zip(&r)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        worst / range
+    };
+    let bw = built_in(GreyBoxKind::BoucWen, &[], rk4(4));
+    let at_fitted = error(&bw, fitted);
+    for (factor, allowed) in [(1.0 / 3.0, 1.0), (2.5, 1.5)] {
+        let stepped = bw
+            .resampled(fitted, factor * fitted)
+            .expect("continuous time");
+        let at_new = error(&stepped, factor * fitted);
+        println!("ts × {factor}: error {at_new:.3e} (fitted: {at_fitted:.3e})");
+        assert!(
+            at_fitted > 0.0 && at_new <= allowed * at_fitted,
+            "{at_new:e} {at_fitted:e}"
+        );
+    }
+    let discrete = equations(DISCRETE, rk4(4));
+    assert!(discrete.resampled(1e-2, 5e-3).is_none());
 }
 
 /// The Newmark cases: the built-in models the library integrates with Newmark (a

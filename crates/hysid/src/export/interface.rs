@@ -17,6 +17,14 @@ pub enum SampleTime {
     Option(f64),
     /// None given, and none is meaningful: a rate-independent operator, exported with 0.
     RateIndependent,
+    /// `--ts` other than the file's, for a continuous-time model: its integration re-stepped
+    /// for the new rate ([`crate::model::saved::FittedModel::resampled`]).
+    Resampled {
+        /// The file's sample time (the data the model was fitted on).
+        fitted: f64,
+        /// The sample time given at export.
+        given: f64,
+    },
 }
 
 impl SampleTime {
@@ -24,13 +32,15 @@ impl SampleTime {
     pub fn seconds(self) -> f64 {
         match self {
             SampleTime::File(ts) | SampleTime::Option(ts) => ts,
+            SampleTime::Resampled { given, .. } => given,
             SampleTime::RateIndependent => 0.0,
         }
     }
 
     /// The sample time of an export (the rule of `docs/export.md`): the file's, or
-    /// `--ts` (which must agree with the file's when both are given), or 0 for a kind
-    /// `operator` (rate-independent); any other kind without one is an error.
+    /// `--ts` (another than the file's is [`SampleTime::Resampled`], which only a
+    /// continuous-time model accepts, `export::model_at`), or 0 for a kind `operator`
+    /// (rate-independent); any other kind without one is an error.
     pub fn of(file: &ModelFile, options: &ExportOptions) -> Result<Self> {
         if let Some(ts) = options.sample_time {
             if !(ts.is_finite() && ts > 0.0) {
@@ -42,15 +52,8 @@ impl SampleTime {
             }
         }
         match (file.sample_time, options.sample_time) {
-            (Some(stored), Some(given)) if (stored - given).abs() > 1e-9 * stored.abs() => {
-                Err(Error::invalid_option(
-                    "ts",
-                    given,
-                    format!(
-                        "the model file's sample time is {stored} s; leave the sample time \
-                         out or give the same value"
-                    ),
-                ))
+            (Some(fitted), Some(given)) if (fitted - given).abs() > 1e-9 * fitted.abs() => {
+                Ok(SampleTime::Resampled { fitted, given })
             }
             (Some(stored), _) => Ok(SampleTime::File(stored)),
             (None, Some(given)) => Ok(SampleTime::Option(given)),
@@ -71,6 +74,10 @@ impl SampleTime {
         match self {
             SampleTime::File(ts) => format!("{ts:?} s (the data the model was fitted on)"),
             SampleTime::Option(ts) => format!("{ts:?} s (given at export)"),
+            SampleTime::Resampled { fitted, given } => format!(
+                "{given:?} s (given at export; the model was fitted at {fitted:?} s, and its\n\
+                 integration takes sub-steps no longer than the fitted model's)"
+            ),
             SampleTime::RateIndependent => {
                 "0 (a rate-independent operator: the step does not depend on time)".into()
             }

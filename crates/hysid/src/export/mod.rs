@@ -270,8 +270,7 @@ fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prep
         limits: export_limits(file, given),
         ..given.clone()
     };
-    let sample_time = SampleTime::of(file, options)?;
-    let model = FittedModel::from_file(file)?;
+    let (model, sample_time) = model_at(file, options)?;
     let program = kinds::program(&model, options, sample_time.seconds())?;
     program.check()?;
     let sizes = if options.inverse {
@@ -281,6 +280,10 @@ fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prep
     };
     let interface = interface::interface(file, name, options, sample_time, sizes);
     let mut comment = interface::comment(file, &interface, given, sample_time);
+    if let SampleTime::Resampled { fitted, given: ts } = sample_time {
+        comment.push('\n');
+        comment.push_str(&resampling_estimate(file, options, fitted, ts)?);
+    }
     let mut bound = 0.0;
     if options.precision.is_single() {
         if let Some(limits) = given
@@ -296,6 +299,74 @@ fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prep
         bound = measured.absolute();
     }
     Ok((program, interface, comment, bound))
+}
+
+/// The model an export of `file` runs, and its sample time: the file's model, its
+/// integration re-stepped for a `--ts` other than the file's ([`FittedModel::resampled`]),
+/// which only a continuous-time grey-box or equation model accepts.
+fn model_at(file: &ModelFile, options: &ExportOptions) -> Result<(FittedModel, SampleTime)> {
+    let sample_time = SampleTime::of(file, options)?;
+    let model = FittedModel::from_file(file)?;
+    let SampleTime::Resampled { fitted, given } = sample_time else {
+        return Ok((model, sample_time));
+    };
+    match model.resampled(fitted, given) {
+        Some(model) => Ok((model, sample_time)),
+        None => Err(Error::invalid_option(
+            "ts",
+            given,
+            format!(
+                "the model file's sample time is {fitted} s, and the {} model runs at the rate \
+                 it was fitted at (only a continuous-time grey-box or equation model is \
+                 re-stepped for another); leave the sample time out or give the same value",
+                interface::model_name(file)
+            ),
+        )),
+    }
+}
+
+/// The opening comment's line on a re-stepped integration ([`SampleTime::Resampled`]): the
+/// largest difference, on the test sequence over the file's input range, between the
+/// exported step and the same step with sub-steps half as long, an estimate of its
+/// integration error (for RK4 the error of the coarser is about 16/15 of it).
+fn resampling_estimate(
+    file: &ModelFile,
+    options: &ExportOptions,
+    fitted: f64,
+    ts: f64,
+) -> Result<String> {
+    let rule = "Integration: sub-steps no longer than those the model was fitted with";
+    let rule = format!("{rule};\n");
+    let Some(ranges) = file.input_range.as_deref() else {
+        return Ok(format!(
+            "{rule}its error is not estimated (the model file records no input range)."
+        ));
+    };
+    let model = FittedModel::from_file(file)?;
+    let forward = ExportOptions {
+        inverse: false,
+        precision: precision::Precision::Double,
+        ..options.clone()
+    };
+    let outputs = |from: f64| -> Result<Vec<Vec<f64>>> {
+        let stepped = model.resampled(from, ts).ok_or_else(|| {
+            Error::Unsupported("the model is not re-stepped for another sample time".into())
+        })?;
+        let program = kinds::program(&stepped, &forward, ts)?;
+        eval::run::<f64>(&program, &sequence::inputs(ranges))
+    };
+    let (steps, halved) = (outputs(fitted)?, outputs(fitted / 2.0)?);
+    let difference = steps
+        .iter()
+        .flatten()
+        .zip(halved.iter().flatten())
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    Ok(format!(
+        "{rule}on the test sequence over the input range the step differs from the same step\n\
+         with sub-steps half as long by at most {difference:.3e} (the output's units), an\n\
+         estimate of its integration error."
+    ))
 }
 
 /// Measures the single-precision `program` of `model` (see [`precision`]) on the rows of
@@ -414,8 +485,8 @@ pub fn test_vectors(
     options: &ExportOptions,
 ) -> Result<vectors::Vectors> {
     check_name(name)?;
-    let sample_time = SampleTime::of(file, options)?;
-    vectors::vectors(file, options, sample_time.seconds())
+    let (model, sample_time) = model_at(file, options)?;
+    vectors::vectors(file, &model, options, sample_time.seconds())
 }
 
 /// The files of the export of `file` to `target` under the name `name`, paths relative to

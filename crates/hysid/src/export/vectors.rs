@@ -107,9 +107,14 @@ fn ranges(file: &ModelFile, options: &ExportOptions, n_inputs: usize) -> Result<
 }
 
 /// The reference vectors of the export of `file` with `options` (see the [module
-/// docs](self)); `sample_time` is the export's.
-pub fn vectors(file: &ModelFile, options: &ExportOptions, sample_time: f64) -> Result<Vectors> {
-    let model = FittedModel::from_file(file)?;
+/// docs](self)) run by `model` (the file's, re-stepped for another sample time:
+/// `export::model_at`); `sample_time` is the export's.
+pub fn vectors(
+    file: &ModelFile,
+    model: &FittedModel,
+    options: &ExportOptions,
+    sample_time: f64,
+) -> Result<Vectors> {
     let mut forward = model.stepper(sample_time, options.initial_output)?;
     let (n_in, n_out) = (forward.n_inputs(), forward.n_outputs());
     let inputs = super::sequence::inputs(&ranges(file, options, n_in)?);

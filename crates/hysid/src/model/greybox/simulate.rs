@@ -93,6 +93,33 @@ impl Default for Simulation {
 }
 
 impl Simulation {
+    /// The settings of the same model sampled every `to` seconds instead of the `from` it was
+    /// fitted at: a fixed-step integrator (RK4, Newmark) takes n′ = ⌈n·to/from⌉ sub-steps of
+    /// h′ = to/n′ ≤ h = from/n, the smallest number whose steps are no longer than the
+    /// fitted model's, so its local error (O(h⁵) per step for RK4, O(h³) for Newmark) is no
+    /// larger per step; the adaptive integrator keeps its tolerances. The interpolation is
+    /// unchanged.
+    pub fn resampled(&self, from: f64, to: f64) -> Self {
+        let more = |n: usize| {
+            let n = n.max(1) as f64;
+            // The 1e-9 margin keeps an integer ratio (to = 2·from) from rounding up by one.
+            ((n * to / from) * (1.0 - 1e-9)).ceil().max(1.0) as usize
+        };
+        let integrator = match self.integrator {
+            Integrator::Rk4 { substeps } => Integrator::Rk4 {
+                substeps: more(substeps),
+            },
+            Integrator::Newmark { substeps } => Integrator::Newmark {
+                substeps: more(substeps),
+            },
+            adaptive @ Integrator::Adaptive { .. } => adaptive,
+        };
+        Self {
+            integrator,
+            interpolation: self.interpolation,
+        }
+    }
+
     /// Points per sample interval at which the integrator evaluates the input (RK4 needs the
     /// half steps).
     fn input_resolution(&self) -> usize {

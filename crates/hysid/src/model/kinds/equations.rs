@@ -157,4 +157,13 @@ impl FittedKind for FittedEquations {
     fn set_evaluator(&mut self, evaluator: Evaluator) {
         self.evaluator = evaluator;
     }
+
+    fn resampled(&self, from: f64, to: f64) -> Option<FittedModel> {
+        (!self.model().ok()?.discrete_time()).then(|| {
+            FittedModel::Equations(Self {
+                simulation: self.simulation.resampled(from, to),
+                ..self.clone()
+            })
+        })
+    }
 }

@@ -192,6 +192,16 @@ impl FittedKind for FittedGreyBox {
         )
     }
 
+    fn resampled(&self, from: f64, to: f64) -> Option<FittedModel> {
+        let model = models::by_kind(&self.kind).ok()?;
+        (!model.discrete_time()).then(|| {
+            FittedModel::GreyBox(Self {
+                simulation: self.simulation.resampled(from, to),
+                ..self.clone()
+            })
+        })
+    }
+
     fn stepper(&self, ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
         let model = models::by_kind(&self.kind)?;
         stream::grey_box(

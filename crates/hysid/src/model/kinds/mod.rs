@@ -95,6 +95,16 @@ pub trait FittedKind {
     fn set_evaluator(&mut self, evaluator: Evaluator) {
         let _ = evaluator;
     }
+
+    /// The same model sampled every `to` seconds instead of the `from` it was fitted at
+    /// ([`FittedModel::resampled`]): a continuous-time model re-steps its integration
+    /// ([`Simulation::resampled`](crate::model::greybox::Simulation::resampled)); None, the
+    /// default, for a model whose step is its sample time (a discrete-time model, an
+    /// operator, a linear block).
+    fn resampled(&self, from: f64, to: f64) -> Option<FittedModel> {
+        let _ = (from, to);
+        None
+    }
 }
 
 /// The refusal to compensate a model of kind `kind`.

@@ -291,7 +291,14 @@ impl Family {
         }
         let mut out: Vec<Family> = Vec::new();
         for name in list.split(',').filter(|s| !s.trim().is_empty()) {
-            let f = Family::parse(name)?;
+            let f = Family::parse(name).map_err(|e| match e {
+                Error::InvalidOption { value, reason, .. } => Error::InvalidOption {
+                    option: "families".into(),
+                    value,
+                    reason,
+                },
+                other => other,
+            })?;
             if !out.contains(&f) {
                 out.push(f);
             }

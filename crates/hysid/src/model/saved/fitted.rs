@@ -280,6 +280,15 @@ impl FittedModel {
         self
     }
 
+    /// The same model sampled every `to` seconds instead of the `from` it was fitted at: a
+    /// continuous-time grey-box or equation model with its integration re-stepped
+    /// ([`Simulation::resampled`](crate::model::greybox::Simulation::resampled)); None for
+    /// a model whose step is tied to its sample time (a discrete-time model, an operator, a
+    /// cascade, a pre-filtered record or an inverse-dynamics regression).
+    pub fn resampled(&self, from: f64, to: f64) -> Option<FittedModel> {
+        self.as_kind()?.resampled(from, to)
+    }
+
     /// [`Self::with_evaluator`] in place.
     fn set_evaluator(&mut self, evaluator: Evaluator) {
         match self {
