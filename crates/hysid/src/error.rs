@@ -105,6 +105,17 @@ pub enum Error {
         reason: String,
     },
 
+    /// The measured loop lies outside what the family can represent, whatever its
+    /// parameters: its turning sense and its trend together (a Dahl loop turns clockwise
+    /// where it rises, [`crate::model::operators::dahl`]).
+    #[error("a {family} operator cannot represent this loop: {reason}")]
+    OutsideFamily {
+        /// The family.
+        family: String,
+        /// What the loop does, what the family's loops do, and what to fit instead.
+        reason: String,
+    },
+
     /// The discrete Coleman–Hodgdon recursion left its valid range: α·|Δx(t)| > 1.
     #[error(
         "input moves too fast at sample {index}: alpha*|dx| = {product:.4} > 1 \
@@ -425,6 +436,7 @@ impl Error {
             | Error::TooFewSamples { .. }
             | Error::NotExciting { .. }
             | Error::UndeterminedOrientation { .. }
+            | Error::OutsideFamily { .. }
             | Error::RateLimit { .. } => Category::Data,
             Error::InvalidParameter { .. }
             | Error::InvalidOption { .. }

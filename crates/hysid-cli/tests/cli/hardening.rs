@@ -258,13 +258,13 @@ fn a_time_limit_keeps_the_best_result_and_says_so() {
 
 #[test]
 fn a_time_limit_stops_an_operator_fit_and_a_comparison() {
-    // The Dahl search on the piezo loop takes about a thousand simulations (seconds); a
-    // 10 ms limit stops it at its first accepted iteration.
+    // The Jiles–Atherton search on the piezo loop takes hundreds of simulations (a second
+    // or more); a 10 ms limit stops it at its first accepted iteration.
     let piezo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/piezo/piezo_150V_1Hz.csv");
     let dir = tempfile::tempdir().unwrap();
     for (command, json) in [
         (
-            &["identify", "operator", "--family", "dahl"][..],
+            &["identify", "operator", "--family", "jiles-atherton"][..],
             "operator.json",
         ),
         (

@@ -76,3 +76,58 @@ fn inverse_follows_a_reachable_reference_and_clips_beyond_fc() {
     assert_eq!(inv.clipped, vec![2, 3]);
     assert!((inv.predicted[4] - 0.0).abs() < 1e-9);
 }
+
+/// A loop no Dahl operator represents — a Bouc–Wen piezo-like loop, counter-clockwise and
+/// rising, or the same mirrored in y (clockwise and falling), on a cut-open record too — is
+/// refused at once with the reason; Dahl's own loops of both orientations, mirrored and cut
+/// open, are not; a given orientation is searched as asked.
+#[test]
+fn a_loop_outside_the_family_is_refused_with_its_reason() {
+    use hysid::model::operators::BoucWen;
+    let u = nested_loops(1500, 1.0);
+    // A rising trend (k_x > 0) and a counter-clockwise loop (k_w < 0), as a piezo stack.
+    let piezo = BoucWen::new(1.5, -0.4, 1.5, 0.5, 1.0).unwrap();
+    let rising = piezo.simulate(&u).unwrap();
+    assert_eq!(
+        LoopOrientation::of_loop(&u, &rising),
+        LoopOrientation::CounterClockwise
+    );
+    let falling: Vec<f64> = rising.iter().map(|v| -v).collect();
+    for (y, sense) in [
+        (&rising, "counter-clockwise and rises"),
+        (&falling, "clockwise and falls"),
+    ] {
+        for cut in [0, 377] {
+            let e = fit(&u[cut..], &y[cut..], &DahlOptions::default())
+                .err()
+                .unwrap_or_else(|| panic!("{sense}, cut at {cut}: not refused"));
+            assert!(
+                matches!(e, hysid::Error::OutsideFamily { .. }) && e.to_string().contains(sense),
+                "{e}"
+            );
+        }
+    }
+    for o in [
+        LoopOrientation::CounterClockwise,
+        LoopOrientation::Clockwise,
+    ] {
+        let y = truth(o).simulate(&u).unwrap();
+        for cut in [0, 377] {
+            assert!(
+                fit(&u[cut..], &y[cut..], &DahlOptions::default()).is_ok(),
+                "{o:?} {cut}"
+            );
+        }
+    }
+    let asked = DahlOptions {
+        orientation: Some(LoopOrientation::CounterClockwise),
+        ..DahlOptions::default()
+    };
+    // Fitted as asked: the search runs (and finds no Dahl operator there, or a poor one).
+    let asked = fit(&u, &rising, &asked);
+    assert!(
+        !matches!(asked, Err(hysid::Error::OutsideFamily { .. })),
+        "{:?}",
+        asked.err()
+    );
+}
