@@ -342,7 +342,7 @@ impl HysteresisIdentification {
     /// Steps 1–2: the d profile, then the separated regression with the switching function
     /// re-estimated until d̂ settles.
     pub fn separated_regression(&self, data: &IdData) -> Result<SeparatedFit> {
-        let d0 = self.profile_d(data)?;
+        let (d0, held_alpha) = self.profile_d(data)?;
         let mut d = d0;
         let mut d_history = vec![d0];
         let mut best: Option<(ColemanHodgdon, LsSolution)> = None;
@@ -379,7 +379,7 @@ impl HysteresisIdentification {
         let (model, ls) = match best {
             Some(b) if termination.converged() => b,
             // The re-estimation wandered off: keep the profile's constrained solution.
-            _ => constrained_fit(data, self.form, d0)?,
+            _ => constrained_fit(data, self.form, d0, held_alpha)?,
         };
         Ok(SeparatedFit {
             model,
@@ -405,30 +405,33 @@ impl HysteresisIdentification {
 
     /// The d with the smallest equation error of the constrained regression: a grid over
     /// (0, max|x|) refined by golden-section search around the best grid point.
-    fn profile_d(&self, data: &IdData) -> Result<f64> {
+    ///
+    /// Returns d̂ and, when the free regression gave α̂ ≤ 0 at every grid point, the α at
+    /// which the profile was held instead ([`held_alpha`]; see the module docs, step 1).
+    fn profile_d(&self, data: &IdData) -> Result<(f64, Option<f64>)> {
         let d_max = max_abs_input(data);
-        let cost = |d: f64| {
-            constrained_fit(data, self.form, d).map_or(f64::INFINITY, |(_, ls)| ls.residual_ss)
-        };
         let n = self.profile_points.max(5);
         let grid: Vec<f64> = (1..=n).map(|i| d_max * i as f64 / (n + 1) as f64).collect();
-        let costs: Vec<f64> = grid.iter().map(|&d| cost(d)).collect();
-        let (best, &best_cost) = costs
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .expect("grid is not empty");
-        if !best_cost.is_finite() {
-            return Err(Error::Singular(
-                "no threshold d gives a solvable regression; the input does not excite the hysteresis".into(),
-            ));
-        }
         let step = d_max / (n + 1) as f64;
-        Ok(golden_section(
-            cost,
-            grid[best] - step,
-            grid[best] + step,
-            40,
+        for alpha in [None, Some(held_alpha(data))] {
+            let cost = |d: f64| {
+                constrained_fit(data, self.form, d, alpha)
+                    .map_or(f64::INFINITY, |(_, ls)| ls.residual_ss)
+            };
+            let costs: Vec<f64> = grid.iter().map(|&d| cost(d)).collect();
+            let (best, &best_cost) = costs
+                .iter()
+                .enumerate()
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .expect("grid is not empty");
+            if best_cost.is_finite() {
+                let d = golden_section(cost, grid[best] - step, grid[best] + step, 40);
+                return Ok((d, alpha));
+            }
+        }
+        Err(Error::Singular(
+            "no threshold d gives a solvable regression; the input does not excite the hysteresis"
+                .into(),
         ))
     }
 }
@@ -502,9 +505,34 @@ fn separated_rows(data: &IdData, form: ChForm, d: f64) -> (DMatrix<f64>, Vec<f64
     (phi, dy)
 }
 
+/// The α at which the d profile is held when the free equation-error regression gives α̂ ≤ 0
+/// for every d: 1/max|x| (the gap to f closes over about one input amplitude of travel), at
+/// most [`alpha_max`]. It scales as α does when x changes units.
+fn held_alpha(data: &IdData) -> f64 {
+    (1.0 / max_abs_input(data)).min(alpha_max(data))
+}
+
 /// The regression with θ3 tied to d (see the module docs); returns the model and the fit.
-fn constrained_fit(data: &IdData, form: ChForm, d: f64) -> Result<(ColemanHodgdon, LsSolution)> {
-    let (full, dy) = separated_rows(data, form, d);
+///
+/// With `alpha` given, α is held at that value: its column −|Δx|y(t−1) moves to the left
+/// side, Δy + α|Δx|y(t−1) = αm1·(…) + αm2·(…) + c1(1−h)Δx + c2·hΔx, and the rest is solved
+/// as before. Errors when the least squares fail or the estimate is no model (α̂ ≤ 0).
+fn constrained_fit(
+    data: &IdData,
+    form: ChForm,
+    d: f64,
+    alpha: Option<f64>,
+) -> Result<(ColemanHodgdon, LsSolution)> {
+    let (full, mut dy) = separated_rows(data, form, d);
+    let alpha_column = match form {
+        ChForm::General6 => 3,
+        ChForm::Saturated4 => 2,
+    };
+    if let Some(a) = alpha {
+        for (r, v) in dy.iter_mut().enumerate() {
+            *v -= a * full[(r, alpha_column)];
+        }
+    }
     // Column combinations that tie θ3 = (θ1 − θ2)·d (ch6) or θ2 = θ1·d (ch4).
     let phi = match form {
         ChForm::General6 => DMatrix::from_fn(full.nrows(), 5, |r, c| match c {
@@ -517,8 +545,19 @@ fn constrained_fit(data: &IdData, form: ChForm, d: f64) -> Result<(ColemanHodgdo
             k => full[(r, k + 1)],
         }),
     };
+    let phi = match alpha {
+        None => phi,
+        Some(_) => phi.remove_column(alpha_column - 1),
+    };
     let ls = least_squares(&phi, &dy, &[])?;
-    let t = &ls.theta;
+    let t: Vec<f64> = match alpha {
+        None => ls.theta.iter().copied().collect(),
+        Some(a) => {
+            let mut t: Vec<f64> = ls.theta.iter().copied().collect();
+            t.insert(alpha_column - 1, a);
+            t
+        }
+    };
     let model = match form {
         ChForm::General6 => ColemanHodgdon::general(t[2], t[0] / t[2], t[1] / t[2], t[3], t[4], d)?,
         ChForm::Saturated4 => ColemanHodgdon::saturated(t[1], t[0] / t[1], t[2], d)?,
