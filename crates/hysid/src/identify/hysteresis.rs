@@ -12,6 +12,27 @@
 //!
 //!    (ch4: drop the m2 and c2 terms). A grid over d refined by golden-section search picks the
 //!    d with the smallest equation error: no starting value is needed.
+//!
+//!    The regression only starts the search, and α̂ ≤ 0 is no model. A few rows the
+//!    hysteresis does not explain can force that at every d: on a measured piezo record the
+//!    input jumps 0 → −87 V in one sample while the sensor reports the displacement a sample
+//!    later, so that row reads "|Δx| = 87, Δy ≈ 0" with regressors hundreds of times the
+//!    others', and the transient after it adds rows with Δy of several µm. The profile then
+//!    tries, in order, until some grid point gives α̂ > 0:
+//!    * plain least squares (the cost its residual sum of squares) — every record it can
+//!      start gives the same numbers as before this fallback existed;
+//!    * **trimmed** least squares: refitted on the rows with |r| ≤ 5σ̂, σ̂ = 1.4826·median|r|,
+//!      the cost the truncated quadratic Σ min(r², (5σ̂)²) over every row;
+//!    * trimmed with **α held** at 1/max|x| (the gap y − f closes over about one input
+//!      amplitude of travel; at most the rate limit): Δy + α|Δx|y(t−1) is regressed on the
+//!      other columns.
+//!
+//!    Every step is unchanged when x changes units (x' = x/s maps α, m, c to s·α, s·m, s·c
+//!    and d to d/s; the grid and the held α follow max|x|). An offset of x is *not* a change
+//!    of units for this model: f is odd about x = 0 and the central segment is |x| ≤ d, so
+//!    the origin of x is part of the model and the input is never centred. (For an input
+//!    that never crosses 0, x' = x + c with y' = y + m1·c is the same hysteresis with
+//!    d' = d + c.)
 //! 2. **Separated regression with the switching function re-estimated** (Vörös 2015): least
 //!    squares on the free 6- (or 4-) parameter separated form with h from the current d̂,
 //!    then d̂ = θ3/(θ1 − θ2) (ch4: θ2/θ1), repeated until d̂ settles.
