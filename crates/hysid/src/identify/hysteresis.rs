@@ -12,6 +12,27 @@
 //!
 //!    (ch4: drop the m2 and c2 terms). A grid over d refined by golden-section search picks the
 //!    d with the smallest equation error: no starting value is needed.
+//!
+//!    The regression only starts the search, and α̂ ≤ 0 is no model. A few rows the
+//!    hysteresis does not explain can force that at every d: on a measured piezo record the
+//!    input jumps 0 → −87 V in one sample while the sensor reports the displacement a sample
+//!    later, so that row reads "|Δx| = 87, Δy ≈ 0" with regressors hundreds of times the
+//!    others', and the transient after it adds rows with Δy of several µm. The profile then
+//!    tries, in order, until some grid point gives α̂ > 0:
+//!    * plain least squares (the cost its residual sum of squares) — every record it can
+//!      start gives the same numbers as before this fallback existed;
+//!    * **trimmed** least squares: refitted on the rows with |r| ≤ 5σ̂, σ̂ = 1.4826·median|r|,
+//!      the cost the truncated quadratic Σ min(r², (5σ̂)²) over every row;
+//!    * trimmed with **α held** at 1/max|x| (the gap y − f closes over about one input
+//!      amplitude of travel; at most the rate limit): Δy + α|Δx|y(t−1) is regressed on the
+//!      other columns.
+//!
+//!    Every step is unchanged when x changes units (x' = x/s maps α, m, c to s·α, s·m, s·c
+//!    and d to d/s; the grid and the held α follow max|x|). An offset of x is *not* a change
+//!    of units for this model: f is odd about x = 0 and the central segment is |x| ≤ d, so
+//!    the origin of x is part of the model and the input is never centred. (For an input
+//!    that never crosses 0, x' = x + c with y' = y + m1·c is the same hysteresis with
+//!    d' = d + c.)
 //! 2. **Separated regression with the switching function re-estimated** (Vörös 2015): least
 //!    squares on the free 6- (or 4-) parameter separated form with h from the current d̂,
 //!    then d̂ = θ3/(θ1 − θ2) (ch4: θ2/θ1), repeated until d̂ settles.
@@ -342,7 +363,7 @@ impl HysteresisIdentification {
     /// Steps 1–2: the d profile, then the separated regression with the switching function
     /// re-estimated until d̂ settles.
     pub fn separated_regression(&self, data: &IdData) -> Result<SeparatedFit> {
-        let d0 = self.profile_d(data)?;
+        let (d0, profile) = self.profile_d(data)?;
         let mut d = d0;
         let mut d_history = vec![d0];
         let mut best: Option<(ColemanHodgdon, LsSolution)> = None;
@@ -379,7 +400,10 @@ impl HysteresisIdentification {
         let (model, ls) = match best {
             Some(b) if termination.converged() => b,
             // The re-estimation wandered off: keep the profile's constrained solution.
-            _ => constrained_fit(data, self.form, d0)?,
+            _ => {
+                let (model, ls, _) = constrained_fit(data, self.form, d0, profile)?;
+                (model, ls)
+            }
         };
         Ok(SeparatedFit {
             model,
@@ -405,30 +429,40 @@ impl HysteresisIdentification {
 
     /// The d with the smallest equation error of the constrained regression: a grid over
     /// (0, max|x|) refined by golden-section search around the best grid point.
-    fn profile_d(&self, data: &IdData) -> Result<f64> {
+    ///
+    /// Tries the [`Profile`]s in order (plain least squares, trimmed, trimmed with α held)
+    /// and keeps the first for which some grid point gives a model (α̂ > 0); returns d̂ and
+    /// that profile. See the module docs, step 1.
+    fn profile_d(&self, data: &IdData) -> Result<(f64, Profile)> {
         let d_max = max_abs_input(data);
-        let cost = |d: f64| {
-            constrained_fit(data, self.form, d).map_or(f64::INFINITY, |(_, ls)| ls.residual_ss)
-        };
         let n = self.profile_points.max(5);
         let grid: Vec<f64> = (1..=n).map(|i| d_max * i as f64 / (n + 1) as f64).collect();
-        let costs: Vec<f64> = grid.iter().map(|&d| cost(d)).collect();
-        let (best, &best_cost) = costs
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .expect("grid is not empty");
-        if !best_cost.is_finite() {
-            return Err(Error::Singular(
-                "no threshold d gives a solvable regression; the input does not excite the hysteresis".into(),
-            ));
-        }
         let step = d_max / (n + 1) as f64;
-        Ok(golden_section(
-            cost,
-            grid[best] - step,
-            grid[best] + step,
-            40,
+        let profiles = [
+            Profile::Plain,
+            Profile::Trimmed { alpha: None },
+            Profile::Trimmed {
+                alpha: Some(held_alpha(data)),
+            },
+        ];
+        for profile in profiles {
+            let cost = |d: f64| {
+                constrained_fit(data, self.form, d, profile).map_or(f64::INFINITY, |(_, _, c)| c)
+            };
+            let costs: Vec<f64> = grid.iter().map(|&d| cost(d)).collect();
+            let (best, &best_cost) = costs
+                .iter()
+                .enumerate()
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .expect("grid is not empty");
+            if best_cost.is_finite() {
+                let d = golden_section(cost, grid[best] - step, grid[best] + step, 40);
+                return Ok((d, profile));
+            }
+        }
+        Err(Error::Singular(
+            "no threshold d gives a solvable regression with α > 0; the input does not excite the hysteresis"
+                .into(),
         ))
     }
 }
@@ -502,9 +536,52 @@ fn separated_rows(data: &IdData, form: ChForm, d: f64) -> (DMatrix<f64>, Vec<f64
     (phi, dy)
 }
 
-/// The regression with θ3 tied to d (see the module docs); returns the model and the fit.
-fn constrained_fit(data: &IdData, form: ChForm, d: f64) -> Result<(ColemanHodgdon, LsSolution)> {
-    let (full, dy) = separated_rows(data, form, d);
+/// How the constrained regression of the d profile is solved (module docs, step 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Profile {
+    /// Least squares on every row; the cost is the residual sum of squares.
+    Plain,
+    /// Least squares on the rows whose residual is within [`TRIM`] robust standard
+    /// deviations, the cost a truncated quadratic; α held at `alpha` when given.
+    Trimmed { alpha: Option<f64> },
+}
+
+/// Rows whose equation error exceeds TRIM·σ̂ (σ̂ = 1.4826·median|r|) leave the trimmed fit.
+const TRIM: f64 = 5.0;
+
+/// The α at which the trimmed profile is held when even the trimmed regression gives α̂ ≤ 0
+/// for every d: 1/max|x| (the gap to f closes over about one input amplitude of travel), at
+/// most [`alpha_max`]. It scales as α does when x changes units.
+fn held_alpha(data: &IdData) -> f64 {
+    (1.0 / max_abs_input(data)).min(alpha_max(data))
+}
+
+/// The regression with θ3 tied to d (see the module docs), solved as `profile` says;
+/// returns the model, the fit and the profile cost. Errors when the least squares fail or
+/// the estimate is no model (α̂ ≤ 0).
+///
+/// With α held, its column −|Δx|y(t−1) moves to the left side,
+/// Δy + α|Δx|y(t−1) = αm1·(…) + αm2·(…) + c1(1−h)Δx + c2·hΔx.
+fn constrained_fit(
+    data: &IdData,
+    form: ChForm,
+    d: f64,
+    profile: Profile,
+) -> Result<(ColemanHodgdon, LsSolution, f64)> {
+    let (full, mut dy) = separated_rows(data, form, d);
+    let alpha_column = match form {
+        ChForm::General6 => 3,
+        ChForm::Saturated4 => 2,
+    };
+    let held = match profile {
+        Profile::Trimmed { alpha } => alpha,
+        Profile::Plain => None,
+    };
+    if let Some(a) = held {
+        for (r, v) in dy.iter_mut().enumerate() {
+            *v -= a * full[(r, alpha_column)];
+        }
+    }
     // Column combinations that tie θ3 = (θ1 − θ2)·d (ch6) or θ2 = θ1·d (ch4).
     let phi = match form {
         ChForm::General6 => DMatrix::from_fn(full.nrows(), 5, |r, c| match c {
@@ -517,13 +594,57 @@ fn constrained_fit(data: &IdData, form: ChForm, d: f64) -> Result<(ColemanHodgdo
             k => full[(r, k + 1)],
         }),
     };
-    let ls = least_squares(&phi, &dy, &[])?;
-    let t = &ls.theta;
+    let phi = match held {
+        None => phi,
+        Some(_) => phi.remove_column(alpha_column - 1),
+    };
+    let (ls, cost) = match profile {
+        Profile::Plain => {
+            let ls = least_squares(&phi, &dy, &[])?;
+            let cost = ls.residual_ss;
+            (ls, cost)
+        }
+        Profile::Trimmed { .. } => trimmed_least_squares(&phi, &dy)?,
+    };
+    let mut t: Vec<f64> = ls.theta.iter().copied().collect();
+    if let Some(a) = held {
+        t.insert(alpha_column - 1, a);
+    }
     let model = match form {
         ChForm::General6 => ColemanHodgdon::general(t[2], t[0] / t[2], t[1] / t[2], t[3], t[4], d)?,
         ChForm::Saturated4 => ColemanHodgdon::saturated(t[1], t[0] / t[1], t[2], d)?,
     };
-    Ok((model, ls))
+    Ok((model, ls, cost))
+}
+
+/// Least squares refitted on the rows with |r| ≤ [`TRIM`]·σ̂ until the kept rows settle (at
+/// most 5 refits), σ̂ = 1.4826·median|r| of the current fit over every row. Returns the
+/// last fit and the truncated quadratic Σ min(r², (TRIM·σ̂)²) over every row.
+fn trimmed_least_squares(phi: &DMatrix<f64>, dy: &[f64]) -> Result<(LsSolution, f64)> {
+    let mut keep = vec![true; dy.len()];
+    let mut ls = least_squares(phi, dy, &[])?;
+    let mut refits = 0;
+    loop {
+        let r: Vec<f64> = (phi * &ls.theta)
+            .iter()
+            .zip(dy)
+            .map(|(p, y)| y - p)
+            .collect();
+        let mut abs: Vec<f64> = r.iter().map(|v| v.abs()).collect();
+        abs.sort_by(f64::total_cmp);
+        let limit = TRIM * 1.4826 * abs[abs.len() / 2];
+        let next: Vec<bool> = r.iter().map(|v| v.abs() <= limit).collect();
+        if limit == 0.0 || next == keep || refits == 5 {
+            let cost = r.iter().map(|v| (v * v).min(limit * limit)).sum();
+            return Ok((ls, cost));
+        }
+        keep = next;
+        let rows: Vec<usize> = (0..dy.len()).filter(|&i| keep[i]).collect();
+        let sub = DMatrix::from_fn(rows.len(), phi.ncols(), |i, j| phi[(rows[i], j)]);
+        let sub_dy: Vec<f64> = rows.iter().map(|&i| dy[i]).collect();
+        ls = least_squares(&sub, &sub_dy, &[])?;
+        refits += 1;
+    }
 }
 
 /// Golden-section search for a minimum of `f` on [a, b] (`iterations` shrinkings).
