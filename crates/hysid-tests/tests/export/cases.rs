@@ -140,17 +140,22 @@ fn hysteresis() -> ColemanHodgdon {
 /// Coleman–Hodgdon hysteresis (from 0, and from the measured output given at export) and
 /// its cascade.
 fn kinds(u: &[f64]) -> Vec<Case> {
-    let mut out = Vec::new();
-    for op in OperatorModel::examples().expect("the registry's examples") {
-        let label = format!("cascade_{}", op.family().name().replace('-', "_"));
-        let cascade = OperatorCascade::new(op, block()).expect("a cascade");
-        let n = cascade.parameters().len();
-        let model = FittedModel::OperatorCascade(FittedOperatorCascade {
-            model: cascade,
-            std: vec![f64::NAN; n],
-        });
-        out.extend(cases_of(&label, &model, u));
-    }
+    use rayon::prelude::*;
+    let examples = OperatorModel::examples().expect("the registry's examples");
+    let cascades: Vec<Vec<Case>> = examples
+        .into_par_iter()
+        .map(|op| {
+            let label = format!("cascade_{}", op.family().name().replace('-', "_"));
+            let cascade = OperatorCascade::new(op, block()).expect("a cascade");
+            let n = cascade.parameters().len();
+            let model = FittedModel::OperatorCascade(FittedOperatorCascade {
+                model: cascade,
+                std: vec![f64::NAN; n],
+            });
+            cases_of(&label, &model, u)
+        })
+        .collect();
+    let mut out: Vec<Case> = cascades.into_iter().flatten().collect();
     // Maxwell-slip without a linear spring saturates: the PI inverse is the per-sample solve.
     let saturating = MaxwellSlip::new(
         0.0,
@@ -217,30 +222,67 @@ fn kinds(u: &[f64]) -> Vec<Case> {
 /// where it has one), forward and inverse; then the other kinds; then the grey-box and
 /// equation-file models ([`crate::greybox`]).
 pub fn all() -> Vec<Case> {
-    let mut out = all_on(&signal(3000, 27));
-    out.extend(crate::greybox::cases());
-    out
+    // Made once per test binary (its library runs are most of a fast export test's time):
+    // the tests that read it run in parallel, and each takes its own copy.
+    static ALL: std::sync::OnceLock<Vec<Case>> = std::sync::OnceLock::new();
+    ALL.get_or_init(|| {
+        let mut out = all_on(&signal(3000, 27));
+        out.extend(crate::greybox::cases());
+        out
+    })
+    .clone()
+}
+
+/// The cases of the registry's first example, the PI operator (`pi_forward`, `pi_inverse`,
+/// `pi_beyond`), as [`all`] makes them.
+pub fn pi() -> Vec<Case> {
+    let op = OperatorModel::examples().expect("examples").remove(0);
+    let n = op.as_operator().parameters().len();
+    cases_of(
+        "pi",
+        &FittedModel::operator(op, vec![f64::NAN; n]),
+        &signal(3000, 27),
+    )
 }
 
 /// The cases of [`all`] but the grey-box ones, on the forward input `u` (the compensators'
 /// references are the models' outputs for it).
 pub fn all_on(u: &[f64]) -> Vec<Case> {
-    let mut out = Vec::new();
-    for op in OperatorModel::examples().expect("the registry's examples") {
-        let label = op.family().name().replace('-', "_");
-        let model = FittedModel::operator(
-            op.clone(),
-            vec![f64::NAN; op.as_operator().parameters().len()],
-        );
-        out.extend(cases_of(&label, &model, u));
-        if let Some(cw) = flipped(&op) {
-            let n = cw.as_operator().parameters().len();
-            let model = FittedModel::operator(cw, vec![f64::NAN; n]);
-            out.extend(cases_of(&format!("{label}_cw"), &model, u));
-        }
-    }
+    use rayon::prelude::*;
+    // The families in parallel (a compensator's library run is most of the time), in order.
+    let examples = OperatorModel::examples().expect("the registry's examples");
+    let families: Vec<Vec<Case>> = examples
+        .par_iter()
+        .map(|op| {
+            let label = op.family().name().replace('-', "_");
+            let model = FittedModel::operator(
+                op.clone(),
+                vec![f64::NAN; op.as_operator().parameters().len()],
+            );
+            let mut out = cases_of(&label, &model, u);
+            if let Some(cw) = flipped(op) {
+                let n = cw.as_operator().parameters().len();
+                let model = FittedModel::operator(cw, vec![f64::NAN; n]);
+                out.extend(cases_of(&format!("{label}_cw"), &model, u));
+            }
+            out
+        })
+        .collect();
+    let mut out: Vec<Case> = families.into_iter().flatten().collect();
     out.extend(kinds(u));
     out
+}
+
+/// The library's model of `case`, as its export runs it: the file's model, re-stepped when
+/// the case is exported at another sample time than the file's (`FittedModel::resampled`).
+pub fn model_of(case: &Case) -> FittedModel {
+    let model = FittedModel::from_file(&case.file).expect("the case's model");
+    match (case.file.sample_time, case.options.sample_time) {
+        (Some(fitted), Some(ts)) if fitted != ts => model
+            .resampled(fitted, ts)
+            .unwrap_or_else(|| panic!("{}: not re-stepped", case.name)),
+        _ => model,
+    }
 }
 
 /// A PI operator's model file with the data's sample time and column names.

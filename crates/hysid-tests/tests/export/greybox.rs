@@ -222,7 +222,7 @@ fn resampled_cases(u: &[f64]) -> Vec<Case> {
     };
     let bw = built_in(GreyBoxKind::BoucWen, &[], newmark);
     out.push(resampled_case(
-        "gb_bouc_wen_newmark_at_double",
+        "gb_bouc_wen_newmark_at_twice",
         &bw,
         scaled(u, 120.0),
         fitted,

@@ -74,7 +74,7 @@ struct Run {
 }
 
 fn library(case: &Case, input: &[f64]) -> Run {
-    let model = FittedModel::from_file(&case.file).expect("the case's model");
+    let model = cases::model_of(case);
     let ts = case.options.sample_time.unwrap_or(TS);
     let mut run = Run {
         y: Vec::new(),
@@ -195,11 +195,17 @@ fn check_library(case: &Case) -> Run {
 
 #[test]
 fn library_streams_are_safe_on_hostile_input() {
+    use rayon::prelude::*;
     let all = hostile_cases();
     assert!(all.iter().filter(|c| c.options.inverse).count() >= 15);
-    for case in &all {
-        check_library(case);
-    }
+    // In parallel, and without the two Jiles–Atherton compensators: their library runs on
+    // these references took 37 s of the 38 s of all cases (measured one by one). The long
+    // tests below check every case, those two included, before they run the generated code.
+    all.par_iter()
+        .filter(|case| !case.name.contains("jiles_atherton_inverse"))
+        .for_each(|case| {
+            check_library(case);
+        });
 }
 
 #[test]

@@ -10,7 +10,6 @@ use crate::cases::{self, Case};
 use hysid::export::eval;
 use hysid::export::{c_code, program, rust_crate, ExportOptions, Precision};
 use hysid::model::compensate::compensate;
-use hysid::model::saved::FittedModel;
 use std::path::Path;
 use std::process::Command;
 
@@ -189,14 +188,14 @@ fn fresh(all: &[Case]) -> Vec<(Vec<f64>, Vec<f64>)> {
         .map(|case| {
             if let Some(o) = other.iter().find(|o| o.name == case.name) {
                 if let (Some(y0), false) = (case.options.initial_output, case.options.inverse) {
-                    let model = FittedModel::from_file(&case.file).expect("a model");
+                    let model = cases::model_of(case);
                     let ts = case.options.sample_time.unwrap_or(1e-3);
                     let y = model.simulate(&[&o.input], ts, Some(y0)).expect("simulate");
                     return (o.input.clone(), y[0].clone());
                 }
                 return (o.input.clone(), o.expected.clone());
             }
-            let model = FittedModel::from_file(&case.file).expect("a model");
+            let model = cases::model_of(case);
             let input: Vec<f64> = case.input.iter().rev().copied().collect();
             let ts = case.options.sample_time.unwrap_or(1e-3);
             let expected = if case.options.inverse {

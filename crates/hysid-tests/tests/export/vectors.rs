@@ -74,7 +74,7 @@ fn vector_cases() -> Vec<Case> {
 
 #[test]
 fn the_pi_test_program_passes_and_fails_on_a_changed_value() {
-    let all = cases::all();
+    let all = cases::pi();
     let dir = tempfile::tempdir().expect("temp dir");
     for name in ["pi_forward", "pi_inverse"] {
         let case = all.iter().find(|c| c.name == name).expect("the PI case");
@@ -92,7 +92,7 @@ fn the_pi_test_program_passes_and_fails_on_a_changed_value() {
 
 #[test]
 fn a_compensators_vectors_hold_hostile_samples_and_the_limits() {
-    let case = cases::all()
+    let case = cases::pi()
         .into_iter()
         .find(|c| c.name == "pi_inverse")
         .expect("the PI compensator");
