@@ -24,11 +24,11 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 COMMON = ["-std=c99", "-O2", "-ffreestanding", "-Wall", "-Wextra", "-Werror", "-pedantic",
           "-Wdouble-promotion", "-Wconversion"]
 
-# The cores: QEMU machine, compiler flags, and the precision of the exported code. The one
-# setting per core: until `--precision single` exists the M4F runs the double-precision code
-# with soft-float double routines (printed with every result).
+# The cores: QEMU machine, compiler flags, and the precision of the exported code. The M4F
+# runs the single-precision export (its FPU has no double); a kind that refuses single
+# precision runs in double there, with soft-float double routines, marked in the results.
 CORES = {
-    "m4f": {"machine": "mps2-an386", "precision": "double",
+    "m4f": {"machine": "mps2-an386", "precision": "single",
             "flags": ["-mcpu=cortex-m4", "-mfpu=fpv4-sp-d16", "-mthumb", "-mfloat-abi=hard"]},
     "m7": {"machine": "mps2-an500", "precision": "double",
            "flags": ["-mcpu=cortex-m7", "-mfpu=fpv5-d16", "-mthumb", "-mfloat-abi=hard"]},
@@ -82,8 +82,18 @@ def count_steps(trace, begin, end):
     return [c - empty for c in counts[1:]]
 
 
-def build_and_run(src, name, core, work):
+def source(exports, name, core):
+    """The directory of the export `name` a core runs and its precision: the single-precision
+    export (the case's `single/`) on a single-precision core unless the kind refused it."""
+    src = os.path.join(exports, name)
+    if CORES[core]["precision"] == "single" and os.path.isdir(os.path.join(src, "single")):
+        return os.path.join(src, "single"), "single"
+    return src, "double"
+
+
+def build_and_run(exports, name, core, work):
     cfg = CORES[core]
+    src, precision = source(exports, name, core)
     flags = cfg["flags"] + COMMON
     cc = "arm-none-eabi-gcc"
     b = os.path.join(work, f"{name}_{core}")
@@ -105,7 +115,7 @@ def build_and_run(src, name, core, work):
     sh([cc, *flags, "-nostartfiles", "-T", os.path.join(HERE, "mps2.ld"),
         *[os.path.join(b, o) for o in ["startup.o", "harness.o", "test.o"]], obj,
         "-lm", "-lc", "-lgcc", "-o", elf])
-    if cfg["precision"] == "single":
+    if precision == "single":
         doubles = [l.split()[-1] for l in sh(["arm-none-eabi-nm", elf]).splitlines()
                    if l.split()[-1].startswith("__aeabi_d")]
         if doubles:
@@ -124,7 +134,8 @@ def build_and_run(src, name, core, work):
                    .splitlines() if l.endswith("hysid_state_bytes")][0][1]
     with open(os.path.join(b, f"{name}.su")) as f:
         stack = sum(int(l.split("\t")[1]) for l in f if l.strip())
-    return {"pass": passed, "mean": sum(steps) / len(steps), "max": max(steps),
+    return {"pass": passed, "precision": precision, "mean": sum(steps) / len(steps),
+            "max": max(steps),
             "code": int(size[0]) + int(size[1]), "state": int(state_bytes, 16), "stack": stack}
 
 
@@ -144,7 +155,7 @@ def main():
         def one(job):
             name, core = job
             try:
-                return build_and_run(os.path.join(exports, name), name, core, work)
+                return build_and_run(exports, name, core, work)
             except (RuntimeError, subprocess.TimeoutExpired) as e:
                 return {"pass": False, "error": str(e).splitlines()[0]}
 
@@ -159,27 +170,38 @@ def main():
                 if not r["pass"]:
                     failed.append(f"{name} on {core}: {r.get('error', 'FAIL')}")
             rows.append(row)
+            refused = os.path.join(exports, name, "single.refused")
+            if os.path.exists(refused):
+                with open(refused) as f:
+                    row["refused"] = f.read().strip()
+            rows.append(row)
             if not args.markdown:
                 print(name, " ".join(
                     f"{c}:{'PASS' if row[c]['pass'] else 'FAIL'}"
                     + (f" {row[c]['mean']:.0f}/{row[c]['max']}" if 'mean' in row[c] else "")
+                    + (f" ({row[c]['precision']})"
+                       if row[c].get("precision", CORES[c]["precision"]) != CORES[c]["precision"]
+                       else "")
                     for c in CORES), flush=True)
     note = ", ".join(f"{c} {CORES[c]['precision']}" for c in CORES)
     if args.markdown:
-        print(f"Instructions per step (mean / max) on QEMU; precision: {note}"
-              + (" (the M4F's double is soft-float)" if CORES["m4f"]["precision"] == "double"
-                 else "") + ".\n")
+        print(f"Instructions per step (mean / max) on QEMU; precision: {note}; † the kind "
+              "refuses single precision and the M4F runs its double code (soft-float).\n")
         print("| export | M4F mean / max | M7 mean / max | code bytes (M4F / M7) "
-              "| state bytes | stack bytes (M4F / M7) |")
+              "| state bytes (M4F / M7) | stack bytes (M4F / M7) |")
         print("|---|---|---|---|---|---|")
         for row in rows:
             a, b = row["m4f"], row["m7"]
             if "mean" not in a or "mean" not in b:
                 print(f"| {row['name']} | failed | failed | | | |")
                 continue
-            print(f"| {row['name']} | {a['mean']:.0f} / {a['max']} | {b['mean']:.0f} / "
-                  f"{b['max']} | {a['code']} / {b['code']} | {b['state']} | "
+            mark = " †" if a["precision"] != CORES["m4f"]["precision"] else ""
+            print(f"| {row['name']} | {a['mean']:.0f} / {a['max']}{mark} | {b['mean']:.0f} / "
+                  f"{b['max']} | {a['code']} / {b['code']} | {a['state']} / {b['state']} | "
                   f"{a['stack']} / {b['stack']} |")
+        refusals = [r for r in rows if "refused" in r]
+        if refusals:
+            print("\n† " + "; ".join(f"{r['name']}: {r['refused']}" for r in refusals))
     else:
         print(f"precision: {note}")
     for f in failed:

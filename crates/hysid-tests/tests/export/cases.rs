@@ -245,6 +245,45 @@ pub fn pi() -> Vec<Case> {
     )
 }
 
+/// The models the instruction bars are stated for (`tools/arm/run.py`), forward and
+/// inverse: a PI operator of 10 plays (`size_pi_10_plays`) and a 20 × 20 Preisach plane with
+/// its linear term (`size_preisach_20`), each of the shape a fit of a piezo record gives —
+/// thresholds spread over the range, weights falling with the threshold; a Preisach density
+/// largest near the diagonal, falling with the loop's width α − β and off its centre.
+pub fn sized() -> Vec<Case> {
+    use hysid::model::operators::PrandtlIshlinskii as Pi;
+    let u = signal(3000, 27);
+    let thresholds: Vec<f64> = (1..=10).map(|i| 0.09 * i as f64).collect();
+    let weights: Vec<f64> = (0..10).map(|i| 0.4 / (1.0 + i as f64)).collect();
+    let pi = Pi::new(0.3, weights, thresholds, 0.05, Orientation::default()).expect("a PI");
+    let n = 20;
+    let h = 2.0 / n as f64;
+    let mut density = Vec::new();
+    for i in 0..n {
+        for j in 0..=i {
+            let (alpha, beta) = (-1.0 + (i as f64 + 0.5) * h, -1.0 + (j as f64 + 0.5) * h);
+            let width = alpha - beta;
+            let centre = 0.5 * (alpha + beta);
+            density.push(0.02 * (-width / 0.6).exp() * (-centre * centre / 0.5).exp());
+        }
+    }
+    let preisach =
+        Preisach::new(-1.0, 1.0, n, density, 0.2, 0.0, Orientation::default()).expect("Preisach");
+    let mut out = Vec::new();
+    for (label, op) in [
+        ("size_pi_10_plays", OperatorModel::from(pi)),
+        ("size_preisach_20", OperatorModel::from(preisach)),
+    ] {
+        let n = op.as_operator().parameters().len();
+        out.extend(cases_of(
+            label,
+            &FittedModel::operator(op, vec![f64::NAN; n]),
+            &u,
+        ));
+    }
+    out
+}
+
 /// The cases of [`all`] but the grey-box ones, on the forward input `u` (the compensators'
 /// references are the models' outputs for it).
 pub fn all_on(u: &[f64]) -> Vec<Case> {

@@ -259,9 +259,21 @@ const KEYWORDS: &[&str] = &[
 ];
 
 /// The program, interface and opening comment of the export `name` of `file`.
-/// What [`prepare`] makes: the program, its interface, the opening comment and the bound
-/// of a single-precision export in the output's units (0 in double: bit-identical).
-type Prepared = (program::Program, Interface, String, f64);
+/// What [`prepare`] makes: the program, its interface, the opening comment and what a
+/// single-precision export measured (None in double: bit-identical).
+type Prepared = (
+    program::Program,
+    Interface,
+    String,
+    Option<precision::SingleBound>,
+);
+
+/// The bound `NAME_BOUND` of the code in the output's units: 0 in double (bit-identical).
+fn absolute_bound(single: &Option<precision::SingleBound>) -> f64 {
+    single
+        .as_ref()
+        .map_or(0.0, precision::SingleBound::absolute)
+}
 
 fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prepared> {
     check_name(name)?;
@@ -284,7 +296,7 @@ fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prep
         comment.push('\n');
         comment.push_str(&resampling_estimate(file, options, fitted, ts)?);
     }
-    let mut bound = 0.0;
+    let mut bound = None;
     if options.precision.is_single() {
         if let Some(limits) = given
             .limits
@@ -296,7 +308,7 @@ fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prep
         let measured = single_bound(file, &model, &program, options, sample_time.seconds())?;
         comment.push('\n');
         comment.push_str(&measured.comment());
-        bound = measured.absolute();
+        bound = Some(measured);
     }
     Ok((program, interface, comment, bound))
 }
@@ -370,8 +382,9 @@ fn resampling_estimate(
 }
 
 /// Measures the single-precision `program` of `model` (see [`precision`]) on the rows of
-/// [`ExportOptions::bound_record`], else on the test sequence over the file's input range,
-/// fed through the forward model (in double) for a compensator.
+/// [`ExportOptions::bound_record`], else on the test sequence over the file's input range
+/// (a file without one: [`ExportOptions::test_range`]), fed through the forward model (in
+/// double) for a compensator.
 fn single_bound(
     file: &ModelFile,
     model: &FittedModel,
@@ -394,14 +407,23 @@ fn single_bound(
         }
         return precision::measure(program, rows, "the record given at export (--data)");
     }
-    let ranges = file.input_range.as_deref().ok_or_else(|| {
+    let model_inputs = if options.inverse {
+        program.n_outputs
+    } else {
+        program.n_inputs
+    };
+    let given = options
+        .test_range
+        .map(|r| vec![[r.lo(), r.hi()]; model_inputs]);
+    let ranges = file.input_range.clone().or(given).ok_or_else(|| {
         Error::Unsupported(
             "single precision: the model file records no input_range (a file of an earlier \
-             version), over which the bound is measured; give a record with --data FILE, or \
-             refit the model"
+             version), over which the bound is measured; give a record with --data FILE (or \
+             the range with --test-range LO:HI), or refit the model"
                 .into(),
         )
     })?;
+    let ranges = ranges.as_slice();
     let mut rows = sequence::inputs(ranges);
     let mut record = format!(
         "the test sequence over the input range {}",
@@ -419,7 +441,14 @@ fn single_bound(
         };
         let plant = kinds::program(model, &forward, ts)?;
         rows = eval::run::<f64>(&plant, &rows)?;
-        record.push_str(" fed through the model (the references)");
+        // Then the test vectors' references beyond reach, which the code must hold to the
+        // bound as well (a compensator of a saturating model may not).
+        let good: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+        rows.extend(vectors::beyond_reach(&good).into_iter().map(|r| vec![r]));
+        record.push_str(
+            " fed through the model (the references), then the test vectors' references \
+             beyond reach",
+        );
     }
     precision::measure(program, &rows, &record)
 }
@@ -440,7 +469,7 @@ pub fn c_code(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<C
         name,
         &comment,
         interface.sample_time,
-        (options.precision, bound),
+        (options.precision, absolute_bound(&bound)),
     );
     Ok(CCode {
         header,
@@ -461,7 +490,7 @@ pub fn rust_crate(
         &program,
         &comment,
         interface.sample_time,
-        (options.precision, bound),
+        (options.precision, absolute_bound(&bound)),
     );
     let cargo = render::rust::cargo_toml(name, &interface.description);
     Ok(vec![
@@ -478,15 +507,22 @@ pub fn rust_crate(
 
 /// The reference vectors of the export `name` of `file` ([`vectors`]): the test sequence (or
 /// the forward model's outputs on it, then hostile samples, for a compensator) and the
-/// library's outputs for it.
+/// library's outputs for it; in single precision the check's bound is the one the header
+/// states (measured as [`c_code`] does).
 pub fn test_vectors(
     file: &ModelFile,
     name: &str,
     options: &ExportOptions,
 ) -> Result<vectors::Vectors> {
     check_name(name)?;
+    let bound = match options.precision {
+        Precision::Double => vectors::DOUBLE_BOUND,
+        Precision::Single => prepare(file, name, options)?
+            .3
+            .map_or(vectors::DOUBLE_BOUND, |single| single.bound()),
+    };
     let (model, sample_time) = model_at(file, options)?;
-    vectors::vectors(file, &model, options, sample_time.seconds())
+    vectors::vectors(file, &model, options, sample_time.seconds(), bound)
 }
 
 /// The files of the export of `file` to `target` under the name `name`, paths relative to
@@ -498,15 +534,6 @@ pub fn export(
     name: &str,
     options: &ExportOptions,
 ) -> Result<Vec<GeneratedFile>> {
-    if options.test_vectors && options.precision.is_single() {
-        return Err(Error::invalid_option(
-            "test-vectors",
-            "single",
-            "test vectors are written for the double code only so far; export them with \
-             --precision double"
-                .into(),
-        ));
-    }
     if options.test_vectors && target == Target::Fmu {
         return Err(Error::invalid_option(
             "test-vectors",

@@ -17,7 +17,13 @@
 //!
 //! |y_kj − e_kj| ≤ B · (max e − min e),
 //!
-//! B = `NAME_TEST_BOUND` (0 in double precision). Every output must also be finite; a
+//! B = `NAME_TEST_BOUND`: 0 in double precision, in single the relative bound the header
+//! states ([`super::precision::SingleBound::bound`]). In single precision the inputs (and a
+//! compensator's references) are rounded to `float` before the library runs them, so that the
+//! code and the library see the same samples, and each expected value is stored as a pair of
+//! `float`s, e = hi + lo with hi = fl(e) and lo = fl(e − hi), checked as (y − hi) − lo:
+//! the test compares with the double result to about 2⁻⁴⁸ of its magnitude without one
+//! `double` operation (none may run on a single-precision FPU). Every output must also be finite; a
 //! compensator's command must lie within its limits, and after the run the faults count must
 //! equal the number of bad samples, the clipped count the library's (when B = 0), and the
 //! diverged flag be clear.
@@ -32,6 +38,7 @@
 //! **Rust** ([`rust_test`]): `NAME/tests/vectors.rs`, the same tables and checks as a
 //! `cargo test`.
 
+use super::precision::Precision;
 use super::ExportOptions;
 use crate::model::limits::Limits;
 use crate::model::saved::{FittedModel, ModelFile};
@@ -44,8 +51,10 @@ pub struct Vectors {
     pub inputs: Vec<Vec<f64>>,
     /// The library's outputs, one row per step.
     pub outputs: Vec<Vec<f64>>,
-    /// The bound B of the check (0: equality).
+    /// The bound B of the check, relative to the expected outputs' range (0: equality).
     pub bound: f64,
+    /// The floating-point type of the code the vectors are for.
+    pub precision: Precision,
     /// A compensator's command limits (checked on every command).
     pub limits: Option<Limits>,
     /// The number of non-finite input samples (the faults count after the run).
@@ -59,8 +68,9 @@ pub struct Vectors {
 pub const DOUBLE_BOUND: f64 = 0.0;
 
 /// The hostile samples appended to a compensator's references (see the [module docs](self)),
-/// `good` the references they are mixed with and `span` their largest magnitude.
-fn hostile(good: &[f64], span: f64) -> Vec<f64> {
+/// `good` the references they are mixed with, ±10 times their largest magnitude (at least 1).
+fn hostile(good: &[f64]) -> Vec<f64> {
+    let span = good.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1.0);
     let bad = [
         vec![f64::NAN],
         vec![f64::INFINITY],
@@ -89,6 +99,16 @@ fn hostile(good: &[f64], span: f64) -> Vec<f64> {
     out
 }
 
+/// The finite part of the hostile samples appended to the references `good` (the references
+/// beyond reach and the good ones between them), on which a single-precision compensator's
+/// bound is measured too (`export::single_bound`).
+pub(crate) fn beyond_reach(good: &[f64]) -> Vec<f64> {
+    hostile(good)
+        .into_iter()
+        .filter(|r| r.is_finite())
+        .collect()
+}
+
 /// The range of the test sequence: `--test-range`, else the file's `input_range`.
 fn ranges(file: &ModelFile, options: &ExportOptions, n_inputs: usize) -> Result<Vec<[f64; 2]>> {
     if let Some(r) = options.test_range {
@@ -108,16 +128,26 @@ fn ranges(file: &ModelFile, options: &ExportOptions, n_inputs: usize) -> Result<
 
 /// The reference vectors of the export of `file` with `options` (see the [module
 /// docs](self)) run by `model` (the file's, re-stepped for another sample time:
-/// `export::model_at`); `sample_time` is the export's.
+/// `export::model_at`); `sample_time` is the export's, `bound` the check's B.
 pub fn vectors(
     file: &ModelFile,
     model: &FittedModel,
     options: &ExportOptions,
     sample_time: f64,
+    bound: f64,
 ) -> Result<Vectors> {
+    let precision = options.precision;
+    // The samples the code sees: in single precision each input is a float.
+    let sample = |v: f64| match precision {
+        Precision::Double => v,
+        Precision::Single => v as f32 as f64,
+    };
     let mut forward = model.stepper(sample_time, options.initial_output)?;
     let (n_in, n_out) = (forward.n_inputs(), forward.n_outputs());
-    let inputs = super::sequence::inputs(&ranges(file, options, n_in)?);
+    let inputs: Vec<Vec<f64>> = super::sequence::inputs(&ranges(file, options, n_in)?)
+        .into_iter()
+        .map(|u| u.into_iter().map(sample).collect())
+        .collect();
     let mut outputs = Vec::with_capacity(inputs.len());
     let mut y = vec![0.0; n_out];
     for u in &inputs {
@@ -128,16 +158,16 @@ pub fn vectors(
         return Ok(Vectors {
             inputs,
             outputs,
-            bound: DOUBLE_BOUND,
+            bound,
+            precision,
             limits: None,
             faults: 0,
             clipped: None,
         });
     }
-    let good: Vec<f64> = outputs.iter().map(|y| y[0]).collect();
-    let span = good.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1.0);
+    let good: Vec<f64> = outputs.iter().map(|y| sample(y[0])).collect();
     let mut references = good.clone();
-    references.extend(hostile(&good, span));
+    references.extend(hostile(&good).into_iter().map(sample));
     let limits = super::export_limits(file, options);
     let mut comp = model.compensator(sample_time)?;
     comp.set_limits(limits);
@@ -149,45 +179,71 @@ pub fn vectors(
         faults: references.iter().filter(|r| !r.is_finite()).count(),
         inputs: references.into_iter().map(|r| vec![r]).collect(),
         outputs: commands,
-        bound: DOUBLE_BOUND,
+        bound,
+        precision,
         limits,
         clipped: Some(comp.clipped()),
     })
 }
 
-/// A value as a C literal: the shortest round-trip decimal, or the `<math.h>` macro of a
-/// non-finite one.
-fn c_literal(v: f64) -> String {
-    if v.is_nan() {
-        "(double)NAN".into()
-    } else if v == f64::INFINITY {
-        "(double)INFINITY".into()
-    } else if v == f64::NEG_INFINITY {
-        "-(double)INFINITY".into()
-    } else {
-        format!("{v:?}")
-    }
+/// The spelling of the vectors' numbers in one language and precision.
+#[derive(Clone, Copy)]
+struct Numbers {
+    /// Rust (else C).
+    rust: bool,
+    /// The floating-point type.
+    precision: Precision,
 }
 
-/// A value as a Rust literal.
-fn rust_literal(v: f64) -> String {
-    if v.is_nan() {
-        "f64::NAN".into()
-    } else if v == f64::INFINITY {
-        "f64::INFINITY".into()
-    } else if v == f64::NEG_INFINITY {
-        "f64::NEG_INFINITY".into()
-    } else {
-        format!("{v:?}")
+impl Numbers {
+    /// The floating-point type's name.
+    fn ty(self) -> &'static str {
+        match (self.rust, self.precision) {
+            (false, Precision::Double) => "double",
+            (false, Precision::Single) => "float",
+            (true, Precision::Double) => "f64",
+            (true, Precision::Single) => "f32",
+        }
     }
-}
 
-/// The table `rows` flattened, one value a line, each through `literal`.
-fn table(rows: &[Vec<f64>], literal: fn(f64) -> String) -> String {
-    rows.iter()
-        .flatten()
-        .map(|v| format!("    {},\n", literal(*v)))
-        .collect()
+    /// `v` as a literal of the type: the shortest decimal that rounds back to it (in single
+    /// precision to the `float` nearest `v`), or the constant of a non-finite value.
+    fn literal(self, v: f64) -> String {
+        let ty = self.ty();
+        match (self.rust, v) {
+            (_, v) if v.is_nan() && self.rust => format!("{ty}::NAN"),
+            (_, v) if v.is_nan() => format!("({ty})NAN"),
+            (true, f64::INFINITY) => format!("{ty}::INFINITY"),
+            (true, f64::NEG_INFINITY) => format!("{ty}::NEG_INFINITY"),
+            (false, f64::INFINITY) => format!("({ty})INFINITY"),
+            (false, f64::NEG_INFINITY) => format!("-({ty})INFINITY"),
+            (rust, v) => match self.precision {
+                Precision::Double => format!("{v:?}"),
+                Precision::Single if rust => format!("{:?}_f32", v as f32),
+                Precision::Single => format!("{:?}f", v as f32),
+            },
+        }
+    }
+
+    /// The table `values`, one literal a line.
+    fn table(self, values: impl Iterator<Item = f64>) -> String {
+        values
+            .map(|v| format!("    {},\n", self.literal(v)))
+            .collect()
+    }
+
+    /// The expected outputs' tables: in double one, `e`; in single the pair `hi` = fl(e) and
+    /// `lo` = fl(e − hi) (see the [module docs](self)).
+    fn expected(self, v: &Vectors) -> (String, Option<String>) {
+        let e = || v.outputs.iter().flatten().copied();
+        match self.precision {
+            Precision::Double => (self.table(e()), None),
+            Precision::Single => (
+                self.table(e().map(|e| e as f32 as f64)),
+                Some(self.table(e().map(|e| e - e as f32 as f64))),
+            ),
+        }
+    }
 }
 
 /// The outputs' range (max − min over every output), the scale of the bound.
@@ -208,35 +264,49 @@ fn output_range(v: &Vectors) -> f64 {
 
 /// `NAME_test.c` for the vectors `v` of the export `name` (see the [module docs](self)).
 pub fn c_test(name: &str, v: &Vectors) -> String {
+    let n = Numbers {
+        rust: false,
+        precision: v.precision,
+    };
+    let ty = n.ty();
     let steps = v.inputs.len();
     let n_in = v.inputs.first().map_or(1, Vec::len);
     let n_out = v.outputs.first().map_or(1, Vec::len);
-    let (limit_check, clipped_check) = match (v.limits, v.clipped) {
-        (Some(l), _) => (
-            format!(
-                "            if (!(y[j] >= {lo}) || !(y[j] <= {hi})) {{\n                \
-                 failures++;\n            }}\n",
-                lo = c_literal(l.lo()),
-                hi = c_literal(l.hi())
-            ),
-            String::new(),
+    let limit_check = match v.limits {
+        Some(l) => format!(
+            "            if (!(y[j] >= {lo}) || !(y[j] <= {hi})) {{\n                \
+             failures++;\n            }}\n",
+            lo = n.literal(l.lo()),
+            hi = n.literal(l.hi())
         ),
-        (None, _) => (String::new(), String::new()),
+        None => String::new(),
     };
     let clipped_check = match v.clipped {
-        Some(n) => format!(
-            "    if ({name}_TEST_BOUND == 0.0 && {name}_clipped(&s) != (size_t){n}) {{\n        \
-             failures++;\n    }}\n"
+        Some(count) if v.bound == 0.0 => format!(
+            "    if ({name}_clipped(&s) != (size_t){count}) {{\n        failures++;\n    }}\n"
         ),
-        None => clipped_check,
+        _ => String::new(),
     };
+    let (expected, low) = n.expected(v);
+    let (low_table, minus_low) = match &low {
+        Some(t) => (
+            format!(
+                "/* The low parts of the expected outputs: each is {name}_test_y + this. */\n\
+                 static const {ty} {name}_test_y_lo[{len}] = {{\n{t}}};\n\n",
+                len = (steps * n_out).max(1)
+            ),
+            format!(" - {name}_test_y_lo[at]"),
+        ),
+        None => (String::new(), String::new()),
+    };
+    let zero = n.literal(0.0);
     format!(
         "/* {name}_test.c: reference vectors of {name} and a program that checks them.\n\
          * Generated by hysid {version}; do not edit. The inputs are hysid's documented test\n\
          * sequence (nested reversals over the identified range{hostile}); the expected outputs\n\
-         * are the hysid library's. Each output must be within {name}_TEST_BOUND times the\n\
-         * expected outputs' range (0: equal), finite{within}; after the run the faults count\n\
-         * must be the number of bad samples{clip} and the diverged flag clear.\n\
+         * are the hysid library's{single}. Each output must be within {name}_TEST_BOUND times\n\
+         * the expected outputs' range (0: equal), finite{within}; after the run the faults\n\
+         * count must be the number of bad samples{clip} and the diverged flag clear.\n\
          * {name}_test_run() returns the number of failed checks and prints nothing (for a\n\
          * bare-metal harness); main() is left out with -D{name}_TEST_NO_MAIN. The macros\n\
          * HYSID_TEST_BEFORE_STEP() and HYSID_TEST_AFTER_STEP() surround each step. */\n\
@@ -245,16 +315,17 @@ pub fn c_test(name: &str, v: &Vectors) -> String {
          #ifndef HYSID_TEST_AFTER_STEP\n#define HYSID_TEST_AFTER_STEP()\n#endif\n\n\
          /* The number of steps, the bound B of the check and the expected outputs' range. */\n\
          #define {name}_TEST_STEPS {steps}\n\
-         #define {name}_TEST_BOUND {bound:?}\n\
+         #define {name}_TEST_BOUND {bound}\n\
          #define {name}_TEST_RANGE {range}\n\
          #define {name}_TEST_FAULTS {faults}\n\n\
-         static const double {name}_test_u[{len_u}] = {{\n{u}}};\n\n\
-         static const double {name}_test_y[{len_y}] = {{\n{y}}};\n\n\
+         static const {ty} {name}_test_u[{len_u}] = {{\n{u}}};\n\n\
+         static const {ty} {name}_test_y[{len_y}] = {{\n{expected}}};\n\n\
+         {low_table}\
          /* Steps {name} over the reference inputs and counts the failed checks (0: pass). */\n\
          int {name}_test_run(void);\n\
          int {name}_test_run(void) {{\n\
-         \x20   {name}_state s;\n    double u[{name}_N_INPUTS];\n    double y[{name}_N_OUTPUTS];\n\
-         \x20   const double tolerance = {name}_TEST_BOUND * {name}_TEST_RANGE;\n\
+         \x20   {name}_state s;\n    {ty} u[{name}_N_INPUTS];\n    {ty} y[{name}_N_OUTPUTS];\n\
+         \x20   const {ty} tolerance = {name}_TEST_BOUND * {name}_TEST_RANGE;\n\
          \x20   int failures = 0;\n\
          \x20   {name}_init(&s);\n\
          \x20   for (size_t k = 0; k < (size_t){name}_TEST_STEPS; k++) {{\n\
@@ -264,9 +335,9 @@ pub fn c_test(name: &str, v: &Vectors) -> String {
          \x20       {name}_step(&s, u, y);\n\
          \x20       HYSID_TEST_AFTER_STEP();\n\
          \x20       for (size_t j = 0; j < (size_t){name}_N_OUTPUTS; j++) {{\n\
-         \x20           const double e = {name}_test_y[k * (size_t){name}_N_OUTPUTS + j];\n\
-         \x20           const double d = y[j] > e ? y[j] - e : e - y[j];\n\
-         \x20           if (!(y[j] - y[j] == 0.0) || !(d <= tolerance)) {{\n\
+         \x20           const size_t at = k * (size_t){name}_N_OUTPUTS + j;\n\
+         \x20           const {ty} d = (y[j] - {name}_test_y[at]){minus_low};\n\
+         \x20           if (!(y[j] - y[j] == {zero}) || !(d <= tolerance && d >= -tolerance)) {{\n\
          \x20               failures++;\n            }}\n{limit_check}        }}\n    }}\n\
          \x20   if ({name}_faults(&s) != (size_t){name}_TEST_FAULTS || s.diverged) {{\n\
          \x20       failures++;\n    }}\n{clipped_check}    return failures;\n}}\n\n\
@@ -284,54 +355,75 @@ pub fn c_test(name: &str, v: &Vectors) -> String {
         } else {
             ""
         },
+        single = if low.is_some() {
+            " in double for the inputs rounded to float,\n * each as a float pair hi + lo \
+             (test_y + test_y_lo)"
+        } else {
+            ""
+        },
         within = if v.limits.is_some() {
             " and within the command limits"
         } else {
             ""
         },
-        clip = if v.clipped.is_some() {
-            ", the clipped count the library's (when B = 0)"
+        clip = if v.clipped.is_some() && v.bound == 0.0 {
+            ", the clipped count the library's"
         } else {
             ""
         },
-        bound = v.bound,
-        range = c_literal(output_range(v)),
+        bound = n.literal(v.bound),
+        range = n.literal(output_range(v)),
         faults = v.faults,
         len_u = (steps * n_in).max(1),
         len_y = (steps * n_out).max(1),
-        u = table(&v.inputs, c_literal),
-        y = table(&v.outputs, c_literal),
+        u = n.table(v.inputs.iter().flatten().copied()),
     )
 }
 
 /// `NAME/tests/vectors.rs` for the vectors `v` of the export `name` (see the [module
 /// docs](self)).
 pub fn rust_test(name: &str, v: &Vectors) -> String {
+    let n = Numbers {
+        rust: true,
+        precision: v.precision,
+    };
+    let ty = n.ty();
     let limits = match v.limits {
         Some(l) => format!(
             "            assert!(y[j] >= {} && y[j] <= {}, \"step {{k}}: command beyond the limits\");\n",
-            rust_literal(l.lo()),
-            rust_literal(l.hi())
+            n.literal(l.lo()),
+            n.literal(l.hi())
         ),
         None => String::new(),
     };
     let clipped = match v.clipped {
-        Some(n) => {
-            format!("    if BOUND == 0.0 {{\n        assert_eq!(m.clipped(), {n});\n    }}\n")
-        }
-        None => String::new(),
+        Some(count) if v.bound == 0.0 => format!("    assert_eq!(m.clipped(), {count});\n"),
+        _ => String::new(),
+    };
+    let len_y = v.outputs.iter().map(Vec::len).sum::<usize>();
+    let (expected, low) = n.expected(v);
+    let (low_table, minus_low) = match &low {
+        Some(t) => (
+            format!(
+                "/// The low parts of the expected outputs: each is `Y` + this.\n\
+                 static Y_LO: [{ty}; {len_y}] = [\n{t}];\n\n"
+            ),
+            " - Y_LO[at]",
+        ),
+        None => (String::new(), ""),
     };
     format!(
-        "//! Reference vectors of `{name}` (hysid's test sequence; the hysid library's outputs):\n\
+        "//! Reference vectors of `{name}` (hysid's test sequence; the hysid library's outputs{single}):\n\
          //! each output within BOUND times the expected outputs' range (0: equal), finite{within};\n\
          //! the faults count, {clip}and the diverged flag as the library's. Generated by hysid\n\
          //! {version}; do not edit.\n\n\
          use {name}::{{Model, N_IN, N_OUT}};\n\n\
-         const BOUND: f64 = {bound:?};\n\
-         const RANGE: f64 = {range};\n\
+         const BOUND: {ty} = {bound};\n\
+         const RANGE: {ty} = {range};\n\
          const FAULTS: usize = {faults};\n\n\
-         static U: [f64; {len_u}] = [\n{u}];\n\n\
-         static Y: [f64; {len_y}] = [\n{y}];\n\n\
+         static U: [{ty}; {len_u}] = [\n{u}];\n\n\
+         static Y: [{ty}; {len_y}] = [\n{expected}];\n\n\
+         {low_table}\
          #[test]\n\
          fn the_model_reproduces_the_reference_vectors() {{\n\
          \x20   let mut m = Model::new();\n\
@@ -341,29 +433,33 @@ pub fn rust_test(name: &str, v: &Vectors) -> String {
          \x20       u.copy_from_slice(&U[k * N_IN..(k + 1) * N_IN]);\n\
          \x20       let y = m.step(&u);\n\
          \x20       for j in 0..N_OUT {{\n\
-         \x20           let e = Y[k * N_OUT + j];\n\
+         \x20           let at = k * N_OUT + j;\n\
+         \x20           let d = (y[j] - Y[at]){minus_low};\n\
          \x20           assert!(y[j].is_finite(), \"step {{k}}: output not finite\");\n\
-         \x20           assert!((y[j] - e).abs() <= tolerance, \"step {{k}}: {{}} vs {{e}}\", y[j]);\n\
+         \x20           assert!(d.abs() <= tolerance, \"step {{k}}: {{}} vs {{}}\", y[j], Y[at]);\n\
          {limits}        }}\n    }}\n\
          \x20   assert_eq!(m.faults(), FAULTS);\n\
          \x20   assert!(!m.diverged());\n{clipped}}}\n",
         version = super::interface::VERSION,
+        single = if low.is_some() {
+            " in double for\n//! the inputs rounded to f32, each as a pair `Y` + `Y_LO`"
+        } else {
+            ""
+        },
         within = if v.limits.is_some() {
             ", within the command limits"
         } else {
             ""
         },
-        clip = if v.clipped.is_some() {
-            "the clipped count (when BOUND = 0) "
+        clip = if v.clipped.is_some() && v.bound == 0.0 {
+            "the clipped count "
         } else {
             ""
         },
-        bound = v.bound,
-        range = rust_literal(output_range(v)),
+        bound = n.literal(v.bound),
+        range = n.literal(output_range(v)),
         faults = v.faults,
         len_u = v.inputs.iter().map(Vec::len).sum::<usize>(),
-        len_y = v.outputs.iter().map(Vec::len).sum::<usize>(),
-        u = table(&v.inputs, rust_literal),
-        y = table(&v.outputs, rust_literal),
+        u = n.table(v.inputs.iter().flatten().copied()),
     )
 }

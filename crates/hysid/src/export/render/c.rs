@@ -69,8 +69,13 @@ impl Syntax for C<'_> {
             "0"
         }
     }
+    /// `<math.h>`'s `NAN` is a float constant: cast in double, so that no float is promoted
+    /// (`-Wdouble-promotion`).
     fn nan(&self) -> &'static str {
-        "NAN"
+        match self.precision {
+            Precision::Double => "((double)NAN)",
+            Precision::Single => "NAN",
+        }
     }
     fn is_finite(&self, x: (String, u8)) -> (String, u8) {
         (format!("isfinite({})", x.0), ATOM)
