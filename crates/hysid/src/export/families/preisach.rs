@@ -1,7 +1,9 @@
 //! The discrete Preisach plane (`model::operators::preisach`): the staircase memory with
 //! wiping-out, the running sums of the strips' Everett integrals and the Everett function
 //! from the triangle's prefix sums, transliterated with the library's order of operations;
-//! G⁻¹ is the library's monotone per-sample solve on a trial copy of the memory.
+//! G⁻¹ is the library's bounded solve on a trial copy of the memory (`Preisach`'s docs,
+//! "Inverse"): bisection over the grid levels and the memory's corners, then the root of the
+//! quadratic on the interval left, at most 1 + ⌈log₂ N⌉ + 6 + 1 trial steps a sample.
 //!
 //! **A bounded memory.** The library keeps the alternating dominant extrema in a growing
 //! list. Within a cell of uniform density the output depends on where every corner of the
@@ -14,10 +16,9 @@
 //! solve evaluates.
 
 use super::oriented::EmitCore;
-use crate::export::code::{call, idx, local, select, Block, Expr, Ty};
+use crate::export::code::{call, idx, local, select, typed, Block, Expr, Ty};
 use crate::export::program::{Ns, Program, DIVERGED_FIELD};
-use crate::export::solve;
-use crate::model::operators::preisach::{prefix_sums, Grid};
+use crate::model::operators::preisach::{column_sums, prefix_sums, row_sums, Grid};
 use crate::model::operators::{Orientation, Preisach};
 use crate::Result;
 use std::ops::Not;
@@ -72,7 +73,8 @@ impl Memory {
     }
 }
 
-/// Emits the Everett function `ns.everett(alpha, beta)` (`Preisach::everett`).
+/// Emits the Everett function `ns.everett(alpha, beta)` of the simulation
+/// (`Preisach::everett`: the cut cells of one row and one column summed).
 fn everett(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<String> {
     let g = *op.grid();
     let n = g.n;
@@ -168,11 +170,85 @@ fn everett(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<String> {
     )
 }
 
-/// Emits `ns.apply(m, x) -> index` (`Memory::apply` on memory m: the first point that
-/// changed) and `ns.advance(m, x) -> f64` (`State::advance`: the integral over S⁺).
-fn advance(op: &Preisach, ns: &Ns, prog: &mut Program, mem: &Memory) -> Result<String> {
+/// Emits the Everett function `ns.everett(alpha, beta)` of the inverse
+/// (`Preisach::everett_by_sums`: O(1) from the prefix sums over the triangle and along the
+/// rows and columns).
+fn everett_by_sums(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<String> {
     let g = *op.grid();
-    let everett = everett(op, ns, prog)?;
+    let n = g.n;
+    let h = (g.upper - g.lower) / n as f64;
+    let levels: Vec<f64> = (0..=n).map(|k| g.level(k)).collect();
+    let level = prog.table(&ns.table("level"), levels)?;
+    let w = prog.table(&ns.table("w"), op.weights().to_vec())?;
+    let q = prog.table(&ns.table("q"), prefix_sums(&g, op.weights()))?;
+    let rows = prog.table(&ns.table("rows"), row_sums(&g, op.weights()))?;
+    let columns = prog.table(&ns.table("columns"), column_sums(&g, op.weights()))?;
+    let t = |name: &str, i: Expr| Expr::Table(name.into(), Box::new(i));
+    let interval = prog.function(
+        &ns.name("interval"),
+        &[("x", Ty::F64)],
+        Some(Ty::Index),
+        |b| {
+            let k = ((local("x") - g.lower) / h).floor().max(0.0);
+            b.ret(k.min((n - 1) as f64).to_index());
+        },
+    )?;
+    let hh = h * h;
+    let cell = |i: Expr, j: Expr| i.clone() * (i + idx(1)) / idx(2) + j;
+    prog.function(
+        &ns.name("everett"),
+        &[("alpha_in", Ty::F64), ("beta_in", Ty::F64)],
+        Some(Ty::F64),
+        |b| {
+            let alpha = b.let_("alpha", local("alpha_in").min(g.upper));
+            let beta = b.let_("beta", local("beta_in").max(g.lower));
+            b.if_(alpha.clone().le(beta.clone()), |b| b.ret(0.0));
+            let i = b.local("i", Ty::Index, false, call(&interval, vec![alpha.clone()]));
+            let j = b.local("j", Ty::Index, false, call(&interval, vec![beta.clone()]));
+            let diagonal = t(&w, cell(i.clone(), i.clone()));
+            b.if_(i.clone().eq(j.clone()), |b| {
+                let d = b.let_("d", alpha.clone() - beta.clone());
+                b.ret(diagonal.clone() * (d.clone() * d) / hh);
+            });
+            let whole = b.var("whole", 0.0);
+            b.if_((j.clone() + idx(1)).lt(i.clone()), |b| {
+                b.set("whole", t(&q, (j.clone() + idx(1)) * n + i.clone() - 1));
+            });
+            let da = b.let_("da", alpha - t(&level, i.clone()));
+            let db = b.let_("db", t(&level, j.clone() + idx(1)) - beta);
+            let row = b.let_(
+                "row",
+                t(&rows, cell(i.clone(), i.clone()))
+                    - t(&rows, cell(i.clone(), j.clone() + idx(1))),
+            );
+            let column = b.let_(
+                "column",
+                t(&columns, cell(i.clone(), j.clone()))
+                    - t(&columns, cell(j.clone() + idx(1), j.clone())),
+            );
+            b.ret(
+                whole
+                    + t(&w, cell(i.clone(), j.clone())) * (db.clone() * da.clone()) / hh
+                    + row * da.clone() / h
+                    + diagonal * (da.clone() * da) / hh
+                    + t(&w, cell(j.clone(), j.clone())) * (db.clone() * db.clone()) / hh
+                    + column * db / h,
+            );
+        },
+    )
+}
+
+/// Emits `ns.apply(m, x) -> index` (`Memory::apply` on memory m: the first point that
+/// changed) and `ns.advance(m, x) -> f64` (`State::advance`: the integral over S⁺, by the
+/// Everett function `everett`).
+fn advance(
+    op: &Preisach,
+    ns: &Ns,
+    prog: &mut Program,
+    mem: &Memory,
+    everett: &str,
+) -> Result<String> {
+    let g = *op.grid();
     let m = local("m");
     let apply = prog.function(
         &ns.name("apply"),
@@ -266,7 +342,7 @@ fn advance(op: &Preisach, ns: &Ns, prog: &mut Program, mem: &Memory) -> Result<S
                 let m_prev = b.let_("m_prev", mem.p(&m, k - idx(1)));
                 let a = b.let_(
                     "a",
-                    call(&everett, vec![big.clone(), m_prev]) - call(&everett, vec![big, m_next]),
+                    call(everett, vec![big.clone(), m_prev]) - call(everett, vec![big, m_next]),
                 );
                 let pl = b.local("pl", Ty::Index, false, mem.plen(&m));
                 let before = select(pl.clone().gt(idx(0)), mem.q(&m, pl.clone() - idx(1)), 0.0);
@@ -297,7 +373,8 @@ impl EmitCore for Preisach {
     fn emit_core(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
         let mem = Memory::declare(prog, ns)?;
         init(prog, &mem, self.lower());
-        let advance = advance(self, ns, prog, &mem)?;
+        let everett = everett(self, ns, prog)?;
+        let advance = advance(self, ns, prog, &mem, &everett)?;
         let (c, a0, q_last) = (self.offset(), self.a0(), last_prefix(self));
         prog.function(&ns.name("g"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
             let up = b.let_("up", call(&advance, vec![idx(0), local("x")]));
@@ -308,7 +385,8 @@ impl EmitCore for Preisach {
     fn emit_core_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<(String, Option<String>)> {
         let mem = Memory::declare(prog, ns)?;
         init(prog, &mem, self.lower());
-        let advance = advance(self, ns, prog, &mem)?;
+        let everett = everett_by_sums(self, ns, prog)?;
+        let advance = advance(self, ns, prog, &mem, &everett)?;
         let (c, a0, q_last) = (self.offset(), self.a0(), last_prefix(self));
         let one = idx(1);
         let trial = prog.function(&ns.name("trial"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
@@ -327,25 +405,204 @@ impl EmitCore for Preisach {
             let up = b.let_("up", call(&advance, vec![one.clone(), local("x")]));
             b.ret(c + a0 * local("x") + 2.0 * up - q_last);
         })?;
-        let solve = solve::emit(prog, ns, &trial)?;
-        let (lower, upper) = (self.lower(), self.upper());
-        let center = 0.5 * (lower + upper);
-        let span = 0.5 * (upper - lower) * (1.0 + 1e-12);
-        let unbounded = Expr::Flag(a0 > 0.0);
-        let name = prog.function(&ns.name("g_inv"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
-            let args = vec![
-                local("v"),
-                center.into(),
-                span.into(),
-                unbounded.clone(),
-                unbounded,
-            ];
-            let x = b.let_("u", call(&solve, args));
-            b.call(&advance, vec![idx(0), x.clone()]);
-            b.ret(x);
-        })?;
+        let name = bounded_inverse(self, ns, prog, &mem, &trial, &advance)?;
         Ok((name, Some(ns.name("clipped"))))
     }
+}
+
+/// Emits `ns.g_inv(v)`, the library's `Preisach::solve` and the advance of the operator's
+/// memory with its root (`Preisach::backward_step`), with the same comparisons and order of
+/// operations; `trial(x)` is the output after x from a copy of the memory. Sets the flag
+/// `ns.clipped`. Returns the function's name.
+fn bounded_inverse(
+    op: &Preisach,
+    ns: &Ns,
+    prog: &mut Program,
+    mem: &Memory,
+    trial: &str,
+    advance: &str,
+) -> Result<String> {
+    let g = *op.grid();
+    let n = g.n;
+    let (c, a0, q_last) = (op.offset(), op.a0(), last_prefix(op));
+    let clipped = prog.field(
+        &ns.name("clipped"),
+        Ty::Flag,
+        None,
+        "the last solve clipped its target to a saturation level",
+    )?;
+    let command = prog.field(&ns.name("command"), Ty::F64, None, "the last command")?;
+    let output = prog.field(
+        &ns.name("output"),
+        Ty::F64,
+        None,
+        "the output of the last command (the branch's start)",
+    )?;
+    let initial = c + a0 * g.lower + 2.0 * 0.0 - q_last;
+    prog.init(|b| {
+        b.set_state(&command, g.lower);
+        b.set_state(&output, initial);
+    });
+    let level = ns.table("level");
+    let lv = |k: Expr| Expr::Table(level.clone(), Box::new(k));
+    let interval = ns.name("interval");
+    let f = |x: Expr| call(trial, vec![x]);
+    let solve = prog.function(&ns.name("solve"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
+        let v = local("v");
+        let tol = typed(1e-12, 16.0 * f32::EPSILON as f64) * (1.0 + v.clone().abs());
+        b.set_state(&clipped, Expr::Flag(false));
+        let u = b.let_("u", Expr::State(command.clone()));
+        let y = b.let_("y", Expr::State(output.clone()));
+        b.if_(v.clone().eq(y.clone()), |b| b.ret(u.clone()));
+        let rising = b.local("rising", Ty::Flag, false, v.clone().gt(y.clone()));
+        let end = b.let_("end", select(rising.clone(), g.upper, g.lower));
+        // Beyond the grid only a0 x moves: from (x0, f0) the root is linear.
+        let linear = |b: &mut Block, x0: Expr, f0: Expr| {
+            if a0 > 0.0 {
+                let x = b.let_("x_lin", x0.clone() + (v.clone() - f0.clone()) / a0);
+                b.if_(x.clone().is_finite(), |b| b.ret(x));
+            }
+            b.set_state(&clipped, (v.clone() - f0).abs().gt(tol.clone()));
+            b.ret(x0);
+        };
+        let beyond = select(
+            rising.clone(),
+            u.clone().ge(end.clone()),
+            u.clone().le(end.clone()),
+        );
+        b.if_(beyond, |b| linear(b, u.clone(), y.clone()));
+        let f_end = b.let_("f_end", f(end.clone()));
+        let short = select(
+            rising.clone(),
+            f_end.clone().lt(v.clone()),
+            f_end.clone().gt(v.clone()),
+        );
+        b.if_(short, |b| linear(b, end.clone(), f_end.clone()));
+        let a = b.var("a", select(rising.clone(), u.clone(), end.clone()));
+        let fa = b.var("fa", select(rising.clone(), y.clone(), f_end.clone()));
+        let bb = b.var("b", select(rising.clone(), end.clone(), u.clone()));
+        let fb = b.var("fb", select(rising.clone(), f_end.clone(), y.clone()));
+        // The grid levels strictly inside (a, b): k_lo <= k < k_end.
+        let k_lo = b.local(
+            "k_lo",
+            Ty::Index,
+            true,
+            select(
+                a.clone().lt(g.lower),
+                idx(0),
+                call(&interval, vec![a.clone()]) + idx(1),
+            ),
+        );
+        b.if_(lv(k_lo.clone()).le(a.clone()), |b| {
+            b.set("k_lo", k_lo.clone() + idx(1))
+        });
+        let k_end = b.local(
+            "k_end",
+            Ty::Index,
+            true,
+            select(
+                bb.clone().gt(g.upper),
+                idx(n + 1),
+                call(&interval, vec![bb.clone()]) + idx(1),
+            ),
+        );
+        b.if_(lv(k_end.clone() - idx(1)).ge(bb.clone()), |b| {
+            b.set("k_end", k_end.clone() - idx(1))
+        });
+        let narrow = |b: &mut Block, x: Expr| {
+            let fx = b.let_("fx", f(x.clone()));
+            b.if_(fx.clone().eq(v.clone()), |b| b.ret(x.clone()));
+            b.if_else(
+                fx.clone().lt(v.clone()),
+                |b| {
+                    b.set("a", x.clone());
+                    b.set("fa", fx.clone());
+                },
+                |b| {
+                    b.set("b", x.clone());
+                    b.set("fb", fx.clone());
+                },
+            );
+            fx
+        };
+        b.while_(k_lo.clone().lt(k_end.clone()), |b| {
+            let mid = b.local(
+                "mid",
+                Ty::Index,
+                false,
+                k_lo.clone() + (k_end.clone() - k_lo.clone()) / idx(2),
+            );
+            let fx = narrow(b, lv(mid.clone()));
+            b.if_else(
+                fx.lt(v.clone()),
+                |b| b.set("k_lo", mid.clone() + idx(1)),
+                |b| b.set("k_end", mid.clone()),
+            );
+        });
+        // The memory's points strictly inside (a, b): p[first], p[first + 2], ...
+        let zero = idx(0);
+        let len = b.local("len", Ty::Index, false, mem.len(&zero));
+        let first = b.local("first", Ty::Index, true, len.clone());
+        let last = b.local("last", Ty::Index, true, idx(0));
+        b.for_("i", idx(0), len.clone() - idx(1), |b, i| {
+            let p = b.let_("p", mem.p(&zero, i.clone()));
+            b.if_(p.clone().gt(a.clone()).and(p.lt(bb.clone())), |b| {
+                b.if_(i.clone().lt(first.clone()), |b| b.set("first", i.clone()));
+                b.set("last", i.clone());
+            });
+        });
+        let j_lo = b.local("j_lo", Ty::Index, true, idx(0));
+        let j_end = b.local(
+            "j_end",
+            Ty::Index,
+            true,
+            select(
+                first.clone().le(last.clone()),
+                (last.clone() - first.clone()) / idx(2) + idx(1),
+                idx(0),
+            ),
+        );
+        b.while_(j_lo.clone().lt(j_end.clone()), |b| {
+            let mid = b.local(
+                "mid",
+                Ty::Index,
+                false,
+                j_lo.clone() + (j_end.clone() - j_lo.clone()) / idx(2),
+            );
+            let fx = narrow(b, mem.p(&zero, first.clone() + idx(2) * mid.clone()));
+            b.if_else(
+                fx.lt(v.clone()).eq(rising.clone()),
+                |b| b.set("j_end", mid.clone()),
+                |b| b.set("j_lo", mid.clone() + idx(1)),
+            );
+        });
+        b.if_(fa.clone().eq(v.clone()), |b| b.ret(a.clone()));
+        b.if_(fb.clone().eq(v.clone()), |b| b.ret(bb.clone()));
+        let m = b.let_("m", 0.5 * (a.clone() + bb.clone()));
+        let fm = b.let_("fm", f(m));
+        let qa = b.let_("qa", 2.0 * (fb.clone() - 2.0 * fm.clone() + fa.clone()));
+        let qb = b.let_("qb", 4.0 * fm - 3.0 * fa.clone() - fb.clone());
+        let qc = b.let_("qc", fa - v.clone());
+        let disc = b.let_(
+            "disc",
+            (qb.clone() * qb.clone() - 4.0 * qa * qc.clone()).max(0.0),
+        );
+        let den = b.let_("den", qb + disc.sqrt());
+        let t = b.var("t", 0.0);
+        b.if_(den.clone().gt(0.0), |b| {
+            let ratio = b.let_("ratio", -2.0 * qc / den);
+            b.set("t", ratio.clamp(0.0, 1.0));
+        });
+        let x = b.let_("x", a.clone() + t * (bb.clone() - a.clone()));
+        b.ret(x.clamp(a, bb));
+    })?;
+    prog.function(&ns.name("g_inv"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
+        let x = b.let_("u", call(&solve, vec![local("v")]));
+        let up = b.let_("up", call(advance, vec![idx(0), x.clone()]));
+        b.set_state(&command, x.clone());
+        b.set_state(&output, c + a0 * x.clone() + 2.0 * up - q_last);
+        b.ret(x);
+    })
 }
 
 /// q\[N − 1\] = Σ w: the output's constant −Σ w (all relays down).

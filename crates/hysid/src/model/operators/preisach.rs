@@ -21,13 +21,44 @@
 //! **Everett function.** E(α, β) = ∫∫_{β ≤ β' ≤ α' ≤ α} μ, computed from the prefix sums of the
 //! weights over the triangle plus the partial cells of one row and one column; the output is
 //! G = c + a₀u + 2 Σₖ [E(Mₖ, mₖ₋₁) − E(Mₖ, mₖ)] − Σ w, a cost of O(memory length · N) per
-//! sample instead of O(N²).
+//! sample instead of O(N²) ([`Preisach::everett`], the simulation's form, unchanged so that
+//! saved models simulate to the bit). The inverse's trial steps use the same function in O(1)
+//! from the sums along each row and column as well ([`Preisach::everett_by_sums`]; equal up to
+//! rounding); the inverse's own memory advances with it too, so that its trials and its state
+//! agree.
+//!
+//! **Inverse in a bounded number of steps.** From the current memory, the branch
+//! f(x) = G\[…, x\] is continuous and non-decreasing in the next input x, and it is a
+//! quadratic in x between consecutive *breakpoints*: the grid levels (where α or β enters
+//! another row or column of cells: the Everett function's partial cells are linear in α or β
+//! off the diagonal and quadratic on it) and the memory's extrema the input would wipe out
+//! (where the staircase, so the strip whose Everett integral moves, changes). Beyond the grid
+//! only the term a₀x moves. [`Preisach`]'s G⁻¹(v) from the last command u with output y:
+//!
+//! 1. v = y gives u. Otherwise the target lies towards the grid's end e in the direction of
+//!    v − y (its upper end for v > y); one trial at e gives f(e). When v is beyond it (or u
+//!    is beyond the grid already) the linear term gives x = e + (v − f(e))/a₀ exactly; with
+//!    a₀ = 0 the command is e and the target is clipped.
+//! 2. Otherwise [a, b] = [u, e] (or [e, u]) brackets v, f(a) ≤ v ≤ f(b). Bisection over the
+//!    grid levels strictly inside it (at most ⌈log₂ N⌉ trials), then over the memory's
+//!    points strictly inside what remains (the extrema the input would wipe out: all on the
+//!    target's side of u, so all maxima or all minima, monotone in their age; at most
+//!    ⌈log₂ 33⌉ = 6 trials for the 64 points a stream holds), narrows [a, b] to an
+//!    interval without a breakpoint.
+//! 3. On it f is the quadratic through f(a), f(m), f(b), m the midpoint (one trial): with
+//!    t = (x − a)/(b − a), f = f(a) + B t + A t², A = 2(f(b) − 2f(m) + f(a)),
+//!    B = 4f(m) − 3f(a) − f(b), and the root in [0, 1] is t = −2C / (B + √(B² − 4AC)),
+//!    C = f(a) − v (the form without cancellation: B ≥ 0 on a non-decreasing branch).
+//!
+//! So a step costs at most 1 + ⌈log₂ N⌉ + 6 + 1 trial steps and the final one (13 + 1 on a
+//! 20 × 20 grid), each a copy of the memory and one advance — whatever the input sequence,
+//! where a bracketing and Illinois solve took up to hundreds; the exported code
+//! (`export::families::preisach`) makes the same computation. The root is exact up to the
+//! rounding of the three values.
 //!
 //! Reference: I. D. Mayergoyz, *Mathematical Models of Hysteresis*, Springer 1991.
 
-use super::elementary::{
-    check_finite, oriented_invert, oriented_simulate, solve_monotone, Branch, Core, Orientation,
-};
+use super::elementary::{check_finite, oriented_invert, oriented_simulate, Core, Orientation};
 use super::{HysteresisOperator, Inversion};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -47,7 +78,8 @@ impl Grid {
     fn h(&self) -> f64 {
         (self.upper - self.lower) / self.n as f64
     }
-    fn level(&self, k: usize) -> f64 {
+    /// The level x_k (x_N is the upper end itself).
+    pub fn level(&self, k: usize) -> f64 {
         if k >= self.n {
             self.upper
         } else {
@@ -202,6 +234,9 @@ impl Memory {
     }
 }
 
+/// A form of the Everett function ([`Preisach::everett`], [`Preisach::everett_by_sums`]).
+type Everett = fn(&Preisach, f64, f64) -> f64;
+
 /// The memory with the running sums of the strips' Everett integrals
 /// Σ_{t≤s} [E(M_t, m_{t−1}) − E(M_t, m_t)], so that a sample costs only the strips it changes.
 #[derive(Clone, Debug)]
@@ -237,15 +272,17 @@ impl State {
         self.prefix.clone_from(&other.prefix);
     }
 
-    /// Moves the input to x and returns the integral of μ over S⁺.
-    fn advance(&mut self, model: &Preisach, x: f64) -> f64 {
+    /// Moves the input to x and returns the integral of μ over S⁺, each changed strip's
+    /// Everett integrals by `everett` (the simulation's [`Preisach::everett`], or the
+    /// inverse's [`Preisach::everett_by_sums`]).
+    fn advance(&mut self, model: &Preisach, x: f64, everett: Everett) -> f64 {
         let first = self.memory.apply(&model.grid, x);
         // strip s uses points 2s … 2s + 2
         let keep = first.saturating_sub(2) / 2;
         self.prefix.truncate(keep.min(self.prefix.len()));
         for s in self.prefix.len()..self.memory.n_strips() {
             let (m_prev, m_next, big) = self.memory.strip(s);
-            let a = model.everett(big, m_prev) - model.everett(big, m_next);
+            let a = everett(model, big, m_prev) - everett(model, big, m_next);
             let before = self.prefix.last().copied().unwrap_or(0.0);
             self.prefix.push(before + a);
         }
@@ -264,6 +301,11 @@ pub struct Preisach {
     /// q[a·N + b] = Σ_{a ≤ j ≤ i ≤ b} w_{ij} (prefix sums over the triangle).
     #[serde(skip)]
     q: Vec<f64>,
+    /// The sums along each row and column ([`row_sums`], [`column_sums`]).
+    #[serde(skip)]
+    rows: Vec<f64>,
+    #[serde(skip)]
+    columns: Vec<f64>,
 }
 
 impl Preisach {
@@ -316,14 +358,15 @@ impl Preisach {
                 reason: "every weight is zero: the operator is constant".into(),
             });
         }
-        let q = prefix_sums(&grid, &weights);
         Ok(Self {
+            q: prefix_sums(&grid, &weights),
+            rows: row_sums(&grid, &weights),
+            columns: column_sums(&grid, &weights),
             grid,
             weights,
             a0,
             offset,
             orientation,
-            q,
         })
     }
 
@@ -361,7 +404,10 @@ impl Preisach {
         self.orientation
     }
 
-    /// The Everett function E(α, β) = ∫∫_{β ≤ β' ≤ α' ≤ α} μ.
+    /// The Everett function E(α, β) = ∫∫_{β ≤ β' ≤ α' ≤ α} μ: the whole cells from the
+    /// prefix sums, the cut cells of α's row and β's column each by its area fraction (O(N)).
+    /// The simulation's form, kept to the bit for saved models; the inverse's trial steps use
+    /// [`Preisach::everett_by_sums`].
     pub fn everett(&self, alpha: f64, beta: f64) -> f64 {
         let g = &self.grid;
         let (alpha, beta) = (alpha.min(g.upper), beta.max(g.lower));
@@ -388,6 +434,47 @@ impl Preisach {
         full + partial_row + partial_col
     }
 
+    /// The Everett function E(α, β) = ∫∫_{β ≤ β' ≤ α' ≤ α} μ in O(1), equal to
+    /// [`Preisach::everett`] up to rounding (the inverse's form): with i = the row of α,
+    /// j = the column of β, dα = α − x_i and dβ = x_{j+1} − β (how far each reaches into
+    /// its cell), E = w_ii (α − β)² / h² when i = j, else
+    ///
+    /// E = Q + w_ij dβ dα / h² + R dα / h + w_ii dα² / h² + w_jj dβ² / h² + C dβ / h,
+    ///
+    /// Q the whole cells strictly between (the prefix sums q), R the row i's cells strictly
+    /// between columns j and i, C the column j's cells strictly between rows j and i (the
+    /// row and column sums): the cells of row i are cut at α (the diagonal one along the
+    /// triangle), those of column j at β.
+    pub fn everett_by_sums(&self, alpha: f64, beta: f64) -> f64 {
+        let g = &self.grid;
+        let (alpha, beta) = (alpha.min(g.upper), beta.max(g.lower));
+        if alpha <= beta {
+            return 0.0;
+        }
+        let (i, j) = (g.interval(alpha), g.interval(beta));
+        let (h, w) = (g.h(), &self.weights);
+        let hh = h * h;
+        if i == j {
+            let d = alpha - beta;
+            return w[Grid::index(i, i)] * (d * d) / hh;
+        }
+        let whole = if j + 1 < i {
+            self.q[(j + 1) * g.n + i - 1]
+        } else {
+            0.0
+        };
+        let da = alpha - g.level(i);
+        let db = g.level(j + 1) - beta;
+        let row = self.rows[Grid::index(i, i)] - self.rows[Grid::index(i, j + 1)];
+        let column = self.columns[Grid::index(i, j)] - self.columns[Grid::index(j + 1, j)];
+        whole
+            + w[Grid::index(i, j)] * (db * da) / hh
+            + row * da / h
+            + w[Grid::index(i, i)] * (da * da) / hh
+            + w[Grid::index(j, j)] * (db * db) / hh
+            + column * db / h
+    }
+
     /// The output from the integral over S⁺ and the input x.
     fn output(&self, up: f64, x: f64) -> f64 {
         self.offset + self.a0 * x + 2.0 * up - self.q[self.grid.n - 1]
@@ -407,6 +494,34 @@ pub(crate) fn prefix_sums(grid: &Grid, w: &[f64]) -> Vec<f64> {
         }
     }
     q
+}
+
+/// rows[index(i, j)] = Σ_{k < j} w_{ik}: the sums along row i, before column j (also the
+/// exported code's table).
+pub(crate) fn row_sums(grid: &Grid, w: &[f64]) -> Vec<f64> {
+    let mut rows = vec![0.0; grid.cells()];
+    for i in 0..grid.n {
+        let mut acc = 0.0;
+        for j in 0..=i {
+            rows[Grid::index(i, j)] = acc;
+            acc += w[Grid::index(i, j)];
+        }
+    }
+    rows
+}
+
+/// columns[index(i, j)] = Σ_{j ≤ k < i} w_{kj}: the sums down column j, before row i (also
+/// the exported code's table).
+pub(crate) fn column_sums(grid: &Grid, w: &[f64]) -> Vec<f64> {
+    let mut columns = vec![0.0; grid.cells()];
+    for j in 0..grid.n {
+        let mut acc = 0.0;
+        for i in j..grid.n {
+            columns[Grid::index(i, j)] = acc;
+            acc += w[Grid::index(i, j)];
+        }
+    }
+    columns
 }
 
 /// The regressors φ_{ij} = 2·(area in S⁺)/(cell area) − 1 of every cell for a memory.
@@ -431,11 +546,151 @@ pub fn regressors(grid: &Grid, memory: &Memory, phi: &mut [f64]) {
     }
 }
 
-/// The inverse's state: the plane's, and scratch space for the solve's trial steps.
+/// The inverse's state: the plane's, the last command and its output (the branch's start),
+/// and scratch space for the solve's trial steps.
 #[derive(Clone, Debug)]
 pub(crate) struct PreisachBackward {
     state: State,
+    command: f64,
+    output: f64,
     trial: RefCell<State>,
+}
+
+/// The largest |v − f| of a reached target: a larger one beyond a saturation level counts
+/// as clipped (the exported code's in double; `float`'s 16 ε in single).
+fn clip_tolerance(v: f64) -> f64 {
+    1e-12 * (1.0 + v.abs())
+}
+
+/// The root t ∈ [0, 1] of the quadratic through (0, fa), (½, fm), (1, fb) equal to v, for
+/// fa ≤ v ≤ fb on a non-decreasing branch (module docs, "Inverse", step 3).
+pub(crate) fn quadratic_root(fa: f64, fm: f64, fb: f64, v: f64) -> f64 {
+    let a = 2.0 * (fb - 2.0 * fm + fa);
+    let b = 4.0 * fm - 3.0 * fa - fb;
+    let c = fa - v;
+    let disc = (b * b - 4.0 * a * c).max(0.0);
+    let den = b + disc.sqrt();
+    if den > 0.0 {
+        (-2.0 * c / den).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+impl Preisach {
+    /// G⁻¹(v) from the last command (module docs, "Inverse"): (command, clipped).
+    fn solve(&self, backward: &PreisachBackward, v: f64) -> (f64, bool) {
+        let g = self.grid;
+        let state = &backward.state;
+        let f = |x: f64| {
+            let mut trial = backward.trial.borrow_mut();
+            trial.copy_from(state);
+            let up = trial.advance(self, x, Preisach::everett_by_sums);
+            self.output(up, x)
+        };
+        let (u, y) = (backward.command, backward.output);
+        if v == y {
+            return (u, false);
+        }
+        let rising = v > y;
+        let end = if rising { g.upper } else { g.lower };
+        // Beyond the grid only a₀x moves: from (x0, f0) the root is linear.
+        let linear = |x0: f64, f0: f64| -> (f64, bool) {
+            if self.a0 > 0.0 {
+                let x = x0 + (v - f0) / self.a0;
+                if x.is_finite() {
+                    return (x, false);
+                }
+            }
+            (x0, (v - f0).abs() > clip_tolerance(v))
+        };
+        if (rising && u >= end) || (!rising && u <= end) {
+            return linear(u, y);
+        }
+        let f_end = f(end);
+        if (rising && f_end < v) || (!rising && f_end > v) {
+            return linear(end, f_end);
+        }
+        let ((mut a, mut fa), (mut b, mut fb)) = if rising {
+            ((u, y), (end, f_end))
+        } else {
+            ((end, f_end), (u, y))
+        };
+        // The grid levels x_0 … x_N strictly inside (a, b): k_lo ≤ k < k_end (the ends x_0,
+        // x_N too when the last command lies beyond the grid).
+        let mut k_lo = if a < g.lower { 0 } else { g.interval(a) + 1 };
+        if g.level(k_lo) <= a {
+            k_lo += 1;
+        }
+        let mut k_end = if b > g.upper {
+            g.n + 1
+        } else {
+            g.interval(b) + 1
+        };
+        if g.level(k_end - 1) >= b {
+            k_end -= 1;
+        }
+        while k_lo < k_end {
+            let mid = k_lo + (k_end - k_lo) / 2;
+            let x = g.level(mid);
+            let fx = f(x);
+            if fx == v {
+                return (x, false);
+            }
+            if fx < v {
+                (a, fa, k_lo) = (x, fx, mid + 1);
+            } else {
+                (b, fb, k_end) = (x, fx, mid);
+            }
+        }
+        // The extrema the input would wipe out on its way: the memory's points strictly
+        // inside (a, b), all on one side of u, so all maxima (rising) or all minima
+        // (falling), every other point p[first], p[first + 2], …, nearer u the later.
+        let p = state.memory.points();
+        let (mut first, mut last) = (p.len(), 0);
+        for (i, &c) in p[..p.len() - 1].iter().enumerate() {
+            if c > a && c < b {
+                if i < first {
+                    first = i;
+                }
+                last = i;
+            }
+        }
+        let mut j_lo = 0;
+        let mut j_end = if first <= last {
+            (last - first) / 2 + 1
+        } else {
+            0
+        };
+        while j_lo < j_end {
+            let mid = j_lo + (j_end - j_lo) / 2;
+            let x = p[first + 2 * mid];
+            let fx = f(x);
+            if fx == v {
+                return (x, false);
+            }
+            if fx < v {
+                (a, fa) = (x, fx);
+            } else {
+                (b, fb) = (x, fx);
+            }
+            // The root lies above x when f(x) < v: rising, towards the older maxima.
+            if (fx < v) == rising {
+                j_end = mid;
+            } else {
+                j_lo = mid + 1;
+            }
+        }
+        if fa == v {
+            return (a, false);
+        }
+        if fb == v {
+            return (b, false);
+        }
+        let m = 0.5 * (a + b);
+        let t = quadratic_root(fa, f(m), fb, v);
+        ((a + t * (b - a)).clamp(a, b), false)
+    }
 }
 
 impl Core for Preisach {
@@ -454,37 +709,29 @@ impl Core for Preisach {
     /// c + a₀u + 2·Σₖ [E(Mₖ, mₖ₋₁) − E(Mₖ, mₖ)] − Σw, the strips' sums accumulated oldest
     /// first (module doc).
     fn forward_step(&self, state: &mut State, u: f64) -> f64 {
-        let up = state.advance(self, u);
+        let up = state.advance(self, u, Preisach::everett);
         self.output(up, u)
     }
 
+    /// Negative saturation, the last command the grid's lower end.
     fn backward_state(&self, horizon: Option<usize>) -> PreisachBackward {
         let state = State::for_horizon(&self.grid, horizon);
         PreisachBackward {
             trial: RefCell::new(state.clone()),
             state,
+            command: self.grid.lower,
+            output: self.output(0.0, self.grid.lower),
         }
     }
 
-    /// The branch from the current memory solved for v by trial steps on a copy of the
-    /// state, then the state advanced with the solution.
+    /// The branch from the current memory solved for v in a bounded number of trial steps
+    /// on a copy of the state (module docs, "Inverse"), then the state advanced with the
+    /// solution.
     fn backward_step(&self, backward: &mut PreisachBackward, v: f64) -> (f64, bool) {
-        let g = self.grid;
-        let branch = Branch {
-            center: 0.5 * (g.lower + g.upper),
-            span: 0.5 * (g.upper - g.lower) * (1.0 + 1e-12),
-            unbounded_below: self.a0 > 0.0,
-            unbounded_above: self.a0 > 0.0,
-        };
-        let state = &backward.state;
-        let trial = |x: f64| {
-            let mut trial_state = backward.trial.borrow_mut();
-            trial_state.copy_from(state);
-            let up = trial_state.advance(self, x);
-            self.output(up, x)
-        };
-        let (u, clipped) = solve_monotone(trial, v, branch);
-        backward.state.advance(self, u);
+        let (u, clipped) = self.solve(backward, v);
+        let up = backward.state.advance(self, u, Preisach::everett_by_sums);
+        backward.command = u;
+        backward.output = self.output(up, u);
         (u, clipped)
     }
 
