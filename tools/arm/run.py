@@ -3,7 +3,12 @@
 mps2-an386) and the Cortex-M7 (mps2-an500), runs each on QEMU, checks it passes and counts
 the instructions of every step exactly (docs/arm.md).
 
-    python3 tools/arm/run.py [--markdown] [--only SUBSTRING] [--exports DIR]
+    python3 tools/arm/run.py [--markdown] [--only SUBSTRING] [--skip SUBSTRING,...]
+                             [--count SUBSTRING,...] [--exports DIR]
+
+Every kind is built and checked on both cores; the instructions are counted (QEMU's
+instruction trace, slow: the differential inverses take minutes) for the kinds whose name
+contains one of the --count substrings (default: all).
 
 The exports (NAME.h, NAME.c, NAME_test.c per kind) are written by the export test
 `write_the_exports_for_the_target_harness` (cargo, release profile) unless --exports names a
@@ -82,6 +87,17 @@ def count_steps(trace, begin, end):
     return [c - empty for c in counts[1:]]
 
 
+# The libm functions that are not correctly rounded: newlib's differ from the host's glibc
+# in the last bits, so double code that calls one is checked on the target within LIBM_BOUND
+# of the range instead of equality. A last-bit difference in a branch evaluation moves where
+# an iterative solve stops (within its tolerance, 1e-13 of the output, over the branch's
+# slope): measured, every such kind passes at 1e-12 but the Jiles-Atherton cascade's
+# compensator, which passes at 1e-9 (docs/arm.md).
+TRANSCENDENTAL = re.compile(r"\b(exp|expm1|log|log1p|log10|pow|sin|cos|tan|sinh|cosh|tanh|"
+                            r"asin|acos|atan|atan2|cbrt)\s*\(")
+LIBM_BOUND = "1e-9"
+
+
 def source(exports, name, core):
     """The directory of the export `name` a core runs and its precision: the single-precision
     export (the case's `single/`) on a single-precision core unless the kind refused it."""
@@ -91,7 +107,7 @@ def source(exports, name, core):
     return src, "double"
 
 
-def build_and_run(exports, name, core, work):
+def build_and_run(exports, name, core, work, counted):
     cfg = CORES[core]
     src, precision = source(exports, name, core)
     flags = cfg["flags"] + COMMON
@@ -100,8 +116,11 @@ def build_and_run(exports, name, core, work):
     os.makedirs(b, exist_ok=True)
     obj = os.path.join(b, f"{name}.o")
     sh([cc, *flags, "-fstack-usage", "-c", os.path.join(src, f"{name}.c"), "-o", obj])
+    with open(os.path.join(src, f"{name}.c")) as f:
+        libm = precision == "double" and TRANSCENDENTAL.search(f.read()) is not None
+    allowance = [f"-D{name}_TEST_BOUND={LIBM_BOUND}"] if libm else []
     sh([cc, *flags, "-include", os.path.join(HERE, "markers.h"), f"-D{name}_TEST_NO_MAIN",
-        "-c", os.path.join(src, f"{name}_test.c"), "-o", os.path.join(b, "test.o")])
+        *allowance, "-c", os.path.join(src, f"{name}_test.c"), "-o", os.path.join(b, "test.o")])
     sh([cc, *flags, f"-DHYSID_TEST_RUN={name}_test_run", "-c",
         os.path.join(HERE, "harness.c"), "-o", os.path.join(b, "harness.o")])
     # The start-up code converts function addresses to table entries, which -pedantic refuses.
@@ -121,21 +140,25 @@ def build_and_run(exports, name, core, work):
         if doubles:
             raise RuntimeError(f"single precision pulls in {', '.join(doubles)}")
     trace = os.path.join(b, "trace.log")
+    tracing = ["-singlestep", "-d", "exec,nochain", "-D", trace] if counted else []
     done = subprocess.run(["qemu-system-arm", "-M", cfg["machine"], "-display", "none",
                            "-serial", "none", "-monitor", "none", "-chardev", "stdio,id=s0",
                            "-semihosting-config", "enable=on,target=native,chardev=s0",
-                           "-singlestep", "-d", "exec,nochain", "-D", trace,
-                           "-kernel", elf], capture_output=True, text=True, timeout=600)
+                           *tracing, "-kernel", elf], capture_output=True, text=True,
+                          timeout=1800 if counted else 900)
     passed = done.returncode == 0 and "PASS" in done.stdout
-    steps = count_steps(trace, symbol(elf, "hysid_step_begin"), symbol(elf, "hysid_step_end"))
-    os.remove(trace)
+    counts = {}
+    if counted:
+        steps = count_steps(trace, symbol(elf, "hysid_step_begin"),
+                            symbol(elf, "hysid_step_end"))
+        os.remove(trace)
+        counts = {"mean": sum(steps) / len(steps), "max": max(steps)}
     size = sh(["arm-none-eabi-size", obj]).splitlines()[1].split()
     state_bytes = [l.split() for l in sh(["arm-none-eabi-nm", "-S", os.path.join(b, "state.o")])
                    .splitlines() if l.endswith("hysid_state_bytes")][0][1]
     with open(os.path.join(b, f"{name}.su")) as f:
         stack = sum(int(l.split("\t")[1]) for l in f if l.strip())
-    return {"pass": passed, "precision": precision, "mean": sum(steps) / len(steps),
-            "max": max(steps),
+    return {"pass": passed, "precision": precision, "libm": libm, **counts,
             "code": int(size[0]) + int(size[1]), "state": int(state_bytes, 16), "stack": stack}
 
 
@@ -144,18 +167,27 @@ def main():
     p.add_argument("--markdown", action="store_true", help="print the README table")
     p.add_argument("--only", default="", help="only the kinds whose name contains this")
     p.add_argument("--exports", help="a directory of exports (default: written by the test)")
+    p.add_argument("--skip", default="",
+                   help="leave out the kinds whose name contains one of these comma-separated "
+                        "substrings")
+    p.add_argument("--count", default="",
+                   help="count instructions only for the kinds whose name contains one of "
+                        "these comma-separated substrings (default: every kind)")
     args = p.parse_args()
     with tempfile.TemporaryDirectory() as work:
         exports = args.exports or os.path.join(work, "exports")
         if not args.exports:
             write_exports(exports)
-        names = sorted(n for n in os.listdir(exports) if args.only in n)
+        skipped = [k for k in args.skip.split(",") if k]
+        names = sorted(n for n in os.listdir(exports)
+                       if args.only in n and not any(k in n for k in skipped))
         rows, failed = [], []
 
         def one(job):
             name, core = job
             try:
-                return build_and_run(exports, name, core, work)
+                counted = not args.count or any(c in name for c in args.count.split(","))
+                return build_and_run(exports, name, core, work, counted)
             except (RuntimeError, subprocess.TimeoutExpired) as e:
                 return {"pass": False, "error": str(e).splitlines()[0]}
 
@@ -169,7 +201,6 @@ def main():
                 row[core] = r
                 if not r["pass"]:
                     failed.append(f"{name} on {core}: {r.get('error', 'FAIL')}")
-            rows.append(row)
             refused = os.path.join(exports, name, "single.refused")
             if os.path.exists(refused):
                 with open(refused) as f:
@@ -182,6 +213,7 @@ def main():
                     + (f" ({row[c]['precision']})"
                        if row[c].get("precision", CORES[c]["precision"]) != CORES[c]["precision"]
                        else "")
+                    + (f" (libm {LIBM_BOUND})" if row[c].get("libm") else "")
                     for c in CORES), flush=True)
     note = ", ".join(f"{c} {CORES[c]['precision']}" for c in CORES)
     if args.markdown:
@@ -192,16 +224,19 @@ def main():
         print("|---|---|---|---|---|---|")
         for row in rows:
             a, b = row["m4f"], row["m7"]
-            if "mean" not in a or "mean" not in b:
+            if not (a["pass"] and b["pass"]):
                 print(f"| {row['name']} | failed | failed | | | |")
+                continue
+            if "mean" not in a or "mean" not in b:
                 continue
             mark = " †" if a["precision"] != CORES["m4f"]["precision"] else ""
             print(f"| {row['name']} | {a['mean']:.0f} / {a['max']}{mark} | {b['mean']:.0f} / "
                   f"{b['max']} | {a['code']} / {b['code']} | {a['state']} / {b['state']} | "
                   f"{a['stack']} / {b['stack']} |")
-        refusals = [r for r in rows if "refused" in r]
+        refusals = [r["name"] for r in rows if "refused" in r]
         if refusals:
-            print("\n† " + "; ".join(f"{r['name']}: {r['refused']}" for r in refusals))
+            print("\n† Refuses single precision (its reason in the export's `single.refused`; "
+                  "docs/export.md, \"Single precision\"): " + ", ".join(refusals) + ".")
     else:
         print(f"precision: {note}")
     for f in failed:

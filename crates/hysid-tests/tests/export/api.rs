@@ -178,3 +178,34 @@ fn grey_box_exports_refuse_band_limited_a_non_mechanical_newmark_and_a_compensat
     assert!(names_ts(&e), "{e}");
     assert!(c_code(&rk4, "bw", &with_ts).is_ok());
 }
+
+/// Every exported step states its worst case in its header (docs/export.md, "A bounded
+/// step"), and the 20 × 20 Preisach compensator's is 13 trial steps (1 at the grid's end,
+/// ⌈log₂ 22⌉ = 5 over the levels, 6 over the memory's corners, 1 at the midpoint).
+#[test]
+fn every_header_states_the_steps_worst_case() {
+    let mut all = cases::pi();
+    all.extend(cases::sized());
+    for case in all.iter().filter(|c| !c.name.ends_with("_beyond")) {
+        let code = c_code(&case.file, &case.name, &case.options)
+            .unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        assert!(
+            code.header
+                .contains("Worst case, for every input sequence:"),
+            "{}: no worst case in the header",
+            case.name
+        );
+    }
+    let preisach = all
+        .iter()
+        .find(|c| c.name == "size_preisach_20_inverse")
+        .expect("the sized Preisach compensator");
+    let header = c_code(&preisach.file, &preisach.name, &preisach.options)
+        .expect("export")
+        .header
+        .replace("\n * ", " ");
+    assert!(
+        header.contains("The Preisach inverse takes at most 13 trial steps a step"),
+        "{header}"
+    );
+}

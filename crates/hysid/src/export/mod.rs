@@ -292,6 +292,8 @@ fn prepare(file: &ModelFile, name: &str, options: &ExportOptions) -> Result<Prep
     };
     let interface = interface::interface(file, name, options, sample_time, sizes);
     let mut comment = interface::comment(file, &interface, given, sample_time);
+    comment.push('\n');
+    comment.push_str(&program.worst_case_comment());
     if let SampleTime::Resampled { fitted, given: ts } = sample_time {
         comment.push('\n');
         comment.push_str(&resampling_estimate(file, options, fitted, ts)?);

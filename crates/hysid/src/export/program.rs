@@ -67,9 +67,46 @@ pub struct Program {
     pub init: Vec<Stmt>,
     /// The step: reads the inputs, writes every output.
     pub step: Vec<Stmt>,
+    /// The worst case of the step's loops, one sentence per part that has them, for every
+    /// input sequence (the header's "Worst case" lines; `docs/export.md`, "A bounded step").
+    pub worst_case: Vec<String>,
 }
 
 impl Program {
+    /// Records the worst case of a part of the step (one sentence; see
+    /// [`Program::worst_case`]). A sentence recorded twice is kept once.
+    pub fn bound(&mut self, sentence: impl Into<String>) {
+        let sentence = sentence.into();
+        if !self.worst_case.contains(&sentence) {
+            self.worst_case.push(sentence);
+        }
+    }
+
+    /// The header's lines on the worst case: every recorded sentence, or that the step has
+    /// no loop whose count depends on the input.
+    pub fn worst_case_comment(&self) -> String {
+        let body = if self.worst_case.is_empty() {
+            "the step's loops run a fixed number of times (none depends on the input).".to_string()
+        } else {
+            self.worst_case.join(" ")
+        };
+        let mut out = String::new();
+        let mut line = String::from("Worst case, for every input sequence:");
+        for word in body.split(' ') {
+            if line.len() + 1 + word.len() > 88 {
+                out.push_str(&line);
+                out.push('\n');
+                line = word.to_string();
+            } else {
+                line.push(' ');
+                line.push_str(word);
+            }
+        }
+        out.push_str(&line);
+        out.push('\n');
+        out
+    }
+
     /// An empty program of `n_inputs` inputs and `n_outputs` outputs.
     pub fn new(n_inputs: usize, n_outputs: usize) -> Self {
         let mut program = Self {
@@ -80,6 +117,7 @@ impl Program {
             functions: Vec::new(),
             init: Vec::new(),
             step: Vec::new(),
+            worst_case: Vec::new(),
         };
         program.fields.push(Field {
             name: ERROR_FIELD.into(),

@@ -16,6 +16,12 @@ use std::ops::Not;
 /// reads the state). It sets the flag field `ns.clipped` when the target lay beyond a
 /// saturation level. Returns the solver's name.
 pub fn emit(prog: &mut Program, ns: &Ns, branch: &str) -> Result<String> {
+    prog.bound(
+        "The monotone solve (bracketing by doubling steps, then Illinois regula falsi) \
+         evaluates its branch at most 2 + D + 300 + 2 times a step, D the doublings of the \
+         bracket: none where the branch is bounded, else at most floor(log2(1e30 / s)) + 1 \
+         from its half-width s (the doubling stops beyond 1e30).",
+    );
     let clipped = prog.field(
         &ns.name("clipped"),
         Ty::Flag,

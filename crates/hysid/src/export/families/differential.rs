@@ -15,7 +15,7 @@ use crate::export::code::{
     call, epsilon, idx, lit, local, min_positive, select, typed, Block, Expr, Ty,
 };
 use crate::export::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
-use crate::model::operators::differential::{InputOde, TOLERANCE};
+use crate::model::operators::differential::{InputOde, BRACKET_DOUBLINGS, TOLERANCE};
 use crate::Result;
 use std::ops::Not;
 
@@ -236,6 +236,10 @@ fn driver<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Result<D
 /// Emits the forward step `ns.step(x)`: the state x₀ at the first sample, then advanced from
 /// the last input to this one; the output h(u, x).
 pub fn forward<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Result<String> {
+    prog.bound(format!(
+        "The Dormand-Prince integration takes at most {SUBSTEP_BUDGET} sub-steps (7 slopes \
+         each) a step; beyond, the step sets the error flag."
+    ));
     let d = driver(ode, ns, prog)?;
     let x0 = ode.initial_state();
     prog.function(&ns.name("step"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
@@ -269,6 +273,12 @@ pub fn forward<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
 /// Emits the inverse step `ns.inverse(r)` (`differential::invert`): the sample's output as
 /// a function of the new input solved for r by `solve_sample` and its Illinois iteration.
 pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Result<String> {
+    prog.bound(format!(
+        "The inverse integrates the branch at most {} times a step (the start and a probe, \
+         {BRACKET_DOUBLINGS} doublings of the bracket each way, 200 Illinois iterations and \
+         the root), each of at most {SUBSTEP_BUDGET} Dormand-Prince sub-steps.",
+        3 + 2 * BRACKET_DOUBLINGS + 200
+    ));
     let d = driver(ode, ns, prog)?;
     let x0 = ode.initial_state();
     let br_x = prog.field(
@@ -414,7 +424,8 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
                 let dd = b.var("dd", 1e-9 * span);
                 let a = b.var("a", start.clone());
                 let ga = b.var("ga", g0.clone());
-                b.while_(dd.clone().le(span), |b| {
+                b.for_("doubling", idx(0), idx(BRACKET_DOUBLINGS), |b, _| {
+                    b.if_(dd.clone().gt(span), |b| b.break_());
                     let v = b.let_("v", start.clone() + direction.clone() * dd.clone());
                     let yv = b.let_("yv", call(&branch, vec![v.clone()]));
                     b.if_(failed.clone(), |b| b.break_());

@@ -101,6 +101,11 @@ impl EmitCore for Kp {
     }
 
     fn emit_core(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
+        prog.bound(format!(
+            "The KP operator evaluates its {} ramps and {} kernels once a step.",
+            self.thresholds().len(),
+            self.weights().len()
+        ));
         let (kernels, ramps) = Kernels::declare(self, ns, prog)?;
         let k = kernels.levels * (kernels.levels + 1) / 2;
         let (c, a0) = (self.offset(), self.a0());
@@ -131,6 +136,16 @@ impl EmitCore for Kp {
     }
 
     fn emit_core_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<(String, Option<String>)> {
+        prog.bound(format!(
+            "The KP inverse's trial evaluates the {} ramps and {} kernels; the solve's \
+             bracket starts from the half-width s = {:e}.",
+            self.thresholds().len(),
+            self.weights().len(),
+            {
+                let t = self.thresholds();
+                0.5 * (t[t.len() - 1] - t[0] + self.width()) * (1.0 + 1e-12)
+            }
+        ));
         let (kernels, ramps) = Kernels::declare(self, ns, prog)?;
         let (c, a0) = (self.offset(), self.a0());
         let trial = prog.function(&ns.name("trial"), &[("x", Ty::F64)], Some(Ty::F64), |b| {

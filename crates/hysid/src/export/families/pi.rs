@@ -42,6 +42,10 @@ pub fn plays(
 
 /// G of a PI operator: `ns.g(x)`.
 pub fn emit_forward(pi: &PrandtlIshlinskii, ns: &Ns, prog: &mut Program) -> Result<String> {
+    prog.bound(format!(
+        "The PI operator updates its {} plays once a step.",
+        pi.weights().len()
+    ));
     let plays = plays(prog, ns, pi.weights(), pi.thresholds())?;
     let (c, a0) = (pi.offset(), pi.a0());
     prog.function(&ns.name("g"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
@@ -57,6 +61,11 @@ pub fn emit_inverse(
     ns: &Ns,
     prog: &mut Program,
 ) -> Result<(String, Option<String>)> {
+    prog.bound(format!(
+        "The PI inverse updates its {} plays once a step (and evaluates them once per \
+         evaluation of a monotone solve, where it has one).",
+        pi.weights().len()
+    ));
     let c = pi.offset();
     match pi.inverse_parameters() {
         Some((b0, b, s)) => {

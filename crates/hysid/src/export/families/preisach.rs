@@ -371,6 +371,13 @@ impl EmitCore for Preisach {
     }
 
     fn emit_core(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
+        prog.bound(format!(
+            "The Preisach memory ({MEMORY_POINTS} points) takes at most {} wipe-outs and \
+             recomputes at most {STRIPS} strips a step, each two Everett integrals over at \
+             most {} cut cells.",
+            MEMORY_POINTS / 2 - 1,
+            2 * self.levels()
+        ));
         let mem = Memory::declare(prog, ns)?;
         init(prog, &mem, self.lower());
         let everett = everett(self, ns, prog)?;
@@ -383,6 +390,20 @@ impl EmitCore for Preisach {
     }
 
     fn emit_core_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<(String, Option<String>)> {
+        let n = self.levels();
+        // ⌈log₂(N + 1)⌉ bisections over the levels, ⌈log₂(STRIPS + 1)⌉ over the corners.
+        let halvings = |k: usize| (usize::BITS - k.leading_zeros()) as usize;
+        prog.bound(format!(
+            "The Preisach inverse takes at most {} trial steps a step (1 at the grid's end, {} \
+             over its {n} levels, {} over the memory's corners, 1 at the last interval's \
+             midpoint), each a copy of the memory ({MEMORY_POINTS} points, {STRIPS} sums), at \
+             most {} wipe-outs and {STRIPS} strips of two O(1) Everett integrals, then one \
+             advance.",
+            2 + halvings(n + 1) + halvings(STRIPS),
+            halvings(n + 1),
+            halvings(STRIPS),
+            MEMORY_POINTS / 2 - 1,
+        ));
         let mem = Memory::declare(prog, ns)?;
         init(prog, &mem, self.lower());
         let everett = everett_by_sums(self, ns, prog)?;

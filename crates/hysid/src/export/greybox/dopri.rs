@@ -23,6 +23,10 @@ pub fn emit(
     (rtol, atol): (f64, f64),
     prog: &mut Program,
 ) -> Result<String> {
+    prog.bound(format!(
+        "The adaptive Dormand-Prince integration tries at most {GUARD} steps (7 right-hand \
+         sides each) a sample interval; beyond, the step sets the error flag."
+    ));
     let model = code.model();
     let (n, n_in) = (model.states().len(), model.inputs().len());
     let ns = &d.ns;

@@ -69,6 +69,11 @@ pub fn emit(
     substeps: usize,
     prog: &mut Program,
 ) -> Result<String> {
+    prog.bound(format!(
+        "Newmark takes {} sub-steps a step, each at most {ITERATIONS} Newton iterations of \
+         one residual, its difference Jacobian and an LU solve.",
+        substeps.max(1)
+    ));
     let model = code.model();
     let (n, n_in) = (model.states().len(), model.inputs().len());
     let dofs = model

@@ -33,6 +33,10 @@ pub fn emit(
     prog: &mut Program,
 ) -> Result<String> {
     let m = substeps.max(1);
+    prog.bound(format!(
+        "RK4 takes {m} sub-steps a step, 4 right-hand sides each (at most 63 stage sets a \
+         sub-step where a stick-slip crossing is located)."
+    ));
     let model = code.model();
     let (n, n_in) = (model.states().len(), model.inputs().len());
     let ns = &d.ns;

@@ -611,6 +611,11 @@ pub fn invert<O: InputOde + ?Sized>(ode: &O, reference: &[f64]) -> Result<Invers
     })
 }
 
+/// The most doublings of the inverse's bracket search in one direction: from 1e-9 of the
+/// inversion span, 2³⁰ · 10⁻⁹ > 1 reaches the span in 30; the cap binds only where
+/// 10⁻⁹ · span rounds to 0 (a span below about 10⁻³¹⁵), whose search would never end.
+pub(crate) const BRACKET_DOUBLINGS: usize = 30;
+
 /// Finds v with y(v) = r near `start`: (v, state, output, clipped).
 type Branch<'a> = dyn Fn(f64) -> Result<(f64, f64)> + 'a;
 
@@ -639,7 +644,10 @@ fn solve_sample<O: InputOde + ?Sized>(
     for direction in [first, -first] {
         let mut d = 1e-9 * span;
         let (mut a, mut ga) = (start, g0);
-        while d <= span {
+        for _ in 0..BRACKET_DOUBLINGS {
+            if d > span {
+                break;
+            }
             let v = start + direction * d;
             let Ok((yv, xv)) = branch(v) else { break };
             if (yv - r).abs() < (best.2 - r).abs() {
