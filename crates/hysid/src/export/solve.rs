@@ -11,6 +11,17 @@ use super::program::{Ns, Program};
 use crate::Result;
 use std::ops::Not;
 
+/// Declares the flag field `ns.clipped` of an inverse's solve: set when the last target lay
+/// beyond a saturation level. Returns its name.
+pub fn clipped_field(prog: &mut Program, ns: &Ns) -> Result<String> {
+    prog.field(
+        &ns.name("clipped"),
+        Ty::Flag,
+        None,
+        "the last solve clipped its target to a saturation level",
+    )
+}
+
 /// Emits `ns.solve(target, center, span, unbounded_below, unbounded_above) -> f64`, the root
 /// of `branch(x) = target` for the helper `branch` (a non-decreasing function of x that only
 /// reads the state). It sets the flag field `ns.clipped` when the target lay beyond a
@@ -22,12 +33,7 @@ pub fn emit(prog: &mut Program, ns: &Ns, branch: &str) -> Result<String> {
          bracket: none where the branch is bounded, else at most floor(log2(1e30 / s)) + 1 \
          from its half-width s (the doubling stops beyond 1e30).",
     );
-    let clipped = prog.field(
-        &ns.name("clipped"),
-        Ty::Flag,
-        None,
-        "the last solve clipped its target to a saturation level",
-    )?;
+    let clipped = clipped_field(prog, ns)?;
     let f = |x: Expr| Expr::Call(branch.into(), vec![x]);
     let illinois = prog.function(
         &ns.name("illinois"),

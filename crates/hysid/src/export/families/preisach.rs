@@ -73,34 +73,53 @@ impl Memory {
     }
 }
 
+/// The names of the grid's tables and its interval function, which both Everett forms use.
+struct GridTables {
+    /// x_0 … x_N.
+    level: String,
+    /// The cell weights.
+    w: String,
+    /// The prefix sums over the triangle.
+    q: String,
+    /// `ns.interval(x)`: the interval of x, clamped to 0 … N − 1 (`Grid::interval`).
+    interval: String,
+}
+
+/// Emits the tables `level`, `w`, `q` and the function `ns.interval(x)`.
+fn grid_tables(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<GridTables> {
+    let g = *op.grid();
+    let n = g.n;
+    let h = (g.upper - g.lower) / n as f64;
+    let levels: Vec<f64> = (0..=n).map(|k| g.level(k)).collect();
+    Ok(GridTables {
+        level: prog.table(&ns.table("level"), levels)?,
+        w: prog.table(&ns.table("w"), op.weights().to_vec())?,
+        q: prog.table(&ns.table("q"), prefix_sums(&g, op.weights()))?,
+        interval: prog.function(
+            &ns.name("interval"),
+            &[("x", Ty::F64)],
+            Some(Ty::Index),
+            |b| {
+                let k = ((local("x") - g.lower) / h).floor().max(0.0);
+                b.ret(k.min((n - 1) as f64).to_index());
+            },
+        )?,
+    })
+}
+
 /// Emits the Everett function `ns.everett(alpha, beta)` of the simulation
 /// (`Preisach::everett`: the cut cells of one row and one column summed).
 fn everett(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<String> {
     let g = *op.grid();
-    let n = g.n;
-    let h = (g.upper - g.lower) / n as f64;
-    let levels: Vec<f64> = (0..=n)
-        .map(|k| {
-            if k >= n {
-                g.upper
-            } else {
-                g.lower + k as f64 * h
-            }
-        })
-        .collect();
-    let level = prog.table(&ns.table("level"), levels)?;
-    let w = prog.table(&ns.table("w"), op.weights().to_vec())?;
-    let q = prog.table(&ns.table("q"), prefix_sums(&g, op.weights()))?;
+    let h = (g.upper - g.lower) / g.n as f64;
+    let GridTables {
+        level,
+        w,
+        q,
+        interval,
+    } = grid_tables(op, ns, prog)?;
     let t = |name: &str, i: Expr| Expr::Table(name.into(), Box::new(i));
-    let interval = prog.function(
-        &ns.name("interval"),
-        &[("x", Ty::F64)],
-        Some(Ty::Index),
-        |b| {
-            let k = ((local("x") - g.lower) / h).floor().max(0.0);
-            b.ret(k.min((n - 1) as f64).to_index());
-        },
-    )?;
+    let n = g.n;
     let hh = h * h;
     let level_c = level.clone();
     let fraction = prog.function(
@@ -175,24 +194,17 @@ fn everett(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<String> {
 /// rows and columns).
 fn everett_by_sums(op: &Preisach, ns: &Ns, prog: &mut Program) -> Result<String> {
     let g = *op.grid();
-    let n = g.n;
-    let h = (g.upper - g.lower) / n as f64;
-    let levels: Vec<f64> = (0..=n).map(|k| g.level(k)).collect();
-    let level = prog.table(&ns.table("level"), levels)?;
-    let w = prog.table(&ns.table("w"), op.weights().to_vec())?;
-    let q = prog.table(&ns.table("q"), prefix_sums(&g, op.weights()))?;
+    let h = (g.upper - g.lower) / g.n as f64;
+    let GridTables {
+        level,
+        w,
+        q,
+        interval,
+    } = grid_tables(op, ns, prog)?;
     let rows = prog.table(&ns.table("rows"), row_sums(&g, op.weights()))?;
     let columns = prog.table(&ns.table("columns"), column_sums(&g, op.weights()))?;
     let t = |name: &str, i: Expr| Expr::Table(name.into(), Box::new(i));
-    let interval = prog.function(
-        &ns.name("interval"),
-        &[("x", Ty::F64)],
-        Some(Ty::Index),
-        |b| {
-            let k = ((local("x") - g.lower) / h).floor().max(0.0);
-            b.ret(k.min((n - 1) as f64).to_index());
-        },
-    )?;
+    let n = g.n;
     let hh = h * h;
     let cell = |i: Expr, j: Expr| i.clone() * (i + idx(1)) / idx(2) + j;
     prog.function(
@@ -446,12 +458,7 @@ fn bounded_inverse(
     let g = *op.grid();
     let n = g.n;
     let (c, a0, q_last) = (op.offset(), op.a0(), last_prefix(op));
-    let clipped = prog.field(
-        &ns.name("clipped"),
-        Ty::Flag,
-        None,
-        "the last solve clipped its target to a saturation level",
-    )?;
+    let clipped = crate::export::solve::clipped_field(prog, ns)?;
     let command = prog.field(&ns.name("command"), Ty::F64, None, "the last command")?;
     let output = prog.field(
         &ns.name("output"),
