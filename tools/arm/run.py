@@ -145,7 +145,7 @@ def build_and_run(exports, name, core, work, counted):
                            "-serial", "none", "-monitor", "none", "-chardev", "stdio,id=s0",
                            "-semihosting-config", "enable=on,target=native,chardev=s0",
                            *tracing, "-kernel", elf], capture_output=True, text=True,
-                          timeout=1800 if counted else 900)
+                          timeout=1800)
     passed = done.returncode == 0 and "PASS" in done.stdout
     counts = {}
     if counted:
