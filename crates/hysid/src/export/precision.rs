@@ -60,6 +60,14 @@ impl Precision {
             })
     }
 
+    /// The value of the type nearest `v` (in single, `v` rounded to `float`), as an `f64`.
+    pub fn nearest(self, v: f64) -> f64 {
+        match self {
+            Precision::Double => v,
+            Precision::Single => v as f32 as f64,
+        }
+    }
+
     /// True for [`Precision::Single`].
     pub fn is_single(self) -> bool {
         self == Precision::Single

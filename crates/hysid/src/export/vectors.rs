@@ -138,10 +138,7 @@ pub fn vectors(
 ) -> Result<Vectors> {
     let precision = options.precision;
     // The samples the code sees: in single precision each input is a float.
-    let sample = |v: f64| match precision {
-        Precision::Double => v,
-        Precision::Single => v as f32 as f64,
-    };
+    let sample = |v: f64| precision.nearest(v);
     let mut forward = model.stepper(sample_time, options.initial_output)?;
     let (n_in, n_out) = (forward.n_inputs(), forward.n_outputs());
     let inputs: Vec<Vec<f64>> = super::sequence::inputs(&ranges(file, options, n_in)?)
@@ -239,8 +236,8 @@ impl Numbers {
         match self.precision {
             Precision::Double => (self.table(e()), None),
             Precision::Single => (
-                self.table(e().map(|e| e as f32 as f64)),
-                Some(self.table(e().map(|e| e - e as f32 as f64))),
+                self.table(e().map(|e| Precision::Single.nearest(e))),
+                Some(self.table(e().map(|e| e - Precision::Single.nearest(e)))),
             ),
         }
     }

@@ -40,7 +40,8 @@
 //!    is beyond the grid already) the linear term gives x = e + (v − f(e))/a₀ exactly; with
 //!    a₀ = 0 the command is e and the target is clipped.
 //! 2. Otherwise [a, b] = [u, e] (or [e, u]) brackets v, f(a) ≤ v ≤ f(b). Bisection over the
-//!    grid levels strictly inside it (at most ⌈log₂ N⌉ trials), then over the memory's
+//!    grid levels strictly inside it (at most ⌈log₂(N + 2)⌉ trials: the N + 1 levels when
+//!    the last command lies beyond the grid), then over the memory's
 //!    points strictly inside what remains (the extrema the input would wipe out: all on the
 //!    target's side of u, so all maxima or all minima, monotone in their age; at most
 //!    ⌈log₂ 33⌉ = 6 trials for the 64 points a stream holds), narrows [a, b] to an
@@ -50,7 +51,7 @@
 //!    B = 4f(m) − 3f(a) − f(b), and the root in [0, 1] is t = −2C / (B + √(B² − 4AC)),
 //!    C = f(a) − v (the form without cancellation: B ≥ 0 on a non-decreasing branch).
 //!
-//! So a step costs at most 1 + ⌈log₂ N⌉ + 6 + 1 trial steps and the final one (13 + 1 on a
+//! So a step costs at most 1 + ⌈log₂(N + 2)⌉ + 6 + 1 trial steps and the final one (13 + 1 on a
 //! 20 × 20 grid), each a copy of the memory and one advance — whatever the input sequence,
 //! where a bracketing and Illinois solve took up to hundreds; the exported code
 //! (`export::families::preisach`) makes the same computation. The root is exact up to the
@@ -564,7 +565,7 @@ fn clip_tolerance(v: f64) -> f64 {
 
 /// The root t ∈ [0, 1] of the quadratic through (0, fa), (½, fm), (1, fb) equal to v, for
 /// fa ≤ v ≤ fb on a non-decreasing branch (module docs, "Inverse", step 3).
-pub(crate) fn quadratic_root(fa: f64, fm: f64, fb: f64, v: f64) -> f64 {
+fn quadratic_root(fa: f64, fm: f64, fb: f64, v: f64) -> f64 {
     let a = 2.0 * (fb - 2.0 * fm + fa);
     let b = 4.0 * fm - 3.0 * fa - fb;
     let c = fa - v;

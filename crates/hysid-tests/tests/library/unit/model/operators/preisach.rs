@@ -140,3 +140,32 @@ fn the_bounded_inverse_solves_arbitrary_references_to_rounding() {
         }
     }
 }
+
+/// The inverse's O(1) Everett function (row and column sums) equals the simulation's (cut
+/// cells summed) up to rounding, on every pair of a fine grid of (α, β) — inside cells, on
+/// levels, on the diagonal and beyond the plane.
+#[test]
+fn the_everett_function_by_sums_equals_the_cell_sum() {
+    for n in [1, 3, 20] {
+        let p = example(n, 0.2, Orientation::default());
+        let total: f64 = p.weights().iter().sum();
+        for a in 0..=97 {
+            for b in 0..=97 {
+                let (alpha, beta) = (-2.3 + 4.6 * a as f64 / 97.0, -2.3 + 4.6 * b as f64 / 97.0);
+                let (direct, by_sums) = (p.everett(alpha, beta), p.everett_by_sums(alpha, beta));
+                assert!(
+                    (direct - by_sums).abs() <= 1e-13 * total,
+                    "n {n}: E({alpha}, {beta}) = {direct} vs {by_sums}"
+                );
+            }
+        }
+        // on the levels themselves
+        for i in 0..=n {
+            for j in 0..=i {
+                let (alpha, beta) = (p.grid().level(i), p.grid().level(j));
+                let d = (p.everett(alpha, beta) - p.everett_by_sums(alpha, beta)).abs();
+                assert!(d <= 1e-13 * total, "n {n}: levels {i}, {j}: {d}");
+            }
+        }
+    }
+}
