@@ -749,8 +749,9 @@ pub struct ExportArgs {
     /// with main and NAME_test_run; rust: DIR/NAME/tests/vectors.rs); not with --target fmu.
     #[arg(long = "test-vectors")]
     pub test_vectors: bool,
-    /// With --test-vectors: the input range LO:HI the test sequence covers (default: the model
-    /// file's input_range; required when the file has none).
+    /// With --test-vectors or --precision single: the input range LO:HI the test sequence
+    /// covers (for the vectors and the single-precision bound; default: the model file's
+    /// input_range; required when the file has none and no --data is given).
     #[arg(long = "test-range", allow_hyphen_values = true, value_parser = crate::options::limits)]
     pub test_range: Option<hysid::model::limits::Limits>,
 }

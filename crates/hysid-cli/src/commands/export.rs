@@ -23,9 +23,9 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         )
         .into());
     }
-    if args.test_range.is_some() && !args.test_vectors {
+    if args.test_range.is_some() && !args.test_vectors && args.precision != PrecisionArg::Single {
         return Err(UsageError(
-            "--test-range applies to --test-vectors only; leave it out; run 'hysid export --help' for the options".into(),
+            "--test-range applies to --test-vectors and --precision single only; leave it out; run 'hysid export --help' for the options".into(),
         )
         .into());
     }

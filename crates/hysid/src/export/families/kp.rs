@@ -1,15 +1,19 @@
 //! The Krasnosel'skii–Pokrovskii operator (`model::operators::kp`): the kernel states ξ_{ij}
 //! (order (0,0), (1,0), (1,1), …) advanced by ξ ← max(ρ(x − tᵢ), min(ρ(x − tⱼ), ξ)) through
 //! comparisons, as the library does; the output c + a₀x + Σ μₖξₖ with the sum in the
-//! library's four interleaved partial sums. G⁻¹ is the library's monotone per-sample solve of
-//! the trial output (one running sum), then the states advance with the solution.
+//! library's four interleaved partial sums. G⁻¹ is the library's bounded per-sample solve of
+//! the trial output (one running sum): bisections over the ramp edges and over the sorted
+//! switch points of the rows and columns whose ramps cover the bracket, then the last piece's
+//! line (`Kp::solve`); then the states advance with the solution.
 
 use super::oriented::EmitCore;
-use crate::export::code::{call, idx, local, select, Block, Expr, Ty};
+use crate::export::code::{call, idx, local, select, typed, Block, Expr, Ty};
 use crate::export::program::{Ns, Program};
 use crate::export::solve;
+use crate::model::operators::kp::ramp_edges;
 use crate::model::operators::{Kp, Orientation};
 use crate::Result;
+use std::ops::Not;
 
 /// The names of the kernels' fields and tables.
 struct Kernels {
@@ -137,14 +141,13 @@ impl EmitCore for Kp {
 
     fn emit_core_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<(String, Option<String>)> {
         prog.bound(format!(
-            "The KP inverse's trial evaluates the {} ramps and {} kernels; the solve's \
-             bracket starts from the half-width s = {:e}.",
+            "The KP inverse takes at most {} trials a step (2 at the outer ramp edges, then \
+             bisections over the ramp edges and the switch points of the rows and columns \
+             whose ramps cover the bracket), each an evaluation of the {} ramps and {} \
+             kernels, then one advance.",
+            self.inverse_trials(),
             self.thresholds().len(),
-            self.weights().len(),
-            {
-                let t = self.thresholds();
-                0.5 * (t[t.len() - 1] - t[0] + self.width()) * (1.0 + 1e-12)
-            }
+            self.weights().len()
         ));
         let (kernels, ramps) = Kernels::declare(self, ns, prog)?;
         let (c, a0) = (self.offset(), self.a0());
@@ -156,28 +159,131 @@ impl EmitCore for Kp {
             });
             b.ret(c + a0 * local("x") + acc);
         })?;
-        let solve = solve::emit(prog, ns, &trial)?;
-        let t = self.thresholds();
-        let (lo, hi) = (
-            t[0] - 0.5 * self.width(),
-            t[t.len() - 1] + 0.5 * self.width(),
-        );
-        let center = 0.5 * (lo + hi);
-        let span = 0.5 * (hi - lo) * (1.0 + 1e-12);
-        let unbounded = Expr::Flag(a0 > 0.0);
+        let solve = bounded_solve(self, ns, prog, &kernels, &trial)?;
         let name = prog.function(&ns.name("g_inv"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
-            let args = vec![
-                local("v"),
-                center.into(),
-                span.into(),
-                unbounded.clone(),
-                unbounded,
-            ];
-            let x = b.let_("u", call(&solve, args));
+            let x = b.let_("u", call(&solve, vec![local("v")]));
             b.call(&ramps, vec![x.clone()]);
             kernels.each(b, |b, k, new| b.set_at(&kernels.xi, k, new));
             b.ret(x);
         })?;
         Ok((name, Some(ns.name("clipped"))))
     }
+}
+
+/// Emits `ns.solve(v)`, the library's `Kp::solve` (module docs of `model::operators::kp`,
+/// "Inverse") with the same comparisons and order of operations; `trial(x)` is the output
+/// after x from the kernel states. Sets the flag `ns.clipped`. Returns the function's name.
+fn bounded_solve(
+    kp: &Kp,
+    ns: &Ns,
+    prog: &mut Program,
+    kernels: &Kernels,
+    trial: &str,
+) -> Result<String> {
+    let clipped = solve::clipped_field(prog, ns)?;
+    let edges = ramp_edges(kp.thresholds(), kp.width());
+    let (m, n) = (edges.len(), kp.thresholds().len());
+    let (e_first, e_last) = (edges[0], edges[m - 1]);
+    let edge = prog.table(&ns.table("edge"), edges)?;
+    let thresholds = ns.table("t");
+    let (a0, h) = (kp.a0(), 0.5 * kp.width());
+    let f = |x: Expr| call(trial, vec![x]);
+    prog.function(&ns.name("solve"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
+        let v = local("v");
+        let tol = typed(1e-12, 16.0 * f32::EPSILON as f64) * (1.0 + v.clone().abs());
+        b.set_state(&clipped, Expr::Flag(false));
+        let (a, bb) = (local("a"), local("b"));
+        b.var("a", e_last);
+        b.var("b", e_first);
+        let fa = b.var("fa", f(a.clone()));
+        let fb = b.var("fb", f(bb.clone()));
+        // Beyond the outer edges only a0 x moves: from (x0, f0) the root is linear.
+        let linear = |b: &mut Block, x0: Expr, f0: Expr| {
+            b.if_(f0.clone().eq(v.clone()), |b| b.ret(x0.clone()));
+            if a0 > 0.0 {
+                let x = b.let_("x_lin", x0.clone() + (v.clone() - f0.clone()) / a0);
+                b.if_(x.clone().is_finite(), |b| b.ret(x));
+            }
+            b.set_state(&clipped, (v.clone() - f0).abs().gt(tol.clone()));
+            b.ret(x0);
+        };
+        b.if_(v.clone().le(fa.clone()), |b| {
+            linear(b, a.clone(), fa.clone())
+        });
+        b.if_(v.clone().ge(fb.clone()), |b| {
+            linear(b, bb.clone(), fb.clone())
+        });
+        // Bisection over the points point(k), k in [lo, end), that do not increase with k:
+        // a trial for each point inside (a, b) (`Bracket::over_sorted`).
+        let over_sorted =
+            |b: &mut Block, tag: &str, lo: Expr, end: Expr, point: &dyn Fn(Expr) -> Expr| {
+                let (lo_name, end_name) = (format!("lo_{tag}"), format!("end_{tag}"));
+                let lo = b.local(&lo_name, Ty::Index, true, lo);
+                let end = b.local(&end_name, Ty::Index, true, end);
+                b.while_(lo.clone().lt(end.clone()), |b| {
+                    let mid = b.local(
+                        "mid",
+                        Ty::Index,
+                        false,
+                        lo.clone() + (end.clone() - lo.clone()) / idx(2),
+                    );
+                    let x = b.let_("x", point(mid.clone()));
+                    // the larger points lie at the smaller k
+                    let above = b.local("above", Ty::Flag, true, Expr::Flag(false));
+                    b.if_else(
+                        x.clone().le(a.clone()),
+                        |b| b.set("above", Expr::Flag(true)),
+                        |b| {
+                            b.if_(x.clone().lt(bb.clone()), |b| {
+                                let fx = b.let_("fx", f(x.clone()));
+                                b.if_(fx.clone().eq(v.clone()), |b| b.ret(x.clone()));
+                                b.if_else(
+                                    fx.clone().lt(v.clone()),
+                                    |b| {
+                                        b.set("a", x.clone());
+                                        b.set("fa", fx.clone());
+                                        b.set("above", Expr::Flag(true));
+                                    },
+                                    |b| {
+                                        b.set("b", x.clone());
+                                        b.set("fb", fx.clone());
+                                    },
+                                );
+                            });
+                        },
+                    );
+                    b.if_else(
+                        above,
+                        |b| b.set(&end_name, mid.clone()),
+                        |b| b.set(&lo_name, mid.clone() + idx(1)),
+                    );
+                });
+            };
+        over_sorted(b, "e", idx(1), idx(m - 1), &|k| {
+            Expr::Table(edge.clone(), Box::new(k))
+        });
+        b.for_("i", idx(0), idx(n), |b, i| {
+            let ti = b.let_("ti", Expr::Table(thresholds.clone(), Box::new(i.clone())));
+            let outside = (ti.clone() + h)
+                .le(a.clone())
+                .or((ti.clone() - h).ge(bb.clone()));
+            b.if_(outside.not(), |b| {
+                let row = b.local(
+                    "row",
+                    Ty::Index,
+                    false,
+                    i.clone() * (i.clone() + idx(1)) / idx(2),
+                );
+                // row i: t_i + h xi[i][j], j < i; column i: t_i + h xi[k][i], k > i
+                over_sorted(b, "r", idx(0), i.clone(), &|j| {
+                    ti.clone() + h * kernels.xi(row.clone() + j)
+                });
+                over_sorted(b, "c", i.clone() + idx(1), idx(n), &|k| {
+                    ti.clone() + h * kernels.xi(k.clone() * (k + idx(1)) / idx(2) + i.clone())
+                });
+            });
+        });
+        let s = b.let_("s", (v.clone() - fa.clone()) / (fb.clone() - fa.clone()));
+        b.ret((a.clone() + s * (bb.clone() - a.clone())).clamp(a, bb));
+    })
 }

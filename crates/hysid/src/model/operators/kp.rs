@@ -58,12 +58,29 @@
 //!
 //! **Inverse.** On a sample the output as a function of the new input x,
 //! f(x) = c + a₀x + Σ μ_{ij} max(ρ_a(x − tᵢ), min(ρ_a(x − tⱼ), ξ_{ij})), is continuous and
-//! non-decreasing, piecewise linear with breakpoints at tᵢ ± a/2, constant (or linear with slope
-//! a₀) outside [t₀ − a/2, t_{n−1} + a/2]. The inverse solves f(x) = reference per sample by
-//! bracketing and safeguarded regula falsi ([`super::solve_monotone`]: at most 300 iterations,
-//! and when a₀ > 0 at most about 500 doublings of the bracket), then advances the kernel states
-//! with the solution. A reference beyond the saturation levels c ± Σμ of an operator without a
-//! reversible part is clipped to the level and listed in [`Inversion::clipped`].
+//! non-decreasing, and linear between its breakpoints: the ramp edges tᵢ ± a/2 (fixed), and
+//! where a kernel leaves its held value, x = tᵢ + aξ_{ij}/2 on the rising side and
+//! x = tⱼ + aξ_{ij}/2 on the falling side (ρ_a(x − tᵢ) = ξ or ρ_a(x − tⱼ) = ξ; the diagonal
+//! kernels, ξ_{ii} = ρ_a(x − tᵢ), have none). Outside [t₀ − a/2, t_{n−1} + a/2] only a₀x
+//! moves. The kernel states are ordered along every row and column of the triangle: ξ_{ij}
+//! does not increase with j (a lower falling threshold) nor with i (a higher rising one) —
+//! true of the initial state, and kept by the update, whose max and min are monotone and
+//! whose ramps ρ_a(x − t) do not increase with t (also in rounded arithmetic). So row i's
+//! switch points tᵢ + aξ_{ij}/2 are sorted in j, column j's tⱼ + aξ_{ij}/2 in i, and the
+//! inverse solves f(x) = v in a number of trials fixed by the grid ([`Kp::inverse_trials`]):
+//!
+//! 1. f at the two outer edges; a reference beyond them is reached on the line of slope a₀
+//!    (exactly) or, without a reversible part, clipped to the saturation level c ± Σμ and
+//!    listed in [`Inversion::clipped`];
+//! 2. bisection over the sorted interior ramp edges, keeping f(a) ≤ v ≤ f(b): the bracket
+//!    then lies between two neighbouring edges, where every ramp is linear or saturated;
+//! 3. for every row and column whose ramp covers the bracket, bisection over its sorted
+//!    switch points inside the bracket (comparisons only for the points outside it);
+//! 4. f is now linear on [a, b]: the root a + (b − a)(v − f(a))/(f(b) − f(a)).
+//!
+//! A trial equal to v ends the solve at once. The kernel states then advance with the
+//! solution. (A state whose rows were not ordered would only leave a breakpoint in the last
+//! bracket: the root stays inside the bracket, every narrowing being by an evaluated trial.)
 //!
 //! | symbol | meaning | constraint |
 //! | --- | --- | --- |
@@ -90,9 +107,7 @@
 //! assert!(back.u.iter().zip(&u).all(|(a, b)| (a - b).abs() < 1e-9));
 //! ```
 
-use super::elementary::{
-    check_finite, oriented_invert, oriented_simulate, solve_monotone, Branch, Core, Orientation,
-};
+use super::elementary::{check_finite, oriented_invert, oriented_simulate, Core, Orientation};
 use super::{HysteresisOperator, Inversion};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -348,15 +363,6 @@ impl Kp {
     pub fn orientation(&self) -> Orientation {
         self.orientation
     }
-
-    /// The interval outside which every kernel is saturated.
-    fn active_range(&self) -> (f64, f64) {
-        let n = self.thresholds.len();
-        (
-            self.thresholds[0] - 0.5 * self.width,
-            self.thresholds[n - 1] + 0.5 * self.width,
-        )
-    }
 }
 
 /// The pair (i, j), j ≤ i, of weight index k in the order (0,0), (1,0), (1,1), (2,0), …
@@ -368,9 +374,213 @@ fn pair(k: usize) -> (usize, usize) {
     (i, k - i * (i + 1) / 2)
 }
 
-/// The kernel states and, for the inverse, scratch space of one ramp per threshold (the
-/// trial evaluations of the solve).
-pub(crate) type KpBackward = (KernelStates, RefCell<Vec<f64>>);
+/// The ramp edges tᵢ ± a/2 of a threshold grid, from the highest down, without repeats: the
+/// breakpoints of f that do not move with the state (module docs, "Inverse"; also the
+/// exported code's table).
+pub(crate) fn ramp_edges(thresholds: &[f64], width: f64) -> Vec<f64> {
+    let h = 0.5 * width;
+    let mut edges: Vec<f64> = thresholds.iter().flat_map(|&t| [t - h, t + h]).collect();
+    edges.sort_by(|x, y| y.total_cmp(x));
+    edges.dedup();
+    edges
+}
+
+/// The most iterations of a bisection over m sorted points, ⌊log₂ m⌋ + 1 (0 for none).
+pub(crate) fn halvings(m: usize) -> usize {
+    (usize::BITS - m.leading_zeros()) as usize
+}
+
+/// The inverse's state: the kernels, scratch space of one ramp per threshold (the trial
+/// evaluations of the solve) and the sorted ramp edges.
+#[derive(Clone, Debug)]
+pub(crate) struct KpBackward {
+    states: KernelStates,
+    ramps: RefCell<Vec<f64>>,
+    edges: Vec<f64>,
+}
+
+/// The largest |v − f| of a reached target beyond a saturation level (as `solve_monotone`'s).
+fn clip_tolerance(v: f64) -> f64 {
+    1e-12 * (1.0 + v.abs())
+}
+
+/// A bracket [a, b] of the root of f(x) = v with f(a) ≤ v ≤ f(b), narrowed by trials.
+struct Bracket {
+    a: f64,
+    fa: f64,
+    b: f64,
+    fb: f64,
+}
+
+impl Bracket {
+    /// Narrows the bracket at x (a < x < b) by the trial f(x): `Err(x)` when f(x) = v, else
+    /// whether the root lies above x.
+    fn narrow(&mut self, x: f64, fx: f64, v: f64) -> std::result::Result<bool, f64> {
+        if fx == v {
+            return Err(x);
+        }
+        if fx < v {
+            (self.a, self.fa) = (x, fx);
+            Ok(true)
+        } else {
+            (self.b, self.fb) = (x, fx);
+            Ok(false)
+        }
+    }
+
+    /// Bisection over the points `point(k)`, k in [lo, end), that do not increase with k
+    /// (step 3 of the module docs' "Inverse"): one trial for each point inside (a, b).
+    fn over_sorted(
+        &mut self,
+        f: &impl Fn(f64) -> f64,
+        v: f64,
+        (mut lo, mut end): (usize, usize),
+        point: impl Fn(usize) -> f64,
+    ) -> std::result::Result<(), f64> {
+        while lo < end {
+            let mid = lo + (end - lo) / 2;
+            let x = point(mid);
+            // the larger points lie at the smaller k
+            let above = if x <= self.a {
+                true
+            } else if x >= self.b {
+                false
+            } else {
+                self.narrow(x, f(x), v)?
+            };
+            if above {
+                end = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Kp {
+    /// The most trial evaluations of f a step of the inverse takes for every input sequence
+    /// (module docs, "Inverse"): 2 at the outer edges, ⌊log₂ m⌋ + 1 over the m interior ramp
+    /// edges, and, on the worst interval between neighbouring edges, ⌊log₂ i⌋ + 1 for every
+    /// row i and ⌊log₂(n − 1 − j)⌋ + 1 for every column j whose ramp covers it (a bisection
+    /// over k sorted points halves them at most ⌊log₂ k⌋ + 1 times, none for k = 0).
+    pub fn inverse_trials(&self) -> usize {
+        let (t, n) = (&self.thresholds, self.thresholds.len());
+        let h = 0.5 * self.width;
+        let edges = ramp_edges(t, self.width);
+        let worst = edges
+            .windows(2)
+            .map(|w| {
+                // edges from the highest down: (w[1], w[0])
+                let covers = |ti: f64| ti - h < w[0] && ti + h > w[1];
+                (0..n)
+                    .filter(|&i| covers(t[i]))
+                    .map(|i| halvings(i) + halvings(n - 1 - i))
+                    .sum::<usize>()
+            })
+            .max()
+            .unwrap_or(0);
+        2 + halvings(edges.len().saturating_sub(2)) + worst
+    }
+
+    /// G⁻¹(v) from the kernel states in a bounded number of trials (module docs, "Inverse"):
+    /// (command, clipped).
+    fn solve(&self, backward: &KpBackward, v: f64) -> (f64, bool) {
+        let f = |x: f64| self.trial(backward, x);
+        self.solve_by(&f, &backward.states, &backward.edges, v)
+    }
+
+    /// f(x): the output if the input moved to x from the inverse's kernel states.
+    fn trial(&self, backward: &KpBackward, x: f64) -> f64 {
+        let mut ramps = backward.ramps.borrow_mut();
+        let s = backward.states.trial_weighted(&self.weights, x, &mut ramps);
+        self.offset + self.a0 * x + s
+    }
+
+    /// [`Kp::solve`] with the trial f(x) given.
+    fn solve_by(
+        &self,
+        f: &impl Fn(f64) -> f64,
+        states: &KernelStates,
+        edges: &[f64],
+        v: f64,
+    ) -> (f64, bool) {
+        let m = edges.len();
+        let (a, b) = (edges[m - 1], edges[0]);
+        let (fa, fb) = (f(a), f(b));
+        // Beyond the outer edges only a₀x moves: from (x0, f0) the root is linear.
+        let linear = |x0: f64, f0: f64| -> (f64, bool) {
+            if f0 == v {
+                return (x0, false);
+            }
+            if self.a0 > 0.0 {
+                let x = x0 + (v - f0) / self.a0;
+                if x.is_finite() {
+                    return (x, false);
+                }
+            }
+            (x0, (v - f0).abs() > clip_tolerance(v))
+        };
+        if v <= fa {
+            return linear(a, fa);
+        }
+        if v >= fb {
+            return linear(b, fb);
+        }
+        let mut br = Bracket { a, fa, b, fb };
+        match self.narrow(&mut br, f, states, edges, v) {
+            Err(x) => (x, false),
+            Ok(()) => {
+                let s = (v - br.fa) / (br.fb - br.fa);
+                ((br.a + s * (br.b - br.a)).clamp(br.a, br.b), false)
+            }
+        }
+    }
+
+    /// G⁻¹\[v\] (the core operator's, whatever the orientation) with the number of trials of
+    /// every sample's solve: the white-box check of [`Kp::inverse_trials`].
+    #[doc(hidden)] // reached by crates/hysid-tests/tests/library/unit/model/operators/kp.rs
+    pub fn core_inverse_counting_trials(&self, reference: &[f64]) -> (Vec<f64>, Vec<usize>) {
+        let mut backward = self.backward_state(None);
+        let (mut u, mut trials) = (Vec::new(), Vec::new());
+        for &v in reference {
+            let count = std::cell::Cell::new(0);
+            let f = |x: f64| {
+                count.set(count.get() + 1);
+                self.trial(&backward, x)
+            };
+            let (x, _) = self.solve_by(&f, &backward.states, &backward.edges, v);
+            backward.states.advance(x);
+            u.push(x);
+            trials.push(count.get());
+        }
+        (u, trials)
+    }
+
+    /// Steps 2 and 3 of the module docs' "Inverse" on a bracket of the outer edges:
+    /// `Err(x)` at a trial with f(x) = v.
+    fn narrow(
+        &self,
+        br: &mut Bracket,
+        f: &impl Fn(f64) -> f64,
+        states: &KernelStates,
+        edges: &[f64],
+        v: f64,
+    ) -> std::result::Result<(), f64> {
+        br.over_sorted(f, v, (1, edges.len() - 1), |k| edges[k])?;
+        let (t, h, xi) = (&self.thresholds, 0.5 * self.width, states.values());
+        for (i, &ti) in t.iter().enumerate() {
+            if ti + h <= br.a || ti - h >= br.b {
+                continue;
+            }
+            // row i: tᵢ + hξ_{ij}, j < i; column i: tᵢ + hξ_{ki}, k > i
+            let row = i * (i + 1) / 2;
+            br.over_sorted(f, v, (0, i), |j| ti + h * xi[row + j])?;
+            br.over_sorted(f, v, (i + 1, t.len()), |k| ti + h * xi[k * (k + 1) / 2 + i])?;
+        }
+        Ok(())
+    }
+}
 
 impl Core for Kp {
     type Forward = KernelStates;
@@ -392,29 +602,18 @@ impl Core for Kp {
     }
 
     fn backward_state(&self, _horizon: Option<usize>) -> KpBackward {
-        (
-            KernelStates::new(&self.thresholds, self.width),
-            RefCell::new(vec![0.0; self.levels()]),
-        )
+        KpBackward {
+            states: KernelStates::new(&self.thresholds, self.width),
+            ramps: RefCell::new(vec![0.0; self.levels()]),
+            edges: ramp_edges(&self.thresholds, self.width),
+        }
     }
 
-    /// The monotone branch from the current kernel states solved for v (module doc), then
-    /// the states advanced with the solution.
-    fn backward_step(&self, (states, scratch): &mut KpBackward, v: f64) -> (f64, bool) {
-        let (lo, hi) = self.active_range();
-        let branch = Branch {
-            center: 0.5 * (lo + hi),
-            span: 0.5 * (hi - lo) * (1.0 + 1e-12),
-            unbounded_below: self.a0 > 0.0,
-            unbounded_above: self.a0 > 0.0,
-        };
-        let trial = |x: f64| {
-            let mut ramps = scratch.borrow_mut();
-            let s = states.trial_weighted(&self.weights, x, &mut ramps);
-            self.offset + self.a0 * x + s
-        };
-        let (u, clipped) = solve_monotone(trial, v, branch);
-        states.advance(u);
+    /// The branch from the current kernel states solved for v in a bounded number of trials
+    /// (module docs, "Inverse"), then the states advanced with the solution.
+    fn backward_step(&self, backward: &mut KpBackward, v: f64) -> (f64, bool) {
+        let (u, clipped) = self.solve(backward, v);
+        backward.states.advance(u);
         (u, clipped)
     }
 }

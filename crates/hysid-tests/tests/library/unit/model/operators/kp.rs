@@ -344,3 +344,62 @@ fn bad_signals_are_refused() {
     assert!(kp.simulate(&[0.0, f64::NAN]).is_err());
     assert!(kp.invert(&[f64::INFINITY]).is_err());
 }
+
+/// The bounded inverse (bisection over the ramp edges, then over the rows' and columns'
+/// switch points, then the last piece's line) solves G(x) = r to rounding on references that
+/// are no model's output — a seeded random walk with reversals of every size, beyond the
+/// saturation levels at times — on grids of 1 to 20 thresholds, with ridges narrower than the
+/// grid's spacing, tiling it, and spanning several thresholds, with and without a₀; and no
+/// sample takes more trials than `Kp::inverse_trials` states.
+#[test]
+fn the_bounded_inverse_solves_arbitrary_references_within_its_stated_trials() {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for n in [1, 2, 5, 20] {
+        let t = Kp::uniform_thresholds(-2.0, 2.0, n).unwrap();
+        let spacing = 4.0 / n as f64;
+        for width in [0.6 * spacing, spacing, 4.0 * spacing, 7.0] {
+            for a0 in [0.3, 0.0] {
+                let k = n * (n + 1) / 2;
+                let w: Vec<f64> = (0..k).map(|_| 0.01 + uniform()).collect();
+                let kp = Kp::new(t.clone(), width, w, a0, 0.3, Orientation::default()).unwrap();
+                let total: f64 = kp.weights().iter().sum();
+                let (lo, hi) = (0.3 - total, 0.3 + total);
+                let mut r = Vec::new();
+                let mut x = 0.3;
+                for _ in 0..2000 {
+                    x += (uniform() - 0.5) * (hi - lo) * uniform().powi(3) * 1.5;
+                    r.push(x);
+                }
+                let bound = kp.inverse_trials();
+                let (u, trials) = kp.core_inverse_counting_trials(&r);
+                let worst = trials.iter().copied().max().unwrap_or(0);
+                assert!(
+                    worst <= bound,
+                    "n {n} width {width} a0 {a0}: {worst} trials, bound {bound}"
+                );
+                let y = kp.simulate(&u).unwrap();
+                for (s, (&rs, &ys)) in r.iter().zip(&y).enumerate() {
+                    let tol = 1e-9 * (1.0 + rs.abs());
+                    if a0 > 0.0 || (rs > lo + tol && rs < hi - tol) {
+                        assert!(
+                            (ys - rs).abs() <= tol,
+                            "n {n} width {width} a0 {a0} sample {s}: G(G⁻¹(r)) = {ys} for r = {rs}"
+                        );
+                    } else {
+                        let level = rs.clamp(lo, hi);
+                        assert!(
+                            (ys - level).abs() <= tol,
+                            "sample {s}: {ys} vs level {level}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
