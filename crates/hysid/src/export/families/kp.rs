@@ -187,6 +187,14 @@ fn bounded_solve(
     let edge = prog.table(&ns.table("edge"), edges)?;
     let thresholds = ns.table("t");
     let (a0, h) = (kp.a0(), 0.5 * kp.width());
+    // The ramps' ends tᵢ ∓ h as `ramp_edges` computes them, for the test whether a ramp
+    // covers the bracket: in single precision the same floats as the edges' (fl(tᵢ) + fl(h)
+    // may differ from them by an ulp, and a ramp would then seem to cover a window it only
+    // touches, costing trials the stated bound does not count). The library's tᵢ + h are
+    // these values in double.
+    let t = kp.thresholds();
+    let t_lo = prog.table(&ns.table("t_lo"), t.iter().map(|&ti| ti - h).collect())?;
+    let t_hi = prog.table(&ns.table("t_hi"), t.iter().map(|&ti| ti + h).collect())?;
     let f = |x: Expr| call(trial, vec![x]);
     prog.function(&ns.name("solve"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
         let v = local("v");
@@ -264,9 +272,11 @@ fn bounded_solve(
         });
         b.for_("i", idx(0), idx(n), |b, i| {
             let ti = b.let_("ti", Expr::Table(thresholds.clone(), Box::new(i.clone())));
-            let outside = (ti.clone() + h)
-                .le(a.clone())
-                .or((ti.clone() - h).ge(bb.clone()));
+            let (lo, hi) = (
+                Expr::Table(t_lo.clone(), Box::new(i.clone())),
+                Expr::Table(t_hi.clone(), Box::new(i.clone())),
+            );
+            let outside = hi.le(a.clone()).or(lo.ge(bb.clone()));
             b.if_(outside.not(), |b| {
                 let row = b.local(
                     "row",
@@ -284,6 +294,7 @@ fn bounded_solve(
             });
         });
         let s = b.let_("s", (v.clone() - fa.clone()) / (fb.clone() - fa.clone()));
-        b.ret((a.clone() + s * (bb.clone() - a.clone())).clamp(a, bb));
+        let root = b.let_("root", a.clone() + s * (bb.clone() - a.clone()));
+        b.ret(root.clamp(a, bb));
     })
 }

@@ -63,14 +63,14 @@
 //! x = tⱼ + aξ_{ij}/2 on the falling side (ρ_a(x − tᵢ) = ξ or ρ_a(x − tⱼ) = ξ; the diagonal
 //! kernels, ξ_{ii} = ρ_a(x − tᵢ), have none). Outside [t₀ − a/2, t_{n−1} + a/2] only a₀x
 //! moves. The kernel states are ordered along every row and column of the triangle: ξ_{ij}
-//! does not increase with j (a lower falling threshold) nor with i (a higher rising one) —
+//! does not increase with j (a higher falling threshold) nor with i (a higher rising one) —
 //! true of the initial state, and kept by the update, whose max and min are monotone and
 //! whose ramps ρ_a(x − t) do not increase with t (also in rounded arithmetic). So row i's
 //! switch points tᵢ + aξ_{ij}/2 are sorted in j, column j's tⱼ + aξ_{ij}/2 in i, and the
 //! inverse solves f(x) = v in a number of trials fixed by the grid ([`Kp::inverse_trials`]):
 //!
 //! 1. f at the two outer edges; a reference beyond them is reached on the line of slope a₀
-//!    (exactly) or, without a reversible part, clipped to the saturation level c ± Σμ and
+//!    or, without a reversible part, clipped to the saturation level c ± Σμ and
 //!    listed in [`Inversion::clipped`];
 //! 2. bisection over the sorted interior ramp edges, keeping f(a) ≤ v ≤ f(b): the bracket
 //!    then lies between two neighbouring edges, where every ramp is linear or saturated;
@@ -459,9 +459,9 @@ impl Bracket {
 }
 
 impl Kp {
-    /// The most trial evaluations of f a step of the inverse takes for every input sequence
-    /// (module docs, "Inverse"): 2 at the outer edges, ⌊log₂ m⌋ + 1 over the m interior ramp
-    /// edges, and, on the worst interval between neighbouring edges, ⌊log₂ i⌋ + 1 for every
+    /// An upper bound on the trial evaluations of f a step of the inverse takes, for every
+    /// input sequence (module docs, "Inverse"): 2 at the outer edges, ⌊log₂ m⌋ + 1 over the
+    /// m interior ramp edges, and, on the worst interval between neighbouring edges, ⌊log₂ i⌋ + 1 for every
     /// row i and ⌊log₂(n − 1 − j)⌋ + 1 for every column j whose ramp covers it (a bisection
     /// over k sorted points halves them at most ⌊log₂ k⌋ + 1 times, none for k = 0).
     pub fn inverse_trials(&self) -> usize {

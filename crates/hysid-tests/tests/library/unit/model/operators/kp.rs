@@ -347,8 +347,8 @@ fn bad_signals_are_refused() {
 
 /// The bounded inverse (bisection over the ramp edges, then over the rows' and columns'
 /// switch points, then the last piece's line) solves G(x) = r to rounding on references that
-/// are no model's output — a seeded random walk with reversals of every size, beyond the
-/// saturation levels at times — on grids of 1 to 20 thresholds, with ridges narrower than the
+/// are no model's output — a seeded random walk with reversals of every size, up to 10 %
+/// beyond the saturation levels, so that most samples take the bisections — on grids of 1 to 20 thresholds, with ridges narrower than the
 /// grid's spacing, tiling it, and spanning several thresholds, with and without a₀; and no
 /// sample takes more trials than `Kp::inverse_trials` states.
 #[test]
@@ -370,10 +370,18 @@ fn the_bounded_inverse_solves_arbitrary_references_within_its_stated_trials() {
                 let kp = Kp::new(t.clone(), width, w, a0, 0.3, Orientation::default()).unwrap();
                 let total: f64 = kp.weights().iter().sum();
                 let (lo, hi) = (0.3 - total, 0.3 + total);
+                // reflected at 10 % beyond the saturation levels, so that most references
+                // are reached inside the grid and take the bisections
+                let (floor, ceiling) = (lo - 0.1 * (hi - lo), hi + 0.1 * (hi - lo));
                 let mut r = Vec::new();
                 let mut x = 0.3;
                 for _ in 0..2000 {
                     x += (uniform() - 0.5) * (hi - lo) * uniform().powi(3) * 1.5;
+                    if x > ceiling {
+                        x = (2.0 * ceiling - x).max(floor);
+                    } else if x < floor {
+                        x = (2.0 * floor - x).min(ceiling);
+                    }
                     r.push(x);
                 }
                 let bound = kp.inverse_trials();
@@ -383,6 +391,13 @@ fn the_bounded_inverse_solves_arbitrary_references_within_its_stated_trials() {
                     worst <= bound,
                     "n {n} width {width} a0 {a0}: {worst} trials, bound {bound}"
                 );
+                if n > 1 {
+                    let inside = trials.iter().filter(|&&t| t > 2).count();
+                    assert!(
+                        inside > trials.len() / 2,
+                        "n {n} width {width} a0 {a0}: only {inside} samples bisected"
+                    );
+                }
                 let y = kp.simulate(&u).unwrap();
                 for (s, (&rs, &ys)) in r.iter().zip(&y).enumerate() {
                     let tol = 1e-9 * (1.0 + rs.abs());
