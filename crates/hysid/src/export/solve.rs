@@ -8,6 +8,7 @@
 
 use super::code::{epsilon, idx, lit, local, typed, Expr, Ty};
 use super::program::{Ns, Program};
+use super::stmt::Block;
 use crate::Result;
 use std::ops::Not;
 
@@ -20,6 +21,29 @@ pub fn clipped_field(prog: &mut Program, ns: &Ns) -> Result<String> {
         None,
         "the last solve clipped its target to a saturation level",
     )
+}
+
+/// Emits the narrowing of a bracket of the root of f(x) = v at a trial x strictly inside it,
+/// the bracket in the mutable locals `a`, `fa`, `b`, `fb` (f(a) ≤ v ≤ f(b)), as the bounded
+/// Preisach and KP solves do (`Preisach::solve`, `Kp::solve`): `fx = f(x)`; return x when
+/// fx = v; else x becomes a (fx < v, then `below` adds its statements: the root lies above x)
+/// or b. Returns the local `fx`.
+pub fn narrow(b: &mut Block, fx: Expr, x: Expr, v: Expr, below: impl FnOnce(&mut Block)) -> Expr {
+    let fx = b.let_("fx", fx);
+    b.if_(fx.clone().eq(v.clone()), |b| b.ret(x.clone()));
+    b.if_else(
+        fx.clone().lt(v),
+        |b| {
+            b.set("a", x.clone());
+            b.set("fa", fx.clone());
+            below(b);
+        },
+        |b| {
+            b.set("b", x.clone());
+            b.set("fb", fx.clone());
+        },
+    );
+    fx
 }
 
 /// Emits `ns.solve(target, center, span, unbounded_below, unbounded_above) -> f64`, the root

@@ -17,6 +17,18 @@ pub fn nested_loops(n: usize, amplitude: f64) -> Vec<f64> {
         .collect()
 }
 
+/// A seeded xorshift generator (Marsaglia 2003, shifts 13, 7, 17) of numbers in [0, 1) from
+/// the top 53 bits: the same sequence on every machine, for references no model produced.
+pub fn xorshift_uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// `y` plus white Gaussian noise at the given SNR (dB) relative to y's spread, seeded.
 pub fn with_noise(y: &[f64], snr_db: f64, seed: u64) -> Vec<f64> {
     let sd = hysid::numerics::metrics::std_dev(y) * 10f64.powf(-snr_db / 20.0);

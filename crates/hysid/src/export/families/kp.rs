@@ -243,20 +243,9 @@ fn bounded_solve(
                         |b| b.set("above", Expr::Flag(true)),
                         |b| {
                             b.if_(x.clone().lt(bb.clone()), |b| {
-                                let fx = b.let_("fx", f(x.clone()));
-                                b.if_(fx.clone().eq(v.clone()), |b| b.ret(x.clone()));
-                                b.if_else(
-                                    fx.clone().lt(v.clone()),
-                                    |b| {
-                                        b.set("a", x.clone());
-                                        b.set("fa", fx.clone());
-                                        b.set("above", Expr::Flag(true));
-                                    },
-                                    |b| {
-                                        b.set("b", x.clone());
-                                        b.set("fb", fx.clone());
-                                    },
-                                );
+                                solve::narrow(b, f(x.clone()), x.clone(), v.clone(), |b| {
+                                    b.set("above", Expr::Flag(true))
+                                });
                             });
                         },
                     );

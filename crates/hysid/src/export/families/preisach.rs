@@ -538,20 +538,7 @@ fn bounded_inverse(
             b.set("k_end", k_end.clone() - idx(1))
         });
         let narrow = |b: &mut Block, x: Expr| {
-            let fx = b.let_("fx", f(x.clone()));
-            b.if_(fx.clone().eq(v.clone()), |b| b.ret(x.clone()));
-            b.if_else(
-                fx.clone().lt(v.clone()),
-                |b| {
-                    b.set("a", x.clone());
-                    b.set("fa", fx.clone());
-                },
-                |b| {
-                    b.set("b", x.clone());
-                    b.set("fb", fx.clone());
-                },
-            );
-            fx
+            crate::export::solve::narrow(b, f(x.clone()), x, v.clone(), |_| {})
         };
         b.while_(k_lo.clone().lt(k_end.clone()), |b| {
             let mid = b.local(

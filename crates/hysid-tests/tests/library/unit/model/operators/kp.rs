@@ -353,13 +353,7 @@ fn bad_signals_are_refused() {
 /// sample takes more trials than `Kp::inverse_trials` states.
 #[test]
 fn the_bounded_inverse_solves_arbitrary_references_within_its_stated_trials() {
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut uniform = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = crate::unit::test_signals::xorshift_uniform(0x9e37_79b9_7f4a_7c15u64);
     for n in [1, 2, 5, 20] {
         let t = Kp::uniform_thresholds(-2.0, 2.0, n).unwrap();
         let spacing = 4.0 / n as f64;

@@ -101,13 +101,7 @@ fn numerical_inverse_round_trip_both_orientations() {
 /// times, on planes of 1 to 20 levels, with and without the linear term.
 #[test]
 fn the_bounded_inverse_solves_arbitrary_references_to_rounding() {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut uniform = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = crate::unit::test_signals::xorshift_uniform(0x2545_f491_4f6c_dd1du64);
     for n in [1, 2, 5, 20] {
         for a0 in [0.3, 0.0] {
             let p = example(n, a0, Orientation::default());
