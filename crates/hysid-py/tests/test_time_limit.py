@@ -16,7 +16,8 @@ PIEZO = pathlib.Path(__file__).resolve().parents[3] / "data" / "piezo" / "piezo_
 
 def piezo(copies: int):
     """The vendored piezo record (2 000 samples: voltage, displacement) repeated `copies`
-    times: at 100 copies a Bouc–Wen fit with defaults runs for over 20 s on one thread."""
+    times: at 100 copies (200 000 samples) a Bouc–Wen fit with defaults runs for about 3 s on
+    one thread (it was over 20 s before long records were refined on their subsample)."""
     d = np.genfromtxt(PIEZO, delimiter=",", names=True)
     return np.tile(d["voltage_V"], copies), np.tile(d["displacement_um"], copies)
 
@@ -41,15 +42,16 @@ def test_a_time_limit_returns_the_best_result_so_far_in_time():
     assert all(isinstance(p, hysid.Progress) and p.elapsed >= 0 for _, p in calls)
 
 
-def test_without_a_time_limit_the_same_fit_runs_far_longer():
-    """The fit of the test above is one that takes over ten seconds, unbounded: shown with
-    a 12 s limit that it reaches (a bounded run keeps the suite's time in hand)."""
+def test_without_a_time_limit_the_same_fit_runs_longer():
+    """The fit of the test above, unbounded: it runs well past the 1 s limit there and ends
+    on its own criteria, not on time."""
     u, y = piezo(100)
     start = time.monotonic()
-    with pytest.warns(hysid.HysidWarning):
-        r = hysid.identify_operator(u, y, family="bouc-wen", threads=1, time_limit=10)
-    assert r.termination_code == "time_limit"
-    assert time.monotonic() - start >= 10.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", hysid.HysidWarning)  # its convergence is not the point
+        r = hysid.identify_operator(u, y, family="bouc-wen", threads=1)
+    assert r.termination_code != "time_limit"
+    assert time.monotonic() - start > 1.5
 
 
 def test_progress_reports_iterations_and_a_quick_fit_ends_normally():
