@@ -18,6 +18,7 @@
 use super::oriented::EmitCore;
 use crate::export::code::{call, idx, local, select, typed, Block, Expr, Ty};
 use crate::export::program::{Ns, Program, DIVERGED_FIELD};
+use crate::model::operators::elementary::halvings;
 use crate::model::operators::preisach::{column_sums, prefix_sums, row_sums, Grid};
 use crate::model::operators::{Orientation, Preisach};
 use crate::Result;
@@ -404,7 +405,6 @@ impl EmitCore for Preisach {
     fn emit_core_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<(String, Option<String>)> {
         let n = self.levels();
         // ⌈log₂(N + 1)⌉ bisections over the levels, ⌈log₂(STRIPS + 1)⌉ over the corners.
-        let halvings = |k: usize| (usize::BITS - k.leading_zeros()) as usize;
         prog.bound(format!(
             "The Preisach inverse takes at most {} trial steps a step (1 at the grid's end, {} \
              over its {n} levels, {} over the memory's corners, 1 at the last interval's \

@@ -400,6 +400,19 @@ pub struct Branch {
     pub unbounded_above: bool,
 }
 
+/// The largest |target − f| of a reached target: a larger one beyond a saturation level
+/// counts as clipped, 1e-12·(1 + |target|) (the monotone solve's and the bounded Preisach and
+/// KP solves'; the exported code's in double, `float`'s 16 ε in single).
+pub(crate) fn clip_tolerance(target: f64) -> f64 {
+    1e-12 * (1.0 + target.abs())
+}
+
+/// The most iterations of a bisection over m sorted points, ⌊log₂ m⌋ + 1 (0 for none): the
+/// bounded Preisach and KP inverses' trial counts.
+pub(crate) fn halvings(m: usize) -> usize {
+    (usize::BITS - m.leading_zeros()) as usize
+}
+
 /// Solves f(u) = target for a continuous non-decreasing f (a hysteresis branch from the current
 /// memory state) by bracketing and the Illinois variant of regula falsi, to machine precision.
 /// Returns (u, clipped): a target beyond a saturation level is clipped to it.
@@ -411,7 +424,7 @@ pub fn solve_monotone(f: impl Fn(f64) -> f64, target: f64, branch: Branch) -> (f
     };
     let (mut lo, mut hi) = (branch.center - span, branch.center + span);
     let (mut flo, mut fhi) = (f(lo), f(hi));
-    let tol = 1e-12 * (1.0 + target.abs());
+    let tol = clip_tolerance(target);
     let mut step = span;
     while fhi < target {
         if !branch.unbounded_above || step > 1e30 {

@@ -107,7 +107,9 @@
 //! assert!(back.u.iter().zip(&u).all(|(a, b)| (a - b).abs() < 1e-9));
 //! ```
 
-use super::elementary::{check_finite, oriented_invert, oriented_simulate, Core, Orientation};
+use super::elementary::{
+    check_finite, clip_tolerance, halvings, oriented_invert, oriented_simulate, Core, Orientation,
+};
 use super::{HysteresisOperator, Inversion};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -385,11 +387,6 @@ pub(crate) fn ramp_edges(thresholds: &[f64], width: f64) -> Vec<f64> {
     edges
 }
 
-/// The most iterations of a bisection over m sorted points, ⌊log₂ m⌋ + 1 (0 for none).
-pub(crate) fn halvings(m: usize) -> usize {
-    (usize::BITS - m.leading_zeros()) as usize
-}
-
 /// The inverse's state: the kernels, scratch space of one ramp per threshold (the trial
 /// evaluations of the solve) and the sorted ramp edges.
 #[derive(Clone, Debug)]
@@ -397,11 +394,6 @@ pub(crate) struct KpBackward {
     states: KernelStates,
     ramps: RefCell<Vec<f64>>,
     edges: Vec<f64>,
-}
-
-/// The largest |v − f| of a reached target beyond a saturation level (as `solve_monotone`'s).
-fn clip_tolerance(v: f64) -> f64 {
-    1e-12 * (1.0 + v.abs())
 }
 
 /// A bracket [a, b] of the root of f(x) = v with f(a) ≤ v ≤ f(b), narrowed by trials.
@@ -461,9 +453,10 @@ impl Bracket {
 impl Kp {
     /// An upper bound on the trial evaluations of f a step of the inverse takes, for every
     /// input sequence (module docs, "Inverse"): 2 at the outer edges, ⌊log₂ m⌋ + 1 over the
-    /// m interior ramp edges, and, on the worst interval between neighbouring edges, ⌊log₂ i⌋ + 1 for every
-    /// row i and ⌊log₂(n − 1 − j)⌋ + 1 for every column j whose ramp covers it (a bisection
-    /// over k sorted points halves them at most ⌊log₂ k⌋ + 1 times, none for k = 0).
+    /// m interior ramp edges, and, on the worst interval between neighbouring edges,
+    /// ⌊log₂ i⌋ + 1 for every row i and ⌊log₂(n − 1 − j)⌋ + 1 for every column j whose ramp
+    /// covers it (a bisection over k sorted points halves them at most ⌊log₂ k⌋ + 1 times,
+    /// none for k = 0).
     pub fn inverse_trials(&self) -> usize {
         let (t, n) = (&self.thresholds, self.thresholds.len());
         let h = 0.5 * self.width;

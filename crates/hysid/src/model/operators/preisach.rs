@@ -59,7 +59,9 @@
 //!
 //! Reference: I. D. Mayergoyz, *Mathematical Models of Hysteresis*, Springer 1991.
 
-use super::elementary::{check_finite, oriented_invert, oriented_simulate, Core, Orientation};
+use super::elementary::{
+    check_finite, clip_tolerance, oriented_invert, oriented_simulate, Core, Orientation,
+};
 use super::{HysteresisOperator, Inversion};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -555,12 +557,6 @@ pub(crate) struct PreisachBackward {
     command: f64,
     output: f64,
     trial: RefCell<State>,
-}
-
-/// The largest |v − f| of a reached target: a larger one beyond a saturation level counts
-/// as clipped (the exported code's in double; `float`'s 16 ε in single).
-fn clip_tolerance(v: f64) -> f64 {
-    1e-12 * (1.0 + v.abs())
 }
 
 /// The root t ∈ [0, 1] of the quadratic through (0, fa), (½, fm), (1, fb) equal to v, for
