@@ -49,9 +49,9 @@ pub struct FamilyArgs {
     /// The initial hysteresis state: demagnetised (the family's neutral state), descending
     /// (the record starts at the end of a descent from above its maximum, e.g. after
     /// standardisation), ascending (from below its minimum), or estimate (fitted from the
-    /// data: the differential families score the three starts and refine x0). Declared
-    /// histories are implemented for jiles-atherton, bouc-wen, duhem and dahl; the other
-    /// families start demagnetised. Saved in the model file and re-applied by `simulate`.
+    /// data: the differential families score the three starts and refine x0, the others
+    /// keep the start of least loss). ch4/ch6 start at the measured output instead. Saved
+    /// in the model file and re-applied by `simulate`.
     #[arg(long = "initial-state", value_enum, default_value = "estimate")]
     pub initial_state: InitialStateArg,
 }

@@ -14,7 +14,7 @@ use hysid::identify::operators::{
     compare as compare_families, fit_operator, CompareOptions, Family, FamilyOptions, Split,
 };
 use hysid::model::compensate::compensate_within;
-use hysid::model::operators::LoopOrientation;
+use hysid::model::operators::{InitialState, LoopOrientation};
 use hysid::model::saved::FittedModel;
 use hysid::report;
 use numpy::{PyArray1, PyReadonlyArray1};
@@ -70,11 +70,17 @@ fn loop_orientation(text: Option<&str>) -> hysid::Result<Option<LoopOrientation>
     text.map(LoopOrientation::parse).transpose()
 }
 
+/// The initial state Python asks for (`"demagnetised"`, `"descending"`, `"ascending"`,
+/// `"estimate"`), None for the default `estimate`.
+fn requested_state(text: Option<&str>) -> hysid::Result<InitialState> {
+    text.map_or(Ok(InitialState::Estimate), InitialState::parse)
+}
+
 /// Fits the hysteresis family `family` to input `u` and output `y`: the report of `hysid
 /// identify operator` as JSON text. `threshold_grid` empty: the uniform grid of
 /// `thresholds`.
 #[pyfunction]
-#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None))]
+#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None, initial_state=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn identify_operator(
     py: Python<'_>,
@@ -91,11 +97,13 @@ fn identify_operator(
     orientation: Option<&str>,
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
+    initial_state: Option<&str>,
 ) -> PyResult<String> {
     let (u, y) = (samples(&u), samples(&y));
     let family = guard(py, || Family::parse(family))?;
     let mut options = family_options(thresholds, threshold_grid, grid, lambda_, dead_zones);
     options.loop_orientation = guard(py, || loop_orientation(orientation))?;
+    options.initial_state = guard(py, || requested_state(initial_state))?;
     run_on(
         py,
         threads,
@@ -189,7 +197,7 @@ type Compared<'py> = (
 /// Fits `families` to (u, y) and ranks them by validation fit % on (u_val, y_val), or on
 /// the last 40 % of (u, y) when those are None (`hysid compare`).
 #[pyfunction]
-#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None))]
+#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None, initial_state=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn compare<'py>(
     py: Python<'py>,
@@ -208,15 +216,18 @@ fn compare<'py>(
     orientation: Option<&str>,
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
+    initial_state: Option<&str>,
 ) -> PyResult<Compared<'py>> {
     let (u, y) = (samples(&u), samples(&y));
     let validation = u_val.zip(y_val).map(|(a, b)| (samples(&a), samples(&b)));
     let families = guard(py, || families.iter().map(|f| Family::parse(f)).collect())?;
     let loop_orientation = guard(py, || loop_orientation(orientation))?;
+    let initial_state = guard(py, || requested_state(initial_state))?;
     let options = CompareOptions {
         families,
         family: FamilyOptions {
             loop_orientation,
+            initial_state,
             ..family_options(thresholds, threshold_grid, grid, lambda_, dead_zones)
         },
         ..CompareOptions::default()

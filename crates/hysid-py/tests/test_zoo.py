@@ -105,3 +105,24 @@ def test_estimates_equal_the_command_line(tmp_path, family):
     assert set(cli_values) == set(r.parameters)
     for name, value in cli_values.items():
         assert abs(r.parameters[name].value - value) <= 1e-12 * max(1.0, abs(value)), (family, name)
+
+
+def test_initial_state_is_the_command_lines():
+    """``initial_state=`` is ``--initial-state``: a record that starts at the end of a
+    descent is fitted from it, reported and saved; an unknown name is a ConfigError."""
+    u, y = _loop()
+    # the plant's plays start on their upper edges: the state after a descent to u[0]
+    plays = u[0] + np.array([0.2, 0.5, 0.9])
+    for k, uk in enumerate(u):
+        for i, r in enumerate((0.2, 0.5, 0.9)):
+            plays[i] = max(uk - r, min(uk + r, plays[i]))
+        y[k] = 0.4 * uk + plays @ np.array([0.5, 0.3, 0.2]) + 0.1
+    declared = hysid.identify_operator(u, y, family="pi", initial_state="descending")
+    assert declared.details["initial_state"] == "descending"
+    estimated = hysid.identify_operator(u, y, family="pi")
+    assert estimated.details["initial_state"] == "descending"
+    neutral = hysid.identify_operator(u, y, family="pi", initial_state="demagnetised")
+    assert neutral.details["initial_state"] == "demagnetised"
+    assert declared.rmse < neutral.rmse
+    with pytest.raises(hysid.ConfigError, match="initial_state"):
+        hysid.identify_operator(u, y, family="pi", initial_state="magnetised")  # type: ignore[arg-type]

@@ -4,7 +4,10 @@
 //! rows that are not scored; a declared history on a family without it is one line.
 
 use crate::common::{hysid, one_line_error, read_json, Assert};
-use hysid::model::operators::{differential, BoucWen, HysteresisOperator};
+use hysid::model::operators::{
+    differential, initial_state, BoucWen, HysteresisOperator, InitialStateUsed, OperatorFamily,
+    PrandtlIshlinskii,
+};
 use std::fs;
 use std::path::{Path, PathBuf};
 use tempfile::TempDir;
@@ -126,17 +129,37 @@ fn a_declared_history_is_saved_reported_and_reapplied_by_simulate() {
 }
 
 #[test]
-fn a_declared_history_on_a_family_without_one_is_refused_in_one_line() {
+fn a_declared_history_on_a_linear_family_is_fitted_saved_and_reapplied() {
     let dir = TempDir::new().unwrap();
-    let u = through(&[-1.0, 1.0, -0.5, 0.5]);
-    let plant = BoucWen::new(0.3, -1.0, 2.5, 1.5, 1.0).unwrap();
-    let data = write(dir.path(), "d.csv", &u, &plant.simulate(&u).unwrap());
+    let u = through(&[0.4, -1.0, 1.0, -0.5, 0.5]);
+    let plant = PrandtlIshlinskii::example().unwrap();
+    let y = initial_state::simulate(&plant, Some(InitialStateUsed::Descending), &u).unwrap();
+    let data = write(dir.path(), "d.csv", &u, &y);
+    let model = dir.path().join("m.json");
+    let report = dir.path().join("r.json");
     hysid()
-        .args(["identify", "operator", "--family", "pi", "--initial-state", "ascending"])
+        .args([
+            "identify",
+            "operator",
+            "--family",
+            "pi",
+            "--initial-state",
+            "descending",
+        ])
         .arg("--data")
         .arg(&data)
-        .args(["--input", "u", "--output", "y"])
+        .args(["--input", "u", "--output", "y", "-q", "--json"])
+        .arg(&report)
+        .arg("--model-out")
+        .arg(&model)
         .assert()
-        .failure()
-        .stderr_contains("a declared initial state 'ascending' is implemented for the differential families only");
+        .success();
+    let saved = read_json(&model);
+    assert_eq!(saved["initial_state"], "descending", "{saved}");
+    let reported = read_json(&report);
+    let fitted = reported["fit"]["fit_percent"].as_f64().unwrap();
+    // simulate re-applies the descent at the record's first input: the fit's own numbers
+    let again = simulate(&model, &data, &dir.path().join("s.json"), &[]);
+    assert!((again - fitted).abs() < 1e-9, "{again} against {fitted}");
+    assert!(again > 99.0, "{again}");
 }

@@ -52,6 +52,7 @@ def identify_operator(
     orientation: Optional[str] = None,
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
+    initial_state: Optional[str] = None,
 ) -> str: ...
 def identify_operator_cascade(
     x: _Array,
@@ -84,6 +85,7 @@ def compare(
     orientation: Optional[str] = None,
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
+    initial_state: Optional[str] = None,
 ) -> Tuple[str, List[Tuple[str, Optional[str]]], _Array, _Array, List[_Array]]: ...
 def compensate(
     model_json: str,

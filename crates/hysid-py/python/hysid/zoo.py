@@ -31,6 +31,16 @@ AllFamilies = Literal["all"]
 LoopOrientation = Literal["ccw", "cw"]
 
 
+#: The initial hysteresis state of an operator fit (``docs/zoo.md``, "Initial states").
+InitialStateName = Literal["demagnetised", "descending", "ascending", "estimate"]
+
+
+def _initial_state(value: Optional[str]) -> Optional[str]:
+    if value is None:
+        return None
+    return check.choice(value, "initial_state", ("demagnetised", "descending", "ascending", "estimate"))
+
+
 def _orientation(value: Optional[str]) -> Optional[str]:
     if value is None:
         return None
@@ -91,6 +101,7 @@ def identify_operator(
     lambda_: float = 1e-6,
     dead_zones: int = 4,
     orientation: Optional[LoopOrientation] = None,
+    initial_state: Optional[InitialStateName] = None,
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
@@ -113,6 +124,11 @@ def identify_operator(
     ``"cw"``; None (default) detects it from the area between the ascending and descending
     branches (a :class:`DataError` naming this argument when the record cannot tell); the
     report's ``details.orientation`` and ``details.orientation_source`` say which was used.
+    ``initial_state``: where the record's memory starts, ``"demagnetised"`` (the family's
+    neutral state), ``"descending"`` (after a descent from above the record's maximum, a
+    standardised magnet), ``"ascending"``, or ``"estimate"`` (None, the default: fitted from
+    the data); the command line's ``--initial-state``, reported in
+    ``details.initial_state`` and saved in the model.
     An unknown family or an option out of range is a :class:`ConfigError` (a ``ValueError``).
     ``names`` and ``units``: the (input, output) channels' names and units, e.g.
     ``names=("voltage", "displacement"), units=("V", "µm")``, which label the plots' axes
@@ -126,7 +142,16 @@ def identify_operator(
     options = _family_options(thresholds, grid, lambda_, dead_zones)
     limit, tell = watching(time_limit, progress)
     text = _hysid.identify_operator(
-        u, y, name, step, *options, check.threads(threads), _orientation(orientation), limit, tell
+        u,
+        y,
+        name,
+        step,
+        *options,
+        check.threads(threads),
+        _orientation(orientation),
+        limit,
+        tell,
+        _initial_state(initial_state),
     )
     record = Record(u, y, step, labels, unit_labels)
     result = FitResult(labelled(json.loads(text), record), data=record)
@@ -146,6 +171,7 @@ def compare(
     lambda_: float = 1e-6,
     dead_zones: int = 4,
     orientation: Optional[LoopOrientation] = None,
+    initial_state: Optional[InitialStateName] = None,
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
@@ -186,7 +212,18 @@ def compare(
     options = _family_options(thresholds, grid, lambda_, dead_zones)
     limit, tell = watching(time_limit, progress)
     report, results, v_in, v_out, simulated = _hysid.compare(
-        u, y, u_val, y_val, chosen, step, *options, check.threads(threads), _orientation(orientation), limit, tell
+        u,
+        y,
+        u_val,
+        y_val,
+        chosen,
+        step,
+        *options,
+        check.threads(threads),
+        _orientation(orientation),
+        limit,
+        tell,
+        _initial_state(initial_state),
     )
     comparison = Comparison.from_extension(
         report,

@@ -101,8 +101,9 @@ fn neighbours(m: f64, d_hat: f64, lower: &mut f64, upper: &mut f64) {
 
 /// Moves d to the mean of its [`threshold_posterior`] and the other free parameters to their
 /// conditional optimum for that d (−H_oo⁻¹H_od·Δd with H = JᵀJ, exact for the locally
-/// quadratic smooth part); one simulation refreshes the fit statistics, the covariance is kept.
-/// `d_index` is the position of d in the parameter vector.
+/// quadratic smooth part), each kept within its bounds; one simulation refreshes the fit
+/// statistics, the covariance is kept (a moved point that cannot be simulated keeps the fit
+/// unmoved). `d_index` is the position of d in the parameter vector.
 pub fn place_threshold<M: OutputErrorModel>(
     make: &dyn Fn(Option<Switching>) -> M,
     data: &IdData,
@@ -116,11 +117,20 @@ pub fn place_threshold<M: OutputErrorModel>(
     }
     let mut theta = fit.parameters.values();
     for (i, delta) in conditional_shift(&fit.report, d_index, threshold.mean - d_hat) {
-        theta[i] += delta;
+        // the quadratic model knows nothing of the bounds (α > 0 near 0 on a slow record)
+        let p = fit.parameters.get(i);
+        theta[i] = (theta[i] + delta).clamp(p.min, p.max);
     }
     theta[d_index] = threshold.mean;
-    let moved = fit.at(&make(Some(classify(data, threshold.mean))), data, &theta)?;
-    Ok((moved, threshold))
+    // A moved point the model cannot simulate leaves the fit where it is: d̂ is then its
+    // own estimate, beside the posterior mean reported.
+    match fit
+        .clone()
+        .at(&make(Some(classify(data, threshold.mean))), data, &theta)
+    {
+        Ok(moved) => Ok((moved, threshold)),
+        Err(_) => Ok((fit, threshold)),
+    }
 }
 
 /// The change of the other free parameters that keeps the quadratic model of the criterion

@@ -11,12 +11,14 @@
 //! Reference: M. A. Krasnosel'skii, A. V. Pokrovskii, *Systems with Hysteresis*, Springer 1989.
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
-use super::linear_support::{check_data, finish, orientation, range, unscaled, Spread};
+use super::linear_support::{
+    check_data, core_path, finish, first_state, orientation, range, settle_state, unscaled, Spread,
+};
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
     oriented, OperatorCascadeIdentification, RankOne, RANK_ONE,
 };
-use crate::model::operators::{play, play_step, Backlash, Orientation};
+use crate::model::operators::{play, play_step, Backlash, InitialStateUsed, Orientation};
 use crate::model::OperatorCascade;
 use crate::{Error, Result};
 use nalgebra::{DMatrix, Matrix3, Vector3};
@@ -31,6 +33,8 @@ pub struct BacklashOptions {
     pub max_iterations: usize,
     /// The orientation; detected from the data when None.
     pub orientation: Option<Orientation>,
+    /// The declared initial state the play starts from (None: from 0, demagnetised).
+    pub initial_state: Option<InitialStateUsed>,
 }
 
 impl Default for BacklashOptions {
@@ -39,15 +43,17 @@ impl Default for BacklashOptions {
             profile_points: 60,
             max_iterations: 100,
             orientation: None,
+            initial_state: None,
         }
     }
 }
 
-/// The play output and its derivative with respect to r.
-fn play_with_sensitivity(x: &[f64], r: f64) -> (Vec<f64>, Vec<f64>) {
+/// The play output and its derivative with respect to r over the record `x`, the play first
+/// run through the declared `history` (empty: from 0).
+fn play_with_sensitivity(history: &[f64], x: &[f64], r: f64) -> (Vec<f64>, Vec<f64>) {
     let (mut z, mut s) = (0.0, 0.0);
     let mut out = (Vec::with_capacity(x.len()), Vec::with_capacity(x.len()));
-    for &xk in x {
+    for (k, &xk) in history.iter().chain(x).enumerate() {
         let next = play_step(z, xk, r);
         if next == xk - r && next != z {
             s = -1.0;
@@ -57,8 +63,10 @@ fn play_with_sensitivity(x: &[f64], r: f64) -> (Vec<f64>, Vec<f64>) {
             s = 0.0;
         }
         z = next;
-        out.0.push(z);
-        out.1.push(s);
+        if k >= history.len() {
+            out.0.push(z);
+            out.1.push(s);
+        }
     }
     out
 }
@@ -75,8 +83,10 @@ fn gain_offset(z: &[f64], v: &[f64]) -> (f64, f64, f64) {
     (g, c, rss)
 }
 
-fn rss_at(x: &[f64], v: &[f64], theta: &Vector3<f64>) -> f64 {
-    let mut z = 0.0;
+fn rss_at(history: &[f64], x: &[f64], v: &[f64], theta: &Vector3<f64>) -> f64 {
+    let mut z = history
+        .iter()
+        .fold(0.0, |z, &xk| play_step(z, xk, theta[1]));
     x.iter()
         .zip(v)
         .map(|(&xk, &vk)| {
@@ -100,20 +110,15 @@ pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFi
     let o = orientation(u, y, options.orientation)?;
     let (x, v) = o.core_data(u, y);
     let (lo, hi) = range(&x);
+    // a play of half-width r ≤ (hi − lo)/2 is wiped by the history's excursion of 2 (hi − lo)
+    let (path, skip) = core_path(options.initial_state, &x, 0.0);
+    let history = &path[..skip];
     let step = (hi - lo) / (2.0 * options.profile_points as f64);
     let mut evaluations = 0;
     let mut best = (f64::INFINITY, Vector3::zeros());
     for k in 0..options.profile_points {
         let r = k as f64 * step;
-        let z: Vec<f64> = {
-            let mut s = 0.0;
-            x.iter()
-                .map(|&xk| {
-                    s = play_step(s, xk, r);
-                    s
-                })
-                .collect()
-        };
+        let (z, _) = play_with_sensitivity(history, &x, r);
         let (g, c, rss) = gain_offset(&z, &v);
         evaluations += 1;
         if g > 0.0 && rss < best.0 {
@@ -126,10 +131,11 @@ pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFi
             reason: "no positive backlash gain fits these data; check the columns".into(),
         });
     }
-    let (theta, jtj, iterations, evals, converged) = polish(&x, &v, best, options.max_iterations);
+    let (theta, jtj, iterations, evals, converged) =
+        polish(history, &x, &v, best, options.max_iterations);
     evaluations += evals;
     let n = x.len();
-    let rss = rss_at(&x, &v, &theta);
+    let rss = rss_at(history, &x, &v, &theta);
     let sigma2 = rss / (n.saturating_sub(3).max(1)) as f64;
     let spread = match jtj.try_inverse() {
         Some(inv) => {
@@ -146,6 +152,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFi
     Ok(finish(
         model,
         o,
+        options.initial_state,
         u,
         y,
         spread,
@@ -158,6 +165,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &BacklashOptions) -> Result<OperatorFi
 
 /// Levenberg–Marquardt on (g, r, c) from the profile's best point.
 fn polish(
+    history: &[f64],
     x: &[f64],
     v: &[f64],
     start: (f64, Vector3<f64>),
@@ -168,7 +176,7 @@ fn polish(
     let mut evaluations = 0;
     let scale: f64 = v.iter().map(|a| a * a).sum::<f64>().max(f64::MIN_POSITIVE);
     for it in 0..max_iterations {
-        let (z, s) = play_with_sensitivity(x, theta[1]);
+        let (z, s) = play_with_sensitivity(history, x, theta[1]);
         let (mut jtj, mut jte) = (Matrix3::zeros(), Vector3::zeros());
         for k in 0..x.len() {
             let j = Vector3::new(z[k], theta[0] * s[k], 1.0);
@@ -191,7 +199,7 @@ fn polish(
             };
             let mut next = theta + delta;
             next[1] = next[1].max(0.0);
-            let r_next = rss_at(x, v, &next);
+            let r_next = rss_at(history, x, v, &next);
             evaluations += 1;
             if r_next < rss {
                 let small = (next - theta).norm() <= 1e-13 * (1.0 + theta.norm());
@@ -201,7 +209,7 @@ fn polish(
                 mu = (mu / 10.0).max(1e-12);
                 accepted = true;
                 if small || flat {
-                    let (z, s) = play_with_sensitivity(x, theta[1]);
+                    let (z, s) = play_with_sensitivity(history, x, theta[1]);
                     let jtj = jacobian_gram(&z, &s, theta[0]);
                     return (theta, jtj, it + 1, evaluations, true);
                 }
@@ -214,7 +222,7 @@ fn polish(
             return (theta, jtj, it + 1, evaluations, true);
         }
     }
-    let (z, s) = play_with_sensitivity(x, theta[1]);
+    let (z, s) = play_with_sensitivity(history, x, theta[1]);
     (
         theta,
         jacobian_gram(&z, &s, theta[0]),
@@ -237,14 +245,15 @@ impl Identify for Backlash {
     const SETTINGS: &'static [FamilySetting] = &[FamilySetting::Orientation];
 
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
-        fit(
-            u,
-            y,
-            &BacklashOptions {
-                orientation: options.given_orientation(u, y)?,
-                ..BacklashOptions::default()
-            },
-        )
+        let request = options.initial_state;
+        let given = options.given_orientation(u, y)?;
+        let settings = |initial_state| BacklashOptions {
+            orientation: given,
+            initial_state,
+            ..BacklashOptions::default()
+        };
+        let first = fit(u, y, &settings(first_state(request)))?;
+        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
     }
 
     /// A profile over the half-width r = k·(max u − min u)/(2P), k = 0 … P − 1 (P the default

@@ -56,10 +56,12 @@ pub struct FamilyOptions {
     /// Bouc–Wen, Duhem, Dahl) and may stop them with the best result so far.
     pub observer: Observer,
     /// The initial state (`--initial-state`, Python `initial_state=`; default
-    /// [`InitialState::Estimate`]). The differential families (Jiles–Atherton, Bouc–Wen,
-    /// Duhem, Dahl) read every value; the other families start demagnetised (their
-    /// structure's documented state) under `estimate` and `demagnetised` and refuse a
-    /// declared history for now.
+    /// [`InitialState::Estimate`]), read by every operator family: the differential ones
+    /// (Jiles–Atherton, Bouc–Wen, Duhem, Dahl) fit x₀; the linear-in-weights ones regress
+    /// from the declared history, and under `estimate` keep the least-loss of the
+    /// demagnetised, descending and ascending starts
+    /// (`linear_support::settle_state`). ch4/ch6 ignore it (their output starts at the
+    /// measured first sample).
     pub initial_state: InitialState,
     /// Choose the threshold count and placement of PI, generalised PI and Maxwell-slip from
     /// the data ([`crate::identify::operators::model_size`]: counts 4, 6, 8, 10, 14, 20,
@@ -346,22 +348,6 @@ pub fn fit_operator(
             parameters: SMALLEST_MODEL.0,
             needed: SMALLEST_MODEL.1,
         });
-    }
-    let differential = matches!(
-        family,
-        Family::JilesAtherton | Family::BoucWen | Family::Duhem | Family::Dahl
-    );
-    if !differential
-        && matches!(
-            options.initial_state,
-            InitialState::Descending | InitialState::Ascending
-        )
-    {
-        return Err(Error::Unsupported(format!(
-            "{family}: a declared initial state '{}' is implemented for the differential \
-             families only (jiles-atherton, bouc-wen, duhem, dahl); use demagnetised or estimate",
-            options.initial_state.name()
-        )));
     }
     let fit = match family {
         Family::Ch4 => coleman_hodgdon(ChForm::Saturated4, u, y)?,

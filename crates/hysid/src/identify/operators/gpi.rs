@@ -21,13 +21,14 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, range, solve_weights, threshold_candidates, threshold_grid,
-    unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
+    check_data, core_path, finish, first_state, orientation, range, settle_state, solve_weights,
+    threshold_candidates, threshold_grid, unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
 };
 use super::model_size::choose;
 use super::OperatorFit;
 use crate::model::operators::{
-    play, validate_thresholds, DeadZones, GeneralizedPi, Orientation, PrandtlIshlinskii,
+    play, validate_thresholds, DeadZones, GeneralizedPi, InitialStateUsed, Orientation,
+    PrandtlIshlinskii,
 };
 use crate::{Error, Result};
 use std::time::Instant;
@@ -45,6 +46,8 @@ pub struct GpiOptions {
     pub dead_zone_grid: Option<(Vec<f64>, Vec<f64>)>,
     /// The orientation; detected from the data when None.
     pub orientation: Option<Orientation>,
+    /// The declared initial state the plays start from (None: from 0, demagnetised).
+    pub initial_state: Option<InitialStateUsed>,
 }
 
 impl Default for GpiOptions {
@@ -55,6 +58,7 @@ impl Default for GpiOptions {
             dead_zones: 4,
             dead_zone_grid: None,
             orientation: None,
+            initial_state: None,
         }
     }
 }
@@ -107,9 +111,11 @@ pub fn fit(u: &[f64], y: &[f64], options: &GpiOptions) -> Result<OperatorFit<Gen
     let m = grid.len();
     let nz = upper.len() + lower.len();
     check_data(u, y, m + 2 + nz)?;
+    let reach = 2.0 * grid.last().copied().unwrap_or(0.0);
+    let (path, skip) = core_path(options.initial_state, &x, reach);
     let mut columns = Vec::with_capacity(m + 2 + nz);
     columns.push(x.clone());
-    columns.extend(grid.iter().map(|&r| play(&x, r)));
+    columns.extend(grid.iter().map(|&r| play(&path, r).split_off(skip)));
     columns.push(vec![1.0; x.len()]);
     columns.extend(upper.iter().chain(&lower).map(|&z| dead_zone(&v, z)));
     // the dead-zone columns enter as −S_z(v), so that their coefficients are d'
@@ -172,6 +178,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &GpiOptions) -> Result<OperatorFit<Gen
     Ok(finish(
         model,
         o,
+        options.initial_state,
         u,
         y,
         Spread::of(&sol, &map),
@@ -195,6 +202,7 @@ impl Identify for GeneralizedPi {
     /// ([`model_size`](super::model_size)).
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         let given = options.given_orientation(u, y)?;
+        let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
             let (x, _) = o.core_data(u, y);
@@ -206,7 +214,8 @@ impl Identify for GeneralizedPi {
                 candidates,
                 10 + extra,
                 PLAY_WORK_BOUND,
-                |u, y, grid| {
+                request,
+                |u, y, grid, state| {
                     fit(
                         u,
                         y,
@@ -214,6 +223,7 @@ impl Identify for GeneralizedPi {
                             grid: Some(grid.clone()),
                             dead_zones: options.dead_zones,
                             orientation: Some(o),
+                            initial_state: state,
                             ..GpiOptions::default()
                         },
                     )
@@ -222,16 +232,15 @@ impl Identify for GeneralizedPi {
             f.model_size = Some(choice);
             return Ok(f);
         }
-        fit(
-            u,
-            y,
-            &GpiOptions {
-                thresholds: options.thresholds,
-                grid: options.threshold_grid.clone(),
-                dead_zones: options.dead_zones,
-                orientation: given,
-                ..GpiOptions::default()
-            },
-        )
+        let settings = |state| GpiOptions {
+            thresholds: options.thresholds,
+            grid: options.threshold_grid.clone(),
+            dead_zones: options.dead_zones,
+            orientation: given,
+            initial_state: state,
+            ..GpiOptions::default()
+        };
+        let first = fit(u, y, &settings(first_state(request)))?;
+        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
     }
 }

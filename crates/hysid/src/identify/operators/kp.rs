@@ -35,13 +35,13 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, range, solve_weights, unscaled, GramAccumulator, Spread,
-    WeightSolution,
+    check_data, core_path, finish, first_state, orientation, range, settle_state, solve_weights,
+    unscaled, GramAccumulator, Spread, WeightSolution,
 };
 use super::model_size::choose_grid;
 use super::OperatorFit;
 use crate::model::operators::kp::KernelStates;
-use crate::model::operators::{Kp, Orientation};
+use crate::model::operators::{InitialStateUsed, Kp, Orientation};
 use crate::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use std::time::Instant;
@@ -72,6 +72,9 @@ pub struct KpOptions {
     pub reversible: bool,
     /// The orientation; detected from the data when None (default).
     pub orientation: Option<Orientation>,
+    /// The declared initial state the kernels start from (None: every kernel down,
+    /// demagnetised).
+    pub initial_state: Option<InitialStateUsed>,
 }
 
 impl KpOptions {
@@ -89,6 +92,7 @@ impl Default for KpOptions {
             range: None,
             reversible: true,
             orientation: None,
+            initial_state: None,
         }
     }
 }
@@ -125,11 +129,19 @@ pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>>
     let mut unconstrained = vec![false; p];
     unconstrained[p - 1] = true;
 
+    let (path, skip) = core_path(options.initial_state, &x, 2.0 * (upper - lower));
     let mut best: Option<(f64, f64, WeightSolution)> = None;
     let mut iterations = 0;
     for &relative in &options.widths {
         let width = relative * (upper - lower);
-        let (g, b, yy, n) = normal_equations(&thresholds, width, &x, &v, options.reversible);
+        let (g, b, yy, n) = normal_equations(
+            &thresholds,
+            width,
+            &path[..skip],
+            &x,
+            &v,
+            options.reversible,
+        );
         let mut g_pen = g.clone();
         add_smoothness(&mut g_pen, thresholds.len(), first, options.lambda);
         let sol = solve_weights(&g_pen, &b, yy, n, &unconstrained, Some(&g))?;
@@ -160,6 +172,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &KpOptions) -> Result<OperatorFit<Kp>>
     Ok(finish(
         model,
         o,
+        options.initial_state,
         u,
         y,
         Spread::of(&sol, &map),
@@ -218,10 +231,12 @@ fn check_options(options: &KpOptions) -> Result<()> {
     Ok(())
 }
 
-/// The normal equations of the regressors [x, ξ_kernels, 1] over the data.
+/// The normal equations of the regressors [x, ξ_kernels, 1] over the data, the kernels
+/// first run through the declared `history` (empty: every kernel down).
 fn normal_equations(
     thresholds: &[f64],
     width: f64,
+    history: &[f64],
     x: &[f64],
     v: &[f64],
     reversible: bool,
@@ -231,6 +246,9 @@ fn normal_equations(
     let p = first + kernels + 1;
     let mut acc = GramAccumulator::new(p);
     let mut states = KernelStates::new(thresholds, width);
+    for &xk in history {
+        states.advance(xk);
+    }
     let mut row = vec![0.0; p];
     row[p - 1] = 1.0;
     for (&xk, &vk) in x.iter().zip(v) {
@@ -292,18 +310,25 @@ impl Identify for Kp {
     /// ([`model_size`](super::model_size)); otherwise `grid` fixes them.
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         let given = options.given_orientation(u, y)?;
-        let settings = |levels: usize, orientation: Option<Orientation>| KpOptions {
+        let request = options.initial_state;
+        let settings = |levels: usize,
+                        orientation: Option<Orientation>,
+                        initial_state: Option<InitialStateUsed>| KpOptions {
             levels,
             lambda: options.lambda,
             orientation,
+            initial_state,
             ..KpOptions::default()
         };
         if options.choose_grid {
             let o = orientation(u, y, given)?;
-            return choose_grid(u, y, GRID_WORK_BOUND, |u, y, n| {
-                fit(u, y, &settings(n, Some(o)))
+            return choose_grid(u, y, GRID_WORK_BOUND, request, |u, y, n, state| {
+                fit(u, y, &settings(n, Some(o), state))
             });
         }
-        fit(u, y, &settings(options.grid, given))
+        let first = fit(u, y, &settings(options.grid, given, first_state(request)))?;
+        settle_state(request, first, u, |state| {
+            fit(u, y, &settings(options.grid, given, state))
+        })
     }
 }

@@ -3,7 +3,9 @@
 
 use super::OperatorFit;
 use crate::model::operators::elementary::{check_signal, oriented_simulate_saturating, Core};
-use crate::model::operators::{HysteresisOperator, Orientation};
+use crate::model::operators::{
+    initial_state, HysteresisOperator, InitialState, InitialStateUsed, Orientation,
+};
 use crate::numerics::metrics;
 use crate::numerics::nnls::{nnls_gram, passive_inverse};
 use crate::numerics::Termination;
@@ -363,11 +365,79 @@ pub(crate) fn solve_weights(
     })
 }
 
-/// Everything a fit reports, from the model and the data.
+/// The core input x of a record with the declared history of `state` prepended, and the
+/// number of samples prepended (MODELS.md §4.8, [`initial_state`]): \[x₀, x_turn\] ++ x,
+/// x_turn = [`InitialStateUsed::turning_point`] over x's range with the core's memory
+/// `reach` (twice its largest threshold, or the extent of its Preisach grid). The core's
+/// input rises with u in every orientation (x = u, or x = s·y = G⁻¹\[u\]), so a descent in u
+/// is a descent in x. A fit computes its regressors over the path and regresses on the rows
+/// after the first `skip`; None or a state held in the structure: x itself.
+pub(crate) fn core_path(
+    state: Option<InitialStateUsed>,
+    x: &[f64],
+    reach: f64,
+) -> (Vec<f64>, usize) {
+    let (lo, hi) = range(x);
+    match (
+        state.and_then(|s| s.turning_point(lo, hi, reach)),
+        x.first(),
+    ) {
+        (Some(turn), Some(&x0)) => {
+            let mut path = vec![x0, turn];
+            path.extend_from_slice(x);
+            (path, 2)
+        }
+        _ => (x.to_vec(), 0),
+    }
+}
+
+/// The declared history a fit of `request` regresses from first: the descending or
+/// ascending history; None (the structure's own, demagnetised state) for `demagnetised`
+/// and for `estimate`, whose other candidates [`settle_state`] refits.
+pub(crate) fn first_state(request: InitialState) -> Option<InitialStateUsed> {
+    request
+        .declared()
+        .filter(|s| *s != InitialStateUsed::Demagnetised)
+}
+
+/// The fit of the initial state `request`, from `first`, the fit from [`first_state`]: a
+/// declared state keeps it; `estimate` compares it with the refits `refit(state)` of the
+/// same structure from the descending and the ascending histories and keeps the one of least
+/// loss on the record (the same parameters, so the loss is the criterion; a tie keeps the
+/// demagnetised state). A candidate whose saved model could not simulate its own record
+/// from that state (a history beyond the domain of an inverse-parameterised, saturating
+/// operator) is dropped.
+pub(crate) fn settle_state<M: HysteresisOperator>(
+    request: InitialState,
+    first: OperatorFit<M>,
+    u: &[f64],
+    refit: impl Fn(Option<InitialStateUsed>) -> Result<OperatorFit<M>>,
+) -> Result<OperatorFit<M>> {
+    if request != InitialState::Estimate {
+        if let Some(state) = first.initial_state {
+            initial_state::simulate(&first.model, Some(state), u)?;
+        }
+        return Ok(first);
+    }
+    let mut best = first;
+    for state in [InitialStateUsed::Descending, InitialStateUsed::Ascending] {
+        let Ok(fit) = refit(Some(state)) else {
+            continue;
+        };
+        if fit.loss < best.loss && initial_state::simulate(&fit.model, Some(state), u).is_ok() {
+            best = fit;
+        }
+    }
+    Ok(best)
+}
+
+/// Everything a fit reports, from the model and the data, simulated from the declared
+/// initial `state` (None: the structure's own).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn finish<M: HysteresisOperator + Core>(
     model: M,
     orientation: Orientation,
+    state: Option<InitialStateUsed>,
     u: &[f64],
     y: &[f64],
     spread: Spread,
@@ -377,7 +447,14 @@ pub(crate) fn finish<M: HysteresisOperator + Core>(
     start: Instant,
 ) -> OperatorFit<M> {
     let Spread { std, covariance } = spread;
-    let (simulated, _) = oriented_simulate_saturating(&model, orientation, u);
+    let simulated = match state {
+        Some(state) => {
+            let path = initial_state::with_history(&model, state, u);
+            let (mut simulated, _) = oriented_simulate_saturating(&model, orientation, &path);
+            simulated.split_off(path.len() - u.len())
+        }
+        None => oriented_simulate_saturating(&model, orientation, u).0,
+    };
     let parameters = model.parameters();
     let estimated = std.iter().filter(|s| s.is_some()).count();
     let n = y.len();
@@ -405,7 +482,7 @@ pub(crate) fn finish<M: HysteresisOperator + Core>(
         evaluations,
         termination,
         elapsed_s: start.elapsed().as_secs_f64(),
-        initial_state: None,
+        initial_state: state,
         model_size: None,
     }
 }

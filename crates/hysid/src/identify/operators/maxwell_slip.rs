@@ -14,13 +14,15 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, solve_weights, threshold_candidates, threshold_grid,
-    GramAccumulator, Spread, PLAY_WORK_BOUND,
+    check_data, core_path, finish, first_state, orientation, settle_state, solve_weights,
+    threshold_candidates, threshold_grid, GramAccumulator, Spread, PLAY_WORK_BOUND,
 };
 use super::model_size::choose;
 use super::OperatorFit;
 use crate::identify::operator_cascade::{OperatorCascadeIdentification, RANK_ONE};
-use crate::model::operators::{stop, validate_thresholds, MaxwellSlip, Orientation};
+use crate::model::operators::{
+    stop, validate_thresholds, InitialStateUsed, MaxwellSlip, Orientation,
+};
 use crate::model::OperatorCascade;
 use crate::{Error, Result};
 use std::time::Instant;
@@ -36,6 +38,8 @@ pub struct MaxwellSlipOptions {
     pub linear_spring: bool,
     /// The orientation; detected from the data when None.
     pub orientation: Option<Orientation>,
+    /// The declared initial state the elements start from (None: unstretched, demagnetised).
+    pub initial_state: Option<InitialStateUsed>,
 }
 
 impl Default for MaxwellSlipOptions {
@@ -45,6 +49,7 @@ impl Default for MaxwellSlipOptions {
             widths: None,
             linear_spring: true,
             orientation: None,
+            initial_state: None,
         }
     }
 }
@@ -74,11 +79,13 @@ pub fn fit(u: &[f64], y: &[f64], options: &MaxwellSlipOptions) -> Result<Operato
     };
     validate_thresholds("delta", &widths)?;
     check_data(u, y, widths.len() + 2)?;
+    let reach = 2.0 * widths.last().copied().unwrap_or(0.0);
+    let (path, skip) = core_path(options.initial_state, &x, reach);
     let mut columns = Vec::with_capacity(widths.len() + 2);
     if options.linear_spring {
         columns.push(x.clone());
     }
-    columns.extend(widths.iter().map(|&d| stop(&x, d)));
+    columns.extend(widths.iter().map(|&d| stop(&path, d).split_off(skip)));
     columns.push(vec![1.0; x.len()]);
     let (g, b, yy, n) = GramAccumulator::from_columns(&columns, &v);
     let p = columns.len();
@@ -105,6 +112,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &MaxwellSlipOptions) -> Result<Operato
     Ok(finish(
         model,
         o,
+        options.initial_state,
         u,
         y,
         Spread::of(&sol, &map),
@@ -135,6 +143,7 @@ impl Identify for MaxwellSlip {
             )),
             (None, None) => None,
         };
+        let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = match given {
                 Some(o) => o,
@@ -142,30 +151,38 @@ impl Identify for MaxwellSlip {
             };
             let (x, _) = o.core_data(u, y);
             let candidates = threshold_candidates(&x, 2)?;
-            let (mut f, choice) = choose(u, y, candidates, 12, PLAY_WORK_BOUND, |u, y, w| {
-                fit(
-                    u,
-                    y,
-                    &MaxwellSlipOptions {
-                        widths: Some(w.clone()),
-                        orientation: Some(o),
-                        ..MaxwellSlipOptions::default()
-                    },
-                )
-            })?;
+            let (mut f, choice) = choose(
+                u,
+                y,
+                candidates,
+                12,
+                PLAY_WORK_BOUND,
+                request,
+                |u, y, w, state| {
+                    fit(
+                        u,
+                        y,
+                        &MaxwellSlipOptions {
+                            widths: Some(w.clone()),
+                            orientation: Some(o),
+                            initial_state: state,
+                            ..MaxwellSlipOptions::default()
+                        },
+                    )
+                },
+            )?;
             f.model_size = Some(choice);
             return Ok(f);
         }
-        fit(
-            u,
-            y,
-            &MaxwellSlipOptions {
-                elements: options.thresholds,
-                widths: options.threshold_grid.clone(),
-                orientation: given,
-                ..MaxwellSlipOptions::default()
-            },
-        )
+        let settings = |state| MaxwellSlipOptions {
+            elements: options.thresholds,
+            widths: options.threshold_grid.clone(),
+            orientation: given,
+            initial_state: state,
+            ..MaxwellSlipOptions::default()
+        };
+        let first = fit(u, y, &settings(first_state(request)))?;
+        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
     }
 
     /// The over-parameterised equation error in the basis u, E_{δᵢ}\[u\], 1 with a rank-one

@@ -11,6 +11,11 @@
 //! small model instead of a refusal; when no candidate fits in the training part, the
 //! smallest one the whole record can hold is fitted on all of it.
 //!
+//! **Initial state.** The candidates are fitted and simulated from the requested initial
+//! state (the demagnetised one under `estimate`); the winner's state is then settled on the
+//! whole record ([`settle_state`](super::linear_support::settle_state): `estimate` refits
+//! its structure from the descending and the ascending histories and keeps the least loss).
+//!
 //! **Work bound.** A fit's cost is dominated by the Gram matrix, N·p² for N samples and p
 //! parameters. The candidates are tried smallest first while the training fits' total
 //! Σ N_train·p² stays within `bound` times the cost N·p₀² of one fit of today's fixed default
@@ -20,8 +25,9 @@
 //! Reference: T. Hastie, R. Tibshirani, J. Friedman, *The Elements of Statistical Learning*,
 //! 2nd ed., Springer 2009, §7.2 (model selection by a validation set).
 
+use super::linear_support::{first_state, settle_state};
 use super::OperatorFit;
-use crate::model::operators::HysteresisOperator;
+use crate::model::operators::{initial_state, HysteresisOperator, InitialState, InitialStateUsed};
 use crate::numerics::metrics;
 use crate::Result;
 use serde::Serialize;
@@ -73,10 +79,16 @@ fn needed(p: usize) -> usize {
 /// [`GRID_CANDIDATES`](super::family::GRID_CANDIDATES), each with its n(n+1)/2 cells, offset
 /// and slope, chosen by [`choose`] within `bound` fits of the default grid 20; `fit` fits
 /// the grid of n intervals. The choice is recorded in the fit's `model_size`.
-pub(crate) fn choose_grid<M, F>(u: &[f64], y: &[f64], bound: f64, fit: F) -> Result<OperatorFit<M>>
+pub(crate) fn choose_grid<M, F>(
+    u: &[f64],
+    y: &[f64],
+    bound: f64,
+    request: InitialState,
+    fit: F,
+) -> Result<OperatorFit<M>>
 where
     M: HysteresisOperator,
-    F: Fn(&[f64], &[f64], usize) -> Result<OperatorFit<M>>,
+    F: Fn(&[f64], &[f64], usize, Option<InitialStateUsed>) -> Result<OperatorFit<M>>,
 {
     let parameters = |n: usize| n * (n + 1) / 2 + 2;
     let candidates = super::family::GRID_CANDIDATES
@@ -87,27 +99,38 @@ where
             parameters: parameters(n),
         })
         .collect();
-    let (mut f, choice) = choose(u, y, candidates, parameters(20), bound, |u, y, &n| {
-        fit(u, y, n)
-    })?;
+    let (mut f, choice) = choose(
+        u,
+        y,
+        candidates,
+        parameters(20),
+        bound,
+        request,
+        |u, y, &n, state| fit(u, y, n, state),
+    )?;
     f.model_size = Some(choice);
     Ok(f)
 }
 
 /// Chooses among `candidates` (smallest first) by the held-out fit % within `bound` default
-/// fits of `default_parameters` parameters, and refits the winner on the whole record.
+/// fits of `default_parameters` parameters, and refits the winner on the whole record; the
+/// candidates are fitted from the initial state [`first_state`] of `request` (each
+/// simulated from it), the winner's state then settled by [`settle_state`]. `fit` fits a
+/// candidate's setting from a declared state (None: the structure's own).
 pub(crate) fn choose<M, C, F>(
     u: &[f64],
     y: &[f64],
     candidates: Vec<Candidate<C>>,
     default_parameters: usize,
     bound: f64,
+    request: InitialState,
     fit: F,
 ) -> Result<(OperatorFit<M>, ModelSizeChoice)>
 where
     M: HysteresisOperator,
-    F: Fn(&[f64], &[f64], &C) -> Result<OperatorFit<M>>,
+    F: Fn(&[f64], &[f64], &C, Option<InitialStateUsed>) -> Result<OperatorFit<M>>,
 {
+    let state = first_state(request);
     let n = u.len().min(y.len());
     let split = n * TRAINING_FRACTION.0 / TRAINING_FRACTION.1;
     let budget = bound * n as f64 * (default_parameters as f64).powi(2);
@@ -127,9 +150,9 @@ where
         let mut skipped = skipped;
         if skipped.is_none() {
             spent += cost;
-            score = fit(&u[..split], &y[..split], &c.setting)
+            score = fit(&u[..split], &y[..split], &c.setting, state)
                 .ok()
-                .and_then(|f| f.model.simulate(&u[..n]).ok())
+                .and_then(|f| initial_state::simulate(&f.model, f.initial_state, &u[..n]).ok())
                 .map(|sim| metrics::fit_percent(&y[split..n], &sim[split..n]))
                 .filter(|s| s.is_finite());
             if score.is_none() {
@@ -161,7 +184,10 @@ where
     let chosen = candidates.get(index).ok_or_else(|| {
         crate::Error::invalid_option("model size", "[]", "no candidate model size".into())
     })?;
-    let result = fit(&u[..n], &y[..n], &chosen.setting)?;
+    let first = fit(&u[..n], &y[..n], &chosen.setting, state)?;
+    let result = settle_state(request, first, &u[..n], |s| {
+        fit(&u[..n], &y[..n], &chosen.setting, s)
+    })?;
     Ok((
         result,
         ModelSizeChoice {

@@ -17,15 +17,17 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, solve_weights, threshold_candidates, threshold_grid, unscaled,
-    GramAccumulator, Spread, PLAY_WORK_BOUND,
+    check_data, core_path, finish, first_state, orientation, settle_state, solve_weights,
+    threshold_candidates, threshold_grid, unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
 };
 use super::model_size::choose;
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
     monotone_weights, OperatorCascadeIdentification, RANK_ONE,
 };
-use crate::model::operators::{play, validate_thresholds, Orientation, PrandtlIshlinskii};
+use crate::model::operators::{
+    initial_state, play, validate_thresholds, InitialStateUsed, Orientation, PrandtlIshlinskii,
+};
 use crate::model::OperatorCascade;
 use crate::numerics::metrics;
 use crate::{Error, Result};
@@ -43,6 +45,9 @@ pub struct PiOptions {
     /// Candidate counts to choose n from by validation: each is fitted on the first 70 % of the
     /// data and the one with the best fit % on the last 30 % is refitted on all of it.
     pub select: Option<Vec<usize>>,
+    /// The declared initial state the plays start from (None: from 0, demagnetised): the
+    /// regressors run through its history first (`linear_support::core_path`).
+    pub initial_state: Option<InitialStateUsed>,
 }
 
 impl Default for PiOptions {
@@ -52,6 +57,7 @@ impl Default for PiOptions {
             grid: None,
             orientation: None,
             select: None,
+            initial_state: None,
         }
     }
 }
@@ -74,9 +80,11 @@ pub fn fit(u: &[f64], y: &[f64], options: &PiOptions) -> Result<OperatorFit<Pran
     };
     validate_thresholds("r", &grid)?;
     check_data(u, y, grid.len() + 2)?;
+    let reach = 2.0 * grid.last().copied().unwrap_or(0.0);
+    let (path, skip) = core_path(options.initial_state, &x, reach);
     let mut columns = Vec::with_capacity(grid.len() + 2);
     columns.push(x.clone());
-    columns.extend(grid.iter().map(|&r| play(&x, r)));
+    columns.extend(grid.iter().map(|&r| play(&path, r).split_off(skip)));
     columns.push(vec![1.0; x.len()]);
     let (g, b, yy, n) = GramAccumulator::from_columns(&columns, &v);
     let mut unconstrained = vec![false; columns.len()];
@@ -98,6 +106,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &PiOptions) -> Result<OperatorFit<Pran
     Ok(finish(
         model,
         o,
+        options.initial_state,
         u,
         y,
         Spread::of(&sol, &map),
@@ -127,7 +136,7 @@ fn fit_selected(
         let Ok(f) = fit(&u[..split], &y[..split], &opts) else {
             continue;
         };
-        let Ok(sim) = crate::model::operators::HysteresisOperator::simulate(&f.model, u) else {
+        let Ok(sim) = initial_state::simulate(&f.model, f.initial_state, u) else {
             continue;
         };
         let score = metrics::fit_percent(&y[split..], &sim[split..]);
@@ -167,34 +176,43 @@ impl Identify for PrandtlIshlinskii {
     /// given one.
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         let given = options.given_orientation(u, y)?;
+        let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
             let (x, _) = o.core_data(u, y);
             let candidates = threshold_candidates(&x, 2)?;
-            let (mut f, choice) = choose(u, y, candidates, 12, PLAY_WORK_BOUND, |u, y, grid| {
-                fit(
-                    u,
-                    y,
-                    &PiOptions {
-                        grid: Some(grid.clone()),
-                        orientation: Some(o),
-                        ..PiOptions::default()
-                    },
-                )
-            })?;
+            let (mut f, choice) = choose(
+                u,
+                y,
+                candidates,
+                12,
+                PLAY_WORK_BOUND,
+                request,
+                |u, y, grid, state| {
+                    fit(
+                        u,
+                        y,
+                        &PiOptions {
+                            grid: Some(grid.clone()),
+                            orientation: Some(o),
+                            initial_state: state,
+                            ..PiOptions::default()
+                        },
+                    )
+                },
+            )?;
             f.model_size = Some(choice);
             return Ok(f);
         }
-        fit(
-            u,
-            y,
-            &PiOptions {
-                thresholds: options.thresholds,
-                grid: options.threshold_grid.clone(),
-                orientation: given,
-                select: None,
-            },
-        )
+        let settings = |state| PiOptions {
+            thresholds: options.thresholds,
+            grid: options.threshold_grid.clone(),
+            orientation: given,
+            select: None,
+            initial_state: state,
+        };
+        let first = fit(u, y, &settings(first_state(request)))?;
+        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
     }
 
     /// The over-parameterised equation error in the basis u, F_{rᵢ}\[u\], 1 with a rank-one

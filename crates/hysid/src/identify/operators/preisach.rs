@@ -17,12 +17,13 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, finish, orientation, range, solve_weights, unscaled, GramAccumulator, Spread,
+    check_data, core_path, finish, first_state, orientation, range, settle_state, solve_weights,
+    unscaled, GramAccumulator, Spread,
 };
 use super::model_size::choose_grid;
 use super::OperatorFit;
 use crate::model::operators::preisach::{regressors, Grid, Memory};
-use crate::model::operators::{Orientation, Preisach};
+use crate::model::operators::{InitialStateUsed, Orientation, Preisach};
 use crate::{Error, Result};
 use nalgebra::DMatrix;
 use std::time::Instant;
@@ -46,6 +47,9 @@ pub struct PreisachOptions {
     pub reversible: bool,
     /// The orientation; detected from the data when None.
     pub orientation: Option<Orientation>,
+    /// The declared initial state the memory starts from (None: negative saturation,
+    /// demagnetised).
+    pub initial_state: Option<InitialStateUsed>,
 }
 
 impl Default for PreisachOptions {
@@ -56,6 +60,7 @@ impl Default for PreisachOptions {
             range: None,
             reversible: true,
             orientation: None,
+            initial_state: None,
         }
     }
 }
@@ -92,7 +97,8 @@ pub fn fit(u: &[f64], y: &[f64], options: &PreisachOptions) -> Result<OperatorFi
     let first = usize::from(options.reversible);
     let p = first + cells + 1;
     check_data(u, y, p)?;
-    let (g, b, yy, n) = normal_equations(&grid, &x, &v, options.reversible);
+    let (path, skip) = core_path(options.initial_state, &x, 2.0 * (upper - lower));
+    let (g, b, yy, n) = normal_equations(&grid, &path[..skip], &x, &v, options.reversible);
     let mut g_pen = g.clone();
     add_smoothness(&mut g_pen, &grid, first, options.lambda);
     let mut unconstrained = vec![false; p];
@@ -116,6 +122,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &PreisachOptions) -> Result<OperatorFi
     Ok(finish(
         model,
         o,
+        options.initial_state,
         u,
         y,
         Spread::of(&sol, &map),
@@ -126,9 +133,11 @@ pub fn fit(u: &[f64], y: &[f64], options: &PreisachOptions) -> Result<OperatorFi
     ))
 }
 
-/// The normal equations of the regressors [x, φ_cells, 1] over the data.
+/// The normal equations of the regressors [x, φ_cells, 1] over the data, the memory first
+/// run through the declared `history` (empty: from negative saturation).
 fn normal_equations(
     grid: &Grid,
+    history: &[f64],
     x: &[f64],
     v: &[f64],
     reversible: bool,
@@ -137,6 +146,9 @@ fn normal_equations(
     let p = first + grid.cells() + 1;
     let mut acc = GramAccumulator::new(p);
     let mut memory = Memory::new(grid);
+    for &xk in history {
+        memory.apply(grid, xk);
+    }
     let mut row = vec![0.0; p];
     row[p - 1] = 1.0;
     for (&xk, &vk) in x.iter().zip(v) {
@@ -191,18 +203,26 @@ impl Identify for Preisach {
     /// ([`model_size`](super::model_size)); otherwise `grid` fixes them.
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         let given = options.given_orientation(u, y)?;
-        let settings = |levels: usize, orientation: Option<Orientation>| PreisachOptions {
-            levels,
-            lambda: options.lambda,
-            orientation,
-            ..PreisachOptions::default()
-        };
+        let request = options.initial_state;
+        let settings =
+            |levels: usize,
+             orientation: Option<Orientation>,
+             initial_state: Option<InitialStateUsed>| PreisachOptions {
+                levels,
+                lambda: options.lambda,
+                orientation,
+                initial_state,
+                ..PreisachOptions::default()
+            };
         if options.choose_grid {
             let o = orientation(u, y, given)?;
-            return choose_grid(u, y, GRID_WORK_BOUND, |u, y, n| {
-                fit(u, y, &settings(n, Some(o)))
+            return choose_grid(u, y, GRID_WORK_BOUND, request, |u, y, n, state| {
+                fit(u, y, &settings(n, Some(o), state))
             });
         }
-        fit(u, y, &settings(options.grid, given))
+        let first = fit(u, y, &settings(options.grid, given, first_state(request)))?;
+        settle_state(request, first, u, |state| {
+            fit(u, y, &settings(options.grid, given, state))
+        })
     }
 }

@@ -131,21 +131,27 @@ impl InitialStateUsed {
     /// The input a declared history turns at before coming back to the record's first
     /// input (u_top or u_bot of the module doc), None for the states held in the structure.
     pub fn turning_input(self, op: &dyn HysteresisOperator, u: &[f64]) -> Option<f64> {
-        let direction = match self {
-            InitialStateUsed::Descending => 1.0,
-            InitialStateUsed::Ascending => -1.0,
-            _ => return None,
-        };
         let (lo, hi) = u
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
                 (lo.min(x), hi.max(x))
             });
+        let reach = op.memory_reach();
+        self.turning_point(lo, hi, if reach.is_finite() { reach } else { 0.0 })
+    }
+
+    /// The turning input for a record of range \[lo, hi\] and an operator of memory reach
+    /// `reach`: hi + M (descending) or lo − M (ascending), M = max(2 (hi − lo), reach)
+    /// (module doc); None for the states held in the structure or a range not finite.
+    pub fn turning_point(self, lo: f64, hi: f64, reach: f64) -> Option<f64> {
+        let direction = match self {
+            InitialStateUsed::Descending => 1.0,
+            InitialStateUsed::Ascending => -1.0,
+            _ => return None,
+        };
         if !(lo.is_finite() && hi.is_finite()) {
             return None;
         }
-        let reach = op.memory_reach();
-        let reach = if reach.is_finite() { reach } else { 0.0 };
         let scale = hi.abs().max(lo.abs()).max(1.0);
         let margin = (2.0 * (hi - lo)).max(reach).max(1e-6 * scale);
         Some(if direction > 0.0 {

@@ -8,6 +8,7 @@ mod differential_fit;
 mod duhem;
 mod family;
 mod gpi;
+mod initial_state;
 mod jiles_atherton;
 mod kp;
 mod maxwell_slip;

@@ -185,12 +185,14 @@ fn explicit_sizes_are_the_recipes_fixed_grids() {
     let u = reversals(5, 40, 40.0);
     let y = plant.simulate(&u).unwrap();
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    // --thresholds 10 and --grid 20: today's uniform grids, the recipes' own defaults
+    // --thresholds 10 and --grid 20: today's uniform grids, the recipes' own defaults (from
+    // the recipes' own demagnetised start)
     let fixed = FamilyOptions {
         thresholds: 10,
         grid: 20,
         choose_thresholds: false,
         choose_grid: false,
+        initial_state: hysid::model::operators::InitialState::Demagnetised,
         ..FamilyOptions::default()
     };
     let f = fit_operator(Family::Pi, &u, &y, &fixed).unwrap();
