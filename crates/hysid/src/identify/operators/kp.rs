@@ -322,8 +322,25 @@ impl Identify for Kp {
         };
         if options.choose_grid {
             let o = orientation(u, y, given)?;
+            // The ridge width is chosen with the grid, from the first start; the refits of
+            // `estimate` from the histories keep the chosen grid's width (a quarter of the
+            // work each).
+            let (x, _) = o.core_data(u, y);
+            let (lower, upper) = range(&x);
+            let chosen = std::cell::Cell::new(None::<(usize, f64)>);
             return choose_grid(u, y, GRID_WORK_BOUND, request, |u, y, n, state| {
-                fit(u, y, &settings(n, Some(o), state))
+                let mut settings = settings(n, Some(o), state);
+                match chosen.get() {
+                    Some((m, width)) if m == n && state.is_some() && u.len() == x.len() => {
+                        settings.widths = vec![width / (upper - lower)];
+                    }
+                    _ => {}
+                }
+                let f = fit(u, y, &settings)?;
+                if state.is_none() && u.len() == x.len() {
+                    chosen.set(Some((n, f.model.width())));
+                }
+                Ok(f)
             });
         }
         let first = fit(u, y, &settings(options.grid, given, first_state(request)))?;

@@ -13,7 +13,7 @@
 //!
 //! **Initial state.** The candidates are fitted and simulated from the requested initial
 //! state (the demagnetised one under `estimate`); the winner's state is then settled on the
-//! whole record ([`settle_state`](super::linear_support::settle_state): `estimate` refits
+//! whole record (`linear_support::settle_state`: `estimate` refits
 //! its structure from the descending and the ascending histories and keeps the least loss).
 //!
 //! **Work bound.** A fit's cost is dominated by the Gram matrix, N·p² for N samples and p
