@@ -9,7 +9,7 @@ import json
 import math
 import os
 import warnings
-from typing import Any, List, Literal, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, List, Literal, NamedTuple, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 
@@ -45,6 +45,35 @@ def _orientation(value: Optional[str]) -> Optional[str]:
     if value is None:
         return None
     return check.choice(value, "orientation", ("ccw", "cw"))
+
+
+class _FitArguments(TypedDict):
+    """The extension module's keyword arguments of every family fit."""
+
+    threads: int
+    orientation: Optional[str]
+    time_limit: Optional[float]
+    progress: Optional[Callable[[str, int, int, Optional[int], Optional[float], float], None]]
+    initial_state: Optional[str]
+
+
+def _fit_arguments(
+    threads: Optional[int],
+    orientation: Optional[str],
+    initial_state: Optional[str],
+    time_limit: Optional[float],
+    progress: ProgressArg,
+) -> _FitArguments:
+    """The fit's threads, orientation, initial state, time limit and progress checked and
+    in the extension module's form."""
+    limit, tell = watching(time_limit, progress)
+    return _FitArguments(
+        threads=check.threads(threads),
+        orientation=_orientation(orientation),
+        time_limit=limit,
+        progress=tell,
+        initial_state=_initial_state(initial_state),
+    )
 
 
 class _FamilyOptions(NamedTuple):
@@ -140,22 +169,11 @@ def identify_operator(
     step = check.sample_time(given_ts, 1.0)
     name = _family(family)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
-    limit, tell = watching(time_limit, progress)
-    text = _hysid.identify_operator(
-        u,
-        y,
-        name,
-        step,
-        *options,
-        check.threads(threads),
-        _orientation(orientation),
-        limit,
-        tell,
-        _initial_state(initial_state),
-    )
+    arguments = _fit_arguments(threads, orientation, initial_state, time_limit, progress)
+    text = _hysid.identify_operator(u, y, name, step, *options, **arguments)
     record = Record(u, y, step, labels, unit_labels)
     result = FitResult(labelled(json.loads(text), record), data=record)
-    warn_if_stopped(result.termination_code, limit, "identify_operator")
+    warn_if_stopped(result.termination_code, arguments["time_limit"], "identify_operator")
     return result
 
 
@@ -210,21 +228,8 @@ def compare(
             raise TypeError("validate: give a pair (u_val, y_val) or a record with .u and .y")
         u_val, y_val, _ = check.pair(pair[0], pair[1], ("validate u", "validate y"), None)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
-    limit, tell = watching(time_limit, progress)
-    report, results, v_in, v_out, simulated = _hysid.compare(
-        u,
-        y,
-        u_val,
-        y_val,
-        chosen,
-        step,
-        *options,
-        check.threads(threads),
-        _orientation(orientation),
-        limit,
-        tell,
-        _initial_state(initial_state),
-    )
+    arguments = _fit_arguments(threads, orientation, initial_state, time_limit, progress)
+    report, results, v_in, v_out, simulated = _hysid.compare(u, y, u_val, y_val, chosen, step, *options, **arguments)
     comparison = Comparison.from_extension(
         report,
         results,
@@ -232,7 +237,7 @@ def compare(
         simulated,
         Record(u, y, step, labels, unit_labels),
     )
-    warn_if_stopped(comparison.termination_code, limit, "compare")
+    warn_if_stopped(comparison.termination_code, arguments["time_limit"], "compare")
     return comparison
 
 

@@ -12,7 +12,7 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, core_path, finish, first_state, orientation, range, settle_state, unscaled, Spread,
+    check_data, core_path, finish, fit_initial_state, orientation, range, unscaled, Spread,
 };
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
@@ -247,13 +247,14 @@ impl Identify for Backlash {
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         let request = options.initial_state;
         let given = options.given_orientation(u, y)?;
-        let settings = |initial_state| BacklashOptions {
-            orientation: given,
-            initial_state,
-            ..BacklashOptions::default()
-        };
-        let first = fit(u, y, &settings(first_state(request)))?;
-        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
+        fit_initial_state(request, u, |start| {
+            let settings = BacklashOptions {
+                orientation: given,
+                initial_state: start.state,
+                ..BacklashOptions::default()
+            };
+            fit(u, y, &settings)
+        })
     }
 
     /// A profile over the half-width r = k·(max u − min u)/(2P), k = 0 … P − 1 (P the default

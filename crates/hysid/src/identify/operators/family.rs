@@ -60,7 +60,7 @@ pub struct FamilyOptions {
     /// (Jiles–Atherton, Bouc–Wen, Duhem, Dahl) fit x₀; the linear-in-weights ones regress
     /// from the declared history, and under `estimate` keep the least-loss of the
     /// demagnetised, descending and ascending starts
-    /// (`linear_support::settle_state`). ch4/ch6 ignore it (their output starts at the
+    /// (`linear_support::fit_initial_state`). ch4/ch6 ignore it (their output starts at the
     /// measured first sample).
     pub initial_state: InitialState,
     /// Choose the threshold count and placement of PI, generalised PI and Maxwell-slip from

@@ -21,10 +21,10 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, core_path, finish, first_state, orientation, range, settle_state, solve_weights,
-    threshold_candidates, threshold_grid, unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
+    check_data, core_path, finish, fit_initial_state, orientation, range, solve_weights,
+    threshold_grid, unscaled, GramAccumulator, Spread,
 };
-use super::model_size::choose;
+use super::model_size::choose_thresholds;
 use super::OperatorFit;
 use crate::model::operators::{
     play, validate_thresholds, DeadZones, GeneralizedPi, InitialStateUsed, Orientation,
@@ -205,42 +205,28 @@ impl Identify for GeneralizedPi {
         let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
-            let (x, _) = o.core_data(u, y);
             let extra = 2 + 2 * options.dead_zones;
-            let candidates = threshold_candidates(&x, extra)?;
-            let (mut f, choice) = choose(
-                u,
-                y,
-                candidates,
-                10 + extra,
-                PLAY_WORK_BOUND,
-                request,
-                |u, y, grid, state| {
-                    fit(
-                        u,
-                        y,
-                        &GpiOptions {
-                            grid: Some(grid.clone()),
-                            dead_zones: options.dead_zones,
-                            orientation: Some(o),
-                            initial_state: state,
-                            ..GpiOptions::default()
-                        },
-                    )
-                },
-            )?;
-            f.model_size = Some(choice);
-            return Ok(f);
+            return choose_thresholds(u, y, o, extra, request, |u, y, grid, start| {
+                let settings = GpiOptions {
+                    grid: Some(grid.clone()),
+                    dead_zones: options.dead_zones,
+                    orientation: Some(o),
+                    initial_state: start.state,
+                    ..GpiOptions::default()
+                };
+                fit(u, y, &settings)
+            });
         }
-        let settings = |state| GpiOptions {
-            thresholds: options.thresholds,
-            grid: options.threshold_grid.clone(),
-            dead_zones: options.dead_zones,
-            orientation: given,
-            initial_state: state,
-            ..GpiOptions::default()
-        };
-        let first = fit(u, y, &settings(first_state(request)))?;
-        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
+        fit_initial_state(request, u, |start| {
+            let settings = GpiOptions {
+                thresholds: options.thresholds,
+                grid: options.threshold_grid.clone(),
+                dead_zones: options.dead_zones,
+                orientation: given,
+                initial_state: start.state,
+                ..GpiOptions::default()
+            };
+            fit(u, y, &settings)
+        })
     }
 }

@@ -35,8 +35,8 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, core_path, finish, first_state, orientation, range, settle_state, solve_weights,
-    unscaled, GramAccumulator, Spread, WeightSolution,
+    check_data, core_path, finish, fit_initial_state, orientation, range, solve_weights, unscaled,
+    Fit, GramAccumulator, Spread, WeightSolution,
 };
 use super::model_size::choose_grid;
 use super::OperatorFit;
@@ -320,32 +320,24 @@ impl Identify for Kp {
             initial_state,
             ..KpOptions::default()
         };
+        // The ridge width is chosen with the structure, from the first start; the refits of
+        // `estimate` from the histories keep it (a quarter of the work each).
+        let fit_from = |u: &[f64], y: &[f64], mut settings: KpOptions, start: Fit<Kp>| {
+            if let Some(first) = start.first {
+                let (x, _) = first.model.orientation().core_data(u, y);
+                let (lower, upper) = settings.range.unwrap_or_else(|| range(&x));
+                settings.widths = vec![first.model.width() / (upper - lower)];
+            }
+            fit(u, y, &settings)
+        };
         if options.choose_grid {
             let o = orientation(u, y, given)?;
-            // The ridge width is chosen with the grid, from the first start; the refits of
-            // `estimate` from the histories keep the chosen grid's width (a quarter of the
-            // work each).
-            let (x, _) = o.core_data(u, y);
-            let (lower, upper) = range(&x);
-            let chosen = std::cell::Cell::new(None::<(usize, f64)>);
-            return choose_grid(u, y, GRID_WORK_BOUND, request, |u, y, n, state| {
-                let mut settings = settings(n, Some(o), state);
-                match chosen.get() {
-                    Some((m, width)) if m == n && state.is_some() && u.len() == x.len() => {
-                        settings.widths = vec![width / (upper - lower)];
-                    }
-                    _ => {}
-                }
-                let f = fit(u, y, &settings)?;
-                if state.is_none() && u.len() == x.len() {
-                    chosen.set(Some((n, f.model.width())));
-                }
-                Ok(f)
+            return choose_grid(u, y, GRID_WORK_BOUND, request, |u, y, n, start| {
+                fit_from(u, y, settings(n, Some(o), start.state), start)
             });
         }
-        let first = fit(u, y, &settings(options.grid, given, first_state(request)))?;
-        settle_state(request, first, u, |state| {
-            fit(u, y, &settings(options.grid, given, state))
+        fit_initial_state(request, u, |start| {
+            fit_from(u, y, settings(options.grid, given, start.state), start)
         })
     }
 }

@@ -148,41 +148,6 @@ pub fn geometric_thresholds(x: &[f64], n: usize) -> Result<Vec<f64>> {
     }
 }
 
-/// The work bound of the threshold-count choice, in fits of the fixed default size
-/// ([`crate::identify::operators::model_size`]): a play sum's fit is a few passes over the
-/// data, so all twelve candidates fit within it on any record.
-pub(crate) const PLAY_WORK_BOUND: f64 = 12.0;
-
-/// The candidate threshold grids of the count choice: every count of
-/// [`crate::identify::operators::family::THRESHOLD_CANDIDATES`], uniform then geometric
-/// (the geometric one only where it differs), labelled `"n uniform"` / `"n geometric"`, with
-/// `extra` parameters beside the n weights.
-pub(crate) fn threshold_candidates(
-    x: &[f64],
-    extra: usize,
-) -> Result<Vec<crate::identify::operators::model_size::Candidate<Vec<f64>>>> {
-    use crate::identify::operators::model_size::Candidate;
-    let mut out = Vec::new();
-    for &n in &crate::identify::operators::family::THRESHOLD_CANDIDATES {
-        let uniform = threshold_grid(x, n)?;
-        let geometric = geometric_thresholds(x, n)?;
-        let distinct = geometric != uniform;
-        out.push(Candidate {
-            setting: uniform,
-            label: format!("{n} uniform"),
-            parameters: n + extra,
-        });
-        if distinct {
-            out.push(Candidate {
-                setting: geometric,
-                label: format!("{n} geometric"),
-                parameters: n + extra,
-            });
-        }
-    }
-    Ok(out)
-}
-
 /// ΦᵀΦ, Φᵀy and yᵀy accumulated over blocks of rows (one regressor row per sample), the
 /// products done as matrix–matrix multiplications.
 pub(crate) struct GramAccumulator {
@@ -393,42 +358,62 @@ pub(crate) fn core_path(
 
 /// The declared history a fit of `request` regresses from first: the descending or
 /// ascending history; None (the structure's own, demagnetised state) for `demagnetised`
-/// and for `estimate`, whose other candidates [`settle_state`] refits.
+/// and for `estimate`, whose other candidates [`fit_initial_state`] refits.
 pub(crate) fn first_state(request: InitialState) -> Option<InitialStateUsed> {
     request
         .declared()
         .filter(|s| *s != InitialStateUsed::Demagnetised)
 }
 
-/// The fit of the initial state `request`, from `first`, the fit from [`first_state`]: a
-/// declared state keeps it; `estimate` compares it with the refits `refit(state)` of the
-/// same structure from the descending and the ascending histories and keeps the one of least
-/// loss on the record (the same parameters, so the loss is the criterion; a tie keeps the
-/// demagnetised state). A candidate whose saved model could not simulate its own record
-/// from that state (a history beyond the domain of an inverse-parameterised, saturating
-/// operator) is dropped.
-pub(crate) fn settle_state<M: HysteresisOperator>(
+/// What one fit of a structure starts from: the declared history it regresses from (None:
+/// the structure's own, demagnetised state), and for the refits of `estimate` the first fit
+/// of the same structure, whose choices a family may keep (KP: its ridge width).
+pub(crate) struct Fit<'a, M> {
+    /// The declared initial state.
+    pub state: Option<InitialStateUsed>,
+    /// The same structure's first fit, for a refit; None for the first fit.
+    pub first: Option<&'a OperatorFit<M>>,
+}
+
+/// The fit of one structure from the initial state `request`; `fit` fits it from a
+/// [`Fit`] start, first from [`first_state`].
+///
+/// A declared state keeps the first fit (checked to simulate from its state). `estimate`
+/// compares it with the refits from the descending and the ascending histories and keeps
+/// the one of least loss on the record (the same parameters, so the loss is the criterion;
+/// a tie keeps the demagnetised state). A candidate whose saved model could not simulate
+/// its own record from that state (a history beyond the domain of an
+/// inverse-parameterised, saturating operator) is dropped.
+pub(crate) fn fit_initial_state<M: HysteresisOperator>(
     request: InitialState,
-    first: OperatorFit<M>,
     u: &[f64],
-    refit: impl Fn(Option<InitialStateUsed>) -> Result<OperatorFit<M>>,
+    fit: impl Fn(Fit<M>) -> Result<OperatorFit<M>>,
 ) -> Result<OperatorFit<M>> {
+    let first = fit(Fit {
+        state: first_state(request),
+        first: None,
+    })?;
     if request != InitialState::Estimate {
         if let Some(state) = first.initial_state {
             initial_state::simulate(&first.model, Some(state), u)?;
         }
         return Ok(first);
     }
-    let mut best = first;
+    let mut best: Option<OperatorFit<M>> = None;
     for state in [InitialStateUsed::Descending, InitialStateUsed::Ascending] {
-        let Ok(fit) = refit(Some(state)) else {
+        let start = Fit {
+            state: Some(state),
+            first: Some(&first),
+        };
+        let Ok(refit) = fit(start) else {
             continue;
         };
-        if fit.loss < best.loss && initial_state::simulate(&fit.model, Some(state), u).is_ok() {
-            best = fit;
+        let lowest = best.as_ref().map_or(first.loss, |b| b.loss);
+        if refit.loss < lowest && initial_state::simulate(&refit.model, Some(state), u).is_ok() {
+            best = Some(refit);
         }
     }
-    Ok(best)
+    Ok(best.unwrap_or(first))
 }
 
 /// Everything a fit reports, from the model and the data, simulated from the declared

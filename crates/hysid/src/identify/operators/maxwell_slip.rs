@@ -14,10 +14,10 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, core_path, finish, first_state, orientation, settle_state, solve_weights,
-    threshold_candidates, threshold_grid, GramAccumulator, Spread, PLAY_WORK_BOUND,
+    check_data, core_path, finish, fit_initial_state, orientation, solve_weights, threshold_grid,
+    GramAccumulator, Spread,
 };
-use super::model_size::choose;
+use super::model_size::choose_thresholds;
 use super::OperatorFit;
 use crate::identify::operator_cascade::{OperatorCascadeIdentification, RANK_ONE};
 use crate::model::operators::{
@@ -149,40 +149,26 @@ impl Identify for MaxwellSlip {
                 Some(o) => o,
                 None => detected_orientation(u, y)?,
             };
-            let (x, _) = o.core_data(u, y);
-            let candidates = threshold_candidates(&x, 2)?;
-            let (mut f, choice) = choose(
-                u,
-                y,
-                candidates,
-                12,
-                PLAY_WORK_BOUND,
-                request,
-                |u, y, w, state| {
-                    fit(
-                        u,
-                        y,
-                        &MaxwellSlipOptions {
-                            widths: Some(w.clone()),
-                            orientation: Some(o),
-                            initial_state: state,
-                            ..MaxwellSlipOptions::default()
-                        },
-                    )
-                },
-            )?;
-            f.model_size = Some(choice);
-            return Ok(f);
+            return choose_thresholds(u, y, o, 2, request, |u, y, w, start| {
+                let settings = MaxwellSlipOptions {
+                    widths: Some(w.clone()),
+                    orientation: Some(o),
+                    initial_state: start.state,
+                    ..MaxwellSlipOptions::default()
+                };
+                fit(u, y, &settings)
+            });
         }
-        let settings = |state| MaxwellSlipOptions {
-            elements: options.thresholds,
-            widths: options.threshold_grid.clone(),
-            orientation: given,
-            initial_state: state,
-            ..MaxwellSlipOptions::default()
-        };
-        let first = fit(u, y, &settings(first_state(request)))?;
-        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
+        fit_initial_state(request, u, |start| {
+            let settings = MaxwellSlipOptions {
+                elements: options.thresholds,
+                widths: options.threshold_grid.clone(),
+                orientation: given,
+                initial_state: start.state,
+                ..MaxwellSlipOptions::default()
+            };
+            fit(u, y, &settings)
+        })
     }
 
     /// The over-parameterised equation error in the basis u, E_{δᵢ}\[u\], 1 with a rank-one

@@ -13,7 +13,7 @@
 //!
 //! **Initial state.** The candidates are fitted and simulated from the requested initial
 //! state (the demagnetised one under `estimate`); the winner's state is then settled on the
-//! whole record (`linear_support::settle_state`: `estimate` refits
+//! whole record (`linear_support::fit_initial_state`: `estimate` refits
 //! its structure from the descending and the ascending histories and keeps the least loss).
 //!
 //! **Work bound.** A fit's cost is dominated by the Gram matrix, N·p² for N samples and p
@@ -25,9 +25,11 @@
 //! Reference: T. Hastie, R. Tibshirani, J. Friedman, *The Elements of Statistical Learning*,
 //! 2nd ed., Springer 2009, §7.2 (model selection by a validation set).
 
-use super::linear_support::{first_state, settle_state};
+use super::linear_support::{
+    first_state, fit_initial_state, geometric_thresholds, threshold_grid, Fit,
+};
 use super::OperatorFit;
-use crate::model::operators::{initial_state, HysteresisOperator, InitialState, InitialStateUsed};
+use crate::model::operators::{initial_state, HysteresisOperator, InitialState, Orientation};
 use crate::numerics::metrics;
 use crate::Result;
 use serde::Serialize;
@@ -78,7 +80,8 @@ fn needed(p: usize) -> usize {
 /// The Preisach-plane families' (Preisach, KP) choice of their grid: the candidates
 /// [`GRID_CANDIDATES`](super::family::GRID_CANDIDATES), each with its n(n+1)/2 cells, offset
 /// and slope, chosen by [`choose`] within `bound` fits of the default grid 20; `fit` fits
-/// the grid of n intervals. The choice is recorded in the fit's `model_size`.
+/// the grid of n intervals (its arguments as [`choose`]'s). The choice is recorded in the
+/// fit's `model_size`.
 pub(crate) fn choose_grid<M, F>(
     u: &[f64],
     y: &[f64],
@@ -88,7 +91,7 @@ pub(crate) fn choose_grid<M, F>(
 ) -> Result<OperatorFit<M>>
 where
     M: HysteresisOperator,
-    F: Fn(&[f64], &[f64], usize, Option<InitialStateUsed>) -> Result<OperatorFit<M>>,
+    F: Fn(&[f64], &[f64], usize, Fit<M>) -> Result<OperatorFit<M>>,
 {
     let parameters = |n: usize| n * (n + 1) / 2 + 2;
     let candidates = super::family::GRID_CANDIDATES
@@ -99,24 +102,77 @@ where
             parameters: parameters(n),
         })
         .collect();
-    let (mut f, choice) = choose(
+    choose(
         u,
         y,
         candidates,
         parameters(20),
         bound,
         request,
-        |u, y, &n, state| fit(u, y, n, state),
-    )?;
-    f.model_size = Some(choice);
-    Ok(f)
+        |u, y, &n, start| fit(u, y, n, start),
+    )
+}
+
+/// The play and stop families' (PI, generalised PI, Maxwell-slip) choice of their
+/// thresholds: the candidates of [`threshold_candidates`] on the core's input
+/// `x`, each with `extra` parameters beside its weights, chosen by [`choose`] within
+/// [`PLAY_WORK_BOUND`] fits of the default ten
+/// thresholds; `fit` fits a threshold grid in the orientation `o`. The choice is recorded in
+/// the fit's `model_size`.
+pub(crate) fn choose_thresholds<M, F>(
+    u: &[f64],
+    y: &[f64],
+    o: Orientation,
+    extra: usize,
+    request: InitialState,
+    fit: F,
+) -> Result<OperatorFit<M>>
+where
+    M: HysteresisOperator,
+    F: Fn(&[f64], &[f64], &Vec<f64>, Fit<M>) -> Result<OperatorFit<M>>,
+{
+    let (x, _) = o.core_data(u, y);
+    let candidates = threshold_candidates(&x, extra)?;
+    choose(u, y, candidates, 10 + extra, PLAY_WORK_BOUND, request, fit)
+}
+
+/// The work bound of the threshold-count choice, in fits of the fixed default size
+/// ([`choose_thresholds`]): a play sum's fit is a few passes over the
+/// data, so all twelve candidates fit within it on any record.
+const PLAY_WORK_BOUND: f64 = 12.0;
+
+/// The candidate threshold grids of the count choice: every count of
+/// [`super::family::THRESHOLD_CANDIDATES`], uniform then geometric
+/// (the geometric one only where it differs), labelled `"n uniform"` / `"n geometric"`, with
+/// `extra` parameters beside the n weights.
+fn threshold_candidates(x: &[f64], extra: usize) -> Result<Vec<Candidate<Vec<f64>>>> {
+    let mut out = Vec::new();
+    for &n in &super::family::THRESHOLD_CANDIDATES {
+        let uniform = threshold_grid(x, n)?;
+        let geometric = geometric_thresholds(x, n)?;
+        let distinct = geometric != uniform;
+        out.push(Candidate {
+            setting: uniform,
+            label: format!("{n} uniform"),
+            parameters: n + extra,
+        });
+        if distinct {
+            out.push(Candidate {
+                setting: geometric,
+                label: format!("{n} geometric"),
+                parameters: n + extra,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// Chooses among `candidates` (smallest first) by the held-out fit % within `bound` default
 /// fits of `default_parameters` parameters, and refits the winner on the whole record; the
 /// candidates are fitted from the initial state [`first_state`] of `request` (each
-/// simulated from it), the winner's state then settled by [`settle_state`]. `fit` fits a
-/// candidate's setting from a declared state (None: the structure's own).
+/// simulated from it), the winner's state then settled by [`fit_initial_state`]. `fit` fits a
+/// candidate's setting from the start [`Fit`]. The choice is recorded in the fit's
+/// `model_size`.
 pub(crate) fn choose<M, C, F>(
     u: &[f64],
     y: &[f64],
@@ -125,10 +181,10 @@ pub(crate) fn choose<M, C, F>(
     bound: f64,
     request: InitialState,
     fit: F,
-) -> Result<(OperatorFit<M>, ModelSizeChoice)>
+) -> Result<OperatorFit<M>>
 where
     M: HysteresisOperator,
-    F: Fn(&[f64], &[f64], &C, Option<InitialStateUsed>) -> Result<OperatorFit<M>>,
+    F: Fn(&[f64], &[f64], &C, Fit<M>) -> Result<OperatorFit<M>>,
 {
     let state = first_state(request);
     let n = u.len().min(y.len());
@@ -150,7 +206,8 @@ where
         let mut skipped = skipped;
         if skipped.is_none() {
             spent += cost;
-            score = fit(&u[..split], &y[..split], &c.setting, state)
+            let start = Fit { state, first: None };
+            score = fit(&u[..split], &y[..split], &c.setting, start)
                 .ok()
                 .and_then(|f| initial_state::simulate(&f.model, f.initial_state, &u[..n]).ok())
                 .map(|sim| metrics::fit_percent(&y[split..n], &sim[split..n]))
@@ -184,17 +241,14 @@ where
     let chosen = candidates.get(index).ok_or_else(|| {
         crate::Error::invalid_option("model size", "[]", "no candidate model size".into())
     })?;
-    let first = fit(&u[..n], &y[..n], &chosen.setting, state)?;
-    let result = settle_state(request, first, &u[..n], |s| {
-        fit(&u[..n], &y[..n], &chosen.setting, s)
+    let mut result = fit_initial_state(request, &u[..n], |start| {
+        fit(&u[..n], &y[..n], &chosen.setting, start)
     })?;
-    Ok((
-        result,
-        ModelSizeChoice {
-            chosen: chosen.label.clone(),
-            criterion,
-            training_samples: split,
-            candidates: scores,
-        },
-    ))
+    result.model_size = Some(ModelSizeChoice {
+        chosen: chosen.label.clone(),
+        criterion,
+        training_samples: split,
+        candidates: scores,
+    });
+    Ok(result)
 }

@@ -17,10 +17,10 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, core_path, finish, first_state, orientation, settle_state, solve_weights,
-    threshold_candidates, threshold_grid, unscaled, GramAccumulator, Spread, PLAY_WORK_BOUND,
+    check_data, core_path, finish, fit_initial_state, orientation, solve_weights, threshold_grid,
+    unscaled, GramAccumulator, Spread,
 };
-use super::model_size::choose;
+use super::model_size::choose_thresholds;
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
     monotone_weights, OperatorCascadeIdentification, RANK_ONE,
@@ -179,40 +179,26 @@ impl Identify for PrandtlIshlinskii {
         let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
-            let (x, _) = o.core_data(u, y);
-            let candidates = threshold_candidates(&x, 2)?;
-            let (mut f, choice) = choose(
-                u,
-                y,
-                candidates,
-                12,
-                PLAY_WORK_BOUND,
-                request,
-                |u, y, grid, state| {
-                    fit(
-                        u,
-                        y,
-                        &PiOptions {
-                            grid: Some(grid.clone()),
-                            orientation: Some(o),
-                            initial_state: state,
-                            ..PiOptions::default()
-                        },
-                    )
-                },
-            )?;
-            f.model_size = Some(choice);
-            return Ok(f);
+            return choose_thresholds(u, y, o, 2, request, |u, y, grid, start| {
+                let settings = PiOptions {
+                    grid: Some(grid.clone()),
+                    orientation: Some(o),
+                    initial_state: start.state,
+                    ..PiOptions::default()
+                };
+                fit(u, y, &settings)
+            });
         }
-        let settings = |state| PiOptions {
-            thresholds: options.thresholds,
-            grid: options.threshold_grid.clone(),
-            orientation: given,
-            select: None,
-            initial_state: state,
-        };
-        let first = fit(u, y, &settings(first_state(request)))?;
-        settle_state(request, first, u, |state| fit(u, y, &settings(state)))
+        fit_initial_state(request, u, |start| {
+            let settings = PiOptions {
+                thresholds: options.thresholds,
+                grid: options.threshold_grid.clone(),
+                orientation: given,
+                select: None,
+                initial_state: start.state,
+            };
+            fit(u, y, &settings)
+        })
     }
 
     /// The over-parameterised equation error in the basis u, F_{rᵢ}\[u\], 1 with a rank-one

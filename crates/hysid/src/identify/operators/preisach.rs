@@ -17,8 +17,8 @@
 
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
-    check_data, core_path, finish, first_state, orientation, range, settle_state, solve_weights,
-    unscaled, GramAccumulator, Spread,
+    check_data, core_path, finish, fit_initial_state, orientation, range, solve_weights, unscaled,
+    GramAccumulator, Spread,
 };
 use super::model_size::choose_grid;
 use super::OperatorFit;
@@ -216,13 +216,12 @@ impl Identify for Preisach {
             };
         if options.choose_grid {
             let o = orientation(u, y, given)?;
-            return choose_grid(u, y, GRID_WORK_BOUND, request, |u, y, n, state| {
-                fit(u, y, &settings(n, Some(o), state))
+            return choose_grid(u, y, GRID_WORK_BOUND, request, |u, y, n, start| {
+                fit(u, y, &settings(n, Some(o), start.state))
             });
         }
-        let first = fit(u, y, &settings(options.grid, given, first_state(request)))?;
-        settle_state(request, first, u, |state| {
-            fit(u, y, &settings(options.grid, given, state))
+        fit_initial_state(request, u, |start| {
+            fit(u, y, &settings(options.grid, given, start.state))
         })
     }
 }
