@@ -458,7 +458,11 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
     // recipe itself accepts a monotone input, on which d and the loop are not identifiable.
     super::differential_fit::check_record(form.short_name(), u, y, form.n_params())?;
     let data = IdData::siso(1.0, "u", u.to_vec(), "y", y.to_vec())?;
-    let id = HysteresisIdentification::new(form);
+    // the zoo's ch6 starts no worse than its nested ch4 (`better_start`)
+    let id = HysteresisIdentification {
+        nested_start: true,
+        ..HysteresisIdentification::new(form)
+    };
     let fit = id.estimate(&data, &mut |_| Control::Continue)?;
     let std = fit.std();
     let std_present: Vec<Option<f64>> = std.iter().map(|s| s.is_finite().then_some(*s)).collect();
