@@ -332,7 +332,10 @@ pub fn one_line_panics() {
             .location()
             .map(|l| format!(" at {}:{}", l.file(), l.line()))
             .unwrap_or_default();
-        eprintln!(
+        // a closed stderr must not turn the report into a second panic (an abort)
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
             "error: internal fault{place}: {}; please report it with the command line that caused it",
             collapse(&what)
         );

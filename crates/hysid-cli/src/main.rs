@@ -5,6 +5,15 @@
 //! code says its class: 0 success, 1 bad input or data, 2 usage, 3 numerical failure, 4 I/O
 //! (the table is in [`exit`]).
 
+/// `println!` that keeps going when stdout is closed (a pipe into `head`): the human report
+/// is lost, the run, its files and its exit code are not.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod budget;
 mod cli;
 mod cli_zoo;

@@ -142,13 +142,13 @@ impl Outputs {
         );
         self.set.commit()?;
         if let Some(dir) = plots {
-            println!("  plots: {}", dir.target.display());
+            say!("  plots: {}", dir.target.display());
         }
         if let Some(out) = json.filter(|_| report.is_some()) {
-            println!("  report: {}", out.target.display());
+            say!("  report: {}", out.target.display());
         }
         if let Some(out) = model_out.filter(|_| model.is_some()) {
-            println!("  model: {}", out.target.display());
+            say!("  model: {}", out.target.display());
         }
         Ok(())
     }

@@ -50,7 +50,7 @@ pub fn print_table(rows: &[Row]) {
         header += &format!("{:>12}", "initial");
     }
     header += &format!("{:>14}   {:<12}", "estimate", "± std");
-    println!("{header}");
+    say!("{header}");
     for r in rows {
         let mut line = format!("  {:<10}", r.name);
         if with_truth {
@@ -69,6 +69,6 @@ pub fn print_table(rows: &[Row]) {
             "n/a".into()
         };
         line += &format!("{:>14.8} ± {std}", r.estimate);
-        println!("{line}");
+        say!("{line}");
     }
 }

@@ -29,7 +29,7 @@ pub fn rig(args: &RigArgs) -> Result<()> {
     let dir = out.dir_at(&args.data_out)?;
     let files = write_rig(&rig, &dir.tmp)?;
     out.finish(None, None)?;
-    println!(
+    say!(
         "virtual actuator rig (Gunnar et al. 2006): {files} data sets in {} (backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {})",
         args.data_out.display(),
         rig.backlash,
@@ -75,7 +75,7 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
     let staged = out.dir_at(&data_dir)?;
     write_rig(&rig, &staged.tmp)?;
     let records = read_data_sets(&staged.tmp)?;
-    println!(
+    say!(
         "Virtual actuator rig (Gunnar et al. 2006): backlash {} rad, angle noise {:.3e} rad, torque noise {:.3e} N·m, seed {}; data in {}",
         rig.backlash,
         rig.angle_noise,
@@ -95,7 +95,7 @@ pub fn demo(args: &DemoActuatorArgs) -> Result<()> {
         (sources, steps.simulation),
         json!({ "rig": rig_json(&rig) }),
     )?;
-    println!("  total time {:.1} s", clock.elapsed().as_secs_f64());
+    say!("  total time {:.1} s", clock.elapsed().as_secs_f64());
     Ok(())
 }
 
@@ -123,11 +123,13 @@ fn publish(
     details: serde_json::Value,
 ) -> Result<()> {
     let markdown = id.markdown(truth);
-    println!("\n{markdown}");
+    say!("\n{markdown}");
     for (name, fit) in &id.step3 {
-        println!(
+        say!(
             "  {name}: {} iterations, stopped: {}, {:.2} s",
-            fit.fit.report.iterations, fit.fit.report.termination, fit.elapsed_s
+            fit.fit.report.iterations,
+            fit.fit.report.termination,
+            fit.elapsed_s
         );
     }
     if let Some(dir) = &out.plots {

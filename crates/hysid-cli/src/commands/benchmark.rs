@@ -77,7 +77,7 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
         fit,
     );
     let residuals = print_residuals(fit, &data);
-    println!(
+    say!(
         "  training e_RMS {:.4e} m (the record's noise is 7.4e-6 m)",
         result.training_e_rms
     );
@@ -108,7 +108,7 @@ pub fn bouc_wen(args: &BoucWenArgs) -> Result<()> {
 /// e_RMS per test record, and the published figures for comparison.
 fn print_tests(tests: &[BenchmarkTest]) {
     for t in tests {
-        println!(
+        say!(
             "  test {}: e_RMS {:.4e} m, fit {:.2} % ({} samples)",
             t.source,
             t.e_rms,
@@ -121,7 +121,7 @@ fn print_tests(tests: &[BenchmarkTest]) {
             .iter()
             .map(|(who, e)| format!("{who} {e:.2e}"))
             .collect();
-        println!(
+        say!(
             "  published e_RMS on the official multisine test set: {}",
             published.join("; ")
         );
@@ -169,7 +169,7 @@ fn generate(args: &BoucWenGenerateArgs) -> Result<()> {
         &[&record.t, &record.u, &record.y],
     )?;
     out.finish(None, None)?;
-    println!(
+    say!(
         "Bouc–Wen {} test signal, {} samples at 750 Hz (Newmark at 15 kHz, decimated) -> {}",
         match args.signal {
             SignalArg::Multisine => "multisine",

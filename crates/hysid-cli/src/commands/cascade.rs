@@ -51,42 +51,44 @@ pub fn rows(fit: &CascadeFit, truth: Option<&[f64]>, initial: Option<&[f64]>) ->
 /// Prints the lines under the table: the paper's iteration, the final fit, warnings.
 pub fn print_summary(fit: &CascadeFit, report: &Report) {
     if let Some(k) = &fit.key_term {
-        println!(
+        say!(
             "  paper iteration (key-term separation): {} iterations, {}",
             k.history.len().saturating_sub(1),
             k.termination
         );
     }
     let oe = &fit.output_error;
-    println!(
+    say!(
         "  output-error fit: {} iterations, {} function evaluations, {}",
-        oe.report.iterations, oe.report.function_evaluations, oe.report.termination
+        oe.report.iterations,
+        oe.report.function_evaluations,
+        oe.report.termination
     );
     let (fit_percent, rmse, fpe) = figures(report);
     let method = report
         .uncertainty
         .as_ref()
         .map_or("none", |u| u.method.as_str());
-    println!(
+    say!(
         "  fit {fit_percent:.2} %   RMSE {rmse:.4e}   FPE {}   time {:.2} s   std: {method} (threshold d: truncated normal)",
         crate::report::criterion(fpe, true),
         fit.elapsed_s
     );
     let adm = fit.model.hysteresis.admissibility();
     if !adm.holds {
-        println!(
+        say!(
             "  warning: the identified hysteresis is not admissible: {}",
             adm.violations.join("; ")
         );
     }
     if !fit.model.linear.is_stable() {
-        println!(
+        say!(
             "  warning: the identified linear block is unstable (spectral radius {:.4})",
             fit.model.linear.spectral_radius()
         );
     }
     if !fit.switching_consistent {
-        println!(
+        say!(
             "  note: re-classifying the samples by the final d did not lower the criterion; the best classification is kept"
         );
     }

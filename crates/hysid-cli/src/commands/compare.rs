@@ -51,7 +51,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     ));
     let comparison = compare(exp.input(0), exp.output(0), held_out, &options)?;
     drop(progress);
-    println!("Split: {}", comparison.split);
+    say!("Split: {}", comparison.split);
     print_table(&comparison.rows);
     for row in comparison.rows.iter().filter(|r| r.error.is_some()) {
         eprintln!(
@@ -62,7 +62,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     }
     let best = comparison.best();
     match best {
-        Some(b) => println!(
+        Some(b) => say!(
             "Best: {} (validation fit {:.3} %)",
             b.family,
             b.validation_fit_percent.unwrap_or(f64::NAN)
@@ -81,19 +81,24 @@ pub fn run(args: &CompareArgs) -> Result<()> {
 }
 
 fn print_table(rows: &[CompareRow]) {
-    println!(
+    say!(
         "  {:<16}{:>16}{:>14}{:>9}{:>14}{:>12}",
-        "family", "validation fit %", "RMSE", "#params", "AIC", "fit time s"
+        "family",
+        "validation fit %",
+        "RMSE",
+        "#params",
+        "AIC",
+        "fit time s"
     );
     let num = |v: Option<f64>, w: usize, p: usize| {
         v.map_or(format!("{:>w$}", "-"), |x| format!("{x:>w$.p$}"))
     };
     for r in rows {
         if let Some(e) = &r.error {
-            println!("  {:<16}  failed: {}", r.family, first_words(e));
+            say!("  {:<16}  failed: {}", r.family, first_words(e));
             continue;
         }
-        println!(
+        say!(
             "  {:<16}{}{}{}{}{}",
             r.family,
             num(r.validation_fit_percent, 16, 3),

@@ -46,12 +46,12 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
         SavedModel::Operator(op) => op.family.as_str(),
         other => other.kind(),
     };
-    println!(
+    say!(
         "Compensated {} samples of '{}' with the {family} model",
         reference.len(),
         args.reference
     );
-    println!("  predicted tracking error: RMS {rms:.4e}, max {max:.4e}");
+    say!("  predicted tracking error: RMS {rms:.4e}, max {max:.4e}");
     if !c.clipped.is_empty() {
         let shown: Vec<String> = ranges
             .iter()
@@ -108,10 +108,10 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     files.commit()?;
-    println!("  compensating input: {}", args.csv.display());
+    say!("  compensating input: {}", args.csv.display());
     for (what, path) in [("report", &args.json), ("plots", &args.plots)] {
         if let Some(p) = path {
-            println!("  {what}: {}", p.display());
+            say!("  {what}: {}", p.display());
         }
     }
     Ok(())

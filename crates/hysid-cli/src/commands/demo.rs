@@ -33,11 +33,11 @@ pub fn voros(args: &VorosArgs) -> Result<()> {
     id.uncertainty = uncertainty(choice, args.replicates);
     id.bootstrap_seed = args.seed;
 
-    println!(
+    say!(
         "Vörös (2015) cascade, project Example {} (docs/models/coleman-hodgdon-cascade.md §13; the paper's own numbers were lost):",
         args.example
     );
-    println!(
+    say!(
         "  {} hysteresis, linear block na = {}, nb = {}, delay k = {}; {} samples, seed {}, {}",
         form.short_name(),
         lin.na(),
@@ -64,7 +64,7 @@ pub fn voros(args: &VorosArgs) -> Result<()> {
         let mut callback = progress.callback();
         id.estimate(&data, &mut callback)?
     };
-    println!();
+    say!();
     let truth_params = truth.params();
     print_table(&rows(&fit, Some(&truth_params), Some(&ex.initial.params())));
     let extra = json!({

@@ -86,7 +86,7 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         )
     })?;
     dir.write(&files)?;
-    println!(
+    say!(
         "Exported the {} of {} ({}) as {}:",
         if args.inverse { "compensator" } else { "model" },
         args.model.display(),
@@ -94,7 +94,7 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         target.name()
     );
     for f in &files {
-        println!("  {}", args.out.join(&f.path).display());
+        say!("  {}", args.out.join(&f.path).display());
     }
     Ok(())
 }

@@ -23,7 +23,7 @@ pub fn voros(args: &GenerateVorosArgs) -> Result<()> {
     let t: Vec<f64> = (0..data.x.len()).map(|k| k as f64).collect();
     write_csv(&csv.tmp, &["t", "x", "y"], &[&t, &data.x, &data.y])?;
     out.finish(None, None)?;
-    println!(
+    say!(
         "Example {} data: {} samples, seed {}, {} -> {}",
         args.example,
         data.x.len(),

@@ -117,7 +117,7 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         id.estimate(&data, &mut callback)?
     };
     let (x, y) = (data.experiment(0).input(0), data.experiment(0).output(0));
-    println!(
+    say!(
         "Cascade {} + linear block (na = {}, nb = {}, k = {}) from {} ({} samples)",
         form.short_name(),
         args.na,
@@ -156,7 +156,7 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
         let mut callback = progress.callback();
         id.estimate(&data, &mut callback)?
     };
-    println!(
+    say!(
         "Coleman–Hodgdon hysteresis {} from {} ({} samples)",
         form.short_name(),
         args.data.data.display(),
@@ -179,7 +179,7 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
     print_table(&rows);
     let sources = vec![args.data.data.display().to_string()];
     let report = hysteresis_report(&fit, &data, sources, id.initial)?;
-    println!(
+    say!(
         "  separated regression: d re-estimated {} times ({}); output-error fit: {} iterations, {}",
         fit.separated.d_history.len().saturating_sub(1),
         fit.separated.termination,
@@ -187,13 +187,13 @@ pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
         fit.output_error.report.termination
     );
     let (fit_percent, rmse, _) = figures(&report);
-    println!(
+    say!(
         "  fit {fit_percent:.2} %   RMSE {rmse:.4e}   time {:.2} s",
         fit.elapsed_s
     );
     let adm = fit.model.admissibility();
     if !adm.holds {
-        println!(
+        say!(
             "  warning: the identified hysteresis is not admissible: {}",
             adm.violations.join("; ")
         );

@@ -84,7 +84,7 @@ fn exp_name(data: &hysid::data::IdData, input: bool) -> String {
 
 fn print_summary(fitted: &FittedOperator, report: &Report) {
     let fit = &fitted.fit;
-    println!(
+    say!(
         "{} operator: {} estimated parameters, {} ({} iterations)",
         fitted.family,
         fitted.estimated_parameters(),
@@ -106,15 +106,17 @@ fn print_summary(fitted: &FittedOperator, report: &Report) {
         .collect();
     print_table(&rows);
     if fit.parameters.len() > PRINTED_PARAMETERS {
-        println!(
+        say!(
             "  … {} more parameters in the report and the model file",
             fit.parameters.len() - PRINTED_PARAMETERS
         );
     }
     if let Some(f) = &report.fit {
-        println!(
+        say!(
             "  fit {:.3} %   RMSE {:.4e}   time {:.3} s",
-            f.fit_percent, f.rmse, fit.elapsed_s
+            f.fit_percent,
+            f.rmse,
+            fit.elapsed_s
         );
     }
     if !fit.termination.converged() {

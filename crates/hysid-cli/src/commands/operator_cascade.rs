@@ -71,7 +71,7 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
         id.estimate(&data, &mut callback)?
     };
     let (u, y) = (data.experiment(0).input(0), data.experiment(0).output(0));
-    println!(
+    say!(
         "Cascade {} + linear block (na = {}, nb = {}, k = {}) from {} ({} samples)",
         id.family.name(),
         args.na,
@@ -86,17 +86,19 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
     let source = vec![args.data.data.display().to_string()];
     let report = operator_cascade_report(id.family.name(), &fit, &data, source, extra)?;
     let (fit_percent, rmse, fpe) = figures(&report);
-    println!(
+    say!(
         "  start: {}; output-error fit: {} iterations, {}",
-        fit.initialisation, fit.iterations, fit.termination
+        fit.initialisation,
+        fit.iterations,
+        fit.termination
     );
-    println!(
+    say!(
         "  fit {fit_percent:.4} %   RMSE {rmse:.4e}   FPE {}   time {:.2} s   std: asymptotic",
         crate::report::criterion(fpe, true),
         fit.elapsed_s
     );
     if !fit.model.linear.is_stable() {
-        println!(
+        say!(
             "  warning: the identified linear block is unstable (spectral radius {:.4})",
             fit.model.linear.spectral_radius()
         );

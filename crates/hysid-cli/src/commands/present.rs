@@ -11,10 +11,14 @@ use hysid::report::greybox_residuals;
 /// Prints the parameter table and the fit statistics.
 pub fn print_fit(title: &str, fit: &GreyBoxFit) {
     let oe = &fit.fit;
-    println!("{title}");
-    println!(
+    say!("{title}");
+    say!(
         "  {:<14}{:>16}   {:<10} {:<10} {:>24}",
-        "parameter", "value", "± std", "unit", "bounds"
+        "parameter",
+        "value",
+        "± std",
+        "unit",
+        "bounds"
     );
     let std = oe.std();
     for (i, p) in oe.parameters.iter().enumerate() {
@@ -33,38 +37,44 @@ pub fn print_fit(title: &str, fit: &GreyBoxFit) {
         } else {
             String::new()
         };
-        println!(
+        say!(
             "  {:<14}{:>16.8e}   {:<10} {:<10} {:>24}",
-            p.name, p.value, std, p.unit, bounds
+            p.name,
+            p.value,
+            std,
+            p.unit,
+            bounds
         );
     }
     for (a, b, r) in strong_correlations(fit, 0.95) {
-        println!("  note: {a} and {b} are correlated (r = {r:+.3})");
+        say!("  note: {a} and {b} are correlated (r = {r:+.3})");
     }
     let fits: Vec<String> = oe
         .fit_percent
         .iter()
         .map(|f| format!("{:.2} %", f[0]))
         .collect();
-    println!("  fit per experiment: {}", fits.join(", "));
-    println!(
+    say!("  fit per experiment: {}", fits.join(", "));
+    say!(
         "  loss {:.4e}   FPE {}   AIC {}   {} iterations, {} function evaluations, {} rejected trials",
         oe.loss, criterion(oe.fpe, true), criterion(oe.aic, false), oe.report.iterations, oe.report.function_evaluations, oe.report.rejected_trials
     );
-    println!(
+    say!(
         "  stopped: {}   time {:.2} s",
-        oe.report.termination, fit.elapsed_s
+        oe.report.termination,
+        fit.elapsed_s
     );
-    println!(
+    say!(
         "  simulations: {} without sensitivities, {} with",
-        oe.report.residual_evaluations, oe.report.sensitivity_evaluations
+        oe.report.residual_evaluations,
+        oe.report.sensitivity_evaluations
     );
     if let Some(evaluation) = &fit.evaluation {
-        println!("  evaluated by: {evaluation}");
+        say!("  evaluated by: {evaluation}");
     }
     if fit.starts.len() > 1 {
         let near = fit.starts_near_best(0.01);
-        println!(
+        say!(
             "  multi-start: {} starts screened, {near} reached the best screened criterion",
             fit.starts.len()
         );
@@ -96,7 +106,7 @@ pub fn strong_correlations(fit: &GreyBoxFit, limit: f64) -> Vec<(String, String,
 pub fn print_residuals(fit: &GreyBoxFit, data: &IdData) -> Vec<ResidualAnalysis> {
     let analyses = greybox_residuals(fit, data);
     for (e, a) in analyses.iter().enumerate() {
-        println!(
+        say!(
             "  residuals, experiment {}: {} of {} auto-correlations and {} of {} input cross-correlations outside the 99 % band ±{:.3}",
             e + 1,
             a.auto_outside,
@@ -111,13 +121,13 @@ pub fn print_residuals(fit: &GreyBoxFit, data: &IdData) -> Vec<ResidualAnalysis>
 
 /// Prints the sensitivity table.
 pub fn print_sensitivity(rows: &[SensitivityRow]) {
-    println!("  change of fit % for ±20 % of each parameter (one at a time), per experiment:");
+    say!("  change of fit % for ±20 % of each parameter (one at a time), per experiment:");
     for r in rows {
         let cells: Vec<String> =
             r.up.iter()
                 .zip(&r.down)
                 .map(|(u, d)| format!("{u:+8.3} / {d:+8.3}"))
                 .collect();
-        println!("    {:<12} {}", r.name, cells.join("   "));
+        say!("    {:<12} {}", r.name, cells.join("   "));
     }
 }

@@ -80,7 +80,7 @@ pub fn ls(args: &RigidBodyLsArgs) -> Result<()> {
 /// The relative error and fit % of the predicted drive signal per record.
 fn print_records(report: &Report) {
     if let Some(fit) = &report.fit {
-        println!(
+        say!(
             "  predicted drive signal: fit {:.2} % on the estimation record (decimated, borders dropped)",
             fit.fit_percent
         );
@@ -90,7 +90,7 @@ fn print_records(report: &Report) {
         .cloned()
         .unwrap_or_default();
     for (r, v) in records.iter().skip(1).zip(&report.validation) {
-        println!(
+        say!(
             "  relative error {:.4} %, fit {:.2} % on {}",
             r["relative_error_percent"].as_f64().unwrap_or(f64::NAN),
             v.fit_percent,
@@ -101,21 +101,24 @@ fn print_records(report: &Report) {
 
 /// The settings, the estimates with their standard deviations, the fit and the condition.
 fn print_estimate(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) {
-    println!(
+    say!(
         "Rigid body g·u = M q̈ + Fv q̇ + Fc sgn(q̇){}: inverse-dynamics least squares on {}",
         if args.offset { " + offset" } else { "" },
         args.data.display()
     );
-    println!(
+    say!(
         "  {} Hz Butterworth (order {}, zero phase), decimation {}, {} border samples, gain {}; {} equations",
         args.cutoff, args.order, args.decimate, args.border, args.gain, estimate.equations
     );
-    println!(
+    say!(
         "  {:<10}{:>16}   {:<12}{:>12}",
-        "parameter", "estimate", "± std", "rel. std"
+        "parameter",
+        "estimate",
+        "± std",
+        "rel. std"
     );
     for i in 0..estimate.names.len() {
-        println!(
+        say!(
             "  {:<10}{:>16.6}   {:<12}{:>10.3} %",
             estimate.names[i],
             estimate.values[i],
@@ -123,7 +126,7 @@ fn print_estimate(estimate: &RigidBodyEstimate, args: &RigidBodyLsArgs) {
             estimate.relative_std_percent[i]
         );
     }
-    println!(
+    say!(
         "  relative error {:.4} % on the estimation record; condition number {:.2} ({:.2} with the columns scaled to unit norm)",
         estimate.relative_error_percent,
         estimate.condition_number_unscaled,

@@ -83,7 +83,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
     }
     let kind = report.model.as_ref().map_or("", |m| m.kind());
     for ((source, d), p) in records.iter().zip(&predictions) {
-        println!(
+        say!(
             "Simulated {kind} on {source} ({} samples{})",
             d.experiment(0).len(),
             if p.outputs[0].len() == d.experiment(0).len() {
@@ -94,10 +94,10 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         );
     }
     if let Some(fit) = &report.fit {
-        println!("  fit {:.2} %   RMSE {:.4e}", fit.fit_percent, fit.rmse);
+        say!("  fit {:.2} %   RMSE {:.4e}", fit.fit_percent, fit.rmse);
     }
     if let Some(path) = &args.csv {
-        println!("  simulated output: {}", path.display());
+        say!("  simulated output: {}", path.display());
     }
     out.finish(Some(&report), None)
 }

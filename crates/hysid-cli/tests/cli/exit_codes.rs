@@ -196,3 +196,38 @@ fn simulate_refuses_to_write_over_its_input_and_commits_both_outputs() {
         .to_string_lossy()
         .contains("hysid-tmp")));
 }
+
+/// A closed stdout (the report piped into `head -1`, which has exited) loses the human
+/// report's text, not the run: the exit code is the run's, stderr holds no fault, and the
+/// files are written.
+#[test]
+fn a_closed_stdout_loses_the_report_text_not_the_run() {
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let data = example_data(dir.path(), "300");
+    let report = dir.path().join("report.json");
+    let mut child = hysid()
+        .args(["identify", "hysteresis", "--data"])
+        .arg(&data)
+        .args([
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch4",
+            "--json",
+        ])
+        .arg(&report)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // the reader goes away before the run has printed anything
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("internal fault"), "{stderr}");
+    assert_eq!(read_json(&report)["schema"], "hysid.report/1");
+}
