@@ -43,6 +43,7 @@ fn bench(c: &mut Criterion) {
         outputs: vec!["qm_m".into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     let emps = IdData::from_csv(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/emps/DATA_EMPS.csv"),

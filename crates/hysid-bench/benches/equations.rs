@@ -29,6 +29,7 @@ fn train() -> IdData {
         outputs: vec!["y_m".into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     IdData::from_csv(
         &root().join("data/bouc-wen/train_multisine_5periods.csv"),

@@ -23,6 +23,7 @@ fn train() -> IdData {
         outputs: vec!["y_m".into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     IdData::from_csv(
         &Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -28,6 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         outputs: vec!["y_m".into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     let data = IdData::from_csv(
         &root.join("data/bouc-wen/train_multisine_5periods.csv"),

@@ -1,6 +1,6 @@
 //! `hysid compensate`: the input that makes a fitted hysteresis model follow a reference.
 
-use super::zoo::signals;
+use super::zoo::{signals, time_steps};
 use crate::cli_zoo::CompensateArgs;
 use anyhow::{Context, Result};
 use hysid::data::{write_csv, CsvSpec, IdData};
@@ -33,6 +33,7 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
         outputs: Vec::new(),
         time: args.time.clone(),
         ts: args.ts,
+        time_steps: time_steps(&model),
     };
     let data = IdData::from_file(&args.data, &spec)
         .with_context(|| format!("reading {}", args.data.display()))?;

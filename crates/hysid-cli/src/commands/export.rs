@@ -137,6 +137,7 @@ fn bound_record(path: &std::path::Path, args: &ExportArgs) -> Result<Vec<Vec<f64
         outputs: args.output.iter().cloned().collect(),
         time: None,
         ts: Some(1.0),
+        ..CsvSpec::default()
     };
     let data = IdData::from_file(path, &spec)
         .with_context(|| format!("reading --data {}", path.display()))?;

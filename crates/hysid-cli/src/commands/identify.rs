@@ -54,6 +54,7 @@ pub fn load_grouped(args: &DataArgs, n_inputs: usize, n_outputs: usize) -> Resul
             outputs: outputs.to_vec(),
             time: args.time.clone(),
             ts: args.ts,
+            ..CsvSpec::default()
         };
         let experiment = IdData::from_file(&args.data, &spec).map_err(|e| match e {
             // The data layer names channels, not files: say which file.

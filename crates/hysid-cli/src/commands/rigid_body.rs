@@ -141,6 +141,7 @@ fn record(path: &Path, args: &RigidBodyLsArgs) -> Result<(Vec<f64>, Vec<f64>, f6
         outputs: vec![args.position.clone()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     let data = IdData::from_file(path, &spec)?;
     let exp = data.experiment(0);

@@ -1,5 +1,6 @@
 //! `hysid simulate`: run a saved model (or the model of a report) on new records.
 
+use super::zoo::time_steps;
 use crate::cli::SimulateArgs;
 use crate::exit::UsageError;
 use crate::output::Outputs;
@@ -30,6 +31,7 @@ pub fn run(args: &SimulateArgs) -> Result<()> {
         outputs: args.output.iter().cloned().collect(),
         time: args.time.clone(),
         ts: args.ts,
+        time_steps: time_steps(&model),
     };
     let data = args
         .data

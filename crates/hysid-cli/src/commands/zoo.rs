@@ -5,8 +5,9 @@ use crate::cli::DataArgs;
 use crate::cli_zoo::FamilyArgs;
 use crate::exit::UsageError;
 use anyhow::{Context, Result};
-use hysid::data::{CsvSpec, IdData};
+use hysid::data::{CsvSpec, IdData, TimeSteps};
 use hysid::identify::operators::FamilyOptions;
+use hysid::model::saved::FittedModel;
 use hysid::report::plot::{render, Figure, Series, Style};
 use std::path::Path;
 
@@ -64,7 +65,9 @@ pub fn columns(args: &DataArgs) -> Result<(&str, &str)> {
     }
 }
 
-/// Reads the input and output columns of `path` (one experiment).
+/// Reads the input and output columns of `path` (one experiment). The hysteresis families
+/// are rate-independent: a time column need only increase (set points at irregular moments,
+/// runs with gaps between them; [`TimeSteps::Ordered`]).
 pub fn load(args: &DataArgs, path: &Path) -> Result<IdData> {
     let (input, output) = columns(args)?;
     let spec = CsvSpec {
@@ -72,8 +75,19 @@ pub fn load(args: &DataArgs, path: &Path) -> Result<IdData> {
         outputs: vec![output.to_string()],
         time: args.time.clone(),
         ts: args.ts,
+        time_steps: TimeSteps::Ordered,
     };
     IdData::from_file(path, &spec).with_context(|| format!("reading {}", path.display()))
+}
+
+/// The rule for the time column of the records `model` runs on: only increasing for a
+/// rate-independent model (a hysteresis operator), uniform otherwise.
+pub fn time_steps(model: &FittedModel) -> TimeSteps {
+    if model.rate_independent() {
+        TimeSteps::Ordered
+    } else {
+        TimeSteps::Uniform
+    }
 }
 
 /// The measured loop (points) with model loops (dashed) over it, as `dir/name`.

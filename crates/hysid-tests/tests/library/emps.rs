@@ -12,6 +12,7 @@ fn emps_reference_model_is_reproduced() {
         outputs: vec!["qm_m".into()],
         time: Some("t_s".into()),
         ts: None,
+        ..CsvSpec::default()
     };
     let data = IdData::from_csv(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/emps/DATA_EMPS.csv"),

@@ -33,6 +33,7 @@ fn csv(path: &str, input: &str, output: &str) -> IdData {
         outputs: vec![output.into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     IdData::from_csv(&root().join(path), &spec).unwrap()
 }

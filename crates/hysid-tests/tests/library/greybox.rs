@@ -68,6 +68,7 @@ fn train_record() -> IdData {
         outputs: vec!["y_m".into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../data/bouc-wen/train_multisine_5periods.csv");

@@ -112,6 +112,7 @@ fn real_piezo_and_ferrite_records_are_fitted() {
         outputs: vec![output.into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     let piezo = IdData::from_csv(
         &root.join("piezo/piezo_150V_1Hz.csv"),

@@ -109,6 +109,7 @@ fn every_fixture_loads_and_simulates_bit_identically() {
             outputs: vec![f.output.clone()],
             time: None,
             ts: None,
+            ..CsvSpec::default()
         };
         let data = IdData::from_file(&f.record, &spec).unwrap();
         let (_, predictions) = simulate_report(&model, &[(f.name.clone(), &data)])

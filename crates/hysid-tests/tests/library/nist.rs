@@ -177,6 +177,7 @@ fn fit_with(name: &str, k: usize, estimation: GreyBoxEstimation) -> Outcome {
         outputs: vec!["y".into()],
         time: None,
         ts: None,
+        ..CsvSpec::default()
     };
     let data = IdData::from_file(&record(name), &spec).unwrap();
     let start = model.parameters();
@@ -222,6 +223,7 @@ fn records_hold_nist_data() {
             outputs: vec!["y".into()],
             time: None,
             ts: None,
+            ..CsvSpec::default()
         };
         let data = IdData::from_file(&record(name), &spec).unwrap();
         let e = data.experiment(0);

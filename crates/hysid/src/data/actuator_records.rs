@@ -36,6 +36,7 @@ pub fn read_data_sets(dir: &Path) -> Result<BTreeMap<usize, Record>> {
         outputs: vec![COLUMNS[2].into()],
         time: Some(COLUMNS[0].into()),
         ts: None,
+        ..CsvSpec::default()
     };
     (1..=8)
         .map(|set| {

@@ -43,6 +43,35 @@ pub struct CsvSpec {
     pub time: Option<String>,
     /// Sample time; when given, any time column is ignored.
     pub ts: Option<f64>,
+    /// What a time column's steps must be: uniform (the default, for every model with
+    /// dynamics in time) or only increasing (the rate-independent hysteresis of the zoo).
+    pub time_steps: TimeSteps,
+}
+
+/// What a time column's steps must be ([`CsvSpec::time_steps`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TimeSteps {
+    /// Strictly increasing and uniform: the sample time is the mean step, and no step may
+    /// differ from it by more than 1 %.
+    #[default]
+    Uniform,
+    /// Strictly increasing only, the samples in time order: the set points of a
+    /// rate-independent model (the hysteresis operators, whose output depends on the
+    /// sequence of inputs, not on when they came), taken at irregular moments or in several
+    /// runs with gaps between them. The sample time is the median step, a label for the
+    /// reports and the time axis of written records; it does not enter the model.
+    Ordered,
+}
+
+impl TimeSteps {
+    /// The sample time of the time column `time` under this rule; else the zero-based index
+    /// of the first offending sample and what is wrong there.
+    pub(super) fn sample_time(self, time: &[f64]) -> std::result::Result<f64, (usize, String)> {
+        match self {
+            TimeSteps::Uniform => uniform_step(time),
+            TimeSteps::Ordered => median_step(time),
+        }
+    }
 }
 
 impl IdData {
@@ -52,8 +81,10 @@ impl IdData {
     /// The sample time is, in order of preference: `spec.ts`; the time column `spec.time`;
     /// a column named `t`, `time`, `t_s` or `time_s` (any case; the first one that is not
     /// an input or output); otherwise 1.0, i.e. time in samples. A time column must be
-    /// strictly increasing and uniform: the sample time is its mean step, and no step may
-    /// differ from it by more than 1 %. See the [module documentation](self) for errors.
+    /// strictly increasing and, under the default [`TimeSteps::Uniform`], uniform: the
+    /// sample time is its mean step, and no step may differ from it by more than 1 %
+    /// ([`TimeSteps::Ordered`]: only increasing, the median step). See the
+    /// [module documentation](self) for errors.
     ///
     /// ```
     /// use hysid::data::{CsvSpec, IdData};
@@ -100,7 +131,7 @@ impl IdData {
             (Some(ts), _) => ts,
             (None, Some(col)) => {
                 let time = columns.pop().expect("the time column was read last");
-                sample_time(path, &table.header[col], &time)?
+                sample_time(path, &table.header[col], &time, spec.time_steps)?
             }
             (None, None) => 1.0,
         };
@@ -399,10 +430,10 @@ fn number(cell: &[u8]) -> Option<f64> {
     float::parse_fast(cell).or_else(|| std::str::from_utf8(cell).ok()?.parse::<f64>().ok())
 }
 
-/// The mean step of a strictly increasing, uniform time column.
-fn sample_time(path: &Path, column: &str, time: &[f64]) -> Result<f64> {
+/// The sample time of a time column under `steps` ([`TimeSteps`]).
+fn sample_time(path: &Path, column: &str, time: &[f64], steps: TimeSteps) -> Result<f64> {
     let column = one_line(column);
-    uniform_step(time).map_err(|(row, problem)| {
+    steps.sample_time(time).map_err(|(row, problem)| {
         Error::InvalidData(format!(
             "{}: line {}: time column '{column}' {problem}; resample the data to a uniform \
              grid, or pass --ts to set the sample time and ignore the time column",
@@ -412,21 +443,38 @@ fn sample_time(path: &Path, column: &str, time: &[f64]) -> Result<f64> {
     })
 }
 
-/// The mean step of a strictly increasing, uniform time vector; else the zero-based index
-/// of the first offending sample and what is wrong there.
-pub(super) fn uniform_step(time: &[f64]) -> std::result::Result<f64, (usize, String)> {
+/// Errors unless the time vector has two values or more and strictly increases: the
+/// zero-based index of the first offending sample and what is wrong there.
+fn increasing(time: &[f64]) -> std::result::Result<(), (usize, String)> {
     if time.len() < 2 {
         return Err((0, "has a single value, which gives no sample time".into()));
     }
-    // Monotonicity first: a step back would otherwise show up as a misleading "bad step".
-    if let Some(k) = time.windows(2).position(|pair| pair[1] <= pair[0]) {
-        let problem = format!(
-            "is not strictly increasing ({} follows {})",
-            time[k + 1],
-            time[k]
-        );
-        return Err((k + 1, problem));
+    match time.windows(2).position(|pair| pair[1] <= pair[0]) {
+        Some(k) => Err((
+            k + 1,
+            format!(
+                "is not strictly increasing ({} follows {})",
+                time[k + 1],
+                time[k]
+            ),
+        )),
+        None => Ok(()),
     }
+}
+
+/// The median step of a strictly increasing time vector ([`TimeSteps::Ordered`]).
+fn median_step(time: &[f64]) -> std::result::Result<f64, (usize, String)> {
+    increasing(time)?;
+    let mut steps: Vec<f64> = time.windows(2).map(|pair| pair[1] - pair[0]).collect();
+    steps.sort_by(f64::total_cmp);
+    Ok(steps[steps.len() / 2])
+}
+
+/// The mean step of a strictly increasing, uniform time vector; else the zero-based index
+/// of the first offending sample and what is wrong there.
+pub(super) fn uniform_step(time: &[f64]) -> std::result::Result<f64, (usize, String)> {
+    // Monotonicity first: a step back would otherwise show up as a misleading "bad step".
+    increasing(time)?;
     let ts = (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64;
     let off = |pair: &[f64]| (pair[1] - pair[0] - ts).abs() > TIME_STEP_RTOL * ts;
     if let Some(k) = time.windows(2).position(off) {

@@ -19,7 +19,7 @@
 use std::fs;
 use std::path::Path;
 
-use super::csv_io::{uniform_step, TIME_COLUMN_NAMES};
+use super::csv_io::{TimeSteps, TIME_COLUMN_NAMES};
 use super::mat5::{self, MatArray as Array};
 use super::{one_line, Channel, CsvSpec, Experiment, IdData};
 use crate::error::{Error, Result};
@@ -69,9 +69,9 @@ impl IdData {
             .collect::<Result<Vec<_>>>()?;
         let ts = match (spec.ts, &spec.time) {
             (Some(ts), _) => ts,
-            (None, Some(name)) => file.sample_time(name)?,
+            (None, Some(name)) => file.sample_time(name, spec.time_steps)?,
             (None, None) => match file.detect_time(spec) {
-                Some(name) => file.sample_time(&name)?,
+                Some(name) => file.sample_time(&name, spec.time_steps)?,
                 None => 1.0,
             },
         };
@@ -205,10 +205,10 @@ impl<'p> MatVariables<'p> {
         Ok(selected)
     }
 
-    /// The mean step of the time variable `name` (strictly increasing and uniform).
-    fn sample_time(&self, name: &str) -> Result<f64> {
+    /// The sample time of the time variable `name` under `steps` ([`TimeSteps`]).
+    fn sample_time(&self, name: &str, steps: TimeSteps) -> Result<f64> {
         let time = self.column(name)?;
-        uniform_step(&time).map_err(|(index, problem)| {
+        steps.sample_time(&time).map_err(|(index, problem)| {
             invalid(
                 self.path,
                 &format!(

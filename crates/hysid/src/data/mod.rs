@@ -19,7 +19,7 @@ pub mod csv_io;
 pub mod mat5;
 pub mod mat_io;
 
-pub use csv_io::{read_columns, write_csv, CsvSpec};
+pub use csv_io::{read_columns, write_csv, CsvSpec, TimeSteps};
 pub use mat_io::is_mat;
 
 /// Sample times of two data sets that differ by less than this relative amount are taken

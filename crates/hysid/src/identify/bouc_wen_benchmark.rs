@@ -52,6 +52,7 @@ pub fn record_spec() -> CsvSpec {
         outputs: vec!["y_m".into()],
         time: Some("t_s".into()),
         ts: None,
+        ..CsvSpec::default()
     }
 }
 

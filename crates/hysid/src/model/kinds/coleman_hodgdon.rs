@@ -77,6 +77,11 @@ impl FittedHysteresis {
 /// The recursion of [`crate::model::coleman_hodgdon`] from its start; the compensator is the
 /// per-sample solve, and the batch compensation runs it one step at a time.
 impl FittedKind for FittedHysteresis {
+    /// A hysteresis in the input alone: the sequence of inputs sets the output.
+    fn rate_independent(&self) -> bool {
+        true
+    }
+
     fn saved(&self) -> SavedModel {
         SavedModel::ColemanHodgdon(ColemanHodgdonFile {
             parameters: hysteresis_records(&self.model, &self.std),

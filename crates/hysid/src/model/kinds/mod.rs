@@ -96,6 +96,12 @@ pub trait FittedKind {
         let _ = evaluator;
     }
 
+    /// Whether its output depends only on the sequence of its inputs
+    /// ([`FittedModel::rate_independent`]); by default not.
+    fn rate_independent(&self) -> bool {
+        false
+    }
+
     /// The same model sampled every `to` seconds instead of the `from` it was fitted at
     /// ([`FittedModel::resampled`]): a continuous-time model re-steps its integration
     /// ([`Simulation::resampled`](crate::model::greybox::Simulation::resampled)); None, the

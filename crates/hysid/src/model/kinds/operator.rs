@@ -74,6 +74,11 @@ pub struct FittedHysteresisOperator {
 /// The family's own simulation from the declared initial state, its step and its inverse
 /// (the registry's operators, [`crate::model::operators`]).
 impl FittedKind for FittedHysteresisOperator {
+    /// A hysteresis in the input alone: the sequence of inputs sets the output.
+    fn rate_independent(&self) -> bool {
+        true
+    }
+
     fn saved(&self) -> SavedModel {
         let model = &self.model;
         SavedModel::Operator(OperatorFile {

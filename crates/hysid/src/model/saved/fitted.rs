@@ -289,6 +289,14 @@ impl FittedModel {
         self.as_kind()?.resampled(from, to)
     }
 
+    /// Whether its output depends only on the sequence of its inputs, not on when they came
+    /// (a hysteresis operator, the Coleman–Hodgdon hysteresis): its records' time columns
+    /// need only increase ([`TimeSteps::Ordered`](crate::data::TimeSteps::Ordered)). False
+    /// for the wrappers, whose record processing runs in time.
+    pub fn rate_independent(&self) -> bool {
+        self.as_kind().is_some_and(|k| k.rate_independent())
+    }
+
     /// [`Self::with_evaluator`] in place.
     fn set_evaluator(&mut self, evaluator: Evaluator) {
         match self {
