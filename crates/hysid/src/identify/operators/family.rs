@@ -21,11 +21,12 @@ use crate::model::operators::{
 use crate::model::saved::FittedModel;
 use crate::model::saved::{FittedHysteresis, FittedHysteresisOperator};
 use crate::model::OperatorCascade;
-use crate::model::{ChForm, Parameter, ParameterSet};
+use crate::model::{ChForm, ColemanHodgdon, Parameter, ParameterSet};
 use crate::numerics::levenberg_marquardt::Control;
 use crate::numerics::metrics;
 use crate::numerics::Observer;
 use crate::{Error, Result};
+use nalgebra::DMatrix;
 use std::time::Instant;
 
 /// The settings of the families' recipes that a user chooses (the rest are each recipe's
@@ -450,27 +451,58 @@ fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>) -> OperatorFit<FittedModel
     }
 }
 
+/// The power of two nearest the largest |v| (1 for a record of zeros): a scale that brings
+/// v to unit size exactly (a binary exponent shift, no rounding).
+fn unit_scale(v: &[f64]) -> f64 {
+    let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if largest > 0.0 && largest.is_finite() {
+        2f64.powi(largest.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
+
 /// The Coleman–Hodgdon hysteresis alone ([`HysteresisIdentification`]), its output starting
 /// at the measured first sample.
+///
+/// The fit runs on the record in units of unit size, x' = x/sₓ and y' = y/s_y (powers of
+/// two, [`unit_scale`]), and the parameters return in the record's units: (D) is unchanged
+/// by α = α'/sₓ, m = m'·s_y/sₓ, c = c'·s_y/sₓ, d = d'·sₓ, so a record in kV and nm fits as
+/// the same record in V and µm does.
 fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<FittedModel>> {
     let started = Instant::now();
     // Equal lengths, enough samples, an input that reverses (a loop, not a curve) — the
     // recipe itself accepts a monotone input, on which d and the loop are not identifiable.
     super::differential_fit::check_record(form.short_name(), u, y, form.n_params())?;
-    let data = IdData::siso(1.0, "u", u.to_vec(), "y", y.to_vec())?;
+    let (sx, sy) = (unit_scale(u), unit_scale(y));
+    let scaled = |v: &[f64], s: f64| v.iter().map(|x| x / s).collect::<Vec<f64>>();
+    let data = IdData::siso(1.0, "u", scaled(u, sx), "y", scaled(y, sy))?;
     // the zoo's ch6 starts no worse than its nested ch4 (`better_start`)
     let id = HysteresisIdentification {
         nested_start: true,
         ..HysteresisIdentification::new(form)
     };
     let fit = id.estimate(&data, &mut |_| Control::Continue)?;
-    let std = fit.std();
+    // α, the slopes m and c, then d
+    let factor: Vec<f64> = (0..form.n_params())
+        .map(|k| match k {
+            0 => 1.0 / sx,
+            k if k + 1 == form.n_params() => sx,
+            _ => sy / sx,
+        })
+        .collect();
+    let unscale = |v: Vec<f64>| -> Vec<f64> { v.iter().zip(&factor).map(|(v, f)| v * f).collect() };
+    let model = ColemanHodgdon::from_params(form, &unscale(fit.model.params()))?;
+    let std = unscale(fit.std());
+    let covariance = DMatrix::from_fn(factor.len(), factor.len(), |i, j| {
+        fit.output_error.covariance.matrix[(i, j)] * factor[i] * factor[j]
+    });
     let std_present: Vec<Option<f64>> = std.iter().map(|s| s.is_finite().then_some(*s)).collect();
-    let simulated = simulate_switched(&fit.model, u, y[0], None);
+    let simulated = simulate_switched(&model, u, y[0], None);
     let parameters = ParameterSet::new(
         form.parameter_names()
             .iter()
-            .zip(fit.model.params())
+            .zip(model.params())
             .map(|(name, v)| Parameter::new(*name, v))
             .collect(),
     )?;
@@ -480,12 +512,12 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
     let report = &fit.output_error.report;
     Ok(OperatorFit {
         model: FittedModel::Hysteresis(FittedHysteresis {
-            model: fit.model.clone(),
+            model,
             initial: InitialOutput::Measured,
             std: std.clone(),
         }),
         parameters,
-        covariance: masked_covariance(&fit.output_error.covariance.matrix, &std_present),
+        covariance: masked_covariance(&covariance, &std_present),
         std: std_present,
         fit_percent: metrics::fit_percent(y, &simulated),
         rmse: loss.sqrt(),

@@ -293,6 +293,13 @@ pub(crate) fn unscaled(
 /// Solves the normal equations under x ≥ 0 (except the unconstrained variables) and the
 /// standard deviations with σ² = RSS/(N − |F|); `penalty` (already in G) is excluded from
 /// the RSS by the caller giving the unpenalised `g_plain`.
+///
+/// The columns are equilibrated first (Jacobi scaling, Golub & Van Loan, *Matrix
+/// Computations*, 4th ed., §3.5.2): with D = diag(1/√Gᵢᵢ) the problem D G D x' = D b,
+/// x' ≥ 0, has the same solution x = D x' (D > 0 keeps the signs), and a unit diagonal.
+/// Regressors in units far apart (an input in kA beside an output's dead zones in µT, a
+/// column of ones beside plays of a few mA) otherwise leave the small columns' duals below
+/// the active-set method's tolerance, and their weights at zero after no iteration.
 pub(crate) fn solve_weights(
     g: &DMatrix<f64>,
     b: &DVector<f64>,
@@ -301,7 +308,22 @@ pub(crate) fn solve_weights(
     unconstrained: &[bool],
     g_plain: Option<&DMatrix<f64>>,
 ) -> Result<WeightSolution> {
-    let sol = nnls_gram(g, b, unconstrained)?;
+    let d: Vec<f64> = (0..b.len())
+        .map(|i| {
+            let gii = g[(i, i)];
+            if gii > 0.0 && gii.is_finite() {
+                1.0 / gii.sqrt()
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let g_scaled = DMatrix::from_fn(g.nrows(), g.ncols(), |i, j| d[i] * g[(i, j)] * d[j]);
+    let b_scaled = DVector::from_fn(b.len(), |i, _| d[i] * b[i]);
+    let mut sol = nnls_gram(&g_scaled, &b_scaled, unconstrained)?;
+    for (x, d) in sol.x.iter_mut().zip(&d) {
+        *x *= d;
+    }
     let x = DVector::from_column_slice(&sol.x);
     let gp = g_plain.unwrap_or(g);
     let rss = (yy - 2.0 * b.dot(&x) + x.dot(&(gp * &x))).max(0.0);

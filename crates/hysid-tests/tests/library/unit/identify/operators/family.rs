@@ -184,3 +184,40 @@ fn ch6_fits_a_real_piezo_record_at_least_as_well_as_its_nested_ch4() {
         );
     }
 }
+
+/// Units far from 1 (#38 item 4): the real piezo record in (V, µm), in (mV, km) and in
+/// (kV, nm·10⁻²) fits to the same fit % in every linear-in-weights family (their normal
+/// equations are equilibrated) and in ch4/ch6 (fitted in units of unit size).
+#[test]
+fn units_far_from_one_fit_to_the_same_figures() {
+    let (u, y) = piezo();
+    let families = [
+        Family::Pi,
+        Family::Gpi,
+        Family::MaxwellSlip,
+        Family::Backlash,
+        Family::Preisach,
+        Family::Kp,
+        Family::Ch4,
+        Family::Ch6,
+    ];
+    let options = FamilyOptions::default();
+    for family in families {
+        let base = fit_operator(family, &u, &y, &options)
+            .unwrap()
+            .fit
+            .fit_percent;
+        for (su, sy) in [(1e3, 1e-6), (1e-4, 1e5)] {
+            let us: Vec<f64> = u.iter().map(|v| v * su).collect();
+            let ys: Vec<f64> = y.iter().map(|v| v * sy).collect();
+            let scaled = fit_operator(family, &us, &ys, &options)
+                .unwrap_or_else(|e| panic!("{family} at ({su}, {sy}): {e}"))
+                .fit
+                .fit_percent;
+            assert!(
+                (scaled - base).abs() < 1e-6,
+                "{family}: fit {scaled} % in units ({su}, {sy}), {base} % in V and µm"
+            );
+        }
+    }
+}
