@@ -226,6 +226,15 @@ pub trait DifferentialFamily: Sync {
     /// θ of a shape point and the least-squares coefficients of its basis; None when the
     /// coefficients leave the family's domain (a loop of the wrong orientation).
     fn assemble(&self, point: &[f64], coefficients: &[f64]) -> Option<Vec<f64>>;
+    /// Why no point of the start grid fits the record (u, y), when none does: what the
+    /// record shows that the family's loops cannot, and what to do (default: every start
+    /// diverged or turned the wrong way).
+    fn unfit_reason(&self, u: &[f64], y: &[f64]) -> String {
+        let _ = (u, y);
+        "every start of its grid diverged or completes to a loop of the wrong orientation; \
+         check the loop's orientation (--orientation) and that the record holds whole loops"
+            .into()
+    }
 }
 
 /// The driver's settings (each family's options carry them).
@@ -769,13 +778,9 @@ pub fn fit<F: DifferentialFamily>(
     };
     evaluations += grid.len();
     if grid.is_empty() {
-        return Err(Error::NotExciting {
-            channel: "input".into(),
-            reason: format!(
-                "no {} start fits the loop (every grid point diverged or has the wrong \
-                 orientation)",
-                family.name()
-            ),
+        return Err(Error::OutsideFamily {
+            family: family.name().into(),
+            reason: family.unfit_reason(u, y),
         });
     }
 

@@ -91,3 +91,27 @@ fn sampling_does_not_change_the_result() {
         "{yc:?}"
     );
 }
+
+/// A B(H) record in other units than A/m and T (here the field ×1000, the flux density
+/// ×10⁻⁶: M = B/μ₀ − H ≈ −H) is refused in one line that says why and what to do, not as
+/// "not exciting" (#38 item 4).
+#[test]
+fn a_record_in_other_units_than_a_per_m_and_tesla_is_refused_with_the_reason() {
+    let truth = truth(LoopOrientation::CounterClockwise);
+    let u: Vec<f64> = (0..600)
+        .map(|k| 800.0 * (k as f64 * 0.03).sin() * (1.0 - k as f64 / 1200.0))
+        .collect();
+    let y = truth.simulate(&u).unwrap();
+    let (uk, ym): (Vec<f64>, Vec<f64>) = (
+        u.iter().map(|v| v * 1e3).collect(),
+        y.iter().map(|v| v * 1e-6).collect(),
+    );
+    let e = fit(&uk, &ym, &JilesAthertonOptions::default()).unwrap_err();
+    assert!(matches!(e, hysid::Error::OutsideFamily { .. }), "{e:?}");
+    let text = e.to_string();
+    assert!(
+        text.contains("A/m") && text.contains("falls as H rises"),
+        "{text}"
+    );
+    assert!(!text.contains('\n'));
+}
