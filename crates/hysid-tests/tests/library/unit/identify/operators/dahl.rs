@@ -123,11 +123,12 @@ fn a_loop_outside_the_family_is_refused_with_its_reason() {
         orientation: Some(LoopOrientation::CounterClockwise),
         ..DahlOptions::default()
     };
-    // Fitted as asked: the search runs (and finds no Dahl operator there, or a poor one).
-    let asked = fit(&u, &rising, &asked);
-    assert!(
-        !matches!(asked, Err(hysid::Error::OutsideFamily { .. })),
-        "{:?}",
-        asked.err()
-    );
+    // Fitted as asked: the search runs (and finds no Dahl operator there, or a poor one),
+    // without the structural refusal.
+    if let Err(e) = fit(&u, &rising, &asked) {
+        assert!(
+            !e.to_string().contains("counter-clockwise and rises"),
+            "{e}"
+        );
+    }
 }
