@@ -6,7 +6,7 @@
 //! | 1 | bad input or data: a malformed or inconsistent file, a parameter out of its range, data that cannot identify the model — degenerate data among them: a channel whose squares overflow or underflow (beyond 1e150, all below 1e-150), an output without variation at double precision, a rig truth that makes the simulation or its tables non-finite |
 //! | 2 | usage: the command line itself is wrong (unknown option, missing or unparsable value, an output path that is an input or another output of the run) |
 //! | 3 | numerical failure: a singular regression, a diverged simulation, a non-finite result |
-//! | 4 | I/O: a file could not be opened, read or written |
+//! | 4 | I/O: a file could not be opened, read or written; stdout failed other than by a closed pipe (a closed pipe loses the report text, not the run) |
 //! | 130 | interrupted (SIGINT, SIGTERM, SIGHUP): the run's partial outputs removed (`main`'s handler) |
 //! | 101 | an internal fault (a panic) — a bug to report |
 //!
@@ -316,6 +316,25 @@ pub fn command_path(root: &clap::Command, args: &[String]) -> String {
 /// Whitespace (newlines included) collapsed to single spaces.
 fn collapse(text: &str) -> String {
     text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// The first failed write of the human report to stdout other than a closed pipe.
+static STDOUT_FAILURE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
+/// Takes the result of a write of the human report to stdout (`say!`): a closed pipe (the
+/// reader has gone, as `head` does) is not a failure; any other error is kept, the first
+/// one, for [`stdout_failure`].
+pub fn on_stdout(result: std::io::Result<()>) {
+    if let Err(e) = result {
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            let _ = STDOUT_FAILURE.set(e.to_string());
+        }
+    }
+}
+
+/// The failed write of [`on_stdout`], if any: the run then exits with 4 (I/O).
+pub fn stdout_failure() -> Option<&'static str> {
+    STDOUT_FAILURE.get().map(String::as_str)
 }
 
 /// Installs a panic hook that reports an internal fault on one line (where, what, and to

@@ -6,11 +6,21 @@
 //! (the table is in [`exit`]).
 
 /// `println!` that keeps going when stdout is closed (a pipe into `head`): the human report
-/// is lost, the run, its files and its exit code are not.
+/// is lost, the run, its files and its exit code are not. Any other failed write (a full
+/// disk under `> report.txt`) ends the run with exit 4 ([`exit::on_stdout`]).
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
+        $crate::exit::on_stdout(writeln!(std::io::stdout(), $($arg)*));
+    }};
+}
+
+/// `eprintln!` that keeps going when stderr is closed: progress, warnings and errors
+/// written to a closed stream are lost, the run is not.
+macro_rules! tell {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
     }};
 }
 
@@ -43,12 +53,16 @@ fn main() -> ExitCode {
     match commands::run(cli) {
         Ok(()) => {
             if let Some(warning) = progress::time_limit_warning() {
-                eprintln!("{warning}");
+                tell!("{warning}");
+            }
+            if let Some(failure) = exit::stdout_failure() {
+                tell!("error: writing the report to stdout: {failure}; free space where stdout goes, or send it elsewhere (the result files are written)");
+                return ExitClass::Io.exit_code();
             }
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {}", exit::one_line(&e));
+            tell!("error: {}", exit::one_line(&e));
             exit::classify(&e).exit_code()
         }
     }
@@ -77,7 +91,7 @@ fn parser_exit(e: &clap::Error) -> ExitCode {
         }
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
             let command = exit::usage_command(&e.render().to_string());
-            eprintln!("error: '{command}' needs a subcommand; run '{command} --help' for the list");
+            tell!("error: '{command}' needs a subcommand; run '{command} --help' for the list");
             ExitClass::Usage.exit_code()
         }
         _ => {
@@ -86,7 +100,7 @@ fn parser_exit(e: &clap::Error) -> ExitCode {
                 .map(|a| a.to_string_lossy().into_owned())
                 .collect();
             let command = exit::command_path(&cli::Cli::command(), &args);
-            eprintln!(
+            tell!(
                 "error: {}",
                 exit::usage_line(&e.render().to_string(), &command)
             );

@@ -46,7 +46,7 @@ pub fn init(quiet: bool, time_limit_s: Option<f64>) {
 /// Prints one line about what the run is doing on stderr, unless `--quiet`.
 pub fn note(message: &str) {
     if !RUN.get().is_some_and(|run| run.quiet) {
-        eprintln!("{message}");
+        tell!("{message}");
     }
 }
 
@@ -153,7 +153,7 @@ impl Sink {
             let Ok(mut last) = last.lock() else { return };
             if last.elapsed() >= PLAIN_EVERY {
                 *last = Instant::now();
-                eprintln!("{}: {message}", self.stage);
+                tell!("{}: {message}", self.stage);
             }
         }
     }

@@ -54,7 +54,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     say!("Split: {}", comparison.split);
     print_table(&comparison.rows);
     for row in comparison.rows.iter().filter(|r| r.error.is_some()) {
-        eprintln!(
+        tell!(
             "warning: {} failed: {}",
             row.family,
             row.error.as_deref().unwrap_or("")
@@ -67,7 +67,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             b.family,
             b.validation_fit_percent.unwrap_or(f64::NAN)
         ),
-        None => eprintln!("warning: no family could be fitted to these data"),
+        None => tell!("warning: no family could be fitted to these data"),
     }
     let report = report(args, &data, &comparison)?;
     if let Some(dir) = &out.plots {

@@ -23,7 +23,7 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
     let model = FittedModel::from_file(&saved)?;
     let limits = args.limits.or_else(|| saved.limits());
     if limits.is_none() {
-        eprintln!(
+        tell!(
             "warning: {} records no input_range (a file of an earlier version) and no --limits was given: the command is not limited",
             args.model.display()
         );
@@ -70,7 +70,7 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
         } else {
             ""
         };
-        eprintln!(
+        tell!(
             "warning: {} of {} reference samples lie outside the model's reachable range or need a command beyond the limits, and were clipped (samples {}{more}); see the report",
             c.clipped.len(),
             reference.len(),

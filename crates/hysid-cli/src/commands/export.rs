@@ -72,7 +72,7 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         .into());
     }
     if args.inverse && hysid::export::export_limits(&file, &options).is_none() {
-        eprintln!(
+        tell!(
             "warning: {} records no input_range (a file of an earlier version) and no --limits was given: the compensator's command is not limited",
             args.model.display()
         );

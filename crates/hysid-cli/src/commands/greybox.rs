@@ -6,7 +6,7 @@ use crate::commands::identify::load_grouped;
 use crate::output::Outputs;
 use crate::progress::FitProgress;
 use anyhow::{bail, Context, Result};
-use hysid::data::IdData;
+use hysid::data::{IdData, TimeSteps};
 use hysid::identify::greybox::{GreyBoxEstimation, InitialStates};
 use hysid::identify::validate::sensitivity_table;
 use hysid::model::greybox::equation_model::EquationStateSpace;
@@ -47,7 +47,12 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
         args.plots.as_deref(),
     )?;
     // A model with k inputs and m outputs takes k --input and m --output per experiment.
-    let data = load_grouped(&args.data, model.inputs().len(), model.outputs().len())?;
+    let data = load_grouped(
+        &args.data,
+        model.inputs().len(),
+        model.outputs().len(),
+        TimeSteps::Uniform,
+    )?;
     out.fitted_on(&data);
     let params = configure(
         model.parameters(),
@@ -111,7 +116,7 @@ pub fn fit(args: &GreyboxFitArgs) -> Result<()> {
     );
     let residuals = print_residuals(&fit, &data);
     for warning in fit.warnings() {
-        eprintln!("warning: {warning}");
+        tell!("warning: {warning}");
     }
     let sensitivity = if args.sensitivity {
         let structure = hysid::identify::greybox::GreyBox::new(

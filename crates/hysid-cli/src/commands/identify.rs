@@ -6,7 +6,7 @@ use crate::output::Outputs;
 use crate::progress::FitProgress;
 use crate::report::{figures, print_table, Row};
 use anyhow::Result;
-use hysid::data::{Channel, CsvSpec, Experiment, IdData};
+use hysid::data::{Channel, CsvSpec, Experiment, IdData, TimeSteps};
 use hysid::identify::cascade::CascadeIdentification;
 use hysid::identify::hysteresis::{HysteresisIdentification, InitialOutput};
 use hysid::model::saved::FittedHysteresis;
@@ -18,16 +18,22 @@ use hysid::Error;
 use serde_json::json;
 
 /// Reads the input and output columns of a CSV file: one experiment per --input/--output
-/// pair.
-pub fn load(args: &DataArgs) -> Result<IdData> {
-    load_grouped(args, 1, 1)
+/// pair, the time column under the rule `steps` (only increasing for a rate-independent
+/// model).
+pub fn load(args: &DataArgs, steps: TimeSteps) -> Result<IdData> {
+    load_grouped(args, 1, 1, steps)
 }
 
 /// Reads the input and output columns of a CSV file for a model with `n_inputs` inputs and
 /// `n_outputs` outputs: the --input columns are taken `n_inputs` at a time and the --output
 /// columns `n_outputs` at a time, in the order given, each group one experiment (for a
 /// single-input, single-output model: one experiment per --input/--output pair).
-pub fn load_grouped(args: &DataArgs, n_inputs: usize, n_outputs: usize) -> Result<IdData> {
+pub fn load_grouped(
+    args: &DataArgs,
+    n_inputs: usize,
+    n_outputs: usize,
+    steps: TimeSteps,
+) -> Result<IdData> {
     let (ni, no) = (n_inputs.max(1), n_outputs.max(1));
     if (ni, no) == (1, 1) {
         anyhow::ensure!(
@@ -54,7 +60,7 @@ pub fn load_grouped(args: &DataArgs, n_inputs: usize, n_outputs: usize) -> Resul
             outputs: outputs.to_vec(),
             time: args.time.clone(),
             ts: args.ts,
-            ..CsvSpec::default()
+            time_steps: steps,
         };
         let experiment = IdData::from_file(&args.data, &spec).map_err(|e| match e {
             // The data layer names channels, not files: say which file.
@@ -102,7 +108,7 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
         form.short_name()
     );
     let mut out = register(&args.data, &args.output)?;
-    let data = load(&args.data)?;
+    let data = load(&args.data, TimeSteps::Uniform)?;
     out.fitted_on(&data);
     let mut id = CascadeIdentification::new(form, args.na, args.nb, args.delay);
     id.uncertainty = uncertainty(args.uncertainty, args.replicates);
@@ -145,7 +151,7 @@ pub fn cascade(args: &CascadeArgs) -> Result<()> {
 pub fn hysteresis(args: &HysteresisArgs) -> Result<()> {
     let form = ChForm::parse(&args.hysteresis)?;
     let mut out = register(&args.data, &args.output)?;
-    let data = load(&args.data)?;
+    let data = load(&args.data, TimeSteps::Ordered)?;
     out.fitted_on(&data);
     let mut id = HysteresisIdentification::new(form);
     id.initial = match args.initial_output {

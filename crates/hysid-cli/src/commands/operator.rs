@@ -120,9 +120,10 @@ fn print_summary(fitted: &FittedOperator, report: &Report) {
         );
     }
     if !fit.termination.converged() {
-        eprintln!(
+        tell!(
             "warning: the {} fit did not converge ({}); treat its parameters with care",
-            fitted.family, fit.termination
+            fitted.family,
+            fit.termination
         );
     }
 }

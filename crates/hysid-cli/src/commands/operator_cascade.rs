@@ -63,7 +63,7 @@ pub fn identify(args: &CascadeArgs) -> Result<()> {
          asymptotic standard deviations (use --uncertainty asymptotic)"
     );
     let mut out = register(&args.data, &args.output)?;
-    let data = load(&args.data)?;
+    let data = load(&args.data, hysid::data::TimeSteps::Uniform)?;
     out.fitted_on(&data);
     let fit = {
         let progress = FitProgress::new("identifying cascade");

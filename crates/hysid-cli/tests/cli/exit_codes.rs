@@ -230,4 +230,63 @@ fn a_closed_stdout_loses_the_report_text_not_the_run() {
     assert_eq!(out.status.code(), Some(0), "{stderr}");
     assert!(!stderr.contains("internal fault"), "{stderr}");
     assert_eq!(read_json(&report)["schema"], "hysid.report/1");
+
+    // both streams closed (progress, warnings and the report all lost): the same
+    fs::remove_file(&report).unwrap();
+    let mut child = hysid()
+        .args(["identify", "hysteresis", "--data"])
+        .arg(&data)
+        .args([
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch4",
+            "--json",
+        ])
+        .arg(&report)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    drop(child.stderr.take());
+    assert_eq!(child.wait().unwrap().code(), Some(0));
+    assert_eq!(read_json(&report)["schema"], "hysid.report/1");
+}
+
+/// A stdout that fails otherwise (a full disk) is an I/O error, exit 4, after the result
+/// files are written.
+#[test]
+fn a_full_stdout_is_an_io_error_after_the_files_are_written() {
+    let full = Path::new("/dev/full");
+    if !full.exists() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let data = example_data(dir.path(), "300");
+    let report = dir.path().join("report.json");
+    let out = hysid()
+        .args(["identify", "hysteresis", "--data"])
+        .arg(&data)
+        .args([
+            "--input",
+            "x",
+            "--output",
+            "y",
+            "--hysteresis",
+            "ch4",
+            "-q",
+            "--json",
+        ])
+        .arg(&report)
+        .stdout(fs::File::create(full).unwrap())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{stderr}");
+    assert!(stderr.contains("writing the report to stdout"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert_eq!(read_json(&report)["schema"], "hysid.report/1");
 }

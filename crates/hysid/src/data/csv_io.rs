@@ -72,6 +72,20 @@ impl TimeSteps {
             TimeSteps::Ordered => median_step(time),
         }
     }
+
+    /// What to do about a time column (`what`: "column" or "variable") this rule refuses.
+    pub(super) fn hint(self, what: &str) -> String {
+        match self {
+            TimeSteps::Uniform => format!(
+                "resample the data to a uniform grid, or pass --ts to set the sample time and \
+                 ignore the time {what}"
+            ),
+            TimeSteps::Ordered => format!(
+                "put the rows in time order on one clock (runs whose clock restarts at 0 \
+                 continue the previous run's time), or pass --ts to ignore the time {what}"
+            ),
+        }
+    }
 }
 
 impl IdData {
@@ -154,7 +168,9 @@ impl IdData {
     }
 
     /// Writes a single-experiment data set: a column `t` (k·ts) then every input and output
-    /// channel, in full precision (see [`write_csv`]).
+    /// channel, in full precision (see [`write_csv`]). A record read under
+    /// [`TimeSteps::Ordered`] is written on the uniform grid of its median step: its own
+    /// irregular times are not kept.
     ///
     /// Reading the file back with [`IdData::from_csv`] restores the samples bit-exactly and
     /// the sample time up to rounding (pass [`CsvSpec::ts`] to restore it exactly).
@@ -435,10 +451,10 @@ fn sample_time(path: &Path, column: &str, time: &[f64], steps: TimeSteps) -> Res
     let column = one_line(column);
     steps.sample_time(time).map_err(|(row, problem)| {
         Error::InvalidData(format!(
-            "{}: line {}: time column '{column}' {problem}; resample the data to a uniform \
-             grid, or pass --ts to set the sample time and ignore the time column",
+            "{}: line {}: time column '{column}' {problem}; {}",
             path.display(),
-            line_of_row(path, row)
+            line_of_row(path, row),
+            steps.hint("column")
         ))
     })
 }
@@ -462,12 +478,18 @@ fn increasing(time: &[f64]) -> std::result::Result<(), (usize, String)> {
     }
 }
 
-/// The median step of a strictly increasing time vector ([`TimeSteps::Ordered`]).
+/// The median step of a strictly increasing time vector ([`TimeSteps::Ordered`]): the
+/// middle one, or the mean of the two middle ones.
 fn median_step(time: &[f64]) -> std::result::Result<f64, (usize, String)> {
     increasing(time)?;
     let mut steps: Vec<f64> = time.windows(2).map(|pair| pair[1] - pair[0]).collect();
     steps.sort_by(f64::total_cmp);
-    Ok(steps[steps.len() / 2])
+    let half = steps.len() / 2;
+    Ok(if steps.len() % 2 == 1 {
+        steps[half]
+    } else {
+        0.5 * (steps[half - 1] + steps[half])
+    })
 }
 
 /// The mean step of a strictly increasing, uniform time vector; else the zero-based index

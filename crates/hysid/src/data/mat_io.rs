@@ -212,9 +212,10 @@ impl<'p> MatVariables<'p> {
             invalid(
                 self.path,
                 &format!(
-                    "time variable '{}' {problem} at sample {}; resample the data to a uniform grid, or pass --ts to set the sample time and ignore the time variable",
+                    "time variable '{}' {problem} at sample {}; {}",
                     one_line(name),
-                    index + 1
+                    index + 1,
+                    steps.hint("variable")
                 ),
             )
         })

@@ -231,11 +231,14 @@ pub trait DifferentialFamily: Sync {
     /// diverged or turned the wrong way).
     fn unfit_reason(&self, u: &[f64], y: &[f64]) -> String {
         let _ = (u, y);
-        "every start of its grid diverged or completes to a loop of the wrong orientation; \
-         check the loop's orientation (--orientation) and that the record holds whole loops"
-            .into()
+        NO_START.into()
     }
 }
+
+/// The default [`DifferentialFamily::unfit_reason`].
+pub(crate) const NO_START: &str = "every start of its grid diverged or completes to a loop of \
+     the wrong orientation; check the loop's orientation (--orientation, Python \
+     orientation=) and that the record holds whole loops";
 
 /// The driver's settings (each family's options carry them).
 #[derive(Clone, Debug)]

@@ -482,7 +482,23 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
         nested_start: true,
         ..HysteresisIdentification::new(form)
     };
-    let fit = id.estimate(&data, &mut |_| Control::Continue)?;
+    // a refusal quotes α and Δx in the record's units
+    let fit = id
+        .estimate(&data, &mut |_| Control::Continue)
+        .map_err(|e| match e {
+            Error::RateLimit {
+                index,
+                alpha,
+                dx,
+                product,
+            } => Error::RateLimit {
+                index,
+                alpha: alpha / sx,
+                dx: dx * sx,
+                product,
+            },
+            e => e,
+        })?;
     // α, the slopes m and c, then d
     let factor: Vec<f64> = (0..form.n_params())
         .map(|k| match k {

@@ -136,14 +136,7 @@ impl DifferentialFamily for Family {
     /// ≤ 0) is no ferromagnet's: a record in other units than A/m and T.
     fn unfit_reason(&self, u: &[f64], y: &[f64]) -> String {
         let (h, m) = self.field_and_magnetisation(u, y);
-        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-        let (hm, mm) = (mean(&h), mean(&m));
-        let (mut shm, mut shh) = (0.0, 0.0);
-        for (h, m) in h.iter().zip(&m) {
-            shm += (h - hm) * (m - mm);
-            shh += (h - hm) * (h - hm);
-        }
-        let slope = shm / shh.max(f64::MIN_POSITIVE);
+        let slope = LoopShape::of(&h, &m).slope;
         if self.output == JaOutput::FluxDensity && slope <= 0.0 {
             format!(
                 "its magnetisation M = B/μ₀ − H falls as H rises (dM/dH = {slope:.3}), which \
@@ -151,10 +144,7 @@ impl DifferentialFamily for Family {
                  record to those units"
             )
         } else {
-            "every start of its grid diverged or completes to a loop of the wrong \
-             orientation; check the loop's orientation (--orientation) and that H is in A/m \
-             and B in T"
-                .into()
+            driver::NO_START.into()
         }
     }
     /// Points (a, k, c, ᾱ, m0/Mₛ).

@@ -308,10 +308,13 @@ pub(crate) fn solve_weights(
     unconstrained: &[bool],
     g_plain: Option<&DMatrix<f64>>,
 ) -> Result<WeightSolution> {
+    // a column at rounding level of the largest (ε² of its square norm) stays unscaled: a
+    // unit diagonal would let its noise in with a large weight
+    let largest = (0..b.len()).fold(0.0f64, |m, i| m.max(g[(i, i)]));
     let d: Vec<f64> = (0..b.len())
         .map(|i| {
             let gii = g[(i, i)];
-            if gii > 0.0 && gii.is_finite() {
+            if gii > f64::EPSILON * f64::EPSILON * largest && gii.is_finite() {
                 1.0 / gii.sqrt()
             } else {
                 1.0

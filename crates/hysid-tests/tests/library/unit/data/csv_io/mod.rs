@@ -546,3 +546,44 @@ fn to_csv_rejects_several_experiments_and_a_channel_named_t() {
     let message = invalid_message(named_t.to_csv(&path));
     assert!(message.contains("called 't'"), "{message}");
 }
+
+/// `TimeSteps::Ordered` (the rate-independent models' records): steps may differ, the
+/// sample time is the median step (the mean of the two middle ones for an even count), two
+/// samples suffice, and a clock that restarts is refused with the rule's own advice.
+#[test]
+fn ordered_time_steps_take_gaps_and_refuse_a_restarted_clock() {
+    let spec = CsvSpec {
+        inputs: vec!["u".into()],
+        outputs: vec!["y".into()],
+        time_steps: TimeSteps::Ordered,
+        ..CsvSpec::default()
+    };
+    let read = |text: &str| {
+        let f = fixture(text);
+        IdData::from_csv(&f.path, &spec)
+    };
+    // steps 1, 600, 1, 7.5: the median of four is (1 + 7.5)/2
+    let data = read("t,u,y\n0,0,0\n1,1,1\n601,2,2\n602,3,3\n609.5,4,4\n").unwrap();
+    assert_eq!(data.ts(), 4.25);
+    assert_eq!(data.input(0, 0), &[0.0, 1.0, 2.0, 3.0, 4.0]);
+    assert_eq!(read("t,u,y\n3,0,0\n5,1,1\n").unwrap().ts(), 2.0);
+    let e = read("t,u,y\n0,0,0\n1,1,1\n2,2,2\n0,3,3\n1,4,4\n")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("line 5") && e.contains("not strictly increasing") && e.contains("one clock"),
+        "{e}"
+    );
+    assert!(!e.contains("uniform grid"), "{e}");
+    // the default rule refuses the gaps
+    let uniform = CsvSpec {
+        time_steps: TimeSteps::Uniform,
+        ..spec.clone()
+    };
+    let f = fixture("t,u,y\n0,0,0\n1,1,1\n601,2,2\n602,3,3\n");
+    let e = IdData::from_csv(&f.path, &uniform).unwrap_err().to_string();
+    assert!(
+        e.contains("1 % off the mean step") && e.contains("uniform grid"),
+        "{e}"
+    );
+}
