@@ -197,28 +197,27 @@ fn simulate_refuses_to_write_over_its_input_and_commits_both_outputs() {
         .contains("hysid-tmp")));
 }
 
+/// `identify hysteresis` (ch4) on `data`, its report written to `report`.
+fn ch4_fit(data: &Path, report: &Path) -> std::process::Command {
+    let mut cmd = hysid();
+    cmd.args(["identify", "hysteresis", "--hysteresis", "ch4", "--data"])
+        .arg(data)
+        .args(["--input", "x", "--output", "y", "--json"])
+        .arg(report);
+    cmd
+}
+
 /// A closed stdout (the report piped into `head -1`, which has exited) loses the human
 /// report's text, not the run: the exit code is the run's, stderr holds no fault, and the
-/// files are written.
+/// files are written; with stderr closed too (progress, warnings and the report all lost),
+/// the same.
 #[test]
 fn a_closed_stdout_loses_the_report_text_not_the_run() {
     use std::process::Stdio;
     let dir = tempfile::tempdir().unwrap();
     let data = example_data(dir.path(), "300");
     let report = dir.path().join("report.json");
-    let mut child = hysid()
-        .args(["identify", "hysteresis", "--data"])
-        .arg(&data)
-        .args([
-            "--input",
-            "x",
-            "--output",
-            "y",
-            "--hysteresis",
-            "ch4",
-            "--json",
-        ])
-        .arg(&report)
+    let mut child = ch4_fit(&data, &report)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -231,21 +230,8 @@ fn a_closed_stdout_loses_the_report_text_not_the_run() {
     assert!(!stderr.contains("internal fault"), "{stderr}");
     assert_eq!(read_json(&report)["schema"], "hysid.report/1");
 
-    // both streams closed (progress, warnings and the report all lost): the same
     fs::remove_file(&report).unwrap();
-    let mut child = hysid()
-        .args(["identify", "hysteresis", "--data"])
-        .arg(&data)
-        .args([
-            "--input",
-            "x",
-            "--output",
-            "y",
-            "--hysteresis",
-            "ch4",
-            "--json",
-        ])
-        .arg(&report)
+    let mut child = ch4_fit(&data, &report)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -267,20 +253,8 @@ fn a_full_stdout_is_an_io_error_after_the_files_are_written() {
     let dir = tempfile::tempdir().unwrap();
     let data = example_data(dir.path(), "300");
     let report = dir.path().join("report.json");
-    let out = hysid()
-        .args(["identify", "hysteresis", "--data"])
-        .arg(&data)
-        .args([
-            "--input",
-            "x",
-            "--output",
-            "y",
-            "--hysteresis",
-            "ch4",
-            "-q",
-            "--json",
-        ])
-        .arg(&report)
+    let out = ch4_fit(&data, &report)
+        .arg("-q")
         .stdout(fs::File::create(full).unwrap())
         .output()
         .unwrap();

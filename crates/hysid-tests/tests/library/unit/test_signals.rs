@@ -72,3 +72,18 @@ pub fn validation_input(n: usize, amplitude: f64) -> Vec<f64> {
         })
         .collect()
 }
+
+/// The piezo record of `data/piezo` (2 000 samples of the real 150 V, 1 Hz record):
+/// (voltage in V, displacement in µm).
+pub fn piezo_record() -> (Vec<f64>, Vec<f64>) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/piezo/piezo_150V_1Hz.csv");
+    let text = std::fs::read_to_string(path).unwrap();
+    let (mut u, mut y) = (Vec::new(), Vec::new());
+    for line in text.lines().skip(1) {
+        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        u.push(cells[1]);
+        y.push(cells[2]);
+    }
+    (u, y)
+}

@@ -1,5 +1,6 @@
 //! Tests of `hysid::identify::operators::family`.
 
+use crate::unit::test_signals::piezo_record;
 use hysid::identify::operators::family::*;
 use hysid::model::operators::{HysteresisOperator, PrandtlIshlinskii};
 use hysid::model::operators::{OperatorModel, Orientation};
@@ -137,21 +138,6 @@ fn families_read_only_the_settings_they_declare() {
     }
 }
 
-/// The piezo record of `data/piezo` (2 000 samples of the real 150 V, 1 Hz record):
-/// (voltage, displacement).
-fn piezo() -> (Vec<f64>, Vec<f64>) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data/piezo/piezo_150V_1Hz.csv");
-    let text = std::fs::read_to_string(path).unwrap();
-    let (mut u, mut y) = (Vec::new(), Vec::new());
-    for line in text.lines().skip(1) {
-        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
-        u.push(cells[1]);
-        y.push(cells[2]);
-    }
-    (u, y)
-}
-
 /// ch4 is ch6 with m2 = c2 = 0, so the zoo's ch6 (started from the better of the separated
 /// regression and the nested ch4 fit, `HysteresisIdentification::better_start`) fits a real
 /// piezo record at least as well as ch4 — on the whole record and on `compare`'s 60 %
@@ -162,7 +148,7 @@ fn ch6_fits_a_real_piezo_record_at_least_as_well_as_its_nested_ch4() {
     use hysid::identify::hysteresis::HysteresisIdentification;
     use hysid::model::ChForm;
     use hysid::numerics::levenberg_marquardt::Control;
-    let (u, y) = piezo();
+    let (u, y) = piezo_record();
     for n in [u.len() * 6 / 10, u.len()] {
         let (u, y) = (&u[..n], &y[..n]);
         let options = FamilyOptions::default();
@@ -190,7 +176,7 @@ fn ch6_fits_a_real_piezo_record_at_least_as_well_as_its_nested_ch4() {
 /// equations are equilibrated) and in ch4/ch6 (fitted in units of unit size).
 #[test]
 fn units_far_from_one_fit_to_the_same_figures() {
-    let (u, y) = piezo();
+    let (u, y) = piezo_record();
     let families = [
         Family::Pi,
         Family::Gpi,

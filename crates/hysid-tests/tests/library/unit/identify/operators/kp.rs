@@ -1,5 +1,6 @@
 //! Tests of `hysid::identify::operators::kp`.
 
+use crate::unit::test_signals::piezo_record;
 use hysid::identify::operators::kp::*;
 use hysid::identify::operators::preisach::{self, PreisachOptions};
 use hysid::model::operators::{HysteresisOperator, Kp, Orientation};
@@ -173,20 +174,6 @@ fn bad_options_are_refused() {
     assert!(fit(&u[..100], &y[..100], &KpOptions::default()).is_err());
 }
 
-/// The piezo record of `data/piezo`: (voltage, displacement).
-fn piezo() -> (Vec<f64>, Vec<f64>) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data/piezo/piezo_150V_1Hz.csv");
-    let text = std::fs::read_to_string(path).unwrap();
-    let (mut u, mut y) = (Vec::new(), Vec::new());
-    for line in text.lines().skip(1) {
-        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
-        u.push(cells[1]);
-        y.push(cells[2]);
-    }
-    (u, y)
-}
-
 fn rms(a: &[f64], b: &[f64]) -> f64 {
     metrics::mse(a, b).sqrt()
 }
@@ -200,7 +187,7 @@ fn rms(a: &[f64], b: &[f64]) -> f64 {
 /// input is fed to the other family's model as the plant.
 #[test]
 fn piezo_record_default_kp_is_at_least_as_good_as_preisach() {
-    let (u, y) = piezo();
+    let (u, y) = piezo_record();
     let split = u.len() * 6 / 10;
     let kp = fit(&u[..split], &y[..split], &KpOptions::default()).unwrap();
     let pr = preisach::fit(&u[..split], &y[..split], &PreisachOptions::default()).unwrap();
