@@ -544,9 +544,11 @@ pub fn simulate_switched(ch: &ColemanHodgdon, x: &[f64], v0: f64, h: Option<&[bo
         return v;
     }
     v.push(v0);
-    for t in 1..x.len() {
-        let next = ch.step_in(v[t - 1], x[t - 1], x[t], h[t]);
-        v.push(next);
+    // y(t−1) carried in a register, as in `simulate_unchecked`
+    let mut prev = v0;
+    for (w, &outside) in x.windows(2).zip(&h[1..]) {
+        prev = ch.step_in(prev, w[0], w[1], outside);
+        v.push(prev);
     }
     v
 }
