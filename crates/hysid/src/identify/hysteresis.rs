@@ -40,7 +40,10 @@
 //!    d' = d + c.)
 //! 2. **Separated regression with the switching function re-estimated** (Vörös 2015): least
 //!    squares on the free 6- (or 4-) parameter separated form with h from the current d̂,
-//!    then d̂ = θ3/(θ1 − θ2) (ch4: θ2/θ1), repeated until d̂ settles.
+//!    then d̂ = θ3/(θ1 − θ2) (ch4: θ2/θ1), repeated until d̂ settles. Where it does not
+//!    (d̂ leaves the input range, no model, or the free form's columns are dependent: a
+//!    record whose input passes d at a sample or two), the profile's constrained solution
+//!    at its d̂ stands.
 //! 3. **Output-error refinement**: Levenberg–Marquardt on the simulated hysteresis output.
 //!    The regression uses the *measured* y(t−1) as a regressor, so noise on y biases it
 //!    (errors in variables); the output-error fit does not, and gives standard deviations.
@@ -491,7 +494,17 @@ impl HysteresisIdentification {
         let d_max = max_abs_input(data);
         for _ in 0..self.max_switching_iterations {
             let (phi, dy) = separated_rows(data, self.form, d);
-            let ls = least_squares(&phi, &dy, self.form_regressor_names())?;
+            // Few samples beyond d can leave the free form's outer columns dependent where
+            // the profile's tied ones are not: the profile's solution then stands.
+            let ls = match least_squares(&phi, &dy, self.form_regressor_names()) {
+                Ok(ls) => ls,
+                Err(e) => {
+                    termination = Termination::Diverged {
+                        reason: e.to_string(),
+                    };
+                    break;
+                }
+            };
             let theta: Vec<f64> = ls.theta.iter().copied().collect();
             let model = match ColemanHodgdon::from_separated(self.form, &theta) {
                 Ok(m) if m.d() < d_max => m,

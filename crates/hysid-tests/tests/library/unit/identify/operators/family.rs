@@ -171,6 +171,39 @@ fn ch6_fits_a_real_piezo_record_at_least_as_well_as_its_nested_ch4() {
     }
 }
 
+/// A record whose input passes the threshold at a single sample: the free separated
+/// regression's outer columns are then dependent (one row), where the d profile's tied
+/// columns are not. Both forms used to refuse it ("regressors … dependent"); they now start
+/// from the profile's solution, and ch6 fits it at least as well as its nested ch4.
+#[test]
+fn a_threshold_passed_by_one_sample_is_fitted_not_refused() {
+    use hysid::model::{ChForm, ColemanHodgdon};
+    let truth = ColemanHodgdon::general(0.3, 1.2, 0.15, 0.6, 0.1, 2.0).unwrap();
+    let mut u = vec![0.0];
+    for a in [1.0, 0.6, 0.8, 0.4, 1.0, 0.7] {
+        let ramp = |from: f64, to: f64, n: usize| -> Vec<f64> {
+            (1..=n)
+                .map(|i| from + (to - from) * i as f64 / n as f64)
+                .collect()
+        };
+        u.extend(ramp(0.0, a, 40));
+        u.extend(ramp(a, -a, 80));
+        u.extend(ramp(-a, 0.0, 40));
+    }
+    u[100] = 2.3;
+    let y = truth.simulate(&u, 0.0).unwrap();
+    assert_eq!(truth.form(), ChForm::General6);
+    let options = FamilyOptions::default();
+    let ch4 = fit_operator(Family::Ch4, &u, &y, &options).unwrap();
+    let ch6 = fit_operator(Family::Ch6, &u, &y, &options).unwrap();
+    println!(
+        "ch6 {:.3} %, ch4 {:.3} %",
+        ch6.fit.fit_percent, ch4.fit.fit_percent
+    );
+    assert!(ch6.fit.rmse <= ch4.fit.rmse * (1.0 + 1e-9));
+    assert!(ch4.fit.fit_percent > 90.0, "{}", ch4.fit.fit_percent);
+}
+
 /// Units far from 1 (#38 item 4): the real piezo record in (V, µm), in (mV, km) and in
 /// (kV, nm·10⁻²) fits to the same fit % in every linear-in-weights family (their normal
 /// equations are equilibrated) and in ch4/ch6 (fitted in units of unit size).
