@@ -131,32 +131,18 @@ impl OutputErrorModel for HysteresisStructure {
         free: &[usize],
         sink: &mut SensitivitySink<'_>,
     ) -> Option<Result<()>> {
-        let ch = match ColemanHodgdon::from_params(self.form, theta) {
-            Ok(ch) => ch,
-            Err(e) => return Some(Err(e)),
-        };
-        let x = data.experiment(exp).input(0);
         let mut row = vec![0.0; free.len()];
-        let mut failed = None;
-        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
-        hysteresis_sensitivities(&ch, x, self.initial_output(data, exp), h, |t, v, s| {
-            if !v.is_finite() && failed.is_none() {
-                failed = Some(t);
-            }
+        Some(self.sensitivity_pass(theta, data, exp, |t, v, s| {
             for (r, &i) in row.iter_mut().zip(free) {
                 *r = s[i];
             }
             // The recursion runs to the end: the sink ignores what follows a Break.
             let _ = sink(t, &[v], &row);
-        });
-        Some(match failed {
-            None => Ok(()),
-            Some(index) => Err(diverged(index)),
-        })
+        }))
     }
 
     /// The rows of [`simulate_sensitivities`](Self::simulate_sensitivities), the same bit
-    /// for bit, handed over [`BLOCK_ROWS`] at a time (the estimator then sums them with its
+    /// for bit, handed over 512 at a time (the estimator then sums them with its
     /// block kernels instead of row by row).
     fn simulate_sensitivity_blocks(
         &self,
@@ -167,45 +153,55 @@ impl OutputErrorModel for HysteresisStructure {
         _threads: usize,
         sink: &mut BlockSink<'_>,
     ) -> Option<Result<()>> {
-        let ch = match ColemanHodgdon::from_params(self.form, theta) {
-            Ok(ch) => ch,
-            Err(e) => return Some(Err(e)),
-        };
-        let x = data.experiment(exp).input(0);
         let width = 1 + free.len();
         let mut rows = Vec::with_capacity(BLOCK_ROWS * width);
         let mut start = 0;
-        let mut failed = None;
-        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
-        hysteresis_sensitivities(&ch, x, self.initial_output(data, exp), h, |t, v, s| {
-            if !v.is_finite() && failed.is_none() {
-                failed = Some(t);
-            }
+        let mut hand_over = |start: usize, rows: &mut Vec<f64>| {
+            sink(&SensitivityBlock { start, rows, width });
+            rows.clear();
+        };
+        let pass = self.sensitivity_pass(theta, data, exp, |t, v, s| {
             if rows.is_empty() {
                 start = t;
             }
             rows.push(v);
             rows.extend(free.iter().map(|&i| s[i]));
             if rows.len() == BLOCK_ROWS * width {
-                sink(&SensitivityBlock {
-                    start,
-                    rows: &rows,
-                    width,
-                });
-                rows.clear();
+                hand_over(start, &mut rows);
             }
         });
         if !rows.is_empty() {
-            sink(&SensitivityBlock {
-                start,
-                rows: &rows,
-                width,
-            });
+            hand_over(start, &mut rows);
         }
-        Some(match failed {
+        Some(pass)
+    }
+}
+
+impl HysteresisStructure {
+    /// The recursion over experiment `exp` with every sensitivity
+    /// ([`hysteresis_sensitivities`]), `on_sample(t, v(t), s(t))` for each sample; errors
+    /// when θ is no model or the output is not finite (at the first such sample).
+    fn sensitivity_pass(
+        &self,
+        theta: &[f64],
+        data: &IdData,
+        exp: usize,
+        mut on_sample: impl FnMut(usize, f64, &[f64]),
+    ) -> Result<()> {
+        let ch = ColemanHodgdon::from_params(self.form, theta)?;
+        let x = data.experiment(exp).input(0);
+        let h = self.switching.as_ref().map(|s| s[exp].as_slice());
+        let mut failed = None;
+        hysteresis_sensitivities(&ch, x, self.initial_output(data, exp), h, |t, v, s| {
+            if !v.is_finite() && failed.is_none() {
+                failed = Some(t);
+            }
+            on_sample(t, v, s);
+        });
+        match failed {
             None => Ok(()),
             Some(index) => Err(diverged(index)),
-        })
+        }
     }
 }
 
