@@ -644,20 +644,36 @@ fn same_switching(data: &IdData, a: f64, b: f64) -> bool {
 
 /// Rows of the free separated regression Δy(t) = φ_h(t)ᵀθ_h for threshold `d`.
 fn separated_rows(data: &IdData, form: ChForm, d: f64) -> (DMatrix<f64>, Vec<f64>) {
-    let p = form.n_params();
+    regression_rows(data, form, d, form.n_params(), |full, dy, row| {
+        row.copy_from_slice(full);
+        dy
+    })
+}
+
+/// The rows of a regression at threshold `d`, one per sample t ≥ 1 of every experiment:
+/// `make(φ_h(t), Δy(t), row)` writes the row's `columns` regressors from the free separated
+/// ones and returns its target.
+fn regression_rows(
+    data: &IdData,
+    form: ChForm,
+    d: f64,
+    columns: usize,
+    make: impl Fn(&[f64], f64, &mut [f64]) -> f64,
+) -> (DMatrix<f64>, Vec<f64>) {
     let rows = data.experiments().iter().map(|e| e.len() - 1).sum();
-    let mut phi = DMatrix::zeros(rows, p);
+    let mut phi = DMatrix::zeros(rows, columns);
     let mut dy = Vec::with_capacity(rows);
-    let mut buf = vec![0.0; p];
+    let mut full = vec![0.0; form.n_params()];
+    let mut row = vec![0.0; columns];
     for e in data.experiments() {
         let (x, y) = (e.input(0), e.output(0));
         for t in 1..x.len() {
-            ColemanHodgdon::separated_regressor(form, d, x[t - 1], x[t], y[t - 1], &mut buf);
+            ColemanHodgdon::separated_regressor(form, d, x[t - 1], x[t], y[t - 1], &mut full);
             let r = dy.len();
-            for (k, v) in buf.iter().enumerate() {
+            dy.push(make(&full, y[t] - y[t - 1], &mut row));
+            for (k, v) in row.iter().enumerate() {
                 phi[(r, k)] = *v;
             }
-            dy.push(y[t] - y[t - 1]);
         }
     }
     (phi, dy)
@@ -750,45 +766,35 @@ fn constrained_rows(
     d: f64,
     held: Option<f64>,
 ) -> (DMatrix<f64>, Vec<f64>) {
-    let p = form.n_params();
-    let alpha_column = alpha_column(form);
-    let columns = p - 1 - usize::from(held.is_some());
-    let rows = data.experiments().iter().map(|e| e.len() - 1).sum();
-    let mut phi = DMatrix::zeros(rows, columns);
-    let mut dy = Vec::with_capacity(rows);
-    let mut full = vec![0.0; p];
-    let mut tied = vec![0.0; p - 1];
-    for e in data.experiments() {
-        let (x, y) = (e.input(0), e.output(0));
-        for t in 1..x.len() {
-            ColemanHodgdon::separated_regressor(form, d, x[t - 1], x[t], y[t - 1], &mut full);
-            match form {
-                ChForm::General6 => {
-                    tied[0] = full[0] + d * full[2];
-                    tied[1] = full[1] - d * full[2];
-                    tied[2..].copy_from_slice(&full[3..]);
-                }
-                ChForm::Saturated4 => {
-                    tied[0] = full[0] + d * full[1];
-                    tied[1..].copy_from_slice(&full[2..]);
-                }
+    let alpha = alpha_column(form);
+    let columns = form.n_params() - 1 - usize::from(held.is_some());
+    regression_rows(data, form, d, columns, |full, dy, row| {
+        let mut tied = [0.0; 5];
+        let tied = &mut tied[..form.n_params() - 1];
+        match form {
+            ChForm::General6 => {
+                tied[0] = full[0] + d * full[2];
+                tied[1] = full[1] - d * full[2];
+                tied[2..].copy_from_slice(&full[3..]);
             }
-            let r = dy.len();
-            let mut target = y[t] - y[t - 1];
-            let mut c = 0;
-            for (k, v) in tied.iter().enumerate() {
-                match held {
-                    Some(a) if k == alpha_column - 1 => target -= a * full[alpha_column],
-                    _ => {
-                        phi[(r, c)] = *v;
-                        c += 1;
-                    }
-                }
+            ChForm::Saturated4 => {
+                tied[0] = full[0] + d * full[1];
+                tied[1..].copy_from_slice(&full[2..]);
             }
-            dy.push(target);
         }
-    }
-    (phi, dy)
+        // the tied α column is alpha − 1 (θ3 left the free form's list before it)
+        let kept = tied
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| held.is_none() || k != alpha - 1);
+        for (cell, (_, v)) in row.iter_mut().zip(kept) {
+            *cell = *v;
+        }
+        match held {
+            Some(a) => dy - a * full[alpha],
+            None => dy,
+        }
+    })
 }
 
 /// The column of α (−|Δx|y(t−1)) in the free separated regression.
