@@ -21,6 +21,13 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
     let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
     let saved = ModelFile::load(&args.model)?;
     let model = FittedModel::from_file(&saved)?;
+    if let Some(state) = saved.declared_history() {
+        tell!(
+            "warning: {} starts after a declared {} history, which the compensator does not run yet: its first commands follow the operator's own initial state until the reference wipes the memory out",
+            args.model.display(),
+            state.name()
+        );
+    }
     let limits = args.limits.or_else(|| saved.limits());
     if limits.is_none() {
         tell!(

@@ -77,6 +77,13 @@ pub fn run(args: &ExportArgs) -> Result<()> {
             args.model.display()
         );
     }
+    if let Some(state) = file.declared_history() {
+        tell!(
+            "warning: {} starts after a declared {} history, which the exported code does not run yet: it starts from the operator's own initial state (simulate and the stream objects apply the history)",
+            args.model.display(),
+            state.name()
+        );
+    }
     let files = export(&file, target, &args.name, &options).with_context(|| {
         format!(
             "exporting {} ({}) to {}",

@@ -93,6 +93,22 @@ fn a_declared_history_is_saved_reported_and_reapplied_by_simulate() {
     assert_eq!(r["details"]["initial_state"], "descending", "{r}");
     let saved = read_json(&model);
     assert_eq!(saved["initial_state"], "descending", "{saved}");
+    // The fit's turn is saved (above the training record's maximum, 1).
+    let turn = saved["history_turn"].as_f64().unwrap();
+    assert!(turn > 1.0 && turn.is_finite(), "{saved}");
+    // compensate and export say that they start from the operator's own state.
+    let out = hysid()
+        .args(["compensate", "--model"])
+        .arg(&model)
+        .arg("--data")
+        .arg(&valid)
+        .args(["--reference", "y", "--csv"])
+        .arg(dir.path().join("u.csv"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("declared descending history"), "{stderr}");
     // The validation record starts at another input (−0.8), after its own descent: the
     // history is re-applied there (exact data: the fit is exact).
     let fit = simulate(&model, &valid, &dir.path().join("s.json"), &[]);

@@ -126,6 +126,103 @@ fn operators() -> Vec<(String, OperatorModel, Vec<f64>)> {
     out
 }
 
+/// A declared history (descending, ascending) runs at the stream's first good sample as the
+/// batch simulation of the saved model runs it before the record: the same bits for every
+/// family and both orientations, with the fit's saved turn, on records starting mid-loop, at
+/// the input's extremes and beyond the saved turn; a non-finite first sample is skipped and
+/// the history runs at the next; a model file keeps the turn.
+#[test]
+fn a_declared_history_streams_as_the_saved_model_simulates_it() {
+    use hysid::model::operators::initial_state::History;
+    use hysid::model::operators::InitialStateUsed;
+    use hysid::model::saved::ModelFile;
+    for (name, model, u) in operators() {
+        let n = model.as_operator().parameters().len();
+        // The two histories start differently (so the test sees which one runs).
+        let starts: Vec<f64> = [InitialStateUsed::Descending, InitialStateUsed::Ascending]
+            .iter()
+            .map(|&state| {
+                let turn = state.turning_input(model.as_operator(), &u);
+                FittedModel::operator(model.clone(), no_std(n))
+                    .with_initial_state(Some(state), turn)
+                    .simulate(&[&u], 1.0, None)
+                    .unwrap()[0][0]
+            })
+            .collect();
+        assert_ne!(starts[0], starts[1], "{name}");
+        let (lo, hi) = u
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        for state in [InitialStateUsed::Descending, InitialStateUsed::Ascending] {
+            // The turn a fit on `u` saves.
+            let turn = state.turning_input(model.as_operator(), &u);
+            let fitted = FittedModel::operator(model.clone(), no_std(n))
+                .with_initial_state(Some(state), turn);
+            let what = format!("{name}, {}", state.name());
+            // The record itself, cut open mid-loop, and one starting at each extreme.
+            let at_min = u.iter().position(|&v| v == lo).unwrap();
+            let at_max = u.iter().position(|&v| v == hi).unwrap();
+            for (cut, label) in [
+                (0, "whole"),
+                (217, "cut open"),
+                (at_min, "at min"),
+                (at_max, "at max"),
+            ] {
+                assert_streams(
+                    &fitted,
+                    &[&u[cut..]],
+                    1.0,
+                    None,
+                    &format!("{what}, {label}"),
+                );
+            }
+            // A saved turn the record starts beyond (a record far outside the fit's range).
+            let beyond = FittedModel::operator(model.clone(), no_std(n))
+                .with_initial_state(Some(state), Some(0.5 * (lo + hi)));
+            let tail: Vec<f64> = u
+                .iter()
+                .copied()
+                .filter(|v| v.abs() <= 0.9 * hi.abs().max(lo.abs()))
+                .collect();
+            assert_streams(
+                &beyond,
+                &[&tail],
+                1.0,
+                None,
+                &format!("{what}, beyond the turn"),
+            );
+            // The history's path: the record's first input, the turn, then the record.
+            let history = History::of(Some(state), turn).unwrap();
+            let path = history.path(model.as_operator(), &u);
+            assert_eq!(&path[..2], &[u[0], turn.unwrap()], "{what}");
+            // A non-finite first sample: skipped, the history runs at the next one.
+            let mut stepper = fitted.stepper(1.0, None).unwrap();
+            let mut y = [0.0];
+            stepper.step(&[f64::NAN], &mut y).unwrap();
+            assert_eq!(stepper.faults(), 1, "{what}");
+            let rest = run(stepper.as_mut(), &[&u[1..]]).unwrap();
+            let expected = fitted.simulate(&[&u[1..]], 1.0, None).unwrap();
+            assert_same(
+                &rest[0],
+                &expected[0],
+                &format!("{what}, after a bad first sample"),
+            );
+            // Saved and read back: the state and the turn.
+            let text = serde_json::to_string(&fitted.to_file()).unwrap();
+            assert!(text.contains("\"history_turn\""), "{what}: {text}");
+            let back =
+                FittedModel::from_file(&serde_json::from_str::<ModelFile>(&text).unwrap()).unwrap();
+            assert_same(
+                &back.simulate(&[&u[217..]], 1.0, None).unwrap()[0],
+                &fitted.simulate(&[&u[217..]], 1.0, None).unwrap()[0],
+                &what,
+            );
+        }
+    }
+}
+
 #[test]
 fn every_operator_streams_as_it_simulates_and_inverts() {
     let families = operators();

@@ -399,7 +399,7 @@ mod by_family {
                 options: &FamilyOptions,
             ) -> Result<OperatorFit<FittedModel>> {
                 match family {
-                    $(Family::$variant => Ok(boxed(<$ty as Identify>::identify(u, y, options)?)),)*
+                    $(Family::$variant => Ok(boxed(<$ty as Identify>::identify(u, y, options)?, u)),)*
                     other => Err(not_an_operator(other)),
                 }
             }
@@ -428,11 +428,16 @@ mod by_family {
     }
 }
 
-/// An operator fit with its model wrapped as a [`FittedModel`].
-fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>) -> OperatorFit<FittedModel> {
+/// An operator fit on the input `u` with its model wrapped as a [`FittedModel`] (a declared
+/// history keeps the turn the fit used on `u`).
+fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>, u: &[f64]) -> OperatorFit<FittedModel> {
     let std = fit.std.iter().map(|s| s.unwrap_or(f64::NAN)).collect();
+    let model: OperatorModel = fit.model.into();
+    let turn = fit
+        .initial_state
+        .and_then(|state| state.turning_input(model.as_operator(), u));
     OperatorFit {
-        model: FittedModel::operator(fit.model.into(), std).with_initial_state(fit.initial_state),
+        model: FittedModel::operator(model, std).with_initial_state(fit.initial_state, turn),
         parameters: fit.parameters,
         std: fit.std,
         covariance: fit.covariance,

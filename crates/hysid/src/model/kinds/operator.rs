@@ -34,6 +34,12 @@ pub struct OperatorFile {
     /// state, as before the field existed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial_state: Option<InitialStateUsed>,
+    /// The input a declared history (`descending`, `ascending`) turns at: the fit's u_top or
+    /// u_bot, re-used for every record so a stream and a batch simulation start from the same
+    /// state ([`crate::model::operators::initial_state`]). Absent (files of earlier
+    /// versions): placed from each record's own range.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history_turn: Option<f64>,
 }
 
 impl ModelKind for OperatorKind {
@@ -54,7 +60,13 @@ impl ModelKind for OperatorKind {
         for p in names.iter() {
             std.push(records.get(&p.name)?.std_or_nan());
         }
-        Ok(FittedModel::operator(model, std).with_initial_state(file.initial_state))
+        if let Some(turn) = file.history_turn.filter(|t| !t.is_finite()) {
+            return Err(crate::Error::InvalidModel(format!(
+                "\"history_turn\" is {turn}; give a finite input or remove the key"
+            )));
+        }
+        Ok(FittedModel::operator(model, std)
+            .with_initial_state(file.initial_state, file.history_turn))
     }
 }
 
@@ -69,6 +81,8 @@ pub struct FittedHysteresisOperator {
     pub std: Vec<f64>,
     /// The initial state it starts from (None: as its structure holds it).
     pub initial_state: Option<InitialStateUsed>,
+    /// The input a declared history turns at (the fit's; None: from each record's range).
+    pub history_turn: Option<f64>,
 }
 
 /// The family's own simulation from the declared initial state, its step and its inverse
@@ -87,17 +101,20 @@ impl FittedKind for FittedHysteresisOperator {
             // As for the operator cascade: a failure would only leave the structure null.
             operator: model.structure().unwrap_or_default(),
             initial_state: self.initial_state,
+            history_turn: self.history_turn,
         })
     }
 
     fn simulate(&self, inputs: &[&[f64]], _ts: f64, _y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
         let operator = self.model.as_operator();
-        let y = initial_state::simulate(operator, self.initial_state, first(inputs)?)?;
+        let history = initial_state::History::of(self.initial_state, self.history_turn);
+        let y = initial_state::simulate_from(operator, history, first(inputs)?)?;
         Ok(vec![y])
     }
 
     fn stepper(&self, _ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
-        self.model.stepper()
+        let history = initial_state::History::of(self.initial_state, self.history_turn);
+        self.model.stepper_from(history)
     }
 
     fn compensator(&self) -> Result<Box<dyn Compensator>> {

@@ -19,6 +19,16 @@
 //! one reached by integrating dz/du from its positive saturation down to u₀. The outputs of
 //! the history are not part of the simulation.
 //!
+//! A fitted model keeps the turn its fit used (the model file's `history_turn`), and every
+//! later record re-applies the history at its own first input with that turn,
+//! u₀ → u_turn → u₀ ([`History::turn_at`]): the turn depends on nothing after the first
+//! sample, so a stream ([`crate::model::OperatorModel::stepper_from`]) runs the same path as a
+//! batch simulation and gives the same bits. A record starting beyond the saved turn (above
+//! u_top, below u_bot) turns at u₀ ± max(reach, |u₀ − u_turn|) instead. A model file without
+//! the key (earlier versions) places the turn from each record's range as above in a batch;
+//! its stream turns at u₀ ± reach (for the linear-in-weights families the same state, by
+//! wiping-out).
+//!
 //! `demagnetised` is the family's neutral state, the one its structure documents (today's
 //! behaviour, and that of a model file without the field): plays from 0, the Preisach plane in
 //! negative saturation, the differential families' state x₀ = 0 when fitted so (their saved
@@ -160,6 +170,87 @@ impl InitialStateUsed {
             lo - margin
         })
     }
+}
+
+/// A declared history as a fitted model holds it: the state and the input the history turns
+/// at (the fit's; None in model files of earlier versions).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct History {
+    /// `descending` or `ascending`.
+    pub state: InitialStateUsed,
+    /// u_top (descending) or u_bot (ascending) of the fit.
+    pub turn: Option<f64>,
+}
+
+impl History {
+    /// The declared history of a model starting from `state` with the saved `turn`; None
+    /// for the states held in the structure (none, `demagnetised`, `estimated`).
+    pub fn of(state: Option<InitialStateUsed>, turn: Option<f64>) -> Option<History> {
+        match state {
+            Some(state @ (InitialStateUsed::Descending | InitialStateUsed::Ascending)) => {
+                Some(History { state, turn })
+            }
+            _ => None,
+        }
+    }
+
+    /// +1 for a descent from above, −1 for an ascent from below.
+    fn direction(&self) -> f64 {
+        if self.state == InitialStateUsed::Descending {
+            1.0
+        } else {
+            -1.0
+        }
+    }
+
+    /// The input the history turns at before a record whose first input is `u0` (module doc):
+    /// the saved turn when it lies beyond u₀ in the history's direction, otherwise (or without
+    /// a saved turn) u₀ ± max(reach, |u₀ − turn|), with `op`'s memory reach.
+    pub fn turn_at(&self, op: &dyn HysteresisOperator, u0: f64) -> f64 {
+        let direction = self.direction();
+        if let Some(turn) = self.turn {
+            if (turn - u0) * direction > 0.0 {
+                return turn;
+            }
+        }
+        let reach = op.memory_reach();
+        let reach = if reach.is_finite() { reach } else { 0.0 };
+        let beyond = self.turn.map_or(0.0, |t| (u0 - t).abs());
+        let margin = reach.max(beyond).max(1e-6 * u0.abs().max(1.0));
+        u0 + direction * margin
+    }
+
+    /// The record u with the history prepended: \[u₀, u_turn\] then u (a model file without a
+    /// saved turn: the turn placed from u's range, [`InitialStateUsed::turning_input`]).
+    pub fn path(&self, op: &dyn HysteresisOperator, u: &[f64]) -> Vec<f64> {
+        let Some(&u0) = u.first() else {
+            return Vec::new();
+        };
+        let turn = match self.turn {
+            Some(_) => Some(self.turn_at(op, u0)),
+            None => self.state.turning_input(op, u),
+        };
+        match turn {
+            Some(turn) => [u0, turn].iter().chain(u).copied().collect(),
+            None => u.to_vec(),
+        }
+    }
+}
+
+/// Γ\[u\] of `op` after the declared `history` (None: from the state its structure holds):
+/// the history's path run first, its outputs dropped. What `simulate` of a saved model does.
+pub fn simulate_from(
+    op: &dyn HysteresisOperator,
+    history: Option<History>,
+    u: &[f64],
+) -> Result<Vec<f64>> {
+    let Some(history) = history else {
+        return op.simulate(u);
+    };
+    let path = history.path(op, u);
+    let skip = path.len() - u.len();
+    let mut y = op.simulate(&path)?;
+    Ok(y.split_off(skip))
 }
 
 /// The input path of a declared history before the record u: \[u₀, u_turn\]

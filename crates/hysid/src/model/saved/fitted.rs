@@ -333,15 +333,17 @@ impl FittedModel {
             model,
             std,
             initial_state: None,
+            history_turn: None,
         })
     }
 
-    /// The same model starting from `state` (an operator; other kinds are returned as they
-    /// are).
-    pub fn with_initial_state(self, state: Option<InitialStateUsed>) -> Self {
+    /// The same model starting from `state`, a declared history turning at `turn` (an
+    /// operator; other kinds are returned as they are).
+    pub fn with_initial_state(self, state: Option<InitialStateUsed>, turn: Option<f64>) -> Self {
         match self {
             FittedModel::Operator(op) => FittedModel::Operator(FittedHysteresisOperator {
                 initial_state: state,
+                history_turn: turn,
                 ..op
             }),
             other => other,

@@ -4,6 +4,7 @@
 //! `operator_families!` list.
 
 use super::{Compensator, CompensatorStep, Guarded, GuardedInverse, InverseKernel, Kernel};
+use crate::model::operators::initial_state::History;
 use crate::model::operators::streaming::StreamingOperator;
 use crate::model::operators::OperatorModel;
 use crate::Result;
@@ -77,6 +78,41 @@ impl<F: StreamingOperator + Send + std::fmt::Debug> InverseKernel for OperatorIn
     }
 }
 
+/// An operator stream that runs a declared history at its first (good) sample u₀: the inputs
+/// u₀ and u_turn go through the stream, their outputs dropped, then u₀ gives the first output
+/// ([`History::turn_at`]: the path a batch simulation of the saved model runs, so the same
+/// bits).
+#[derive(Debug)]
+struct AfterHistory {
+    inner: AnyOperatorStream,
+    operator: OperatorModel,
+    history: History,
+    primed: bool,
+}
+
+impl Kernel for AfterHistory {
+    fn reset(&mut self) {
+        self.inner.reset();
+        self.primed = false;
+    }
+    fn step(&mut self, k: usize, u: &[f64], y: &mut [f64]) -> Result<()> {
+        if !self.primed {
+            let turn = self.history.turn_at(self.operator.as_operator(), u[0]);
+            let mut dropped = [0.0];
+            let run = self
+                .inner
+                .step(k, u, &mut dropped)
+                .and_then(|()| self.inner.step(k, &[turn], &mut dropped));
+            if let Err(e) = run {
+                self.inner.reset();
+                return Err(e);
+            }
+            self.primed = true;
+        }
+        self.inner.step(k, u, y)
+    }
+}
+
 /// An operator of any family streamed, the family's type erased: what a cascade holds.
 pub(super) type AnyOperatorStream = Box<dyn Kernel>;
 /// An operator's inverse of any family streamed, the family's type erased.
@@ -113,6 +149,28 @@ impl OperatorModel {
     /// [`simulate`]: crate::model::operators::HysteresisOperator::simulate
     pub fn stepper(&self) -> Result<Box<dyn super::Stepper>> {
         Ok(Box::new(Guarded::new(self.stream()?, 1, 1)))
+    }
+
+    /// [`OperatorModel::stepper`] after the declared `history` (None: from the documented
+    /// initial state): the history runs at the first good sample, as
+    /// [`initial_state::simulate_from`] runs it before a record; equal to it to the bit.
+    ///
+    /// [`initial_state::simulate_from`]: crate::model::operators::initial_state::simulate_from
+    pub fn stepper_from(&self, history: Option<History>) -> Result<Box<dyn super::Stepper>> {
+        let Some(history) = history else {
+            return self.stepper();
+        };
+        let primed = AfterHistory {
+            inner: self.stream()?,
+            operator: self.clone(),
+            history,
+            primed: false,
+        };
+        Ok(Box::new(Guarded::new(
+            Box::new(primed) as AnyOperatorStream,
+            1,
+            1,
+        )))
     }
 
     /// The operator's inverse as a [`Compensator`]: the command uₖ with Γ\[u\]ₖ = rₖ, clipped

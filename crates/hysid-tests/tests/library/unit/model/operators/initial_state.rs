@@ -89,7 +89,7 @@ fn a_model_file_saves_the_state_and_a_file_without_it_reads_as_before() {
         bw.simulate(&u).unwrap()
     );
 
-    let declared = plain.with_initial_state(Some(InitialStateUsed::Descending));
+    let declared = plain.with_initial_state(Some(InitialStateUsed::Descending), None);
     let text = serde_json::to_string(&declared.to_file()).unwrap();
     assert!(text.contains("\"initial_state\":\"descending\""), "{text}");
     let back = FittedModel::from_file(&serde_json::from_str::<ModelFile>(&text).unwrap()).unwrap();
