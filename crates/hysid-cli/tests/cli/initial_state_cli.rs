@@ -172,6 +172,61 @@ fn a_declared_history_on_a_linear_family_is_fitted_saved_and_reapplied() {
         .success();
     let saved = read_json(&model);
     assert_eq!(saved["initial_state"], "descending", "{saved}");
+    // The PI compensator runs the history (no warning) and its commands reproduce the
+    // record's input where the model is exact.
+    let commands = dir.path().join("u.csv");
+    let out = hysid()
+        .args(["compensate", "--model"])
+        .arg(&model)
+        .arg("--data")
+        .arg(&data)
+        .args(["--reference", "y", "--csv"])
+        .arg(&commands)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("declared"), "{stderr}");
+    // `simulate` (which runs the history) of those commands gives the reference back.
+    let text = fs::read_to_string(&commands).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    let sent: Vec<f64> = rows.iter().map(|r| r[column("u")]).collect();
+    let wanted: Vec<f64> = rows.iter().map(|r| r[column("reference")]).collect();
+    let back = write(dir.path(), "commands.csv", &sent, &wanted);
+    let followed = simulate(&model, &back, &dir.path().join("c.json"), &[]);
+    assert!(followed > 99.999, "{followed}");
+    // A file without the turn (an earlier version) compensates from the operator's own
+    // state, says so, and its commands miss the record's first loop.
+    let mut old = read_json(&model);
+    old.as_object_mut().unwrap().remove("history_turn");
+    let old_model = dir.path().join("old.json");
+    fs::write(&old_model, old.to_string()).unwrap();
+    let out = hysid()
+        .args(["compensate", "--model"])
+        .arg(&old_model)
+        .arg("--data")
+        .arg(&data)
+        .args(["--reference", "y", "--csv"])
+        .arg(&commands)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("declared descending history"), "{stderr}");
+    let text = fs::read_to_string(&commands).unwrap();
+    let sent: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(column("u")).unwrap().parse().unwrap())
+        .collect();
+    let back = write(dir.path(), "commands.csv", &sent, &wanted);
+    let missed = simulate(&model, &back, &dir.path().join("c.json"), &[]);
+    assert!(missed < followed - 0.1, "{missed} against {followed}");
     let reported = read_json(&report);
     let fitted = reported["fit"]["fit_percent"].as_f64().unwrap();
     // simulate re-applies the descent at the record's first input: the fit's own numbers

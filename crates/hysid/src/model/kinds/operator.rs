@@ -118,16 +118,39 @@ impl FittedKind for FittedHysteresisOperator {
     }
 
     fn compensator(&self) -> Result<Box<dyn Compensator>> {
-        self.model.compensator()
+        let history = initial_state::History::of(self.initial_state, self.history_turn);
+        self.model.compensator_from(history)
     }
 
+    /// The inverse after the declared history: the priming reference first
+    /// ([`OperatorModel::priming_reference`]), its command dropped.
     fn compensate(&self, reference: &[f64]) -> Result<Compensation> {
-        let inv = self.model.as_operator().invert(reference)?;
+        let history = initial_state::History::of(self.initial_state, self.history_turn);
+        let operator = self.model.as_operator();
+        let Some(r) = self.model.priming_reference(history)? else {
+            let inv = operator.invert(reference)?;
+            return Ok(Compensation {
+                reference: reference.to_vec(),
+                u: inv.u,
+                predicted: inv.predicted,
+                clipped: inv.clipped,
+                settled_from: 0,
+            });
+        };
+        let primed: Vec<f64> = std::iter::once(r)
+            .chain(reference.iter().copied())
+            .collect();
+        let mut inv = operator.invert(&primed)?;
         Ok(Compensation {
             reference: reference.to_vec(),
-            u: inv.u,
-            predicted: inv.predicted,
-            clipped: inv.clipped,
+            u: inv.u.split_off(1),
+            predicted: inv.predicted.split_off(1),
+            clipped: inv
+                .clipped
+                .iter()
+                .filter(|&&k| k > 0)
+                .map(|k| k - 1)
+                .collect(),
             settled_from: 0,
         })
     }

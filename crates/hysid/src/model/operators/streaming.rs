@@ -36,6 +36,10 @@ pub(crate) trait StreamingOperator {
     type Forward: Clone + std::fmt::Debug + Send;
     /// Γ⁻¹'s state.
     type Inverse: Clone + std::fmt::Debug + Send;
+    /// True when a monotone excursion of the operator's memory reach leaves a state that
+    /// depends on nothing before it (the wiping-out property, Mayergoyz 2003): the
+    /// linear-in-weights families. A differential family's state only fades.
+    const WIPES_OUT: bool;
 
     /// Γ's initial state (an operator whose values cannot be simulated is refused here).
     fn forward_stream(&self) -> Result<Self::Forward>;
@@ -65,6 +69,7 @@ fn memory_full(k: usize) -> Error {
 impl<C: Core + Clone + std::fmt::Debug> StreamingOperator for C {
     type Forward = OrientedState<C>;
     type Inverse = OrientedInverse<C>;
+    const WIPES_OUT: bool = true;
 
     fn forward_stream(&self) -> Result<Self::Forward> {
         Ok(oriented_state(self, self.orientation(), None))
@@ -114,6 +119,7 @@ macro_rules! differential_streaming {
         impl $crate::model::operators::streaming::StreamingOperator for $ty {
             type Forward = $crate::model::operators::differential::Stream;
             type Inverse = $crate::model::operators::differential::InverseStream;
+            const WIPES_OUT: bool = false;
 
             fn forward_stream(&self) -> $crate::Result<Self::Forward> {
                 self.validate()?;

@@ -350,6 +350,19 @@ impl FittedModel {
         }
     }
 
+    /// The declared history (`descending`, `ascending`) this model starts after that its
+    /// compensator does not run: a differential family's, or one saved without its turn
+    /// (files of earlier versions); None otherwise
+    /// ([`crate::model::OperatorModel::history_reaches_the_inverse`]).
+    pub fn history_beyond_the_inverse(&self) -> Option<InitialStateUsed> {
+        let FittedModel::Operator(op) = self else {
+            return None;
+        };
+        let history =
+            crate::model::operators::initial_state::History::of(op.initial_state, op.history_turn)?;
+        (!op.model.history_reaches_the_inverse(Some(history))).then_some(history.state)
+    }
+
     /// Rebuilds a fitted model from a model file, checking every value.
     pub fn from_file(file: &ModelFile) -> Result<Self> {
         if file.schema != MODEL_SCHEMA {

@@ -211,8 +211,9 @@ impl ModelFile {
     }
 
     /// The declared history an operator model starts after (`descending`, `ascending`), None
-    /// for every other state and kind: what `simulate` and the streams apply and the
-    /// compensators and exports do not yet (`docs/zoo.md`, "Initial states").
+    /// for every other state and kind: what `simulate`, the streams and (for the
+    /// linear-in-weights families) the compensators apply and the exports do not yet
+    /// (`docs/zoo.md`, "Initial states").
     pub fn declared_history(&self) -> Option<crate::model::operators::InitialStateUsed> {
         use crate::model::operators::InitialStateUsed::{Ascending, Descending};
         match &self.model {

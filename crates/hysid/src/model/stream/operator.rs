@@ -113,6 +113,33 @@ impl Kernel for AfterHistory {
     }
 }
 
+/// An operator's inverse primed by a declared history: at construction and at every reset it
+/// takes the reference r_turn, the operator's output at the history's turn from its own
+/// initial state, its command dropped ([`OperatorModel::compensator_from`]).
+#[derive(Debug)]
+struct PrimedInverse {
+    inner: AnyOperatorInverse,
+    reference: f64,
+}
+
+impl PrimedInverse {
+    fn new(mut inner: AnyOperatorInverse, reference: f64) -> Result<Self> {
+        inner.step(0, reference)?;
+        Ok(Self { inner, reference })
+    }
+}
+
+impl InverseKernel for PrimedInverse {
+    fn reset(&mut self) {
+        self.inner.reset();
+        // It succeeded at construction, from the same state.
+        let _ = self.inner.step(0, self.reference);
+    }
+    fn step(&mut self, k: usize, r: f64) -> Result<CompensatorStep> {
+        self.inner.step(k, r)
+    }
+}
+
 /// An operator of any family streamed, the family's type erased: what a cascade holds.
 pub(super) type AnyOperatorStream = Box<dyn Kernel>;
 /// An operator's inverse of any family streamed, the family's type erased.
@@ -136,6 +163,13 @@ macro_rules! dispatch {
                 Ok(match self {
                     $(OperatorModel::$variant(m) => Box::new(OperatorInverse::new(m.clone())?),)*
                 })
+            }
+
+            /// The family's [`StreamingOperator::WIPES_OUT`].
+            fn wipes_out(&self) -> bool {
+                match self {
+                    $(OperatorModel::$variant(_) => <$ty as StreamingOperator>::WIPES_OUT,)*
+                }
             }
         }
     };
@@ -179,5 +213,47 @@ impl OperatorModel {
     /// [`invert`]: crate::model::operators::HysteresisOperator::invert
     pub fn compensator(&self) -> Result<Box<dyn Compensator>> {
         Ok(Box::new(GuardedInverse::new(self.inverse_stream()?)))
+    }
+
+    /// The reference that primes the inverse for a declared `history` saved with its turn
+    /// u_turn: Γ's first output at u_turn from the documented initial state. None without a
+    /// history or a saved turn, and for a family whose memory does not wipe out
+    /// ([`OperatorModel::history_reaches_the_inverse`]).
+    ///
+    /// After it the inverse's state is the operator's after the input u_turn, and the first
+    /// command u₀ descends (ascends) from there: exactly the state after the history
+    /// u₀ → u_turn → u₀ that `simulate` runs, since the descent of at least the memory reach
+    /// wipes out what preceded u_turn.
+    pub fn priming_reference(&self, history: Option<History>) -> Result<Option<f64>> {
+        let Some(turn) = history.and_then(|h| h.turn) else {
+            return Ok(None);
+        };
+        if !self.wipes_out() {
+            return Ok(None);
+        }
+        let mut forward = self.stream()?;
+        let mut y = [0.0];
+        forward.step(0, &[turn], &mut y)?;
+        Ok(Some(y[0]))
+    }
+
+    /// True when the compensator and the batch compensation start after a declared history
+    /// saved with its turn (the linear-in-weights families, whose memory wipes out); a
+    /// differential family's inverse starts from its own initial state x₀.
+    pub fn history_reaches_the_inverse(&self, history: Option<History>) -> bool {
+        history.is_some_and(|h| h.turn.is_some()) && self.wipes_out()
+    }
+
+    /// [`OperatorModel::compensator`] after the declared `history`: primed by
+    /// [`OperatorModel::priming_reference`] (none: from the documented initial state); equal
+    /// to the batch compensation of the saved model to the bit.
+    pub fn compensator_from(&self, history: Option<History>) -> Result<Box<dyn Compensator>> {
+        match self.priming_reference(history)? {
+            None => self.compensator(),
+            Some(r) => Ok(Box::new(GuardedInverse::new(PrimedInverse::new(
+                self.inverse_stream()?,
+                r,
+            )?))),
+        }
     }
 }
