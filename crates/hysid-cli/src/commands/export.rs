@@ -77,12 +77,17 @@ pub fn run(args: &ExportArgs) -> Result<()> {
             args.model.display()
         );
     }
-    if let Some(state) = file.declared_history() {
-        tell!(
-            "warning: {} starts after a declared {} history, which the exported code does not run yet: it starts from the operator's own initial state (simulate and the stream objects apply the history)",
-            args.model.display(),
-            state.name()
-        );
+    if args.inverse {
+        let beyond = hysid::model::saved::FittedModel::from_file(&file)
+            .ok()
+            .and_then(|m| m.history_beyond_the_inverse());
+        if let Some(state) = beyond {
+            tell!(
+                "warning: {} starts after a declared {} history, which the compensator of this family (or of a file without history_turn) does not run: its first commands follow the operator's own initial state until the reference wipes the memory out",
+                args.model.display(),
+                state.name()
+            );
+        }
     }
     let files = export(&file, target, &args.name, &options).with_context(|| {
         format!(

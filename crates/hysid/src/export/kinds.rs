@@ -64,12 +64,16 @@ pub fn program(model: &FittedModel, options: &ExportOptions, ts: f64) -> Result<
     }
 }
 
+/// After the declared history the model starts from, as `simulate`, the streams and the
+/// compensators run it (`model::operators::initial_state`).
 impl ExportKind for FittedHysteresisOperator {
     fn program(&self, options: &ExportOptions, _ts: f64) -> Result<Program> {
+        use crate::model::operators::initial_state::History;
+        let history = History::of(self.initial_state, self.history_turn);
         chained(options, |op, _, _, prog| {
             Ok(vec![match options.inverse {
-                false => families::forward(&self.model, op, prog)?,
-                true => families::inverse(&self.model, op, prog)?,
+                false => families::forward_after(&self.model, history, op, prog)?,
+                true => families::inverse_after(&self.model, history, op, prog)?,
             }])
         })
     }

@@ -22,9 +22,12 @@ pub mod oriented;
 pub mod pi;
 pub mod preisach;
 
+use super::code::{lit, local, Expr, Ty};
 use super::program::{Ns, Program};
+use crate::model::operators::initial_state::History;
 use crate::model::operators::OperatorModel;
 use crate::Result;
+use std::ops::Not;
 
 /// What a family supplies to the exporter: its forward step and its inverse step, as helpers
 /// of a [`Program`] in the namespace `ns`.
@@ -56,3 +59,85 @@ macro_rules! dispatch {
     };
 }
 crate::model::operators::operator_families!(dispatch);
+
+/// The forward step after the declared `history` (none: the family's step as it is): at the
+/// first good sample u₀ the step runs u₀ and the turn u_turn (their outputs dropped), then u₀,
+/// the path of the library's stream (`OperatorModel::stepper_from`) with the same arithmetic
+/// for u_turn ([`History::turn_at`]), so the same bits. Returns the helper to call.
+pub fn forward_after(
+    op: &OperatorModel,
+    history: Option<History>,
+    ns: &Ns,
+    prog: &mut Program,
+) -> Result<String> {
+    let step = forward(op, ns, prog)?;
+    let Some(history) = history else {
+        return Ok(step);
+    };
+    let primed = prog.field(
+        &ns.name("history_run"),
+        Ty::Flag,
+        None,
+        "the declared history has run (at the first good sample)",
+    )?;
+    let reach = op.as_operator().memory_reach();
+    let reach = if reach.is_finite() { reach } else { 0.0 };
+    let direction = if history.state == crate::model::operators::InitialStateUsed::Descending {
+        1.0
+    } else {
+        -1.0
+    };
+    prog.bound(format!(
+        "the first good sample runs the declared {} history: three steps of the operator",
+        history.state.name()
+    ));
+    prog.function(
+        &ns.name("after_history"),
+        &[("x", Ty::F64)],
+        Some(Ty::F64),
+        |b| {
+            b.if_(Expr::State(primed.clone()).not(), |b| {
+                let x = local("x");
+                // u0 ± max(reach, |u0 − turn|, 1e-6·max(|u0|, 1)), as History::turn_at.
+                let beyond = match history.turn {
+                    Some(t) => (x.clone() - lit(t)).abs(),
+                    None => lit(0.0),
+                };
+                let margin = lit(reach)
+                    .max(beyond)
+                    .max(lit(1e-6) * x.clone().abs().max(lit(1.0)));
+                let own = x.clone() + lit(direction) * margin;
+                let turn = match history.turn {
+                    Some(t) => super::code::select(
+                        ((lit(t) - x.clone()) * lit(direction)).gt(lit(0.0)),
+                        lit(t),
+                        own,
+                    ),
+                    None => own,
+                };
+                let turn = b.let_("turn", turn);
+                b.call(&step, vec![x]);
+                b.call(&step, vec![turn]);
+                b.set_state(&primed, Expr::Flag(true));
+            });
+            b.ret(Expr::Call(step.clone(), vec![local("x")]));
+        },
+    )
+}
+
+/// The inverse step after the declared `history`: where the history reaches the library's
+/// inverse (`OperatorModel::history_reaches_the_inverse`), the initialisation runs the
+/// inverse once on the priming reference r_turn (`OperatorModel::priming_reference`), as
+/// the library's compensator does at construction and reset. Returns the helper to call.
+pub fn inverse_after(
+    op: &OperatorModel,
+    history: Option<History>,
+    ns: &Ns,
+    prog: &mut Program,
+) -> Result<String> {
+    let inverse = inverse(op, ns, prog)?;
+    if let Some(r) = op.priming_reference(history)? {
+        prog.init(|b| b.call(&inverse, vec![lit(r)]));
+    }
+    Ok(inverse)
+}

@@ -210,20 +210,6 @@ impl ModelFile {
         crate::model::limits::Limits::of_range(self.input_range.as_deref(), 0)
     }
 
-    /// The declared history an operator model starts after (`descending`, `ascending`), None
-    /// for every other state and kind: what `simulate`, the streams and (for the
-    /// linear-in-weights families) the compensators apply and the exports do not yet
-    /// (`docs/zoo.md`, "Initial states").
-    pub fn declared_history(&self) -> Option<crate::model::operators::InitialStateUsed> {
-        use crate::model::operators::InitialStateUsed::{Ascending, Descending};
-        match &self.model {
-            SavedModel::Operator(op) => op
-                .initial_state
-                .filter(|s| matches!(s, Descending | Ascending)),
-            _ => None,
-        }
-    }
-
     /// The model kind (the `kind` key).
     pub fn kind(&self) -> &str {
         self.model.kind()
