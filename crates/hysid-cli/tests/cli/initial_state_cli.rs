@@ -53,6 +53,22 @@ fn simulate(model: &Path, data: &Path, report: &Path, extra: &[&str]) -> f64 {
     read_json(report)["fit"]["fit_percent"].as_f64().unwrap()
 }
 
+/// `hysid compensate` of the column y of `data` into `commands`: its stderr (it succeeded).
+fn compensate(model: &Path, data: &Path, commands: &Path) -> String {
+    let out = hysid()
+        .args(["compensate", "--model"])
+        .arg(model)
+        .arg("--data")
+        .arg(data)
+        .args(["--reference", "y", "--csv"])
+        .arg(commands)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{stderr}");
+    stderr
+}
+
 #[test]
 fn a_declared_history_is_saved_reported_and_reapplied_by_simulate() {
     let dir = TempDir::new().unwrap();
@@ -97,17 +113,7 @@ fn a_declared_history_is_saved_reported_and_reapplied_by_simulate() {
     let turn = saved["history_turn"].as_f64().unwrap();
     assert!(turn > 1.0 && turn.is_finite(), "{saved}");
     // compensate and export say that they start from the operator's own state.
-    let out = hysid()
-        .args(["compensate", "--model"])
-        .arg(&model)
-        .arg("--data")
-        .arg(&valid)
-        .args(["--reference", "y", "--csv"])
-        .arg(dir.path().join("u.csv"))
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let stderr = compensate(&model, &valid, &dir.path().join("u.csv"));
     assert!(stderr.contains("declared descending history"), "{stderr}");
     // The validation record starts at another input (−0.8), after its own descent: the
     // history is re-applied there (exact data: the fit is exact).
@@ -175,17 +181,7 @@ fn a_declared_history_on_a_linear_family_is_fitted_saved_and_reapplied() {
     // The PI compensator runs the history (no warning) and its commands reproduce the
     // record's input where the model is exact.
     let commands = dir.path().join("u.csv");
-    let out = hysid()
-        .args(["compensate", "--model"])
-        .arg(&model)
-        .arg("--data")
-        .arg(&data)
-        .args(["--reference", "y", "--csv"])
-        .arg(&commands)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let stderr = compensate(&model, &data, &commands);
     assert!(!stderr.contains("declared"), "{stderr}");
     // `simulate` (which runs the history) of those commands gives the reference back.
     let text = fs::read_to_string(&commands).unwrap();
@@ -207,16 +203,7 @@ fn a_declared_history_on_a_linear_family_is_fitted_saved_and_reapplied() {
     old.as_object_mut().unwrap().remove("history_turn");
     let old_model = dir.path().join("old.json");
     fs::write(&old_model, old.to_string()).unwrap();
-    let out = hysid()
-        .args(["compensate", "--model"])
-        .arg(&old_model)
-        .arg("--data")
-        .arg(&data)
-        .args(["--reference", "y", "--csv"])
-        .arg(&commands)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = compensate(&old_model, &data, &commands);
     assert!(stderr.contains("declared descending history"), "{stderr}");
     let text = fs::read_to_string(&commands).unwrap();
     let sent: Vec<f64> = text

@@ -247,8 +247,12 @@ pub fn simulate_from(
     let Some(history) = history else {
         return op.simulate(u);
     };
-    let path = history.path(op, u);
-    let skip = path.len() - u.len();
+    run_after(op, history.path(op, u), u.len())
+}
+
+/// Γ along `path` (a history, then a record of `n` samples), the record's outputs only.
+fn run_after(op: &dyn HysteresisOperator, path: Vec<f64>, n: usize) -> Result<Vec<f64>> {
+    let skip = path.len() - n;
     let mut y = op.simulate(&path)?;
     Ok(y.split_off(skip))
 }
@@ -281,14 +285,8 @@ pub fn simulate(
     state: Option<InitialStateUsed>,
     u: &[f64],
 ) -> Result<Vec<f64>> {
-    let Some(state) = state else {
-        return op.simulate(u);
-    };
-    let path = with_history(op, state, u);
-    let skip = path.len() - u.len();
-    if skip == 0 {
-        return op.simulate(u);
+    match state {
+        Some(state) => run_after(op, with_history(op, state, u), u.len()),
+        None => op.simulate(u),
     }
-    let mut y = op.simulate(&path)?;
-    Ok(y.split_off(skip))
 }
