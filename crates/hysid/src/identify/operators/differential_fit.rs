@@ -28,10 +28,11 @@
 //!    three times as many when the record is short enough to be kept whole): bounded
 //!    Levenberg–Marquardt ([`crate::numerics::levenberg_marquardt`]) with exact
 //!    sensitivities, at most 200 iterations each. **The race:** a search still above
-//!    [`RACE_FACTOR`] times the best grid start's criterion after [`RACE_ITERATIONS`]
-//!    iterations is not heading for the minimum the fit keeps and gives up. **The line
-//!    check:** a best minimum whose residuals are [`LINE_FACTOR`] times a least-squares
-//!    straight line's is a loop the family cannot follow (its structure turns the other way,
+//!    [`RACE_FACTOR`] times the best grid start's criterion, or above [`LINE_FACTOR`]² times
+//!    a least-squares straight line's, after [`RACE_ITERATIONS`] iterations gives up (it is
+//!    not heading for the minimum the fit keeps). **The line check:** when the best search
+//!    (run to its end or given up so) leaves residuals [`LINE_FACTOR`] times the line's, the
+//!    record is a loop the family cannot follow (its structure turns the other way,
 //!    its saturation cannot take the record's shape): the fit stops there with that reason
 //!    ([`Error::OutsideFamily`]) instead of grinding on the full record.
 //! 4. **Refinement on the full record** of the best local minimum (and of the runner-up when
@@ -123,8 +124,9 @@ pub const MEDIUM_SAMPLES: usize = 3000;
 /// tolerance took 181 iterations and 1.0 s, for the same fit % to the third decimal as after
 /// 12; the Jiles–Atherton fit's the same fit % after 12 as after 200.)
 pub const POLISH_ITERATIONS: usize = 12;
-/// A family whose best local minimum on the decimated record leaves residuals this many
-/// times the root-mean-square of a least-squares straight line's cannot follow the loop
+/// A family whose best local search on the decimated record (run to its end, or given up by
+/// the race) leaves residuals this many times the root-mean-square of a least-squares
+/// straight line's cannot follow the loop
 /// (its structure turns the other way, or its saturation cannot take the record's shape): the
 /// fit stops there with that reason instead of refining on the full record. (Dahl turned
 /// counter-clockwise on the piezo record ends at 0.6 %, a residual 6.5 times the line's,
@@ -133,8 +135,8 @@ pub const LINE_FACTOR: f64 = 2.0;
 /// Iterations a local search on the decimated record takes before the race judges it.
 pub const RACE_ITERATIONS: usize = 10;
 /// A local search whose criterion after [`RACE_ITERATIONS`] iterations is still above this
-/// multiple of the best grid start's gives up: it is not heading for the minimum the fit
-/// keeps.
+/// multiple of the best grid start's (or above [`LINE_FACTOR`]² times a straight line's)
+/// gives up: it is not heading for the minimum the fit keeps.
 pub const RACE_FACTOR: f64 = 4.0;
 /// Shape points of the grid scored from the descending and ascending states too when the
 /// initial state is estimated: the best ones from the family's own start.
@@ -981,6 +983,7 @@ pub fn fit<F: DifferentialFamily>(
         started,
     )?;
     fit.initial_state = Some(declared.unwrap_or(InitialStateUsed::Estimated));
+    fit.history_turn = history.map(|(_, turn)| turn);
     Ok(fit)
 }
 
@@ -1152,6 +1155,7 @@ fn report_fit<F: DifferentialFamily>(
         termination,
         elapsed_s: started.elapsed().as_secs_f64(),
         initial_state: None,
+        history_turn: None,
         model_size: None,
     })
 }

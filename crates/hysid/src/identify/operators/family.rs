@@ -433,9 +433,10 @@ mod by_family {
 fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>, u: &[f64]) -> OperatorFit<FittedModel> {
     let std = fit.std.iter().map(|s| s.unwrap_or(f64::NAN)).collect();
     let model: OperatorModel = fit.model.into();
-    let turn = fit
-        .initial_state
-        .and_then(|state| state.turning_input(model.as_operator(), u));
+    let turn = fit.history_turn.or_else(|| {
+        fit.initial_state
+            .and_then(|state| state.turning_input(model.as_operator(), u))
+    });
     OperatorFit {
         model: FittedModel::operator(model, std).with_initial_state(fit.initial_state, turn),
         parameters: fit.parameters,
@@ -452,6 +453,7 @@ fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>, u: &[f64]) -> OperatorFit<
         termination: fit.termination,
         elapsed_s: fit.elapsed_s,
         initial_state: fit.initial_state,
+        history_turn: turn,
         model_size: fit.model_size,
     }
 }
@@ -551,6 +553,7 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
         termination: report.termination.clone(),
         elapsed_s: started.elapsed().as_secs_f64(),
         initial_state: None,
+        history_turn: None,
         model_size: None,
     })
 }

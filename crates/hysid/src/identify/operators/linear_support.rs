@@ -493,6 +493,7 @@ pub(crate) fn finish<M: HysteresisOperator + Core>(
         termination,
         elapsed_s: start.elapsed().as_secs_f64(),
         initial_state: state,
+        history_turn: None,
         model_size: None,
     }
 }

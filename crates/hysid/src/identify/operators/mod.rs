@@ -84,6 +84,13 @@ pub struct OperatorFit<M> {
     /// the family's neutral state; [`crate::model::operators::initial_state`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub initial_state: Option<InitialStateUsed>,
+    /// The input a declared history turned at in the fit, where the fit placed it with
+    /// another model than the one it returns (a differential family's turn is placed with the
+    /// best grid point's memory reach); None: placed from the returned model and the record
+    /// ([`InitialStateUsed::turning_input`]), which for the linear-in-weights families, whose
+    /// reach depends only on the structure, is the fit's.
+    #[serde(skip)]
+    pub history_turn: Option<f64>,
     /// How the model size was chosen from the data (None: fixed by the options or the
     /// family's structure; [`model_size`]).
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -187,7 +187,9 @@ impl OperatorModel {
 
     /// [`OperatorModel::stepper`] after the declared `history` (None: from the documented
     /// initial state): the history runs at the first good sample, as
-    /// [`initial_state::simulate_from`] runs it before a record; equal to it to the bit.
+    /// [`initial_state::simulate_from`] runs it before a record; equal to it to the bit when
+    /// the history has its saved turn (without one, a file of an earlier version, the batch
+    /// places the turn from the record's range and the stream at u₀ ± reach).
     ///
     /// [`initial_state::simulate_from`]: crate::model::operators::initial_state::simulate_from
     pub fn stepper_from(&self, history: Option<History>) -> Result<Box<dyn super::Stepper>> {
@@ -222,8 +224,11 @@ impl OperatorModel {
     ///
     /// After it the inverse's state is the operator's after the input u_turn, and the first
     /// command u₀ descends (ascends) from there: exactly the state after the history
-    /// u₀ → u_turn → u₀ that `simulate` runs, since the descent of at least the memory reach
-    /// wipes out what preceded u_turn.
+    /// u₀ → u_turn → u₀ that `simulate` runs for a u₀ on the record's side of the saved turn
+    /// (the fit placed it at least the memory reach beyond the record, and a compensator's
+    /// limits keep its commands within the record's range), since the excursion to u_turn
+    /// wipes out what preceded it. A command beyond the saved turn (no limits, a reference
+    /// far beyond the record) starts from this state, where `simulate` would turn beyond u₀.
     pub fn priming_reference(&self, history: Option<History>) -> Result<Option<f64>> {
         let Some(turn) = history.and_then(|h| h.turn) else {
             return Ok(None);
