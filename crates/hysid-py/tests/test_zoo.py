@@ -69,12 +69,15 @@ def test_fits_and_simulates(family):
 def test_estimates_equal_the_command_line(tmp_path, family):
     u, y = _loop()
     # The loop is counter-clockwise and rising, which no Dahl operator represents: both
-    # refuse it (a DataError naming why) unless the orientation is given.
-    given: list[str] = ["--orientation", "ccw"] if family == "dahl" else []
-    asked: dict[str, str] = {"orientation": "ccw"} if family == "dahl" else {}
+    # refuse it (a DataError naming why), also when asked to turn counter-clockwise (its
+    # best fit is worse than a straight line); turned clockwise as asked, it is fitted.
+    given: list[str] = ["--orientation", "cw"] if family == "dahl" else []
+    asked: dict[str, str] = {"orientation": "cw"} if family == "dahl" else {}
     if family == "dahl":
         with pytest.raises(hysid.DataError, match="cannot represent this loop"):
             hysid.identify_operator(u, y, family=family)
+        with pytest.raises(hysid.DataError, match="less than a straight line"):
+            hysid.identify_operator(u, y, family=family, orientation="ccw")
     csv = tmp_path / "loop.csv"
     np.savetxt(csv, np.column_stack([u, y]), delimiter=",", header="u,y", comments="", fmt="%.17g")
     report = tmp_path / "report.json"
