@@ -21,13 +21,7 @@ pub fn run(args: &CompensateArgs) -> Result<()> {
     let json_tmp = args.json.as_deref().map(|p| files.file(p)).transpose()?;
     let saved = ModelFile::load(&args.model)?;
     let model = FittedModel::from_file(&saved)?;
-    if let Some(state) = model.history_beyond_the_inverse() {
-        tell!(
-            "warning: {} starts after a declared {} history, which the compensator of this family (or of a file without history_turn) does not run: its first commands follow the operator's own initial state until the reference wipes the memory out",
-            args.model.display(),
-            state.name()
-        );
-    }
+    super::warn_history_beyond_the_inverse(&model, &args.model);
     let limits = args.limits.or_else(|| saved.limits());
     if limits.is_none() {
         tell!(

@@ -78,15 +78,9 @@ pub fn run(args: &ExportArgs) -> Result<()> {
         );
     }
     if args.inverse {
-        let beyond = hysid::model::saved::FittedModel::from_file(&file)
-            .ok()
-            .and_then(|m| m.history_beyond_the_inverse());
-        if let Some(state) = beyond {
-            tell!(
-                "warning: {} starts after a declared {} history, which the compensator of this family (or of a file without history_turn) does not run: its first commands follow the operator's own initial state until the reference wipes the memory out",
-                args.model.display(),
-                state.name()
-            );
+        // A file that does not rebuild is refused, with its reason, by the export below.
+        if let Ok(model) = hysid::model::saved::FittedModel::from_file(&file) {
+            super::warn_history_beyond_the_inverse(&model, &args.model);
         }
     }
     let files = export(&file, target, &args.name, &options).with_context(|| {

@@ -40,3 +40,18 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Export(args) => export::run(&args),
     }
 }
+
+/// The warning of `compensate` and `export --inverse` for a model (read from `path`) whose
+/// compensator does not run its declared history (`FittedModel::history_beyond_the_inverse`).
+fn warn_history_beyond_the_inverse(
+    model: &hysid::model::saved::FittedModel,
+    path: &std::path::Path,
+) {
+    if let Some(state) = model.history_beyond_the_inverse() {
+        tell!(
+            "warning: {} starts after a declared {} history, which the compensator of this family (or of a file without history_turn) does not run: its first commands follow the operator's own initial state until the reference wipes the memory out",
+            path.display(),
+            state.name()
+        );
+    }
+}

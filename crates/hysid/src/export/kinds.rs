@@ -68,8 +68,7 @@ pub fn program(model: &FittedModel, options: &ExportOptions, ts: f64) -> Result<
 /// compensators run it (`model::operators::initial_state`).
 impl ExportKind for FittedHysteresisOperator {
     fn program(&self, options: &ExportOptions, _ts: f64) -> Result<Program> {
-        use crate::model::operators::initial_state::History;
-        let history = History::of(self.initial_state, self.history_turn);
+        let history = self.history();
         chained(options, |op, _, _, prog| {
             Ok(vec![match options.inverse {
                 false => families::forward_after(&self.model, history, op, prog)?,

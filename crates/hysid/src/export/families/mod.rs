@@ -80,13 +80,7 @@ pub fn forward_after(
         None,
         "the declared history has run (at the first good sample)",
     )?;
-    let reach = op.as_operator().memory_reach();
-    let reach = if reach.is_finite() { reach } else { 0.0 };
-    let direction = if history.state == crate::model::operators::InitialStateUsed::Descending {
-        1.0
-    } else {
-        -1.0
-    };
+    let (reach, direction) = (History::reach(op.as_operator()), history.direction());
     prog.bound(format!(
         "the first good sample runs the declared {} history: three steps of the operator",
         history.state.name()

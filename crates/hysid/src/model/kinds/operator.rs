@@ -85,6 +85,14 @@ pub struct FittedHysteresisOperator {
     pub history_turn: Option<f64>,
 }
 
+impl FittedHysteresisOperator {
+    /// The declared history it starts after, with its saved turn (None: the structure's
+    /// own state).
+    pub fn history(&self) -> Option<initial_state::History> {
+        initial_state::History::of(self.initial_state, self.history_turn)
+    }
+}
+
 /// The family's own simulation from the declared initial state, its step and its inverse
 /// (the registry's operators, [`crate::model::operators`]).
 impl FittedKind for FittedHysteresisOperator {
@@ -107,49 +115,37 @@ impl FittedKind for FittedHysteresisOperator {
 
     fn simulate(&self, inputs: &[&[f64]], _ts: f64, _y0: Option<f64>) -> Result<Vec<Vec<f64>>> {
         let operator = self.model.as_operator();
-        let history = initial_state::History::of(self.initial_state, self.history_turn);
-        let y = initial_state::simulate_from(operator, history, first(inputs)?)?;
+        let y = initial_state::simulate_from(operator, self.history(), first(inputs)?)?;
         Ok(vec![y])
     }
 
     fn stepper(&self, _ts: f64, _y0: Option<f64>) -> Result<Box<dyn Stepper>> {
-        let history = initial_state::History::of(self.initial_state, self.history_turn);
-        self.model.stepper_from(history)
+        self.model.stepper_from(self.history())
     }
 
     fn compensator(&self) -> Result<Box<dyn Compensator>> {
-        let history = initial_state::History::of(self.initial_state, self.history_turn);
-        self.model.compensator_from(history)
+        self.model.compensator_from(self.history())
     }
 
     /// The inverse after the declared history: the priming reference first
     /// ([`OperatorModel::priming_reference`]), its command dropped.
     fn compensate(&self, reference: &[f64]) -> Result<Compensation> {
-        let history = initial_state::History::of(self.initial_state, self.history_turn);
-        let operator = self.model.as_operator();
-        let Some(r) = self.model.priming_reference(history)? else {
-            let inv = operator.invert(reference)?;
-            return Ok(Compensation {
-                reference: reference.to_vec(),
-                u: inv.u,
-                predicted: inv.predicted,
-                clipped: inv.clipped,
-                settled_from: 0,
-            });
-        };
-        let primed: Vec<f64> = std::iter::once(r)
+        let priming = self.model.priming_reference(self.history())?;
+        let skip = usize::from(priming.is_some());
+        let primed: Vec<f64> = priming
+            .into_iter()
             .chain(reference.iter().copied())
             .collect();
-        let mut inv = operator.invert(&primed)?;
+        let mut inv = self.model.as_operator().invert(&primed)?;
         Ok(Compensation {
             reference: reference.to_vec(),
-            u: inv.u.split_off(1),
-            predicted: inv.predicted.split_off(1),
+            u: inv.u.split_off(skip),
+            predicted: inv.predicted.split_off(skip),
             clipped: inv
                 .clipped
                 .iter()
-                .filter(|&&k| k > 0)
-                .map(|k| k - 1)
+                .filter(|&&k| k >= skip)
+                .map(|k| k - skip)
                 .collect(),
             settled_from: 0,
         })

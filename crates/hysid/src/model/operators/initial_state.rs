@@ -195,7 +195,7 @@ impl History {
     }
 
     /// +1 for a descent from above, −1 for an ascent from below.
-    fn direction(&self) -> f64 {
+    pub fn direction(&self) -> f64 {
         if self.state == InitialStateUsed::Descending {
             1.0
         } else {
@@ -203,18 +203,27 @@ impl History {
         }
     }
 
+    /// `op`'s memory reach as the turn uses it (0 when not finite).
+    pub fn reach(op: &dyn HysteresisOperator) -> f64 {
+        let reach = op.memory_reach();
+        if reach.is_finite() {
+            reach
+        } else {
+            0.0
+        }
+    }
+
     /// The input the history turns at before a record whose first input is `u0` (module doc):
     /// the saved turn when it lies beyond u₀ in the history's direction, otherwise (or without
-    /// a saved turn) u₀ ± max(reach, |u₀ − turn|), with `op`'s memory reach.
-    pub fn turn_at(&self, op: &dyn HysteresisOperator, u0: f64) -> f64 {
+    /// a saved turn) u₀ ± max(reach, |u₀ − turn|, 10⁻⁶·max(|u₀|, 1)), with the operator's
+    /// memory `reach` ([`History::reach`]).
+    pub fn turn_at(&self, reach: f64, u0: f64) -> f64 {
         let direction = self.direction();
         if let Some(turn) = self.turn {
             if (turn - u0) * direction > 0.0 {
                 return turn;
             }
         }
-        let reach = op.memory_reach();
-        let reach = if reach.is_finite() { reach } else { 0.0 };
         let beyond = self.turn.map_or(0.0, |t| (u0 - t).abs());
         let margin = reach.max(beyond).max(1e-6 * u0.abs().max(1.0));
         u0 + direction * margin
@@ -223,16 +232,12 @@ impl History {
     /// The record u with the history prepended: \[u₀, u_turn\] then u (a model file without a
     /// saved turn: the turn placed from u's range, [`InitialStateUsed::turning_input`]).
     pub fn path(&self, op: &dyn HysteresisOperator, u: &[f64]) -> Vec<f64> {
-        let Some(&u0) = u.first() else {
-            return Vec::new();
-        };
-        let turn = match self.turn {
-            Some(_) => Some(self.turn_at(op, u0)),
-            None => self.state.turning_input(op, u),
-        };
-        match turn {
-            Some(turn) => [u0, turn].iter().chain(u).copied().collect(),
-            None => u.to_vec(),
+        match (self.turn, u.first()) {
+            (Some(_), Some(&u0)) => {
+                let turn = self.turn_at(Self::reach(op), u0);
+                [u0, turn].iter().chain(u).copied().collect()
+            }
+            _ => with_history(op, self.state, u),
         }
     }
 }

@@ -358,8 +358,7 @@ impl FittedModel {
         let FittedModel::Operator(op) = self else {
             return None;
         };
-        let history =
-            crate::model::operators::initial_state::History::of(op.initial_state, op.history_turn)?;
+        let history = op.history()?;
         (!op.model.history_reaches_the_inverse(Some(history))).then_some(history.state)
     }
 

@@ -85,7 +85,8 @@ impl<F: StreamingOperator + Send + std::fmt::Debug> InverseKernel for OperatorIn
 #[derive(Debug)]
 struct AfterHistory {
     inner: AnyOperatorStream,
-    operator: OperatorModel,
+    /// The operator's memory reach ([`History::reach`]).
+    reach: f64,
     history: History,
     primed: bool,
 }
@@ -97,7 +98,7 @@ impl Kernel for AfterHistory {
     }
     fn step(&mut self, k: usize, u: &[f64], y: &mut [f64]) -> Result<()> {
         if !self.primed {
-            let turn = self.history.turn_at(self.operator.as_operator(), u[0]);
+            let turn = self.history.turn_at(self.reach, u[0]);
             let mut dropped = [0.0];
             let run = self
                 .inner
@@ -198,7 +199,7 @@ impl OperatorModel {
         };
         let primed = AfterHistory {
             inner: self.stream()?,
-            operator: self.clone(),
+            reach: History::reach(self.as_operator()),
             history,
             primed: false,
         };
@@ -230,12 +231,12 @@ impl OperatorModel {
     /// wipes out what preceded it. A command beyond the saved turn (no limits, a reference
     /// far beyond the record) starts from this state, where `simulate` would turn beyond u₀.
     pub fn priming_reference(&self, history: Option<History>) -> Result<Option<f64>> {
-        let Some(turn) = history.and_then(|h| h.turn) else {
+        let Some(turn) = history
+            .and_then(|h| h.turn)
+            .filter(|_| self.history_reaches_the_inverse(history))
+        else {
             return Ok(None);
         };
-        if !self.wipes_out() {
-            return Ok(None);
-        }
         let mut forward = self.stream()?;
         let mut y = [0.0];
         forward.step(0, &[turn], &mut y)?;
