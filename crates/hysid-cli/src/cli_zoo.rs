@@ -4,6 +4,7 @@
 
 use crate::cli::{DataArgs, OutputArgs};
 use clap::{Args, ValueEnum};
+use hysid::identify::operators::EnvelopeChoice;
 use hysid::model::operators::{Family, InitialState, LoopOrientation};
 use std::path::PathBuf;
 
@@ -54,6 +55,33 @@ pub struct FamilyArgs {
     /// in the model file and re-applied by `simulate`.
     #[arg(long = "initial-state", value_enum, default_value = "estimate")]
     pub initial_state: InitialStateArg,
+    /// The PI's static envelope, a monotone cubic E(u) beside the plays for a static curve
+    /// they cannot follow (a saturating magnet; docs/zoo.md): auto (each candidate size is
+    /// tried without and with it on the last 30 % of the record; none when --thresholds is
+    /// given), none, or cubic. Read by pi only.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub envelope: EnvelopeArg,
+}
+
+/// The `--envelope` values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EnvelopeArg {
+    /// Chosen with the thresholds on the held-out part.
+    Auto,
+    /// No envelope.
+    None,
+    /// A cubic envelope.
+    Cubic,
+}
+
+impl From<EnvelopeArg> for EnvelopeChoice {
+    fn from(e: EnvelopeArg) -> Self {
+        match e {
+            EnvelopeArg::Auto => EnvelopeChoice::Auto,
+            EnvelopeArg::None => EnvelopeChoice::None,
+            EnvelopeArg::Cubic => EnvelopeChoice::Cubic,
+        }
+    }
 }
 
 /// The `--initial-state` values.

@@ -11,7 +11,8 @@ use crate::watch::watching;
 use hysid::data::IdData;
 use hysid::identify::operator_cascade::OperatorCascadeIdentification;
 use hysid::identify::operators::{
-    compare as compare_families, fit_operator, CompareOptions, Family, FamilyOptions, Split,
+    compare as compare_families, fit_operator, CompareOptions, EnvelopeChoice, Family,
+    FamilyOptions, FamilySetting, Split,
 };
 use hysid::model::compensate::compensate_within;
 use hysid::model::operators::{InitialState, LoopOrientation};
@@ -76,11 +77,17 @@ fn requested_state(text: Option<&str>) -> hysid::Result<InitialState> {
     text.map_or(Ok(InitialState::Estimate), InitialState::parse)
 }
 
+/// The PI's static envelope Python asks for (`"auto"`, `"none"`, `"cubic"`), None for the
+/// default `auto`.
+fn requested_envelope(text: Option<&str>) -> hysid::Result<EnvelopeChoice> {
+    text.map_or(Ok(EnvelopeChoice::Auto), EnvelopeChoice::parse)
+}
+
 /// Fits the hysteresis family `family` to input `u` and output `y`: the report of `hysid
 /// identify operator` as JSON text. `threshold_grid` empty: the uniform grid of
 /// `thresholds`.
 #[pyfunction]
-#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None, initial_state=None))]
+#[pyo3(signature = (u, y, family, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None, initial_state=None, envelope=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn identify_operator(
     py: Python<'_>,
@@ -98,12 +105,25 @@ fn identify_operator(
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
     initial_state: Option<&str>,
+    envelope: Option<&str>,
 ) -> PyResult<String> {
     let (u, y) = (samples(&u), samples(&y));
     let family = guard(py, || Family::parse(family))?;
     let mut options = family_options(thresholds, threshold_grid, grid, lambda_, dead_zones);
     options.loop_orientation = guard(py, || loop_orientation(orientation))?;
     options.initial_state = guard(py, || requested_state(initial_state))?;
+    options.envelope = guard(py, || requested_envelope(envelope))?;
+    if options.envelope != EnvelopeChoice::Auto
+        && !family.settings().contains(&FamilySetting::Envelope)
+    {
+        return guard(py, || {
+            Err(hysid::Error::invalid_option(
+                "envelope",
+                options.envelope.name(),
+                format!("the static envelope is a pi option, not {family}'s; leave it out"),
+            ))
+        });
+    }
     run_on(
         py,
         threads,
@@ -197,7 +217,7 @@ type Compared<'py> = (
 /// Fits `families` to (u, y) and ranks them by validation fit % on (u_val, y_val), or on
 /// the last 40 % of (u, y) when those are None (`hysid compare`).
 #[pyfunction]
-#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None, initial_state=None))]
+#[pyo3(signature = (u, y, u_val, y_val, families, ts, thresholds, threshold_grid, grid, lambda_, dead_zones, threads=0, orientation=None, time_limit=None, progress=None, initial_state=None, envelope=None))]
 #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
 fn compare<'py>(
     py: Python<'py>,
@@ -217,17 +237,20 @@ fn compare<'py>(
     time_limit: Option<f64>,
     progress: Option<Py<PyAny>>,
     initial_state: Option<&str>,
+    envelope: Option<&str>,
 ) -> PyResult<Compared<'py>> {
     let (u, y) = (samples(&u), samples(&y));
     let validation = u_val.zip(y_val).map(|(a, b)| (samples(&a), samples(&b)));
     let families = guard(py, || families.iter().map(|f| Family::parse(f)).collect())?;
     let loop_orientation = guard(py, || loop_orientation(orientation))?;
     let initial_state = guard(py, || requested_state(initial_state))?;
+    let envelope = guard(py, || requested_envelope(envelope))?;
     let options = CompareOptions {
         families,
         family: FamilyOptions {
             loop_orientation,
             initial_state,
+            envelope,
             ..family_options(thresholds, threshold_grid, grid, lambda_, dead_zones)
         },
         ..CompareOptions::default()

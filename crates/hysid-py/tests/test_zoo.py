@@ -110,6 +110,33 @@ def test_estimates_equal_the_command_line(tmp_path, family):
         assert abs(r.parameters[name].value - value) <= 1e-12 * max(1.0, abs(value)), (family, name)
 
 
+def test_envelope_is_the_command_lines():
+    """``envelope=`` is ``--envelope``: on a record whose static curve saturates (plays beside
+    a tanh of the input, a magnet's yoke) the default PI chooses a cubic envelope and fits
+    what the plays alone cannot; ``"none"`` keeps the plays alone; the model simulates the
+    record as fitted; other families refuse a non-default value, unknown names are ConfigErrors."""
+    u, plays_part = _loop()
+    y = 0.3 * plays_part + 4.0 * np.tanh(u / 1.2)
+    auto = hysid.identify_operator(u, y, family="pi")
+    assert auto.details["model_size"]["chosen"].endswith("+ envelope")
+    assert {"e0", "e1", "e2", "e_lo", "e_hi"} <= set(auto.parameters)
+    none = hysid.identify_operator(u, y, family="pi", envelope="none")
+    assert "e0" not in none.parameters
+    assert auto.fit_percent is not None and none.fit_percent is not None
+    assert auto.fit_percent > none.fit_percent + 3.0
+    assert auto.model is not None
+    simulated = auto.model.simulate(u, ts=1.0)
+    assert 100.0 * (1.0 - np.linalg.norm(y - simulated) / np.linalg.norm(y - y.mean())) == pytest.approx(
+        auto.fit_percent, abs=1e-9
+    )
+    cubic = hysid.identify_operator(u, y, family="pi", thresholds=6, envelope="cubic")
+    assert "e0" in cubic.parameters
+    with pytest.raises(hysid.ConfigError, match="envelope"):
+        hysid.identify_operator(u, y, family="gpi", envelope="cubic")
+    with pytest.raises(hysid.ConfigError, match="envelope"):
+        hysid.identify_operator(u, y, family="pi", envelope="quadratic")  # type: ignore[arg-type]
+
+
 def test_initial_state_is_the_command_lines():
     """``initial_state=`` is ``--initial-state``: a record that starts at the end of a
     descent is fitted from it, reported and saved; an unknown name is a ConfigError."""

@@ -2,11 +2,14 @@
 
 use super::zoo::{family_options, load, loops, signals};
 use crate::cli_zoo::OperatorArgs;
+use crate::exit::UsageError;
 use crate::output::Outputs;
 use crate::progress::FitProgress;
 use crate::report::{print_table, Row};
 use anyhow::{Context, Result};
-use hysid::identify::operators::{fit_operator, Family, FamilySetting, FittedOperator};
+use hysid::identify::operators::{
+    fit_operator, EnvelopeChoice, Family, FamilySetting, FittedOperator,
+};
 use hysid::report::{operator_report, operator_simulation, Report};
 
 /// Parameters printed before the table is cut short (a Preisach plane has hundreds).
@@ -16,17 +19,30 @@ const PRINTED_PARAMETERS: usize = 16;
 pub fn run(args: &OperatorArgs) -> Result<()> {
     let family = Family::parse(&args.family)?;
     let mut options = family_options(&args.options)?;
+    let reading = |setting| {
+        Family::reading(setting)
+            .into_iter()
+            .map(Family::name)
+            .collect::<Vec<&str>>()
+            .join(", ")
+    };
     if options.loop_orientation.is_some()
         && !family.settings().contains(&FamilySetting::Orientation)
     {
-        let reading: Vec<&str> = Family::reading(FamilySetting::Orientation)
-            .into_iter()
-            .map(Family::name)
-            .collect();
-        anyhow::bail!(
+        return Err(UsageError(format!(
             "--orientation applies to {}, not {family} (its orientation is a result of the fit)",
-            reading.join(", ")
-        );
+            reading(FamilySetting::Orientation)
+        ))
+        .into());
+    }
+    if options.envelope != EnvelopeChoice::Auto
+        && !family.settings().contains(&FamilySetting::Envelope)
+    {
+        return Err(UsageError(format!(
+            "--envelope applies to {}, not {family} (its static curve is part of its own fit)",
+            reading(FamilySetting::Envelope)
+        ))
+        .into());
     }
     let o = &args.output;
     let mut out = Outputs::new(

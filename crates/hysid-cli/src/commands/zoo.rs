@@ -21,6 +21,7 @@ pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
         dead_zones: args.dead_zones as usize,
         loop_orientation: args.orientation.map(Into::into),
         initial_state: args.initial_state.into(),
+        envelope: args.envelope.into(),
         ..FamilyOptions::default()
     };
     let text = args.thresholds.as_deref().unwrap_or("10").trim();

@@ -7,6 +7,7 @@ mod actuator_cli;
 mod commands;
 #[cfg(unix)] // SIGKILL
 mod crash_safety;
+mod envelope_cli;
 mod equations_cli;
 mod exit_codes;
 mod export_cli;

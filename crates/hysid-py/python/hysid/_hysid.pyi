@@ -53,6 +53,7 @@ def identify_operator(
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
     initial_state: Optional[str] = None,
+    envelope: Optional[str] = None,
 ) -> str: ...
 def identify_operator_cascade(
     x: _Array,
@@ -86,6 +87,7 @@ def compare(
     time_limit: Optional[float] = None,
     progress: Optional[_Progress] = None,
     initial_state: Optional[str] = None,
+    envelope: Optional[str] = None,
 ) -> Tuple[str, List[Tuple[str, Optional[str]]], _Array, _Array, List[_Array]]: ...
 def compensate(
     model_json: str,

@@ -35,6 +35,17 @@ LoopOrientation = Literal["ccw", "cw"]
 InitialStateName = Literal["demagnetised", "descending", "ascending", "estimate"]
 
 
+#: The PI's static envelope (``docs/zoo.md``, "Static envelope"): chosen with the thresholds,
+#: none, or a cubic.
+EnvelopeName = Literal["auto", "none", "cubic"]
+
+
+def _envelope(value: Optional[str]) -> Optional[str]:
+    if value is None:
+        return None
+    return check.choice(value, "envelope", ("auto", "none", "cubic"))
+
+
 def _initial_state(value: Optional[str]) -> Optional[str]:
     if value is None:
         return None
@@ -55,6 +66,7 @@ class _FitArguments(TypedDict):
     time_limit: Optional[float]
     progress: Optional[Callable[[str, int, int, Optional[int], Optional[float], float], None]]
     initial_state: Optional[str]
+    envelope: Optional[str]
 
 
 def _fit_arguments(
@@ -63,9 +75,10 @@ def _fit_arguments(
     initial_state: Optional[str],
     time_limit: Optional[float],
     progress: ProgressArg,
+    envelope: Optional[str] = None,
 ) -> _FitArguments:
-    """The fit's threads, orientation, initial state, time limit and progress checked and
-    in the extension module's form."""
+    """The fit's threads, orientation, initial state, time limit, progress and envelope
+    checked and in the extension module's form."""
     limit, tell = watching(time_limit, progress)
     return _FitArguments(
         threads=check.threads(threads),
@@ -73,6 +86,7 @@ def _fit_arguments(
         time_limit=limit,
         progress=tell,
         initial_state=_initial_state(initial_state),
+        envelope=_envelope(envelope),
     )
 
 
@@ -131,6 +145,7 @@ def identify_operator(
     dead_zones: int = 4,
     orientation: Optional[LoopOrientation] = None,
     initial_state: Optional[InitialStateName] = None,
+    envelope: Optional[EnvelopeName] = None,
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
@@ -158,6 +173,10 @@ def identify_operator(
     standardised magnet), ``"ascending"``, or ``"estimate"`` (None, the default: fitted from
     the data); the command line's ``--initial-state``, reported in
     ``details.initial_state`` and saved in the model.
+    ``envelope``: the PI's monotone static envelope beside its plays, for a static curve they
+    cannot follow (a saturating magnet): ``"auto"`` (None, the default: each candidate size is
+    tried without and with a cubic on the held-out part; none when ``thresholds`` is given),
+    ``"none"`` or ``"cubic"``; the command line's ``--envelope``, read by ``"pi"`` only.
     An unknown family or an option out of range is a :class:`ConfigError` (a ``ValueError``).
     ``names`` and ``units``: the (input, output) channels' names and units, e.g.
     ``names=("voltage", "displacement"), units=("V", "µm")``, which label the plots' axes
@@ -169,7 +188,7 @@ def identify_operator(
     step = check.sample_time(given_ts, 1.0)
     name = _family(family)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
-    arguments = _fit_arguments(threads, orientation, initial_state, time_limit, progress)
+    arguments = _fit_arguments(threads, orientation, initial_state, time_limit, progress, envelope)
     text = _hysid.identify_operator(u, y, name, step, *options, **arguments)
     record = Record(u, y, step, labels, unit_labels)
     result = FitResult(labelled(json.loads(text), record), data=record)
@@ -190,6 +209,7 @@ def compare(
     dead_zones: int = 4,
     orientation: Optional[LoopOrientation] = None,
     initial_state: Optional[InitialStateName] = None,
+    envelope: Optional[EnvelopeName] = None,
     threads: Optional[int] = None,
     time_limit: Optional[float] = None,
     progress: ProgressArg = None,
@@ -228,7 +248,7 @@ def compare(
             raise TypeError("validate: give a pair (u_val, y_val) or a record with .u and .y")
         u_val, y_val, _ = check.pair(pair[0], pair[1], ("validate u", "validate y"), None)
     options = _family_options(thresholds, grid, lambda_, dead_zones)
-    arguments = _fit_arguments(threads, orientation, initial_state, time_limit, progress)
+    arguments = _fit_arguments(threads, orientation, initial_state, time_limit, progress, envelope)
     report, results, v_in, v_out, simulated = _hysid.compare(u, y, u_val, y_val, chosen, step, *options, **arguments)
     comparison = Comparison.from_extension(
         report,

@@ -338,6 +338,22 @@ pub fn all_on(u: &[f64]) -> Vec<Case> {
         })
         .collect();
     let mut out: Vec<Case> = families.into_iter().flatten().collect();
+    // The structures the examples do not show (a PI with a static envelope: `pi_envelope`).
+    for (variant, op) in OperatorModel::variants().expect("the registry's variants") {
+        let label = format!("{}_{variant}", op.family().name().replace('-', "_"));
+        let n = op.as_operator().parameters().len();
+        out.extend(cases_of(
+            &label,
+            &FittedModel::operator(op.clone(), vec![f64::NAN; n]),
+            u,
+        ));
+        out.extend(after_histories(&label, &op, u));
+        if let Some(cw) = flipped(&op) {
+            let n = cw.as_operator().parameters().len();
+            let model = FittedModel::operator(cw, vec![f64::NAN; n]);
+            out.extend(cases_of(&format!("{label}_cw"), &model, u));
+        }
+    }
     out.extend(kinds(u));
     out
 }

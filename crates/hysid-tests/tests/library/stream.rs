@@ -106,17 +106,27 @@ fn no_std(n: usize) -> Vec<f64> {
     vec![f64::NAN; n]
 }
 
-/// Every operator of the registry, and of every linear-in-weights family its clockwise
-/// (inverse-operator) form too: (name, operator, an input inside its domain).
+/// Every operator of the registry with its variants (a PI with a static envelope), and of
+/// every linear-in-weights family its clockwise (inverse-operator) form too: (name,
+/// operator, an input inside its domain).
 fn operators() -> Vec<(String, OperatorModel, Vec<f64>)> {
     let u = signal(600, 1.0, 7);
     let mut out = Vec::new();
-    for model in OperatorModel::examples().unwrap() {
-        let name = model.family().name().to_string();
+    let variants = OperatorModel::variants().unwrap().into_iter();
+    let examples = OperatorModel::examples()
+        .unwrap()
+        .into_iter()
+        .map(|m| ("", m));
+    for (variant, model) in examples.chain(variants) {
+        let family = model.family().name().to_string();
+        let name = match variant {
+            "" => family.clone(),
+            v => format!("{family} ({v})"),
+        };
         let mut structure = model.structure().unwrap();
         if let Some(o) = structure.get_mut("orientation").filter(|o| o.is_object()) {
             o["inverse"] = serde_json::Value::Bool(true);
-            let clockwise = OperatorModel::from_structure(&name, &structure).unwrap();
+            let clockwise = OperatorModel::from_structure(&family, &structure).unwrap();
             // Γ = G⁻¹ takes G's outputs: the counter-clockwise operator's on the signal.
             let inside = model.as_operator().simulate(&u).unwrap();
             out.push((format!("{name} (clockwise)"), clockwise, inside));

@@ -2,13 +2,15 @@
 //! with the play states zᵢ (from 0) in the state; G⁻¹ is Krejčí & Kuhnen's analytic inverse
 //! b₀(v − c) + Σ bᵢ F_{sᵢ}\[v − c\] (its constants computed by the library itself, so they are
 //! the same bits), or, when some âᵢ ≤ 0, the library's exact per-sample solve of the
-//! piecewise-linear branch. The Maxwell-slip and generalised PI families reuse these pieces.
+//! piecewise-linear branch. A static envelope E(u) (`model::operators::envelope`) is its own
+//! helper `ns.envelope(x)`, added after c + a₀x as the library adds it, with the library's
+//! Horner coefficients. The Maxwell-slip and generalised PI families reuse these pieces.
 
 use super::oriented::EmitCore;
-use crate::export::code::{idx, local, Block, Expr, Ty};
+use crate::export::code::{idx, lit, local, select, Block, Expr, Ty};
 use crate::export::program::{Ns, Program};
 use crate::export::solve;
-use crate::model::operators::{Orientation, PrandtlIshlinskii};
+use crate::model::operators::{Envelope, Orientation, PrandtlIshlinskii};
 use crate::Result;
 
 /// F_r\[u\] one step: max(u − r, min(u + r, z)).
@@ -40,6 +42,52 @@ pub fn plays(
     })
 }
 
+/// E(x) of a static envelope: `ns.envelope(x)`, its end tangents beyond [lo, hi] and
+/// Horner's rule in t = (x − lo)·(1/w) on it, p = m_n then p = p·t + mₖ (`Envelope::value`).
+fn emit_envelope(e: &Envelope, ns: &Ns, prog: &mut Program) -> Result<String> {
+    let (c_lo, c_hi) = e.end_slopes();
+    let (lo, hi, top, inverse_width) = (e.lo(), e.hi(), e.top(), e.inverse_width());
+    let monomial = e.monomial().to_vec();
+    prog.function(
+        &ns.name("envelope"),
+        &[("x", Ty::F64)],
+        Some(Ty::F64),
+        |b| {
+            let x = local("x");
+            let t = b.let_("t", (x.clone() - lo) * inverse_width);
+            let (last, rest) = monomial.split_last().expect("an envelope's coefficients");
+            let horner = rest
+                .iter()
+                .rev()
+                .fold(lit(*last), |p, &m| p * t.clone() + m);
+            let above = top + c_hi * (x.clone() - hi);
+            let below = c_lo * (x.clone() - lo);
+            b.ret(select(
+                x.clone().lt(lo),
+                below,
+                select(x.gt(hi), above, horner),
+            ));
+        },
+    )
+}
+
+/// c + a₀x + E(x), the static part of G, in the library's order (`static_part`).
+fn static_part(pi: &PrandtlIshlinskii, envelope: &Option<String>, x: Expr) -> Expr {
+    let (c, a0) = (pi.offset(), pi.a0());
+    let y = c + a0 * x.clone();
+    match envelope {
+        Some(e) => y + Expr::Call(e.clone(), vec![x]),
+        None => y,
+    }
+}
+
+/// The envelope helper of `pi`, if it has one.
+fn envelope_of(pi: &PrandtlIshlinskii, ns: &Ns, prog: &mut Program) -> Result<Option<String>> {
+    pi.envelope()
+        .map(|e| emit_envelope(e, ns, prog))
+        .transpose()
+}
+
 /// G of a PI operator: `ns.g(x)`.
 pub fn emit_forward(pi: &PrandtlIshlinskii, ns: &Ns, prog: &mut Program) -> Result<String> {
     prog.bound(format!(
@@ -47,9 +95,9 @@ pub fn emit_forward(pi: &PrandtlIshlinskii, ns: &Ns, prog: &mut Program) -> Resu
         pi.weights().len()
     ));
     let plays = plays(prog, ns, pi.weights(), pi.thresholds())?;
-    let (c, a0) = (pi.offset(), pi.a0());
+    let envelope = envelope_of(pi, ns, prog)?;
     prog.function(&ns.name("g"), &[("x", Ty::F64)], Some(Ty::F64), |b| {
-        b.var("acc", c + a0 * local("x"));
+        b.var("acc", static_part(pi, &envelope, local("x")));
         plays(b, local("x"));
         b.ret(local("acc"));
     })
@@ -94,7 +142,7 @@ fn emit_numerical_inverse(
     let u_prev = prog.field(&ns.name("u_prev"), Ty::F64, None, "the last input")?;
     let a = prog.table(&ns.table("a"), pi.weights().to_vec())?;
     let r = prog.table(&ns.table("r"), pi.thresholds().to_vec())?;
-    let (c, a0) = (pi.offset(), pi.a0());
+    let envelope = envelope_of(pi, ns, prog)?;
     let at = |name: &str, i: Expr| Expr::Table(name.into(), Box::new(i));
     let zi = |i: Expr| Expr::StateAt(z.clone(), Box::new(i));
     // G's output for the input x from the play states (not updated).
@@ -104,15 +152,16 @@ fn emit_numerical_inverse(
             let step = play_step(zi(i.clone()), local("x"), at(&r, i.clone()));
             b.set("sum", sum.clone() + at(&a, i) * step);
         });
-        b.ret(c + a0 * local("x") + sum);
+        b.ret(static_part(pi, &envelope, local("x")) + sum);
     })?;
     let solve = solve::emit(prog, ns, &branch)?;
     let r_max = pi.thresholds().last().copied().unwrap_or(0.0);
-    let unbounded = Expr::Flag(pi.final_slope() > 0.0);
+    let (below, above) = pi.unbounded();
+    let (below, above) = (Expr::Flag(below), Expr::Flag(above));
     let name = prog.function(&ns.name("g_inv"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
         let up = Expr::State(u_prev.clone());
         let span = 2.0 * r_max + 1e-9 * (1.0 + up.clone().abs()) + f64::MIN_POSITIVE;
-        let args = vec![local("v"), up, span, unbounded.clone(), unbounded.clone()];
+        let args = vec![local("v"), up, span, below.clone(), above.clone()];
         let uk = b.let_("uk", Expr::Call(solve.clone(), args));
         b.for_("i", idx(0), idx(n), |b, i| {
             b.set_at(

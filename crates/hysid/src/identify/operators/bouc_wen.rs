@@ -28,6 +28,7 @@ use crate::model::operators::{BoucWen, LoopOrientation};
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
 use crate::Result;
+use nalgebra::DMatrix;
 
 /// Options of the Bouc–Wen fit.
 #[derive(Clone, Debug)]
@@ -163,6 +164,37 @@ impl DifferentialFamily for Family {
     }
     fn assemble(&self, p: &[f64], c: &[f64]) -> Option<Vec<f64>> {
         (c[1] * self.sign >= 0.0).then(|| vec![c[0], c[1], 1.0, p[0], p[1], p[2], 0.0])
+    }
+
+    const UNIT_FREE: bool = true;
+
+    /// With w = sᵤw′ (w has the input's units, A = 1): dw′/du′ = A − (β·sign + γ)sᵤⁿ|w′|ⁿ
+    /// and y/s_y = (k_x sᵤ/s_y)u′ + (k_w sᵤ/s_y)w′, so k_x = k_x′s_y/sᵤ, k_w = k_w′s_y/sᵤ,
+    /// β = β′sᵤ⁻ⁿ, γ = γ′sᵤ⁻ⁿ (∂β/∂n = −β ln sᵤ), w0 = w0′sᵤ; A and n are unit-free.
+    fn in_record_units(&self, t: &[f64], su: f64, sy: f64) -> Option<(Vec<f64>, DMatrix<f64>)> {
+        let n = t[5];
+        let shrink = su.powf(-n);
+        let theta = vec![
+            t[0] * sy / su,
+            t[1] * sy / su,
+            t[2],
+            t[3] * shrink,
+            t[4] * shrink,
+            n,
+            t[6] * su,
+        ];
+        let mut j = DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![
+            sy / su,
+            sy / su,
+            1.0,
+            shrink,
+            shrink,
+            1.0,
+            su,
+        ]));
+        j[(3, 5)] = -theta[3] * su.ln();
+        j[(4, 5)] = -theta[4] * su.ln();
+        Some((theta, j))
     }
 }
 

@@ -36,6 +36,7 @@ use crate::model::OperatorCascade;
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
 use crate::{Error, Result};
+use nalgebra::DMatrix;
 
 /// Options of the Dahl fit.
 #[derive(Clone, Debug)]
@@ -149,6 +150,15 @@ impl DifferentialFamily for Family {
     fn assemble(&self, p: &[f64], c: &[f64]) -> Option<Vec<f64>> {
         let fc = c[0];
         (fc > 0.0).then(|| vec![p[0] * fc, fc, p[1], p[2] * fc])
+    }
+
+    const UNIT_FREE: bool = true;
+
+    /// With x = sᵤx′, F = s_y F′: dF′/dx′ = (σsᵤ/s_y)(1 − (F′/F_c′)·sign)ⁱ, F_c′ = F_c/s_y, so
+    /// σ = σ′s_y/sᵤ, F_c = F_c′s_y, f0 = f0′s_y; i is unit-free (the sign flip of a
+    /// counter-clockwise loop leaves the magnitudes alone).
+    fn in_record_units(&self, t: &[f64], su: f64, sy: f64) -> Option<(Vec<f64>, DMatrix<f64>)> {
+        Some(driver::scaled_by(t, &[sy / su, sy, 1.0, sy]))
     }
 }
 

@@ -63,6 +63,14 @@
 //!    parameters at the optimum (Ljung 1999, §9.3), the simulated output, fit %, the
 //!    iterations and evaluations of every stage together.
 //!
+//! **Units.** A family whose parameters carry the record's units only through u and y
+//! ([`DifferentialFamily::in_record_units`]: Bouc–Wen, Duhem, Dahl) is fitted on the record in units of
+//! unit size, u′ = u/sᵤ and y′ = y/s_y with sᵤ, s_y the powers of two nearest the largest
+//! |u| and |y| (an exact shift of the binary exponent), and its parameters, their covariance
+//! (J C Jᵀ with J = ∂θ/∂θ′), the output and the declared history's turn return in the
+//! record's units: the search's tolerances, its damping and its flat-region test then see
+//! the same numbers whether a record is in V and µm or in kV and m.
+//!
 //! A family's search may run in coordinates φ other than the model's θ when that turns its
 //! domain into a box (Bouc–Wen: β + γ > 0, β − γ ≥ 0); the map is linear,
 //! [`DifferentialFamily::theta_of`] and [`DifferentialFamily::chain`].
@@ -253,6 +261,19 @@ pub trait DifferentialFamily: Sync {
     fn unfit_reason(&self, u: &[f64], y: &[f64]) -> String {
         let _ = (u, y);
         NO_START.into()
+    }
+    /// Whether the family's parameters carry units only through u and y, so that it is
+    /// fitted on the record in units of unit size and mapped back by
+    /// [`in_record_units`](Self::in_record_units) (module doc, "Units"). False (the
+    /// default): fitted in the record's own units (its parameters are physical, as
+    /// Jiles–Atherton's μ₀ ties B in T to H in A/m; or its search is unit-free already).
+    const UNIT_FREE: bool = false;
+    /// θ in the record's units of θ′ fitted on the record in units of unit size (u′ = u/`su`,
+    /// y′ = y/`sy`), with its Jacobian ∂θ/∂θ′; None where the family has no such map (the
+    /// default, with [`UNIT_FREE`](Self::UNIT_FREE) false).
+    fn in_record_units(&self, theta: &[f64], su: f64, sy: f64) -> Option<(Vec<f64>, DMatrix<f64>)> {
+        let _ = (theta, su, sy);
+        None
     }
 }
 
@@ -753,8 +774,85 @@ enum Start {
     History(InitialStateUsed),
 }
 
-/// Fits `family` to input `u` and output `y` (module doc).
+/// Fits `family` to input `u` and output `y` (module doc), in units of unit size where the
+/// family maps its parameters back ([`DifferentialFamily::in_record_units`]).
 pub fn fit<F: DifferentialFamily>(
+    family: &F,
+    u: &[f64],
+    y: &[f64],
+    settings: &Settings,
+) -> Result<OperatorFit<F::Model>> {
+    let (su, sy) = (unit_scale(u), unit_scale(y));
+    if !F::UNIT_FREE || (su, sy) == (1.0, 1.0) {
+        return fit_as_given(family, u, y, settings);
+    }
+    let scaled = |v: &[f64], s: f64| v.iter().map(|x| x / s).collect::<Vec<f64>>();
+    let fit = fit_as_given(family, &scaled(u, su), &scaled(y, sy), settings)?;
+    in_record_units(family, fit, su, sy)
+}
+
+/// The fit `fit` on the record in units of unit size (u/`su`, y/`sy`) in the record's units
+/// (module doc, "Units").
+fn in_record_units<F: DifferentialFamily>(
+    family: &F,
+    fit: OperatorFit<F::Model>,
+    su: f64,
+    sy: f64,
+) -> Result<OperatorFit<F::Model>> {
+    let scaled = fit.model.parameters().values();
+    let (theta, jacobian) = family
+        .in_record_units(&scaled, su, sy)
+        .ok_or_else(|| Error::Unsupported(format!("{}: no unit map", family.name())))?;
+    let model = family.model(&theta)?;
+    let p = theta.len();
+    let c = DMatrix::from_fn(p, p, |i, j| fit.covariance[i][j]);
+    let covariance = &jacobian * c * jacobian.transpose();
+    let std: Vec<Option<f64>> = (0..p)
+        .map(|i| fit.std[i].map(|_| covariance[(i, i)].max(0.0).sqrt()))
+        .collect();
+    let simulated: Vec<f64> = fit.simulated.iter().map(|v| v * sy).collect();
+    let loss = fit.loss * sy * sy;
+    let n = simulated.len();
+    let free = std.iter().filter(|s| s.is_some()).count();
+    Ok(OperatorFit {
+        parameters: model.parameters(),
+        model,
+        covariance: masked_covariance(&covariance, &std),
+        std,
+        simulated,
+        rmse: loss.sqrt(),
+        loss,
+        fpe: metrics::fpe(loss, n, free),
+        aic: metrics::aic(loss, n, free),
+        history_turn: fit.history_turn.map(|t| t * su),
+        ..fit
+    })
+}
+
+/// θᵢ = θ′ᵢ·fᵢ and its (diagonal) Jacobian: the [`DifferentialFamily::in_record_units`] of a
+/// family whose every parameter scales by a power of the units.
+pub(crate) fn scaled_by(theta: &[f64], factors: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
+    let values = theta.iter().zip(factors).map(|(t, f)| t * f).collect();
+    let jacobian = DMatrix::from_diagonal(&DVector::from_column_slice(factors));
+    (values, jacobian)
+}
+
+/// The power of two nearest the largest |v| (1 for a record of zeros): a scale that brings
+/// v to unit size exactly (a binary exponent shift, no rounding).
+pub(crate) fn unit_scale(v: &[f64]) -> f64 {
+    let largest = v
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    if largest > 0.0 && largest.is_finite() {
+        2f64.powi(largest.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
+
+/// [`fit`] in the record's own units.
+fn fit_as_given<F: DifferentialFamily>(
     family: &F,
     u: &[f64],
     y: &[f64],

@@ -22,6 +22,7 @@ use crate::model::operators::InitialState;
 use crate::numerics::levenberg_marquardt::LmConfig;
 use crate::numerics::Observer;
 use crate::Result;
+use nalgebra::DMatrix;
 
 /// Options of the Duhem fit.
 #[derive(Clone, Debug)]
@@ -110,6 +111,14 @@ impl DifferentialFamily for Family {
     }
     fn assemble(&self, p: &[f64], c: &[f64]) -> Option<Vec<f64>> {
         Some(vec![p[0], c[0], c[1], c[2], c[3]])
+    }
+
+    const UNIT_FREE: bool = true;
+
+    /// With u = sᵤu′, y = s_y y′: dy′ = αsᵤ|du′|((a sᵤ/s_y)u′ + b/s_y − y′) + (c sᵤ/s_y)du′, so
+    /// α = α′/sᵤ, a = a′s_y/sᵤ, b = b′s_y, c = c′s_y/sᵤ, y0 = y0′s_y.
+    fn in_record_units(&self, t: &[f64], su: f64, sy: f64) -> Option<(Vec<f64>, DMatrix<f64>)> {
+        Some(driver::scaled_by(t, &[1.0 / su, sy / su, sy, sy / su, sy]))
     }
 }
 

@@ -74,6 +74,66 @@ pub struct FamilyOptions {
     /// within the work bound) instead of `grid` (default true; false when `--grid` or
     /// `grid=` is given).
     pub choose_grid: bool,
+    /// The PI's static envelope (`--envelope`, Python `envelope=`; default
+    /// [`EnvelopeChoice::Auto`]).
+    pub envelope: EnvelopeChoice,
+}
+
+/// Whether a PI fit carries a monotone static envelope E(u) beside its plays
+/// (`model::operators::envelope`): `--envelope auto|none|cubic`, Python `envelope=`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EnvelopeChoice {
+    /// Chosen with the thresholds: every candidate size is tried without and with a cubic
+    /// envelope on the held-out part ([`FamilyOptions::choose_thresholds`]); with fixed
+    /// thresholds (`--thresholds N`, a grid) none, today's fixed recipe.
+    #[default]
+    Auto,
+    /// No envelope.
+    None,
+    /// A cubic envelope, whatever the thresholds.
+    Cubic,
+}
+
+impl EnvelopeChoice {
+    /// Every choice, in the order the help lists them.
+    pub const ALL: [EnvelopeChoice; 3] = [Self::Auto, Self::None, Self::Cubic];
+
+    /// The name on the command line and in Python.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Auto => "auto",
+            Self::None => "none",
+            Self::Cubic => "cubic",
+        }
+    }
+
+    /// The choice named `name`; the error lists them.
+    pub fn parse(name: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| {
+                Error::invalid_option(
+                    "envelope",
+                    name,
+                    "choose auto (chosen with the thresholds), none or cubic".into(),
+                )
+            })
+    }
+
+    /// The envelope variants a size choice tries: both under `auto`, else the one asked for.
+    pub fn variants(self) -> &'static [bool] {
+        match self {
+            Self::Auto => &[false, true],
+            Self::None => &[false],
+            Self::Cubic => &[true],
+        }
+    }
+
+    /// Whether a fit of fixed size carries an envelope (only under `cubic`).
+    pub fn fixed(self) -> bool {
+        self == Self::Cubic
+    }
 }
 
 /// The candidate threshold counts of [`FamilyOptions::choose_thresholds`].
@@ -95,6 +155,7 @@ impl Default for FamilyOptions {
             initial_state: InitialState::Estimate,
             choose_thresholds: true,
             choose_grid: true,
+            envelope: EnvelopeChoice::Auto,
         }
     }
 }
@@ -307,6 +368,8 @@ pub enum FamilySetting {
     DeadZones,
     /// [`FamilyOptions::orientation`].
     Orientation,
+    /// [`FamilyOptions::envelope`].
+    Envelope,
 }
 
 impl Family {
@@ -458,22 +521,11 @@ fn boxed<M: Into<OperatorModel>>(fit: OperatorFit<M>, u: &[f64]) -> OperatorFit<
     }
 }
 
-/// The power of two nearest the largest |v| (1 for a record of zeros): a scale that brings
-/// v to unit size exactly (a binary exponent shift, no rounding).
-fn unit_scale(v: &[f64]) -> f64 {
-    let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    if largest > 0.0 && largest.is_finite() {
-        2f64.powi(largest.log2().round() as i32)
-    } else {
-        1.0
-    }
-}
-
 /// The Coleman–Hodgdon hysteresis alone ([`HysteresisIdentification`]), its output starting
 /// at the measured first sample.
 ///
 /// The fit runs on the record in units of unit size, x' = x/sₓ and y' = y/s_y (powers of
-/// two, [`unit_scale`]), and the parameters return in the record's units: (D) is unchanged
+/// two, `differential_fit::unit_scale`), and the parameters return in the record's units: (D) is unchanged
 /// by α = α'/sₓ, m = m'·s_y/sₓ, c = c'·s_y/sₓ, d = d'·sₓ, so a record in kV and nm fits as
 /// the same record in V and µm does.
 fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<FittedModel>> {
@@ -481,7 +533,10 @@ fn coleman_hodgdon(form: ChForm, u: &[f64], y: &[f64]) -> Result<OperatorFit<Fit
     // Equal lengths, enough samples, an input that reverses (a loop, not a curve) — the
     // recipe itself accepts a monotone input, on which d and the loop are not identifiable.
     super::differential_fit::check_record(form.short_name(), u, y, form.n_params())?;
-    let (sx, sy) = (unit_scale(u), unit_scale(y));
+    let (sx, sy) = (
+        super::differential_fit::unit_scale(u),
+        super::differential_fit::unit_scale(y),
+    );
     let scaled = |v: &[f64], s: f64| v.iter().map(|x| x / s).collect::<Vec<f64>>();
     let data = IdData::siso(1.0, "u", scaled(u, sx), "y", scaled(y, sy))?;
     // the zoo's ch6 starts no worse than its nested ch4 (`better_start`)

@@ -206,9 +206,9 @@ impl Identify for GeneralizedPi {
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
             let extra = 2 + 2 * options.dead_zones;
-            return choose_thresholds(u, y, o, extra, request, |u, y, grid, start| {
+            return choose_thresholds(u, y, o, extra, &[false], request, |u, y, size, start| {
                 let settings = GpiOptions {
-                    grid: Some(grid.clone()),
+                    grid: Some(size.grid.clone()),
                     dead_zones: options.dead_zones,
                     orientation: Some(o),
                     initial_state: start.state,

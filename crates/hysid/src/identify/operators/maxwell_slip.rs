@@ -149,9 +149,9 @@ impl Identify for MaxwellSlip {
                 Some(o) => o,
                 None => detected_orientation(u, y)?,
             };
-            return choose_thresholds(u, y, o, 2, request, |u, y, w, start| {
+            return choose_thresholds(u, y, o, 2, &[false], request, |u, y, size, start| {
                 let settings = MaxwellSlipOptions {
-                    widths: Some(w.clone()),
+                    widths: Some(size.grid.clone()),
                     orientation: Some(o),
                     initial_state: start.state,
                     ..MaxwellSlipOptions::default()

@@ -28,8 +28,8 @@ use serde::Serialize;
 
 pub use compare::{compare, CompareOptions, CompareRow, Comparison, Split};
 pub use family::{
-    fit_operator, Family, FamilyOptions, FamilySetting, FittedOperator, OrientationSource,
-    OrientationUsed,
+    fit_operator, EnvelopeChoice, Family, FamilyOptions, FamilySetting, FittedOperator,
+    OrientationSource, OrientationUsed,
 };
 
 pub mod backlash;

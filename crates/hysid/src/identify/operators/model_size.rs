@@ -1,5 +1,6 @@
 //! The model size of the linear-in-weights families chosen from the data: threshold counts
-//! and placements (PI, generalised PI, Maxwell-slip) and the Preisach / KP grid.
+//! and placements (PI, generalised PI, Maxwell-slip), the PI's static envelope, and the
+//! Preisach / KP grid.
 //!
 //! **Rule.** Each candidate size is fitted on the first 70 % of the record
 //! ([`TRAINING_FRACTION`]), the fitted model simulates the whole record from its start, and
@@ -113,27 +114,42 @@ where
     )
 }
 
+/// A play family's candidate size: its thresholds, and whether it carries a static envelope
+/// (the PI's cubic, `model::operators::envelope`; the other play families have none).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct PlaySize {
+    /// The thresholds r₁ < … < rₙ.
+    pub grid: Vec<f64>,
+    /// A cubic static envelope beside the plays.
+    pub envelope: bool,
+}
+
+/// The parameters a static envelope adds to a candidate (a cubic's three slope values).
+const ENVELOPE_PARAMETERS: usize = crate::model::operators::envelope::CUBIC;
+
 /// The play and stop families' (PI, generalised PI, Maxwell-slip) choice of their
 /// thresholds: the candidates of [`threshold_candidates`] on the core's input
-/// `x`, each with `extra` parameters beside its weights, chosen by [`choose`] within
-/// [`PLAY_WORK_BOUND`] fits of the default ten
-/// thresholds; `fit` fits a threshold grid in the orientation `o`. The choice is recorded in
-/// the fit's `model_size`.
+/// `x`, each with `extra` parameters beside its weights and, for each entry of `envelopes`,
+/// without (false) or with (true) a static envelope, chosen by [`choose`] within
+/// [`PLAY_WORK_BOUND`] fits of the default ten thresholds per entry; `fit` fits a
+/// [`PlaySize`] in the orientation `o`. The choice is recorded in the fit's `model_size`.
 pub(crate) fn choose_thresholds<M, F>(
     u: &[f64],
     y: &[f64],
     o: Orientation,
     extra: usize,
+    envelopes: &[bool],
     request: InitialState,
     fit: F,
 ) -> Result<OperatorFit<M>>
 where
     M: HysteresisOperator,
-    F: Fn(&[f64], &[f64], &Vec<f64>, Fit<M>) -> Result<OperatorFit<M>>,
+    F: Fn(&[f64], &[f64], &PlaySize, Fit<M>) -> Result<OperatorFit<M>>,
 {
     let (x, _) = o.core_data(u, y);
-    let candidates = threshold_candidates(&x, extra)?;
-    choose(u, y, candidates, 10 + extra, PLAY_WORK_BOUND, request, fit)
+    let candidates = threshold_candidates(&x, extra, envelopes)?;
+    let bound = PLAY_WORK_BOUND * envelopes.len().max(1) as f64;
+    choose(u, y, candidates, 10 + extra, bound, request, fit)
 }
 
 /// The work bound of the threshold-count choice, in fits of the fixed default size
@@ -143,25 +159,37 @@ const PLAY_WORK_BOUND: f64 = 12.0;
 
 /// The candidate threshold grids of the count choice: every count of
 /// [`super::family::THRESHOLD_CANDIDATES`], uniform then geometric
-/// (the geometric one only where it differs), labelled `"n uniform"` / `"n geometric"`, with
-/// `extra` parameters beside the n weights.
-fn threshold_candidates(x: &[f64], extra: usize) -> Result<Vec<Candidate<Vec<f64>>>> {
+/// (the geometric one only where it differs), each once per entry of `envelopes`, labelled
+/// `"n uniform"` / `"n geometric"` (`"… + envelope"` with one), with `extra` parameters
+/// beside the n weights (and the envelope's).
+fn threshold_candidates(
+    x: &[f64],
+    extra: usize,
+    envelopes: &[bool],
+) -> Result<Vec<Candidate<PlaySize>>> {
     let mut out = Vec::new();
     for &n in &super::family::THRESHOLD_CANDIDATES {
         let uniform = threshold_grid(x, n)?;
         let geometric = geometric_thresholds(x, n)?;
-        let distinct = geometric != uniform;
-        out.push(Candidate {
-            setting: uniform,
-            label: format!("{n} uniform"),
-            parameters: n + extra,
-        });
-        if distinct {
-            out.push(Candidate {
-                setting: geometric,
-                label: format!("{n} geometric"),
-                parameters: n + extra,
-            });
+        let mut grids = vec![(uniform.clone(), "uniform")];
+        if geometric != uniform {
+            grids.push((geometric, "geometric"));
+        }
+        for &envelope in envelopes {
+            for (grid, placement) in &grids {
+                let (suffix, added) = match envelope {
+                    true => (" + envelope", ENVELOPE_PARAMETERS),
+                    false => ("", 0),
+                };
+                out.push(Candidate {
+                    setting: PlaySize {
+                        grid: grid.clone(),
+                        envelope,
+                    },
+                    label: format!("{n} {placement}{suffix}"),
+                    parameters: n + extra + added,
+                });
+            }
         }
     }
     Ok(out)

@@ -8,6 +8,13 @@
 //! a weight held at 0 has none. The count n can also be chosen by validation
 //! ([`PiOptions::select`]).
 //!
+//! With [`PiOptions::envelope`] the regression also has the d + 1 slope values of a monotone
+//! static envelope E(u) on the core input's range (`model::operators::envelope`, a cubic:
+//! three columns, each E for a unit slope vector), held ≥ 0 by the same NNLS, for a static
+//! curve the plays cannot follow (a saturating magnet). The envelope then takes the place of
+//! a₀u: the slope values sum the Bernstein basis to one, so a₀u + E(u) is E with every slope
+//! value raised by a₀ (and a constant), and a₀ would be undetermined; a₀ = 0 is fitted.
+//!
 //! A clockwise loop is fitted in the inverse parameterisation (u = G\[y\], thresholds over the
 //! output range) and Γ = G⁻¹ (Kuhnen 2003); the reported weights are then those of G.
 //!
@@ -26,7 +33,8 @@ use crate::identify::operator_cascade::{
     monotone_weights, OperatorCascadeIdentification, RANK_ONE,
 };
 use crate::model::operators::{
-    initial_state, play, validate_thresholds, InitialStateUsed, Orientation, PrandtlIshlinskii,
+    envelope, initial_state, play, validate_thresholds, Envelope, InitialStateUsed, Orientation,
+    PrandtlIshlinskii,
 };
 use crate::model::OperatorCascade;
 use crate::numerics::metrics;
@@ -48,6 +56,8 @@ pub struct PiOptions {
     /// The declared initial state the plays start from (None: from 0, demagnetised): the
     /// regressors run through its history first (`linear_support::core_path`).
     pub initial_state: Option<InitialStateUsed>,
+    /// Fit a cubic static envelope E(u) beside the plays (`model::operators::envelope`).
+    pub envelope: bool,
 }
 
 impl Default for PiOptions {
@@ -58,6 +68,7 @@ impl Default for PiOptions {
             orientation: None,
             select: None,
             initial_state: None,
+            envelope: false,
         }
     }
 }
@@ -79,29 +90,55 @@ pub fn fit(u: &[f64], y: &[f64], options: &PiOptions) -> Result<OperatorFit<Pran
         None => threshold_grid(&x, options.thresholds)?,
     };
     validate_thresholds("r", &grid)?;
-    check_data(u, y, grid.len() + 2)?;
+    let shape = match options.envelope {
+        true => Envelope::over(&x, envelope::CUBIC),
+        false => None,
+    };
+    let d = shape.as_ref().map_or(0, |e| e.slopes().len());
+    check_data(u, y, grid.len() + 2 + d)?;
     let reach = 2.0 * grid.last().copied().unwrap_or(0.0);
     let (path, skip) = core_path(options.initial_state, &x, reach);
-    let mut columns = Vec::with_capacity(grid.len() + 2);
-    columns.push(x.clone());
+    let mut columns = Vec::with_capacity(grid.len() + 2 + d);
+    // a₀'s column, or with an envelope (which holds a₀u) a zero one: a₀ = 0
+    columns.push(match shape {
+        Some(_) => vec![0.0; x.len()],
+        None => x.clone(),
+    });
     columns.extend(grid.iter().map(|&r| play(&path, r).split_off(skip)));
+    if let Some(e) = &shape {
+        columns.extend(e.columns(&x));
+    }
     columns.push(vec![1.0; x.len()]);
     let (g, b, yy, n) = GramAccumulator::from_columns(&columns, &v);
     let mut unconstrained = vec![false; columns.len()];
     unconstrained[columns.len() - 1] = true;
     let sol = solve_weights(&g, &b, yy, n, &unconstrained, None)?;
     let m = grid.len();
-    let model = PrandtlIshlinskii::new(sol.x[0], sol.x[1..=m].to_vec(), grid, sol.x[m + 1], o)
-        .map_err(|e| Error::NotExciting {
-            channel: "u".into(),
-            reason: format!("no monotone PI operator fits these data ({e})"),
-        })?;
-    // (a0, w₁…w_m, r₁…r_m, c): the thresholds are given, not estimated.
+    let fitted_envelope = shape
+        .map(|e| e.with_slopes(sol.x[m + 1..m + 1 + d].iter().map(|c| c.max(0.0)).collect()))
+        .transpose()?;
+    let model = PrandtlIshlinskii::with_static_envelope(
+        sol.x[0],
+        sol.x[1..=m].to_vec(),
+        grid,
+        sol.x[m + 1 + d],
+        o,
+        fitted_envelope,
+    )
+    .map_err(|e| Error::NotExciting {
+        channel: "u".into(),
+        reason: format!("no monotone PI operator fits these data ({e})"),
+    })?;
+    // (a0, w₁…w_m, r₁…r_m, c[, e₀…e_d, e_lo, e_hi]): the thresholds and the envelope's range
+    // are given, not estimated.
     let map = unscaled(
-        (0..=m)
-            .map(Some)
+        [(d == 0).then_some(0)]
+            .into_iter()
+            .chain((1..=m).map(Some))
             .chain(std::iter::repeat_n(None, m))
-            .chain([Some(m + 1)]),
+            .chain([Some(m + 1 + d)])
+            .chain((m + 1..m + 1 + d).map(Some))
+            .chain(std::iter::repeat_n(None, if d > 0 { 2 } else { 0 })),
     );
     Ok(finish(
         model,
@@ -168,22 +205,26 @@ impl Identify for PrandtlIshlinskii {
         FamilySetting::Thresholds,
         FamilySetting::ThresholdGrid,
         FamilySetting::Orientation,
+        FamilySetting::Envelope,
     ];
 
     /// With [`FamilyOptions::choose_thresholds`] (and no explicit grid) the count and the
-    /// placement (uniform or geometric, `linear_support::geometric_thresholds`) are chosen on a held-out part
-    /// ([`model_size`](super::model_size)); otherwise the `thresholds` uniform grid or the
-    /// given one.
+    /// placement (uniform or geometric, `linear_support::geometric_thresholds`) and, under
+    /// [`EnvelopeChoice::Auto`](super::family::EnvelopeChoice), the static envelope are chosen
+    /// on a held-out part ([`model_size`](super::model_size)); otherwise the `thresholds`
+    /// uniform grid or the given one, with an envelope only when one is asked for.
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         let given = options.given_orientation(u, y)?;
         let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
-            return choose_thresholds(u, y, o, 2, request, |u, y, grid, start| {
+            let envelopes = options.envelope.variants();
+            return choose_thresholds(u, y, o, 2, envelopes, request, |u, y, size, start| {
                 let settings = PiOptions {
-                    grid: Some(grid.clone()),
+                    grid: Some(size.grid.clone()),
                     orientation: Some(o),
                     initial_state: start.state,
+                    envelope: size.envelope,
                     ..PiOptions::default()
                 };
                 fit(u, y, &settings)
@@ -196,6 +237,7 @@ impl Identify for PrandtlIshlinskii {
                 orientation: given,
                 select: None,
                 initial_state: start.state,
+                envelope: options.envelope.fixed(),
             };
             fit(u, y, &settings)
         })

@@ -53,6 +53,7 @@ pub mod dahl;
 pub mod differential;
 pub mod duhem;
 pub(crate) mod elementary;
+pub mod envelope;
 pub(crate) mod gpi;
 pub mod initial_state;
 pub mod jiles_atherton;
@@ -73,6 +74,7 @@ pub use duhem::Duhem;
 pub use elementary::{
     play, play_step, solve_monotone, stop, validate_thresholds, Branch, Orientation,
 };
+pub use envelope::Envelope;
 pub use gpi::{DeadZones, GeneralizedPi};
 pub use initial_state::{InitialState, InitialStateUsed};
 pub use jiles_atherton::{Anhysteretic, JaOutput, JilesAtherton};

@@ -12,6 +12,11 @@
 //! tail) the inverse is the exact per-sample solve of the piecewise-linear branch and
 //! references beyond a saturation level are clipped.
 //!
+//! **Static envelope.** G may carry a monotone static term E(u) ([`super::envelope`]):
+//! G[u] = c + a₀u + E(u) + Σ aᵢ F_{rᵢ}[u], for a static curve the plays cannot follow (a
+//! saturating magnet). G then has no PI-shaped inverse; its inverse is the per-sample solve,
+//! unbounded on a side where the final slope âₙ plus E's end slope there is > 0.
+//!
 //! References: M. Brokate, J. Sprekels, *Hysteresis and Phase Transitions*, Springer 1996;
 //! P. Krejčí, K. Kuhnen, "Inverse control of systems with hysteresis and creep", IEE Proc.
 //! Control Theory Appl. 148 (2001) 185–192; K. Kuhnen, "Modeling, identification and
@@ -22,6 +27,7 @@ use super::elementary::{
     check_finite, oriented_invert, oriented_simulate, play_step, solve_monotone,
     validate_thresholds, Branch, Core, Orientation,
 };
+use super::envelope::Envelope;
 use super::{HysteresisOperator, Inversion};
 use crate::model::{Parameter, ParameterSet};
 use crate::{Error, Result};
@@ -35,6 +41,9 @@ pub struct PrandtlIshlinskii {
     thresholds: Vec<f64>,
     offset: f64,
     orientation: Orientation,
+    /// The static envelope E(u), if any (absent from files without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    envelope: Option<Envelope>,
 }
 
 impl PrandtlIshlinskii {
@@ -47,6 +56,20 @@ impl PrandtlIshlinskii {
         thresholds: Vec<f64>,
         offset: f64,
         orientation: Orientation,
+    ) -> Result<Self> {
+        Self::with_static_envelope(a0, weights, thresholds, offset, orientation, None)
+    }
+
+    /// A PI operator as [`PrandtlIshlinskii::new`] with the static envelope `envelope` added
+    /// to G (`model::operators::envelope`); the plays' weights may then all be zero if the
+    /// envelope has a positive slope value.
+    pub fn with_static_envelope(
+        a0: f64,
+        weights: Vec<f64>,
+        thresholds: Vec<f64>,
+        offset: f64,
+        orientation: Orientation,
+        envelope: Option<Envelope>,
     ) -> Result<Self> {
         check_finite("a0", a0)?;
         check_finite("c", offset)?;
@@ -79,7 +102,10 @@ impl PrandtlIshlinskii {
                 });
             }
         }
-        if a0 == 0.0 && weights.iter().all(|&a| a == 0.0) {
+        let sloped = envelope
+            .as_ref()
+            .is_some_and(|e| e.slopes().iter().any(|&c| c > 0.0));
+        if a0 == 0.0 && weights.iter().all(|&a| a == 0.0) && !sloped {
             return Err(Error::InvalidParameter {
                 name: "a0".into(),
                 value: 0.0,
@@ -92,7 +118,13 @@ impl PrandtlIshlinskii {
             thresholds,
             offset,
             orientation,
+            envelope,
         })
+    }
+
+    /// The static envelope E(u) of G, if any.
+    pub fn envelope(&self) -> Option<&Envelope> {
+        self.envelope.as_ref()
     }
 
     /// a₀, the weight of the input itself (the play of threshold 0).
@@ -117,9 +149,9 @@ impl PrandtlIshlinskii {
     }
 
     /// The analytic inverse's parameters (b₀, [b₁ … bₙ], [s₁ … sₙ]) of Krejčí & Kuhnen (2001),
-    /// or None when some âᵢ = a₀ + … + aᵢ is not > 0.
+    /// or None when some âᵢ = a₀ + … + aᵢ is not > 0 or G has a static envelope.
     pub fn inverse_parameters(&self) -> Option<(f64, Vec<f64>, Vec<f64>)> {
-        if self.a0 <= 0.0 {
+        if self.a0 <= 0.0 || self.envelope.is_some() {
             return None;
         }
         let n = self.weights.len();
@@ -147,10 +179,29 @@ impl PrandtlIshlinskii {
         self.a0 + self.weights.iter().sum::<f64>()
     }
 
+    /// Whether G grows without bound as u → −∞ and as u → +∞: its final slope plus the
+    /// envelope's end slope on that side is > 0.
+    pub fn unbounded(&self) -> (bool, bool) {
+        let (below, above) = self
+            .envelope
+            .as_ref()
+            .map_or((0.0, 0.0), Envelope::end_slopes);
+        let slope = self.final_slope();
+        (slope + below > 0.0, slope + above > 0.0)
+    }
+
+    /// c + a₀u + E(u), the static part of G (summed in that order).
+    fn static_part(&self, u: f64) -> f64 {
+        let y = self.offset + self.a0 * u;
+        match &self.envelope {
+            Some(e) => y + e.value(u),
+            None => y,
+        }
+    }
+
     /// G's output for input `u` from play states `z` (not updated).
     fn branch(&self, z: &[f64], u: f64) -> f64 {
-        self.offset
-            + self.a0 * u
+        self.static_part(u)
             + self
                 .weights
                 .iter()
@@ -199,9 +250,9 @@ impl Core for PrandtlIshlinskii {
         vec![0.0; self.weights.len()]
     }
 
-    /// y = (c + a₀u) + a₁z₁ + … + aₙzₙ, summed in that order.
+    /// y = (c + a₀u + E(u)) + a₁z₁ + … + aₙzₙ, summed in that order.
     fn forward_step(&self, z: &mut Vec<f64>, u: f64) -> f64 {
-        let mut y = self.offset + self.a0 * u;
+        let mut y = self.static_part(u);
         for ((zi, a), &r) in z.iter_mut().zip(&self.weights).zip(&self.thresholds) {
             *zi = play_step(*zi, u, r);
             y += a * *zi;
@@ -232,12 +283,12 @@ impl Core for PrandtlIshlinskii {
             }
             PiBackward::Numerical { z, u_prev } => {
                 let r_max = self.thresholds.last().copied().unwrap_or(0.0);
-                let unbounded = self.final_slope() > 0.0;
+                let (unbounded_below, unbounded_above) = self.unbounded();
                 let branch = Branch {
                     center: *u_prev,
                     span: 2.0 * r_max + 1e-9 * (1.0 + u_prev.abs()) + f64::MIN_POSITIVE,
-                    unbounded_below: unbounded,
-                    unbounded_above: unbounded,
+                    unbounded_below,
+                    unbounded_above,
                 };
                 let (u, clipped) = solve_monotone(|x| self.branch(z, x), v, branch);
                 for (zi, r) in z.iter_mut().zip(&self.thresholds) {
@@ -255,15 +306,26 @@ impl HysteresisOperator for PrandtlIshlinskii {
         <Self as super::OperatorFamily>::NAME
     }
 
+    /// `a0, a1…an, r1…rn (fixed), c`, then with an envelope `e0…ed, e_lo, e_hi (fixed)`.
     fn parameters(&self) -> ParameterSet {
-        pi_parameters(
+        let base = pi_parameters(
             self.a0,
             &self.weights,
             &self.thresholds,
             self.offset,
             "a",
             "r",
-        )
+        );
+        let Some(e) = &self.envelope else {
+            return base;
+        };
+        let mut p: Vec<Parameter> = base.iter().cloned().collect();
+        for (j, &c) in e.slopes().iter().enumerate() {
+            p.push(Parameter::new(format!("e{j}"), c).bounds(0.0, f64::INFINITY));
+        }
+        p.push(Parameter::new("e_lo", e.lo()).fixed(true));
+        p.push(Parameter::new("e_hi", e.hi()).fixed(true));
+        ParameterSet::new(p).unwrap_or_default()
     }
 
     fn simulate(&self, u: &[f64]) -> Result<Vec<f64>> {
@@ -314,32 +376,69 @@ impl super::OperatorFamily for PrandtlIshlinskii {
         )
     }
 
+    /// The example with a saturating static envelope on [−1, 1] (slope values 0.1, 0.8,
+    /// 0.05: steep in the middle, flat at the ends).
+    fn variants() -> Result<Vec<(&'static str, Self)>> {
+        let example = Self::example()?;
+        let envelope = Envelope::new(-1.0, 1.0, vec![0.1, 0.8, 0.05])?;
+        let enveloped = Self::with_static_envelope(
+            example.a0,
+            example.weights,
+            example.thresholds,
+            example.offset,
+            example.orientation,
+            Some(envelope),
+        )?;
+        Ok(vec![("envelope", enveloped)])
+    }
+
     fn checked(self) -> Result<Self> {
-        Self::new(
-            self.a0(),
-            self.weights().to_vec(),
-            self.thresholds().to_vec(),
-            self.offset(),
-            self.orientation(),
+        Self::with_static_envelope(
+            self.a0,
+            self.weights,
+            self.thresholds,
+            self.offset,
+            self.orientation,
+            self.envelope,
         )
     }
 
-    /// Values a0, a1 … an, r1 … rn, c.
+    /// Values a0, a1 … an, r1 … rn, c, then with an envelope e0 … ed, e_lo, e_hi.
     fn with_values(&self, values: &[f64]) -> Result<Self> {
         super::check_values(self, values)?;
         let n = self.weights().len();
-        Self::new(
+        let envelope = match &self.envelope {
+            Some(e) => {
+                let d = e.slopes().len();
+                let at = 2 * n + 2;
+                Some(Envelope::new(
+                    values[at + d],
+                    values[at + d + 1],
+                    values[at..at + d].to_vec(),
+                )?)
+            }
+            None => None,
+        };
+        Self::with_static_envelope(
             values[0],
             values[1..=n].to_vec(),
             values[n + 1..=2 * n].to_vec(),
             values[2 * n + 1],
             self.orientation(),
+            envelope,
         )
     }
 
-    /// a0 … an and c (not for the inverse-operator parameterisation).
+    /// a0 … an, c and the envelope's slope values (not for the inverse-operator
+    /// parameterisation).
     fn output_scale(&self) -> Option<Vec<usize>> {
         let n = self.weights().len();
-        (!self.orientation().inverse).then(|| (0..=n).chain([2 * n + 1]).collect())
+        let d = self.envelope.as_ref().map_or(0, |e| e.slopes().len());
+        (!self.orientation().inverse).then(|| {
+            (0..=n)
+                .chain([2 * n + 1])
+                .chain(2 * n + 2..2 * n + 2 + d)
+                .collect()
+        })
     }
 }

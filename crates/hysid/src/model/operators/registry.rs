@@ -36,6 +36,15 @@ pub trait OperatorFamily:
     /// checks): an input range of about ±1.
     fn example() -> Result<Self>;
 
+    /// Further small valid operators of the family, one per structure its [`example`] does
+    /// not show, each with a short name (a PI with a static envelope: `"envelope"`); the
+    /// registry-wide checks and the export checks run them too.
+    ///
+    /// [`example`]: OperatorFamily::example
+    fn variants() -> Result<Vec<(&'static str, Self)>> {
+        Ok(Vec::new())
+    }
+
     /// The same operator rebuilt through the family's validating constructor: what a model
     /// file read back must pass (a non-monotone grid, a negative weight, β ≤ 0, … are refused).
     fn checked(self) -> Result<Self>;
@@ -178,6 +187,17 @@ macro_rules! define_registry {
             /// [`OperatorFamily::example`] of every family, in the registry's order.
             pub fn examples() -> Result<Vec<Self>> {
                 Ok(vec![$(Self::$variant(<$ty as OperatorFamily>::example()?),)*])
+            }
+
+            /// [`OperatorFamily::variants`] of every family, in the registry's order.
+            pub fn variants() -> Result<Vec<(&'static str, Self)>> {
+                let mut out = Vec::new();
+                $(out.extend(
+                    <$ty as OperatorFamily>::variants()?
+                        .into_iter()
+                        .map(|(name, m)| (name, Self::$variant(m))),
+                );)*
+                Ok(out)
             }
 
             /// See [`OperatorFamily::output_scale`].

@@ -206,3 +206,145 @@ fn dense_pi_on_a_preisach_loop() {
         );
     }
 }
+
+/// A PI with a saturating static envelope on the record's own range, fitted on its own
+/// thresholds with an envelope: the weights, the offset and the envelope's slope values come
+/// back (a round trip with known parameters), in both orientations. The fit holds a₀u in the
+/// envelope (a₀ = 0, every slope value raised by the plant's a₀: the same operator).
+#[test]
+fn recovers_an_envelope_both_orientations() {
+    use hysid::model::operators::Envelope;
+    let u = input(4000);
+    for o in [Orientation::COUNTER_CLOCKWISE, Orientation::CLOCKWISE] {
+        let plays = truth(&u, o);
+        // the core's input is u counter-clockwise and G's output clockwise: the envelope
+        // lives on the range the fit sees (G's input)
+        let core_input = match o.inverse {
+            false => u.clone(),
+            true => truth(&u, Orientation::COUNTER_CLOCKWISE)
+                .simulate(&u)
+                .unwrap(),
+        };
+        let lo = core_input.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = core_input.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let slopes = vec![0.2, 1.4, 0.05];
+        let t = PrandtlIshlinskii::with_static_envelope(
+            plays.a0(),
+            plays.weights().to_vec(),
+            plays.thresholds().to_vec(),
+            plays.offset(),
+            o,
+            Some(Envelope::new(lo, hi, slopes.clone()).unwrap()),
+        )
+        .unwrap();
+        let x = match o.inverse {
+            // Γ = G⁻¹: feed G's outputs of the counter-clockwise form so that the core's
+            // input covers [lo, hi]
+            false => u.clone(),
+            true => {
+                let ccw = PrandtlIshlinskii::with_static_envelope(
+                    plays.a0(),
+                    plays.weights().to_vec(),
+                    plays.thresholds().to_vec(),
+                    plays.offset(),
+                    Orientation::COUNTER_CLOCKWISE,
+                    Some(Envelope::new(lo, hi, slopes.clone()).unwrap()),
+                )
+                .unwrap();
+                ccw.simulate(&core_input).unwrap()
+            }
+        };
+        let y = t.simulate(&x).unwrap();
+        let opts = PiOptions {
+            grid: Some(t.thresholds().to_vec()),
+            orientation: Some(o),
+            envelope: true,
+            ..PiOptions::default()
+        };
+        let f = fit(&x, &y, &opts).unwrap();
+        let e = f.model.envelope().expect("an envelope was asked for");
+        assert_eq!(
+            (e.lo(), e.hi()),
+            (lo, hi),
+            "{o:?}: the range is the core input's"
+        );
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1.0);
+        for (a, b) in e.slopes().iter().zip(&slopes) {
+            let b = b + t.a0();
+            assert!(rel(*a, b) < 1e-6, "{o:?}: slope value {a} vs {b}");
+        }
+        assert_eq!(f.model.a0(), 0.0);
+        for (a, b) in f.model.weights().iter().zip(t.weights()) {
+            assert!(rel(*a, *b) < 1e-6, "{o:?}: {a} vs {b}");
+        }
+        // a₀u = a₀(u − lo) + a₀lo: the offset takes a₀lo
+        let offset = t.offset() + t.a0() * lo;
+        assert!(rel(f.model.offset(), offset) < 1e-6, "{o:?}: offset");
+        assert!(f.fit_percent > 99.9999, "{o:?}: {}", f.fit_percent);
+        // parameters a0, a1…a6, r1…r6, c, e0…e2, e_lo, e_hi; the range has no σ
+        let names = f.parameters.names();
+        assert_eq!(&names[14..], ["e0", "e1", "e2", "e_lo", "e_hi"]);
+        assert!(f.std[14].is_some() && f.std[17].is_none() && f.std[18].is_none());
+        assert!(f.std[0].is_none(), "a0 is not estimated beside an envelope");
+    }
+}
+
+/// By default the envelope is a candidate of the size choice: on a saturating record it is
+/// chosen and fits what the plays alone cannot; `none` keeps the plays alone, `cubic` with
+/// fixed thresholds adds it to today's fixed grid.
+#[test]
+fn the_default_fit_chooses_an_envelope_where_the_plays_cannot_follow() {
+    use hysid::identify::operators::{fit_operator, EnvelopeChoice, Family, FamilyOptions};
+    let u = input(3000);
+    let grid = threshold_grid(&u, 6).unwrap();
+    let x = PrandtlIshlinskii::new(
+        1.0,
+        vec![0.4, 0.3, 0.2, 0.0, 0.0, 0.0],
+        grid,
+        0.0,
+        Orientation::default(),
+    )
+    .unwrap()
+    .simulate(&u)
+    .unwrap();
+    // the plays beside a saturating static curve of the input (a magnet's yoke)
+    let y: Vec<f64> = x
+        .iter()
+        .zip(&u)
+        .map(|(p, v)| 0.3 * p + 10.0 * ((v - 2.0) / 2.5).tanh())
+        .collect();
+    let fitted = |envelope, choose| {
+        let options = FamilyOptions {
+            envelope,
+            choose_thresholds: choose,
+            ..FamilyOptions::default()
+        };
+        fit_operator(Family::Pi, &u, &y, &options).unwrap()
+    };
+    let auto = fitted(EnvelopeChoice::Auto, true);
+    let none = fitted(EnvelopeChoice::None, true);
+    let size = auto.fit.model_size.clone().unwrap();
+    println!(
+        "auto: {} {:.3} %, none: {:.3} %",
+        size.chosen, auto.fit.fit_percent, none.fit.fit_percent
+    );
+    assert!(size.chosen.ends_with("+ envelope"), "{size:?}");
+    assert!(size.candidates.iter().any(|c| !c.size.contains("envelope")));
+    // a cubic follows this tanh (to 0.89 of its saturation) to about 1 %
+    assert!(auto.fit.fit_percent > 98.5, "{}", auto.fit.fit_percent);
+    assert!(auto.fit.fit_percent > none.fit.fit_percent + 3.0);
+    let none_size = none.fit.model_size.clone().unwrap();
+    assert!(none_size
+        .candidates
+        .iter()
+        .all(|c| !c.size.contains("envelope")));
+    let names = |f: &hysid::identify::operators::FittedOperator| f.fit.parameters.names();
+    assert!(!names(&none).iter().any(|n| n == "e0"));
+    // fixed thresholds: auto keeps today's recipe, cubic adds the envelope to it
+    assert!(!names(&fitted(EnvelopeChoice::Auto, false))
+        .iter()
+        .any(|n| n == "e0"));
+    assert!(names(&fitted(EnvelopeChoice::Cubic, false))
+        .iter()
+        .any(|n| n == "e0"));
+}

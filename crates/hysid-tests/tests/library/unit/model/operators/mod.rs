@@ -6,6 +6,7 @@ mod dahl;
 mod differential;
 mod duhem;
 mod elementary;
+mod envelope;
 mod gpi;
 mod initial_state;
 mod jiles_atherton;
