@@ -30,7 +30,11 @@
 //!    sensitivities, at most 200 iterations each. **The race:** a search still above
 //!    [`RACE_FACTOR`] times the best grid start's criterion, or above [`LINE_FACTOR`]² times
 //!    a least-squares straight line's, after [`RACE_ITERATIONS`] iterations gives up (it is
-//!    not heading for the minimum the fit keeps). **The line check:** when the best search
+//!    not heading for the minimum the fit keeps); a search whose criterion fell by less than
+//!    [`STALL_DECREASE`] over its last [`STALL_WINDOW`] iterations has stalled in a valley
+//!    and stops there (the refinement takes the best point on: on the real piezo record's
+//!    60 % part Jiles–Atherton went from 622 to 267 iterations, one ferrite loop's Bouc–Wen
+//!    from 2 106 to 512, every fit % the same to 10⁻³ points). **The line check:** when the best search
 //!    (run to its end or given up so) leaves residuals [`LINE_FACTOR`] times the line's, the
 //!    record is a loop the family cannot follow (its structure turns the other way,
 //!    its saturation cannot take the record's shape): the fit stops there with that reason
@@ -146,6 +150,12 @@ pub const RACE_ITERATIONS: usize = 10;
 /// multiple of the best grid start's (or above [`LINE_FACTOR`]² times a straight line's)
 /// gives up: it is not heading for the minimum the fit keeps.
 pub const RACE_FACTOR: f64 = 4.0;
+/// A local search whose criterion fell by less than [`STALL_DECREASE`] (relative) over its
+/// last `STALL_WINDOW` iterations has stalled in a valley: it stops there (the refinement
+/// on the full record takes the best such point on).
+pub const STALL_WINDOW: usize = 30;
+/// See [`STALL_WINDOW`].
+pub const STALL_DECREASE: f64 = 1e-3;
 /// Shape points of the grid scored from the descending and ascending states too when the
 /// initial state is estimated: the best ones from the family's own start.
 pub const HISTORY_POINTS: usize = 12;
@@ -675,6 +685,7 @@ impl<F: DifferentialFamily> Driver<'_, F> {
     ) -> Result<Run> {
         let mut stopped = false;
         let observer = &self.settings.observer;
+        let mut costs: Vec<f64> = Vec::new();
         let report = minimize(
             problem,
             &self.clamp(phi),
@@ -686,6 +697,12 @@ impl<F: DifferentialFamily> Driver<'_, F> {
                 let c = observer.report("iteration", r.iteration, config.max_iterations);
                 stopped |= c == Control::Stop;
                 if r.iteration >= RACE_ITERATIONS && r.cost > ceiling {
+                    return Control::Stop;
+                }
+                costs.push(r.cost);
+                let stalled = costs.len() > STALL_WINDOW
+                    && r.cost > costs[costs.len() - 1 - STALL_WINDOW] * (1.0 - STALL_DECREASE);
+                if stalled {
                     return Control::Stop;
                 }
                 c

@@ -383,3 +383,22 @@ fn a_flat_region_is_not_convergence() {
     let code = serde_json::to_value(&t).unwrap();
     assert_eq!(code["code"], "flat_region");
 }
+
+/// A local search that stalls in a valley (its criterion down by less than 0.1 % over 30
+/// iterations, `STALL_WINDOW`) stops there instead of running to its iteration limit; the
+/// refinement on the full record takes the best point on. On the vendored piezo record
+/// Jiles–Atherton took 575 iterations before the rule and takes 201 now, to the same fit
+/// (96.983 %); Bouc–Wen 1200 → 835 (98.6935 → 98.6933 %).
+#[test]
+fn a_stalled_local_search_stops_instead_of_grinding() {
+    use crate::unit::test_signals::piezo_record;
+    use hysid::identify::operators::{fit_operator, Family, FamilyOptions};
+    let (u, y) = piezo_record();
+    let fitted = fit_operator(Family::JilesAtherton, &u, &y, &FamilyOptions::default()).unwrap();
+    println!(
+        "jiles-atherton: {} iterations, fit {:.4} %",
+        fitted.fit.iterations, fitted.fit.fit_percent
+    );
+    assert!(fitted.fit.iterations <= 300, "{}", fitted.fit.iterations);
+    assert!(fitted.fit.fit_percent > 96.98, "{}", fitted.fit.fit_percent);
+}
