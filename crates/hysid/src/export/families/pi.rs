@@ -155,12 +155,18 @@ fn emit_numerical_inverse(
         b.ret(static_part(pi, &envelope, local("x")) + sum);
     })?;
     let solve = solve::emit(prog, ns, &branch)?;
-    let r_max = pi.thresholds().last().copied().unwrap_or(0.0);
+    let plays = 2.0 * pi.thresholds().last().copied().unwrap_or(0.0);
+    let range = pi.envelope().map(|e| (e.lo(), e.hi()));
     let (below, above) = pi.unbounded();
     let (below, above) = (Expr::Flag(below), Expr::Flag(above));
     let name = prog.function(&ns.name("g_inv"), &[("v", Ty::F64)], Some(Ty::F64), |b| {
         let up = Expr::State(u_prev.clone());
-        let span = 2.0 * r_max + 1e-9 * (1.0 + up.clone().abs()) + f64::MIN_POSITIVE;
+        // `solve_reach`: 2rₙ, with an envelope max(2rₙ, hi − u_prev, u_prev − lo)
+        let reach = match range {
+            Some((lo, hi)) => lit(plays).max(lit(hi) - up.clone()).max(up.clone() - lo),
+            None => lit(plays),
+        };
+        let span = reach + 1e-9 * (1.0 + up.clone().abs()) + f64::MIN_POSITIVE;
         let args = vec![local("v"), up, span, below.clone(), above.clone()];
         let uk = b.let_("uk", Expr::Call(solve.clone(), args));
         b.for_("i", idx(0), idx(n), |b, i| {

@@ -33,8 +33,8 @@
 //!    not heading for the minimum the fit keeps); a search whose criterion fell by less than
 //!    [`STALL_DECREASE`] over its last [`STALL_WINDOW`] iterations has stalled in a valley
 //!    and stops there (the refinement takes the best point on: on the real piezo record's
-//!    60 % part Jiles–Atherton went from 622 to 267 iterations, one ferrite loop's Bouc–Wen
-//!    from 2 106 to 512, every fit % the same to 10⁻³ points). **The line check:** when the best search
+//!    60 % part Jiles–Atherton went from 622 to 385 iterations, one ferrite loop's Bouc–Wen
+//!    from 2 106 to 594, every fit % the same to 10⁻³ points). **The line check:** when the best search
 //!    (run to its end or given up so) leaves residuals [`LINE_FACTOR`] times the line's, the
 //!    record is a loop the family cannot follow (its structure turns the other way,
 //!    its saturation cannot take the record's shape): the fit stops there with that reason
@@ -670,18 +670,31 @@ impl<F: DifferentialFamily> Driver<'_, F> {
     }
 
     fn run(&self, problem: &OutputError<'_, F>, phi: &[f64], config: &LmConfig) -> Result<Run> {
-        self.run_raced(problem, phi, config, f64::INFINITY)
+        self.search(problem, phi, config, None)
     }
 
     /// [`Driver::run`] that gives up after [`RACE_ITERATIONS`] iterations when its criterion
-    /// is still above `ceiling` (the race of the local searches, module doc stage 3); the
-    /// observer's stop alone sets [`Run::stopped`].
+    /// is still above `ceiling`, or when it stalls ([`STALL_WINDOW`]): the race of the local
+    /// searches (module doc stage 3).
     fn run_raced(
         &self,
         problem: &OutputError<'_, F>,
         phi: &[f64],
         config: &LmConfig,
         ceiling: f64,
+    ) -> Result<Run> {
+        self.search(problem, phi, config, Some(ceiling))
+    }
+
+    /// One Levenberg–Marquardt search from `phi`, raced against `ceiling` and stopped when
+    /// it stalls where one is given (the local searches), else run to its own termination
+    /// (the refinements); the observer's stop alone sets [`Run::stopped`].
+    fn search(
+        &self,
+        problem: &OutputError<'_, F>,
+        phi: &[f64],
+        config: &LmConfig,
+        race: Option<f64>,
     ) -> Result<Run> {
         let mut stopped = false;
         let observer = &self.settings.observer;
@@ -696,6 +709,9 @@ impl<F: DifferentialFamily> Driver<'_, F> {
             &mut |r| {
                 let c = observer.report("iteration", r.iteration, config.max_iterations);
                 stopped |= c == Control::Stop;
+                let Some(ceiling) = race else {
+                    return c;
+                };
                 if r.iteration >= RACE_ITERATIONS && r.cost > ceiling {
                     return Control::Stop;
                 }
@@ -829,8 +845,7 @@ fn in_record_units<F: DifferentialFamily>(
         .collect();
     let simulated: Vec<f64> = fit.simulated.iter().map(|v| v * sy).collect();
     let loss = fit.loss * sy * sy;
-    let n = simulated.len();
-    let free = std.iter().filter(|s| s.is_some()).count();
+    let n = simulated.len() as f64;
     Ok(OperatorFit {
         parameters: model.parameters(),
         model,
@@ -839,8 +854,9 @@ fn in_record_units<F: DifferentialFamily>(
         simulated,
         rmse: loss.sqrt(),
         loss,
-        fpe: metrics::fpe(loss, n, free),
-        aic: metrics::aic(loss, n, free),
+        // both scale with the loss: FPE by s_y², AIC = N ln V + … by N ln s_y²
+        fpe: fit.fpe * sy * sy,
+        aic: fit.aic + n * (sy * sy).ln(),
         history_turn: fit.history_turn.map(|t| t * su),
         ..fit
     })

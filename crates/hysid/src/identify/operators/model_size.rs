@@ -124,8 +124,9 @@ pub(crate) struct PlaySize {
     pub envelope: bool,
 }
 
-/// The parameters a static envelope adds to a candidate (a cubic's three slope values).
-const ENVELOPE_PARAMETERS: usize = crate::model::operators::envelope::CUBIC;
+/// The parameters a static envelope adds to a candidate: a cubic's three slope values less
+/// a₀, which the envelope holds (`identify::operators::pi`).
+const ENVELOPE_PARAMETERS: usize = crate::model::operators::envelope::CUBIC - 1;
 
 /// The play and stop families' (PI, generalised PI, Maxwell-slip) choice of their
 /// thresholds: the candidates of [`threshold_candidates`] on the core's input
@@ -161,7 +162,8 @@ const PLAY_WORK_BOUND: f64 = 12.0;
 /// [`super::family::THRESHOLD_CANDIDATES`], uniform then geometric
 /// (the geometric one only where it differs), each once per entry of `envelopes`, labelled
 /// `"n uniform"` / `"n geometric"` (`"… + envelope"` with one), with `extra` parameters
-/// beside the n weights (and the envelope's).
+/// beside the n weights (and the envelope's); smallest first (a stable sort by the
+/// parameter count, so that the work bound and a tie favour the smaller model).
 fn threshold_candidates(
     x: &[f64],
     extra: usize,
@@ -192,6 +194,7 @@ fn threshold_candidates(
             }
         }
     }
+    out.sort_by_key(|c| c.parameters);
     Ok(out)
 }
 

@@ -95,7 +95,8 @@ pub fn fit(u: &[f64], y: &[f64], options: &PiOptions) -> Result<OperatorFit<Pran
         false => None,
     };
     let d = shape.as_ref().map_or(0, |e| e.slopes().len());
-    check_data(u, y, grid.len() + 2 + d)?;
+    // the weights, c and a₀ or the envelope's slope values (which hold a₀)
+    check_data(u, y, grid.len() + 1 + d.max(1))?;
     let reach = 2.0 * grid.last().copied().unwrap_or(0.0);
     let (path, skip) = core_path(options.initial_state, &x, reach);
     let mut columns = Vec::with_capacity(grid.len() + 2 + d);

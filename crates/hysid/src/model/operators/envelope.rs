@@ -24,7 +24,7 @@
 //! mₖ = w Σ_{i≤k} Pᵢ C(n, i) C(n − i, k − i) (−1)^{k−i} (n = d + 1) and E is evaluated by
 //! Horner's rule in t, t = (u − lo)·(1/w); the exported code takes these same coefficients
 //! and performs the same operations, so it gives the same bits. E(hi) is Horner's value at
-//! t = 1, so the pieces meet exactly.
+//! t(hi) = (hi − lo)·(1/w) as computed (within an ulp of 1), so the pieces meet exactly.
 //!
 //! References: R. T. Farouki, "The Bernstein polynomial basis: a centennial retrospective",
 //! Computer Aided Geometric Design 29 (2012) 379–419 (non-negativity of the basis). A static
@@ -92,7 +92,7 @@ impl Envelope {
         check_finite("e_lo", lo)?;
         check_finite("e_hi", hi)?;
         let width = hi - lo;
-        if !(width > 0.0 && width.is_finite()) {
+        if !(width > 0.0 && width.is_finite() && (1.0 / width).is_finite()) {
             return Err(Error::InvalidParameter {
                 name: "e_hi".into(),
                 value: hi,
@@ -146,7 +146,9 @@ impl Envelope {
             monomial,
             top: 0.0,
         };
-        e.top = e.horner(1.0);
+        // Horner's value at t(hi) as `value` computes it (not always exactly 1): the pieces
+        // meet exactly
+        e.top = e.horner((hi - lo) * e.inverse_width);
         e
     }
 

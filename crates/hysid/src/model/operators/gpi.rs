@@ -242,6 +242,13 @@ impl super::OperatorFamily for GeneralizedPi {
     }
 
     fn checked(self) -> Result<Self> {
+        if self.pi.envelope().is_some() {
+            return Err(Error::InvalidModel(
+                "a generalised PI's plays carry no static envelope (its dead zones shape the \
+                 static curve); remove \"envelope\" from its \"pi\""
+                    .into(),
+            ));
+        }
         let z = self.dead_zones();
         let zones = DeadZones::new(z.d0(), z.upper().to_vec(), z.lower().to_vec())?;
         Ok(Self::new(

@@ -190,6 +190,18 @@ impl PrandtlIshlinskii {
         (slope + below > 0.0, slope + above > 0.0)
     }
 
+    /// How far from the previous input `u_prev` the branch may still bend, the numerical
+    /// inverse's bracket: 2rₙ (beyond it every play moves with the input), and with an
+    /// envelope as far as its range reaches, max(2rₙ, hi − u_prev, u_prev − lo) (beyond it
+    /// E is a tangent line). The bracket is grown past it only on an unbounded side.
+    pub fn solve_reach(&self, u_prev: f64) -> f64 {
+        let plays = 2.0 * self.thresholds.last().copied().unwrap_or(0.0);
+        match &self.envelope {
+            Some(e) => plays.max(e.hi() - u_prev).max(u_prev - e.lo()),
+            None => plays,
+        }
+    }
+
     /// c + a₀u + E(u), the static part of G (summed in that order).
     fn static_part(&self, u: f64) -> f64 {
         let y = self.offset + self.a0 * u;
@@ -282,11 +294,12 @@ impl Core for PrandtlIshlinskii {
                 (u, false)
             }
             PiBackward::Numerical { z, u_prev } => {
-                let r_max = self.thresholds.last().copied().unwrap_or(0.0);
                 let (unbounded_below, unbounded_above) = self.unbounded();
                 let branch = Branch {
                     center: *u_prev,
-                    span: 2.0 * r_max + 1e-9 * (1.0 + u_prev.abs()) + f64::MIN_POSITIVE,
+                    span: self.solve_reach(*u_prev)
+                        + 1e-9 * (1.0 + u_prev.abs())
+                        + f64::MIN_POSITIVE,
                     unbounded_below,
                     unbounded_above,
                 };

@@ -388,7 +388,7 @@ fn a_flat_region_is_not_convergence() {
 /// iterations, `STALL_WINDOW`) stops there instead of running to its iteration limit; the
 /// refinement on the full record takes the best point on. On the vendored piezo record
 /// Jiles–Atherton took 575 iterations before the rule and takes 201 now, to the same fit
-/// (96.983 %); Bouc–Wen 1200 → 835 (98.6935 → 98.6933 %).
+/// (96.983 %); Bouc–Wen 1200 → 987 (98.6935 → 98.6934 %).
 #[test]
 fn a_stalled_local_search_stops_instead_of_grinding() {
     use crate::unit::test_signals::piezo_record;

@@ -89,6 +89,8 @@ fn any_non_negative_slope_values_give_a_monotone_envelope() {
 #[test]
 fn bad_envelopes_are_refused_and_a_file_round_trips() {
     assert!(Envelope::new(1.0, 1.0, vec![1.0, 1.0]).is_err());
+    // a range so narrow that 1/w overflows
+    assert!(Envelope::new(0.0, 1e-310, vec![1.0, 1.0]).is_err());
     assert!(Envelope::new(2.0, 1.0, vec![1.0, 1.0]).is_err());
     assert!(Envelope::new(0.0, f64::INFINITY, vec![1.0, 1.0]).is_err());
     assert!(Envelope::new(0.0, 1.0, vec![1.0]).is_err());
@@ -170,4 +172,43 @@ fn a_pi_with_an_envelope_adds_it_and_inverts() {
     assert!(
         PrandtlIshlinskii::new(0.0, vec![0.0], vec![0.5], 0.0, Orientation::default()).is_err()
     );
+}
+
+/// A PI whose final slope is zero above (saturating plays, an envelope flat at its top end)
+/// is bounded there, and its inverse still reaches every output its envelope's range gives
+/// (the bracket spans the envelope's range, `solve_reach`), clipping only beyond it.
+#[test]
+fn a_bounded_enveloped_pi_inverts_across_its_envelope() {
+    let e = Envelope::new(-1.0, 1.0, vec![0.1, 0.8, 0.0]).unwrap();
+    let op = PrandtlIshlinskii::with_static_envelope(
+        0.0,
+        vec![0.3, -0.3],
+        vec![0.1, 0.3],
+        0.0,
+        Orientation::default(),
+        Some(e),
+    )
+    .unwrap();
+    assert_eq!(op.unbounded(), (true, false));
+    let u = [0.0, 0.9, -0.2, 0.95, -0.9, 0.5];
+    let y = op.simulate(&u).unwrap();
+    let back = op.invert(&y).unwrap();
+    assert!(back.clipped.is_empty(), "{:?}", back.clipped);
+    for (got, want) in back.u.iter().zip(&u) {
+        assert!((got - want).abs() <= 1e-9, "{got} vs {want}");
+    }
+    // above its saturation the reference is clipped, and said so
+    let high = op.invert(&[y[0], y[3] + 1.0]).unwrap();
+    assert_eq!(high.clipped, vec![1]);
+}
+
+/// A generalised PI's plays take no envelope: a model file with one is refused.
+#[test]
+fn a_generalised_pi_refuses_an_envelope_in_its_plays() {
+    let example = GeneralizedPi::example().unwrap();
+    let mut json = serde_json::to_value(&example).unwrap();
+    json["pi"]["envelope"] = serde_json::json!({"lo": -1.0, "hi": 1.0, "slopes": [1.0, 1.0]});
+    let raw = serde_json::json!({"family": "gpi", "operator": json});
+    let err = serde_json::from_value::<OperatorModel>(raw).unwrap_err();
+    assert!(err.to_string().contains("envelope"), "{err}");
 }
