@@ -820,8 +820,33 @@ pub fn fit<F: DifferentialFamily>(
         return fit_as_given(family, u, y, settings);
     }
     let scaled = |v: &[f64], s: f64| v.iter().map(|x| x / s).collect::<Vec<f64>>();
-    let fit = fit_as_given(family, &scaled(u, su), &scaled(y, sy), settings)?;
+    let fit = fit_as_given(family, &scaled(u, su), &scaled(y, sy), settings)
+        .map_err(|e| error_in_record_units(e, su))?;
     in_record_units(family, fit, su, sy)
+}
+
+/// An error of a fit run in units of unit size (inputs u′ = u/`su`) as the record's units
+/// state it: a divergence's input position, the integrator's "at u = u′", becomes u′·sᵤ
+/// (exact: sᵤ is a power of two); every other error is unit-free or quotes percentages.
+pub fn error_in_record_units(e: Error, su: f64) -> Error {
+    const AT: &str = "at u = ";
+    match e {
+        Error::Diverged { index, reason } => {
+            let reason = match reason.find(AT) {
+                Some(start) => {
+                    let rest = &reason[start + AT.len()..];
+                    let end = rest.find(':').unwrap_or(rest.len());
+                    match rest[..end].parse::<f64>() {
+                        Ok(u) => format!("{}{AT}{}{}", &reason[..start], u * su, &rest[end..]),
+                        Err(_) => reason,
+                    }
+                }
+                None => reason,
+            };
+            Error::Diverged { index, reason }
+        }
+        e => e,
+    }
 }
 
 /// The fit `fit` on the record in units of unit size (u/`su`, y/`sy`) in the record's units

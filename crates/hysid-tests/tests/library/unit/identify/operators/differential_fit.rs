@@ -402,3 +402,25 @@ fn a_stalled_local_search_stops_instead_of_grinding() {
     assert!(fitted.fit.iterations <= 300, "{}", fitted.fit.iterations);
     assert!(fitted.fit.fit_percent > 96.98, "{}", fitted.fit.fit_percent);
 }
+
+/// A fit run in units of unit size quotes a divergence's input in the record's units: the
+/// integrator's "at u = u′" becomes u′·sᵤ; other errors pass unchanged.
+#[test]
+fn a_divergence_is_quoted_in_the_records_units() {
+    use hysid::identify::operators::differential_fit::error_in_record_units;
+    use hysid::Error;
+    let e = Error::Diverged {
+        index: 515,
+        reason: "integration in the input at u = 1.25: too many sub-steps".into(),
+    };
+    let back = error_in_record_units(e, 64.0).to_string();
+    assert!(back.contains("at u = 80: too many sub-steps"), "{back}");
+    assert!(back.contains("515"), "{back}");
+    let other = Error::Diverged {
+        index: 3,
+        reason: "the output is not finite".into(),
+    };
+    assert!(error_in_record_units(other, 64.0)
+        .to_string()
+        .contains("the output is not finite"));
+}
