@@ -69,6 +69,31 @@ fn compensate(model: &Path, data: &Path, commands: &Path) -> String {
     stderr
 }
 
+/// The column `name` of the CSV file at `path`.
+fn column(path: &Path, name: &str) -> Vec<f64> {
+    let text = fs::read_to_string(path).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let at = header.iter().position(|h| *h == name).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(at).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// `hysid compensate` of the column y of `data` (into `dir/u.csv`), then `simulate` of the
+/// commands against the reference: compensate's stderr and the fit % the commands reach.
+fn followed(dir: &Path, model: &Path, data: &Path) -> (String, f64) {
+    let commands = dir.join("u.csv");
+    let stderr = compensate(model, data, &commands);
+    let back = write(
+        dir,
+        "commands.csv",
+        &column(&commands, "u"),
+        &column(&commands, "reference"),
+    );
+    (stderr, simulate(model, &back, &dir.join("c.json"), &[]))
+}
+
 #[test]
 fn a_declared_history_is_saved_reported_and_reapplied_by_simulate() {
     let dir = TempDir::new().unwrap();
@@ -112,8 +137,32 @@ fn a_declared_history_is_saved_reported_and_reapplied_by_simulate() {
     // The fit's turn is saved (above the training record's maximum, 1).
     let turn = saved["history_turn"].as_f64().unwrap();
     assert!(turn > 1.0 && turn.is_finite(), "{saved}");
-    // compensate and export say that they start from the operator's own state.
-    let stderr = compensate(&model, &valid, &dir.path().join("u.csv"));
+    // The compensator runs the history too (no warning): each trial of its first command
+    // integrates the descent, so the commands are the validation record's input from its
+    // first sample on, while the reference falls (this Bouc–Wen's ascending branch is not
+    // monotone, kₓ = 0.3 against k_w·dw/du from −2 up to 0, and past the branch's minimum
+    // the inverse may take the other root).
+    let commands = dir.path().join("u.csv");
+    let stderr = compensate(&model, &valid, &commands);
+    assert!(!stderr.contains("declared"), "{stderr}");
+    let (sent, reference) = (column(&commands, "u"), column(&commands, "reference"));
+    let falling = reference.windows(2).position(|w| w[1] >= w[0]).unwrap();
+    assert!(falling > 20, "{falling}");
+    for k in 0..falling {
+        assert!(
+            (sent[k] - valid_u[k]).abs() < 1e-6,
+            "{k}: {} against {}",
+            sent[k],
+            valid_u[k]
+        );
+    }
+    // A file without the turn (an earlier version) starts its inverse from w₀ instead, and
+    // says so.
+    let mut old = read_json(&model);
+    old.as_object_mut().unwrap().remove("history_turn");
+    let old_model = dir.path().join("old.json");
+    fs::write(&old_model, old.to_string()).unwrap();
+    let stderr = compensate(&old_model, &valid, &commands);
     assert!(stderr.contains("declared descending history"), "{stderr}");
     // The validation record starts at another input (−0.8), after its own descent: the
     // history is re-applied there (exact data: the fit is exact).
@@ -180,23 +229,11 @@ fn a_declared_history_on_a_linear_family_is_fitted_saved_and_reapplied() {
     assert_eq!(saved["initial_state"], "descending", "{saved}");
     // The PI compensator runs the history (no warning) and its commands reproduce the
     // record's input where the model is exact.
-    let commands = dir.path().join("u.csv");
-    let stderr = compensate(&model, &data, &commands);
+    let (stderr, followed) = followed(dir.path(), &model, &data);
     assert!(!stderr.contains("declared"), "{stderr}");
-    // `simulate` (which runs the history) of those commands gives the reference back.
-    let text = fs::read_to_string(&commands).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let rows: Vec<Vec<f64>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
-        .collect();
-    let sent: Vec<f64> = rows.iter().map(|r| r[column("u")]).collect();
-    let wanted: Vec<f64> = rows.iter().map(|r| r[column("reference")]).collect();
-    let back = write(dir.path(), "commands.csv", &sent, &wanted);
-    let followed = simulate(&model, &back, &dir.path().join("c.json"), &[]);
     assert!(followed > 99.999, "{followed}");
+    let commands = dir.path().join("u.csv");
+    let wanted = column(&commands, "reference");
     // A file without the turn (an earlier version) compensates from the operator's own
     // state, says so, and its commands miss the record's first loop.
     let mut old = read_json(&model);
@@ -205,13 +242,7 @@ fn a_declared_history_on_a_linear_family_is_fitted_saved_and_reapplied() {
     fs::write(&old_model, old.to_string()).unwrap();
     let stderr = compensate(&old_model, &data, &commands);
     assert!(stderr.contains("declared descending history"), "{stderr}");
-    let text = fs::read_to_string(&commands).unwrap();
-    let sent: Vec<f64> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(column("u")).unwrap().parse().unwrap())
-        .collect();
-    let back = write(dir.path(), "commands.csv", &sent, &wanted);
+    let back = write(dir.path(), "commands.csv", &column(&commands, "u"), &wanted);
     let missed = simulate(&model, &back, &dir.path().join("c.json"), &[]);
     assert!(missed < followed - 0.1, "{missed} against {followed}");
     let reported = read_json(&report);

@@ -285,10 +285,11 @@ pub fn sized() -> Vec<Case> {
 }
 
 /// The operator `op` after a declared descending and an ascending history with the turn a fit
-/// on `u` saves (`history_turn`): the forward step runs the history at its first sample and
-/// the compensators of the families whose memory wipes out take its priming reference, as
-/// the library does; a differential family's forward step only. (Jiles–Atherton's example, whose memory reach is 10⁴ times the signal's
-/// span, is left out: its history alone takes the library seconds.)
+/// on `u` saves (`history_turn`): the forward step runs the history at its first sample, the
+/// compensators of the families whose memory wipes out take its priming reference and a
+/// differential family's first command runs the history on each trial, as the library does.
+/// (Jiles–Atherton's example, whose memory reach is 10⁴ times the signal's span, is left
+/// out: its history alone takes the library seconds.)
 fn after_histories(label: &str, op: &OperatorModel, u: &[f64]) -> Vec<Case> {
     use hysid::model::operators::initial_state::History;
     use hysid::model::operators::InitialStateUsed;
@@ -303,12 +304,8 @@ fn after_histories(label: &str, op: &OperatorModel, u: &[f64]) -> Vec<Case> {
             let model = FittedModel::operator(op.clone(), vec![f64::NAN; n])
                 .with_initial_state(Some(state), turn);
             let history = History::of(Some(state), turn);
-            let primed = op.history_reaches_the_inverse(history);
-            // A differential family's compensator does not run the history: its cases are
-            // those of the model without it; the forward step is what is new.
-            let mut cases = cases_of(&format!("{label}_{}", state.name()), &model, u);
-            cases.retain(|c| primed || !c.options.inverse);
-            cases
+            assert!(op.history_reaches_the_inverse(history), "{label}");
+            cases_of(&format!("{label}_{}", state.name()), &model, u)
         })
         .collect()
 }
@@ -448,11 +445,17 @@ pub fn parse_outputs(text: &str) -> (Vec<f64>, bool) {
 ///
 /// The same holds for the Bouc–Wen operator's compensator on references beyond its reach
 /// (measured 1.2e-10 alone, 6.2e-11 in a cascade): its per-sample solve searches the closest
-/// output of a `pow`-based branch, and an ulp there moves the best point found.
-pub const RUST_EXCEPTIONS: [(&str, f64); 3] = [
+/// output of a `pow`-based branch, and an ulp there moves the best point found; and after a
+/// declared history (measured 8.9e-10 descending, 3.4e-10 and 4.4e-10 beyond reach), whose
+/// first command integrates each trial's long excursion to the turn, where an ulp of `pow`
+/// in the step control flips a sub-step's acceptance.
+pub const RUST_EXCEPTIONS: [(&str, f64); 6] = [
     ("gb_bouc_wen_newmark_nu", 1e-7),
     ("bouc_wen_beyond", 1e-9),
     ("cascade_bouc_wen_beyond", 1e-9),
+    ("bouc_wen_descending_inverse", 2e-9),
+    ("bouc_wen_descending_beyond", 1e-9),
+    ("bouc_wen_ascending_beyond", 1e-9),
 ];
 
 /// The bar of `case` in `target`: [`BAR`], or its entry in [`RUST_EXCEPTIONS`] for Rust.

@@ -244,6 +244,12 @@ fn a_declared_history_streams_as_the_saved_model_simulates_it() {
                     .unwrap()
                     .remove(0);
                 let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                // A differential family's branch y(v) is its integration's, smooth to its
+                // tolerance (1e-10 of the state's scale) as v moves the sub-steps; the
+                // inverse's root is as close as the branch's steps allow.
+                let differential = ["bouc-wen", "duhem", "dahl", "jiles-atherton"]
+                    .contains(&model.family().name());
+                let tolerance = if differential { 1e-9 } else { 1e-12 };
                 assert!(
                     commands.clipped.is_empty(),
                     "{what}: {:?}",
@@ -251,16 +257,16 @@ fn a_declared_history_streams_as_the_saved_model_simulates_it() {
                 );
                 for (k, (a, b)) in followed.iter().zip(&reference).enumerate() {
                     assert!(
-                        (a - b).abs() <= 1e-12 * scale,
+                        (a - b).abs() <= tolerance * scale,
                         "{what}: sample {k}: {a} against {b}"
                     );
                 }
                 // Where the history is not the structure's own start (the Preisach plane's
-                // negative saturation is the ascending one), the own inverse misses the
-                // first samples.
+                // negative saturation is the ascending one), a linear-in-weights family's own
+                // inverse misses the first samples.
                 let own = FittedModel::operator(model.clone(), no_std(n));
                 let own_start = own.simulate(&[&u[217..]], 1.0, None).unwrap().remove(0);
-                if own_start[0] != reference[0] {
+                if !differential && own_start[0] != reference[0] {
                     let missed = compensate(&own, &reference).unwrap().u;
                     let off = fitted.simulate(&[&missed], 1.0, None).unwrap().remove(0);
                     assert!((off[0] - reference[0]).abs() > 1e-6 * scale, "{what}");
@@ -278,8 +284,8 @@ fn a_declared_history_streams_as_the_saved_model_simulates_it() {
             );
         }
     }
-    // Every linear-in-weights family in both orientations, both histories.
-    assert!(primed >= 2 * 10, "{primed}");
+    // Every family in both orientations, both histories.
+    assert!(primed >= 2 * 14, "{primed}");
 }
 
 #[test]

@@ -15,7 +15,7 @@ use crate::export::code::{
     call, epsilon, idx, lit, local, min_positive, select, typed, Block, Expr, Ty,
 };
 use crate::export::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
-use crate::model::operators::differential::{InputOde, BRACKET_DOUBLINGS, TOLERANCE};
+use crate::model::operators::differential::{HistoryRun, InputOde, BRACKET_DOUBLINGS, TOLERANCE};
 use crate::Result;
 use std::ops::Not;
 
@@ -283,14 +283,29 @@ pub fn forward<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
 }
 
 /// Emits the inverse step `ns.inverse(r)` (`differential::invert`): the sample's output as
-/// a function of the new input solved for r by `solve_sample` and its Illinois iteration.
-pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Result<String> {
+/// a function of the new input solved for r by `solve_sample` and its Illinois iteration;
+/// with a declared `history`, the first command's trials v each run it from x₀ at v to the
+/// turn and back (`differential::HistoryRun::state_at`, the turn by [`super::turn_at`]).
+pub fn inverse<O: EmitOde + ?Sized>(
+    ode: &O,
+    history: Option<HistoryRun>,
+    ns: &Ns,
+    prog: &mut Program,
+) -> Result<String> {
     prog.bound(format!(
         "The inverse integrates the branch at most {} times a step (the start and a probe, \
          {BRACKET_DOUBLINGS} doublings of the bracket each way, 200 Illinois iterations and \
          the root), each of at most {SUBSTEP_BUDGET} Dormand-Prince sub-steps.",
         3 + 2 * BRACKET_DOUBLINGS + 200
     ));
+    if let Some(run) = history {
+        prog.bound(format!(
+            "The first command runs the declared {} history on each trial: its branch \
+             integrates two intervals, to the turn and back, of at most {SUBSTEP_BUDGET} \
+             sub-steps each.",
+            run.history.state.name()
+        ));
+    }
     let d = driver(ode, ns, prog)?;
     let x0 = ode.initial_state();
     let br_x = prog.field(
@@ -317,9 +332,24 @@ pub fn inverse<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
                 ];
                 b.set_state(&br_x, call(&d.advance, args));
             },
-            |b| {
-                b.set_state(&d.fail, Expr::Flag(false));
-                b.set_state(&br_x, x0);
+            |b| match history {
+                None => {
+                    b.set_state(&d.fail, Expr::Flag(false));
+                    b.set_state(&br_x, x0);
+                }
+                Some(run) => {
+                    let v = local("v");
+                    let turn = b.let_("turn", super::turn_at(run.history, run.reach, v.clone()));
+                    let x_turn = b.let_(
+                        "x_turn",
+                        call(&d.advance, vec![lit(x0), v.clone(), turn.clone()]),
+                    );
+                    b.if_(Expr::State(d.fail.clone()), |b| {
+                        b.set_state(&br_x, x_turn.clone());
+                        b.ret(call(&d.output, vec![v.clone(), x_turn.clone()]));
+                    });
+                    b.set_state(&br_x, call(&d.advance, vec![x_turn, turn, v]));
+                }
             },
         );
         b.ret(call(&d.output, vec![local("v"), Expr::State(br_x.clone())]));

@@ -7,6 +7,7 @@ use super::differential::{self, EmitOde};
 use super::Emit;
 use crate::export::code::{lit, local, select, Block, Expr, Ty};
 use crate::export::program::{Ns, Program};
+use crate::model::operators::differential::HistoryRun;
 use crate::model::operators::jiles_atherton::MU0;
 use crate::model::operators::{Anhysteretic, JaOutput, JilesAtherton};
 use crate::Result;
@@ -96,7 +97,12 @@ impl Emit for JilesAtherton {
     fn emit_forward(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
         differential::forward(self, ns, prog)
     }
-    fn emit_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
-        differential::inverse(self, ns, prog)
+    fn emit_inverse(
+        &self,
+        history: Option<HistoryRun>,
+        ns: &Ns,
+        prog: &mut Program,
+    ) -> Result<String> {
+        differential::inverse(self, history, ns, prog)
     }
 }

@@ -24,6 +24,7 @@ pub mod preisach;
 
 use super::code::{lit, local, Expr, Ty};
 use super::program::{Ns, Program};
+use crate::model::operators::differential::HistoryRun;
 use crate::model::operators::initial_state::History;
 use crate::model::operators::OperatorModel;
 use crate::Result;
@@ -37,8 +38,16 @@ pub trait Emit {
     /// initialisation it needs. Returns the helper's name.
     fn emit_forward(&self, ns: &Ns, prog: &mut Program) -> Result<String>;
     /// Emits `ns.inverse(r) -> f64`: the input uₖ the library's `invert` gives for the
-    /// reference rₖ, advancing the state. Returns the helper's name.
-    fn emit_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<String>;
+    /// reference rₖ, advancing the state; with `history`, the first command runs that
+    /// declared history as the library's differential inverse does
+    /// (`differential::HistoryRun`; the other families are primed by [`inverse_after`] and
+    /// are given None). Returns the helper's name.
+    fn emit_inverse(
+        &self,
+        history: Option<HistoryRun>,
+        ns: &Ns,
+        prog: &mut Program,
+    ) -> Result<String>;
 }
 
 /// The dispatch from an operator of any family to its [`Emit`].
@@ -50,10 +59,20 @@ macro_rules! dispatch {
                 $(OperatorModel::$variant(m) => Emit::emit_forward(m, ns, prog),)*
             }
         }
-        /// The family's inverse step ([`Emit::emit_inverse`]).
+        /// The family's inverse step ([`Emit::emit_inverse`]) from its documented initial
+        /// state.
         pub fn inverse(op: &OperatorModel, ns: &Ns, prog: &mut Program) -> Result<String> {
+            inverse_running(op, None, ns, prog)
+        }
+        /// The family's inverse step ([`Emit::emit_inverse`]) running `history`.
+        fn inverse_running(
+            op: &OperatorModel,
+            history: Option<HistoryRun>,
+            ns: &Ns,
+            prog: &mut Program,
+        ) -> Result<String> {
             match op {
-                $(OperatorModel::$variant(m) => Emit::emit_inverse(m, ns, prog),)*
+                $(OperatorModel::$variant(m) => Emit::emit_inverse(m, history, ns, prog),)*
             }
         }
     };
@@ -80,7 +99,7 @@ pub fn forward_after(
         None,
         "the declared history has run (at the first good sample)",
     )?;
-    let (reach, direction) = (History::reach(op.as_operator()), history.direction());
+    let reach = History::reach(op.as_operator());
     prog.bound(format!(
         "the first good sample runs the declared {} history: three steps of the operator",
         history.state.name()
@@ -91,26 +110,9 @@ pub fn forward_after(
         Some(Ty::F64),
         |b| {
             b.if_(Expr::State(primed.clone()).not(), |b| {
-                let x = local("x");
-                // u0 ± max(reach, |u0 − turn|, 1e-6·max(|u0|, 1)), as History::turn_at.
-                let beyond = match history.turn {
-                    Some(t) => (x.clone() - lit(t)).abs(),
-                    None => lit(0.0),
-                };
-                let margin = lit(reach)
-                    .max(beyond)
-                    .max(lit(1e-6) * x.clone().abs().max(lit(1.0)));
-                let own = x.clone() + lit(direction) * margin;
-                let turn = match history.turn {
-                    Some(t) => super::code::select(
-                        ((lit(t) - x.clone()) * lit(direction)).gt(lit(0.0)),
-                        lit(t),
-                        own,
-                    ),
-                    None => own,
-                };
+                let turn = turn_at(history, reach, local("x"));
                 let turn = b.let_("turn", turn);
-                b.call(&step, vec![x]);
+                b.call(&step, vec![local("x")]);
                 b.call(&step, vec![turn]);
                 b.set_state(&primed, Expr::Flag(true));
             });
@@ -119,18 +121,46 @@ pub fn forward_after(
     )
 }
 
-/// The inverse step after the declared `history`: where the history reaches the library's
-/// inverse (`OperatorModel::history_reaches_the_inverse`), the initialisation runs the
-/// inverse once on the priming reference r_turn (`OperatorModel::priming_reference`), as
-/// the library's compensator does at construction and reset. Returns the helper to call.
+/// The turn of a declared history before a record whose first input is `x`, with the
+/// library's arithmetic ([`History::turn_at`]): the saved turn when it lies beyond x in the
+/// history's direction, otherwise x ± max(reach, |x − turn|, 10⁻⁶·max(|x|, 1)).
+pub(super) fn turn_at(history: History, reach: f64, x: Expr) -> Expr {
+    let direction = history.direction();
+    let beyond = match history.turn {
+        Some(t) => (x.clone() - lit(t)).abs(),
+        None => lit(0.0),
+    };
+    let margin = lit(reach)
+        .max(beyond)
+        .max(lit(1e-6) * x.clone().abs().max(lit(1.0)));
+    let own = x.clone() + lit(direction) * margin;
+    match history.turn {
+        Some(t) => super::code::select(((lit(t) - x) * lit(direction)).gt(lit(0.0)), lit(t), own),
+        None => own,
+    }
+}
+
+/// The inverse step after the declared `history`, where it reaches the library's inverse
+/// (`OperatorModel::history_reaches_the_inverse`): for a family whose memory wipes out the
+/// initialisation runs the inverse once on the priming reference r_turn
+/// (`OperatorModel::priming_reference`), as the library's compensator does at construction
+/// and reset; a differential family's first command runs the history on each trial
+/// (`differential::HistoryRun`). Returns the helper to call.
 pub fn inverse_after(
     op: &OperatorModel,
     history: Option<History>,
     ns: &Ns,
     prog: &mut Program,
 ) -> Result<String> {
-    let inverse = inverse(op, ns, prog)?;
-    if let Some(r) = op.priming_reference(history)? {
+    let priming = op.priming_reference(history)?;
+    let run = history
+        .filter(|_| priming.is_none() && op.history_reaches_the_inverse(history))
+        .map(|history| HistoryRun {
+            history,
+            reach: History::reach(op.as_operator()),
+        });
+    let inverse = inverse_running(op, run, ns, prog)?;
+    if let Some(r) = priming {
         prog.init(|b| b.call(&inverse, vec![lit(r)]));
     }
     Ok(inverse)

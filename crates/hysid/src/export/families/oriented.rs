@@ -13,6 +13,7 @@
 use super::Emit;
 use crate::export::code::{lit, local, typed, Expr, Ty};
 use crate::export::program::{mark_clip, Ns, Program, DIVERGED_FIELD};
+use crate::model::operators::differential::HistoryRun;
 use crate::model::operators::Orientation;
 use crate::Result;
 
@@ -52,7 +53,14 @@ impl<T: EmitCore> Emit for T {
         }
     }
 
-    fn emit_inverse(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
+    /// The history is never run here: these families' inverses are primed instead
+    /// ([`super::inverse_after`]).
+    fn emit_inverse(
+        &self,
+        _history: Option<HistoryRun>,
+        ns: &Ns,
+        prog: &mut Program,
+    ) -> Result<String> {
         let o = self.orientation();
         let s = o.sign();
         if !o.inverse {

@@ -127,26 +127,14 @@ impl FittedKind for FittedHysteresisOperator {
         self.model.compensator_from(self.history())
     }
 
-    /// The inverse after the declared history: the priming reference first
-    /// ([`OperatorModel::priming_reference`]), its command dropped.
+    /// The inverse after the declared history ([`OperatorModel::invert_from`]).
     fn compensate(&self, reference: &[f64]) -> Result<Compensation> {
-        let priming = self.model.priming_reference(self.history())?;
-        let skip = usize::from(priming.is_some());
-        let primed: Vec<f64> = priming
-            .into_iter()
-            .chain(reference.iter().copied())
-            .collect();
-        let mut inv = self.model.as_operator().invert(&primed)?;
+        let inv = self.model.invert_from(self.history(), reference)?;
         Ok(Compensation {
             reference: reference.to_vec(),
-            u: inv.u.split_off(skip),
-            predicted: inv.predicted.split_off(skip),
-            clipped: inv
-                .clipped
-                .iter()
-                .filter(|&&k| k >= skip)
-                .map(|k| k - skip)
-                .collect(),
+            u: inv.u,
+            predicted: inv.predicted,
+            clipped: inv.clipped,
             settled_from: 0,
         })
     }

@@ -40,6 +40,7 @@
 //! problems in chemical reaction kinetics", in *Modelling of Chemical Reaction Systems*,
 //! Springer 1981, 102–125.
 
+use super::initial_state::History;
 use super::streaming::CompensatorStep;
 use super::Inversion;
 use crate::{Error, Result};
@@ -548,14 +549,47 @@ impl Stream {
     }
 }
 
-/// The inverse one sample at a time (see the module doc): the previous command and state.
+/// The inverse one sample at a time (see the module doc): the previous command and state,
+/// and the declared history its first command starts after, if any.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct InverseStream {
     /// (u_{k−1}, x_{k−1}) after the first sample.
     last: Option<(f64, f64)>,
+    /// The history run before the first command (None: the first command meets x₀).
+    history: Option<HistoryRun>,
+}
+
+/// A declared history as the inverse's first command runs it: the operator's memory reach
+/// that places the turn ([`History::turn_at`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HistoryRun {
+    /// The declared history, with the fit's saved turn.
+    pub history: History,
+    /// The operator's memory reach ([`History::reach`]).
+    pub reach: f64,
+}
+
+impl HistoryRun {
+    /// The state after the history before a first command `v`: x₀ at v, integrated to the
+    /// turn u_turn = [`History::turn_at`]`(reach, v)` and back to v, the path
+    /// v → u_turn → v a simulation of the saved model runs before a record starting at v
+    /// ([`super::initial_state::simulate_from`]), with the same steps and so the same bits.
+    pub fn state_at<O: InputOde + ?Sized>(&self, ode: &O, v: f64) -> Result<f64> {
+        let turn = self.history.turn_at(self.reach, v);
+        let at_turn = advance(ode, ode.initial_state(), v, turn)?;
+        advance(ode, at_turn, turn, v)
+    }
 }
 
 impl InverseStream {
+    /// The inverse whose first command starts after `history` (None: from x₀).
+    pub fn after(history: Option<HistoryRun>) -> Self {
+        Self {
+            last: None,
+            history,
+        }
+    }
+
     /// The command for the reference r_k = `r`, what the operator makes of it, and whether
     /// r_k was out of reach (clipped); the state moves on.
     pub fn step<O: InputOde + ?Sized>(
@@ -565,11 +599,22 @@ impl InverseStream {
         r: f64,
     ) -> Result<CompensatorStep> {
         let (u, x, predicted, clipped) = match self.last {
-            // The first sample: the state is x₀ whatever the input, only h(u, x₀) can be matched.
-            None => {
-                let x0 = ode.initial_state();
-                solve_sample(&|v| Ok((ode.output(v, x0), x0)), ode.anchor_input(), ode, r)?
-            }
+            // The first sample: the state is x₀ whatever the input, only h(u, x₀) can be
+            // matched; after a declared history, the state the history leaves at u.
+            None => match self.history {
+                None => {
+                    let x0 = ode.initial_state();
+                    solve_sample(&|v| Ok((ode.output(v, x0), x0)), ode.anchor_input(), ode, r)?
+                }
+                Some(run) => {
+                    let branch = |v: f64| -> Result<(f64, f64)> {
+                        let xv = run.state_at(ode, v)?;
+                        Ok((ode.output(v, xv), xv))
+                    };
+                    solve_sample(&branch, ode.anchor_input(), ode, r)
+                        .map_err(|e| at_sample(e, k))?
+                }
+            },
             Some((u_prev, x_prev)) => {
                 let branch = |v: f64| -> Result<(f64, f64)> {
                     let xv = advance(ode, x_prev, u_prev, v)?;
@@ -591,8 +636,17 @@ impl InverseStream {
 /// sample from the initial state ([`InverseStream`]); unreachable samples are clipped and
 /// listed.
 pub fn invert<O: InputOde + ?Sized>(ode: &O, reference: &[f64]) -> Result<Inversion> {
+    invert_after(ode, None, reference)
+}
+
+/// [`invert`] with the first command after the declared `history` ([`InverseStream::after`]).
+pub fn invert_after<O: InputOde + ?Sized>(
+    ode: &O,
+    history: Option<HistoryRun>,
+    reference: &[f64],
+) -> Result<Inversion> {
     check_signal("reference", reference)?;
-    let mut stream = InverseStream::default();
+    let mut stream = InverseStream::after(history);
     let n = reference.len();
     let (mut u, mut predicted, mut clipped) =
         (Vec::with_capacity(n), Vec::with_capacity(n), Vec::new());

@@ -15,6 +15,7 @@
 use super::elementary::{
     oriented_state, oriented_step, outside_domain, Core, OrientedInverse, OrientedState,
 };
+use super::initial_state::History;
 use crate::{Error, Result};
 
 /// One sample of an operator's inverse: the command, what the operator makes of it, and
@@ -54,6 +55,14 @@ pub(crate) trait StreamingOperator {
         k: usize,
         r: f64,
     ) -> Result<CompensatorStep>;
+    /// Γ⁻¹'s initial state when its first command starts after the declared `history` (with
+    /// its saved turn) by running it: a differential family, whose state after the history
+    /// depends on the first command ([`super::differential::HistoryRun`]). None for the
+    /// families whose memory wipes out, whose inverse is primed by one reference instead
+    /// (`OperatorModel::priming_reference`).
+    fn inverse_stream_after(&self, _history: History) -> Result<Option<Self::Inverse>> {
+        Ok(None)
+    }
 }
 
 /// The error of a stream whose Preisach memory outgrew its fixed capacity at sample `k`.
@@ -144,6 +153,19 @@ macro_rules! differential_streaming {
                 r: f64,
             ) -> $crate::Result<$crate::model::operators::streaming::CompensatorStep> {
                 state.step(self, k, r)
+            }
+            fn inverse_stream_after(
+                &self,
+                history: $crate::model::operators::initial_state::History,
+            ) -> $crate::Result<Option<Self::Inverse>> {
+                use $crate::model::operators::differential::HistoryRun;
+                use $crate::model::operators::initial_state::History;
+                self.validate()?;
+                let reach = History::reach(self);
+                Ok(Some(Self::Inverse::after(Some(HistoryRun {
+                    history,
+                    reach,
+                }))))
             }
         }
     };

@@ -351,8 +351,8 @@ impl FittedModel {
     }
 
     /// The declared history (`descending`, `ascending`) this model starts after that its
-    /// compensator does not run: a differential family's, or one saved without its turn
-    /// (files of earlier versions); None otherwise
+    /// compensator does not run: one saved without its turn (files of earlier versions);
+    /// None otherwise
     /// ([`crate::model::OperatorModel::history_reaches_the_inverse`]).
     pub fn history_beyond_the_inverse(&self) -> Option<InitialStateUsed> {
         let FittedModel::Operator(op) = self else {

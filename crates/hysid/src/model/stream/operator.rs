@@ -6,7 +6,7 @@
 use super::{Compensator, CompensatorStep, Guarded, GuardedInverse, InverseKernel, Kernel};
 use crate::model::operators::initial_state::History;
 use crate::model::operators::streaming::StreamingOperator;
-use crate::model::operators::OperatorModel;
+use crate::model::operators::{Inversion, OperatorModel};
 use crate::Result;
 
 /// Γ of one family, streamed.
@@ -61,11 +61,16 @@ impl<F: StreamingOperator> OperatorInverse<F> {
     /// The inverse at its initial state.
     pub(super) fn new(operator: F) -> Result<Self> {
         let initial = operator.inverse_stream()?;
-        Ok(Self {
+        Ok(Self::at(operator, initial))
+    }
+
+    /// The inverse at the initial state `initial` (its reset goes back there).
+    fn at(operator: F, initial: F::Inverse) -> Self {
+        Self {
             operator,
             state: initial.clone(),
             initial,
-        })
+        }
     }
 }
 
@@ -166,6 +171,17 @@ macro_rules! dispatch {
                 })
             }
 
+            /// The inverse whose first command runs the declared `history`
+            /// ([`StreamingOperator::inverse_stream_after`]); None for the families that
+            /// prime it instead.
+            fn inverse_stream_after(&self, history: History) -> Result<Option<AnyOperatorInverse>> {
+                Ok(match self {
+                    $(OperatorModel::$variant(m) => m.inverse_stream_after(history)?.map(|initial| {
+                        Box::new(OperatorInverse::at(m.clone(), initial)) as AnyOperatorInverse
+                    }),)*
+                })
+            }
+
             /// The family's [`StreamingOperator::WIPES_OUT`].
             fn wipes_out(&self) -> bool {
                 match self {
@@ -231,10 +247,7 @@ impl OperatorModel {
     /// wipes out what preceded it. A command beyond the saved turn (no limits, a reference
     /// far beyond the record) starts from this state, where `simulate` would turn beyond u₀.
     pub fn priming_reference(&self, history: Option<History>) -> Result<Option<f64>> {
-        let Some(turn) = history
-            .and_then(|h| h.turn)
-            .filter(|_| self.history_reaches_the_inverse(history))
-        else {
+        let Some(turn) = history.and_then(|h| h.turn).filter(|_| self.wipes_out()) else {
             return Ok(None);
         };
         let mut forward = self.stream()?;
@@ -243,23 +256,86 @@ impl OperatorModel {
         Ok(Some(y[0]))
     }
 
-    /// True when the compensator and the batch compensation start after a declared history
-    /// saved with its turn (the linear-in-weights families, whose memory wipes out); a
-    /// differential family's inverse starts from its own initial state x₀.
+    /// True when the compensator and the batch compensation start after a declared history:
+    /// one saved with its turn. The families whose memory wipes out prime their inverse with
+    /// one reference ([`OperatorModel::priming_reference`]); a differential family's first
+    /// command runs the history's path itself
+    /// ([`crate::model::operators::differential::HistoryRun`]). A file of an earlier version
+    /// (no saved turn) starts the inverse from the family's documented initial state.
     pub fn history_reaches_the_inverse(&self, history: Option<History>) -> bool {
-        history.is_some_and(|h| h.turn.is_some()) && self.wipes_out()
+        history.is_some_and(|h| h.turn.is_some())
     }
 
-    /// [`OperatorModel::compensator`] after the declared `history`: primed by
-    /// [`OperatorModel::priming_reference`] (none: from the documented initial state); equal
-    /// to the batch compensation of the saved model to the bit.
-    pub fn compensator_from(&self, history: Option<History>) -> Result<Box<dyn Compensator>> {
-        match self.priming_reference(history)? {
-            None => self.compensator(),
-            Some(r) => Ok(Box::new(GuardedInverse::new(PrimedInverse::new(
-                self.inverse_stream()?,
-                r,
-            )?))),
+    /// The inverse stream after the declared `history` (module doc of
+    /// [`OperatorModel::history_reaches_the_inverse`]): primed, run by its first command, or
+    /// from the documented initial state.
+    fn inverse_stream_from(&self, history: Option<History>) -> Result<AnyOperatorInverse> {
+        if let Some(r) = self.priming_reference(history)? {
+            return Ok(Box::new(PrimedInverse::new(self.inverse_stream()?, r)?));
         }
+        let after = history.filter(|h| h.turn.is_some());
+        match after
+            .map(|h| self.inverse_stream_after(h))
+            .transpose()?
+            .flatten()
+        {
+            Some(inverse) => Ok(inverse),
+            None => self.inverse_stream(),
+        }
+    }
+
+    /// [`OperatorModel::compensator`] after the declared `history`
+    /// ([`OperatorModel::history_reaches_the_inverse`]); equal to
+    /// [`OperatorModel::invert_from`] to the bit.
+    pub fn compensator_from(&self, history: Option<History>) -> Result<Box<dyn Compensator>> {
+        Ok(Box::new(GuardedInverse::new(
+            self.inverse_stream_from(history)?,
+        )))
+    }
+
+    /// The batch inversion of `reference` after the declared `history`, the state
+    /// [`OperatorModel::compensator_from`] starts in: the operator's [`invert`] of the priming
+    /// reference and then `reference` (the families whose memory wipes out), the differential
+    /// family's inverse steps from the state its history leaves (its [`invert`] is the loop
+    /// of the same steps), or its [`invert`] as it is.
+    ///
+    /// [`invert`]: crate::model::operators::HysteresisOperator::invert
+    pub fn invert_from(&self, history: Option<History>, reference: &[f64]) -> Result<Inversion> {
+        if let Some(r) = self.priming_reference(history)? {
+            let primed: Vec<f64> = std::iter::once(r)
+                .chain(reference.iter().copied())
+                .collect();
+            let mut inv = self.as_operator().invert(&primed)?;
+            return Ok(Inversion {
+                u: inv.u.split_off(1),
+                predicted: inv.predicted.split_off(1),
+                clipped: inv
+                    .clipped
+                    .iter()
+                    .filter(|&&k| k >= 1)
+                    .map(|k| k - 1)
+                    .collect(),
+            });
+        }
+        if !self.history_reaches_the_inverse(history) {
+            return self.as_operator().invert(reference);
+        }
+        let mut inverse = self.inverse_stream_from(history)?;
+        crate::model::operators::differential::check_signal("reference", reference)?;
+        let n = reference.len();
+        let mut out = Inversion {
+            u: Vec::with_capacity(n),
+            predicted: Vec::with_capacity(n),
+            clipped: Vec::new(),
+        };
+        for (k, &r) in reference.iter().enumerate() {
+            let step = inverse.step(k, r)?;
+            out.u.push(step.u);
+            out.predicted.push(step.predicted);
+            if step.clipped {
+                out.clipped.push(k);
+            }
+        }
+        Ok(out)
     }
 }
