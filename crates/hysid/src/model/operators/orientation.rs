@@ -36,6 +36,19 @@
 //! the input is monotone there): σ̂ = 1.4826·median |e_k| / √(1 + λ_k² + (1 − λ_k)²). The
 //! confidence is z = A / (σ̂‖c‖).
 //!
+//! **Static curve removed first.** The branches are straight lines between their samples,
+//! and a quasi-static record (a magnet's set points) has few samples on a curved static
+//! curve: the chords of a saturating curve between set points a few percent of the range
+//! apart differ by more than a narrow loop's width, with a sign that depends on how the set
+//! points fall, and the neighbours' residuals that measure the noise are its curvature. So
+//! the method runs on r = y − ŷ_s(u), ŷ_s the least-squares cubic regression spline in u with
+//! up to [`STATIC_KNOTS`] interior knots at the quantiles of u (one per 20 samples; the
+//! truncated-power basis 1, t, t², t³, (t − κ)³₊ in t = (u − min u)/(max u − min u), de Boor,
+//! *A Practical Guide to Splines*, 2001, ch. VIII). A function of u alone cannot take up
+//! the loop (it has one value at each u, the loop two), and it cancels from the exact area
+//! between the branches; what it removes is the chords' curvature. Without enough samples
+//! for the spline (fewer than twice its coefficients) y is used as it is.
+//!
 //! The loop is counter-clockwise when A > 0, clockwise when A < 0, provided g̃ has the same
 //! sign and |z| ≥ [`MIN_CONFIDENCE`]; otherwise (no reversal, a loop indistinguishable from
 //! noise, pairs that disagree) the orientation cannot be told and
@@ -57,6 +70,53 @@ pub const SIGMA_FLOOR: f64 = 1e-5;
 
 /// The clip of each pair's mean gap, in units of the weighted median gap.
 pub const CLIP: f64 = 3.0;
+
+/// The most interior knots of the static curve's regression spline (module doc), one per
+/// [`SAMPLES_PER_KNOT`] samples.
+pub const STATIC_KNOTS: usize = 6;
+
+/// The samples per interior knot of the static curve's spline.
+pub const SAMPLES_PER_KNOT: usize = 20;
+
+/// y − ŷ_s(u), ŷ_s the least-squares cubic regression spline of y on u (module doc, "Static
+/// curve removed first") over the input range [lo, hi]; None when the record has fewer than
+/// twice the spline's coefficients or its regression is rank deficient.
+fn without_static_curve(u: &[f64], y: &[f64], lo: f64, hi: f64) -> Option<Vec<f64>> {
+    let n = u.len();
+    let t: Vec<f64> = u.iter().map(|v| (v - lo) / (hi - lo)).collect();
+    let mut sorted = t.clone();
+    sorted.sort_by(f64::total_cmp);
+    let wanted = (n / SAMPLES_PER_KNOT).min(STATIC_KNOTS);
+    let mut knots: Vec<f64> = Vec::with_capacity(wanted);
+    for j in 1..=wanted {
+        let q = sorted[j * (n - 1) / (wanted + 1)];
+        if q > 0.0 && q < 1.0 && knots.last().is_none_or(|&k| q > k) {
+            knots.push(q);
+        }
+    }
+    let p = 4 + knots.len();
+    if n < 2 * p {
+        return None;
+    }
+    let basis = |x: f64, j: usize| match j {
+        0 => 1.0,
+        1 => x,
+        2 => x * x,
+        3 => x * x * x,
+        _ => (x - knots[j - 4]).max(0.0).powi(3),
+    };
+    let phi = nalgebra::DMatrix::from_fn(n, p, |i, j| basis(t[i], j));
+    let names: Vec<String> = (0..p).map(|j| format!("spline term {j}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let (theta, _) =
+        crate::numerics::least_squares::least_squares_estimate(&phi, y, &names).ok()?;
+    Some(
+        t.iter()
+            .zip(y)
+            .map(|(&x, &yk)| yk - (0..p).map(|j| theta[j] * basis(x, j)).sum::<f64>())
+            .collect(),
+    )
+}
 
 /// What the detector found ([`loop_evidence`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -232,6 +292,14 @@ pub fn loop_evidence(u: &[f64], y: &[f64]) -> Result<LoopEvidence> {
     let Some((turns, first)) = (hi > lo).then(|| segments(u, h)).flatten() else {
         return Err(undetermined("the input does not move"));
     };
+    // the noise floor's scale: the output's own range
+    let (ylo, yhi) = y
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let detrended = without_static_curve(u, y, lo, hi);
+    let y = detrended.as_deref().unwrap_or(y);
     let reversals = turns.len().saturating_sub(2);
     if reversals == 0 {
         return Err(undetermined(
@@ -278,11 +346,6 @@ pub fn loop_evidence(u: &[f64], y: &[f64]) -> Result<LoopEvidence> {
     });
     // a floor of 1e-5 of the output's range: a loop thinner than that (a record that does
     // not excite the hysteresis, rounding) is no loop to tell a direction from
-    let (ylo, yhi) = y
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
     let sigma = sigma.max(SIGMA_FLOOR * (yhi - ylo));
     let confidence = if sigma * spread > 0.0 {
         area / (sigma * spread)
