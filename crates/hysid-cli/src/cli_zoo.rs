@@ -37,9 +37,11 @@ pub struct FamilyArgs {
     /// [0, 1e6].
     #[arg(long, default_value_t = 1e-6, value_parser = crate::options::nonnegative)]
     pub lambda: f64,
-    /// Dead zones on each side of the generalised PI, 0..=20.
-    #[arg(long = "dead-zones", default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=20))]
-    pub dead_zones: u32,
+    /// Dead zones on each side of the generalised PI, 0..=20. Default: chosen with the
+    /// thresholds from the data (4, 8 or 12, scored on the last 30 % of the record as the
+    /// thresholds are); 4 when --thresholds is given.
+    #[arg(long = "dead-zones", value_parser = clap::value_parser!(u32).range(0..=20))]
+    pub dead_zones: Option<u32>,
     /// The loop's turning sense in the (u, y) plane, u horizontal: ccw (counter-clockwise:
     /// the output lags the input, as a piezo stack or a magnet's B(H)) or cw. Default:
     /// detected from the area between the ascending and descending branches (an error

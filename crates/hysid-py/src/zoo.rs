@@ -46,7 +46,7 @@ fn family_options(
     threshold_grid: Vec<f64>,
     grid: Option<usize>,
     lambda: f64,
-    dead_zones: usize,
+    dead_zones: Option<usize>,
 ) -> FamilyOptions {
     let defaults = FamilyOptions::default();
     let choose_thresholds = thresholds.is_none() && threshold_grid.is_empty();
@@ -59,7 +59,8 @@ fn family_options(
         threshold_grid: (!threshold_grid.is_empty()).then_some(threshold_grid),
         grid: grid.unwrap_or(defaults.grid),
         lambda,
-        dead_zones,
+        dead_zones: dead_zones.unwrap_or(defaults.dead_zones),
+        choose_dead_zones: dead_zones.is_none(),
         choose_thresholds,
         choose_grid: grid.is_none(),
         ..defaults
@@ -99,7 +100,7 @@ fn identify_operator(
     threshold_grid: Vec<f64>,
     grid: Option<usize>,
     lambda_: f64,
-    dead_zones: usize,
+    dead_zones: Option<usize>,
     threads: usize,
     orientation: Option<&str>,
     time_limit: Option<f64>,
@@ -231,7 +232,7 @@ fn compare<'py>(
     threshold_grid: Vec<f64>,
     grid: Option<usize>,
     lambda_: f64,
-    dead_zones: usize,
+    dead_zones: Option<usize>,
     threads: usize,
     orientation: Option<&str>,
     time_limit: Option<f64>,

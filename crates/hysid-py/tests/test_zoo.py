@@ -137,6 +137,22 @@ def test_envelope_is_the_command_lines():
         hysid.identify_operator(u, y, family="pi", envelope="quadratic")  # type: ignore[arg-type]
 
 
+def test_dead_zones_are_chosen_unless_given():
+    """``dead_zones=None`` (the default) chooses the GPI's dead zones with its thresholds,
+    as the command line does without ``--dead-zones``; a given count fixes them (labels
+    without dead zones); a bad count is a ConfigError."""
+    u, plays_part = _loop()
+    y = 0.3 * plays_part + 4.0 * np.tanh(u / 1.2)
+    chosen = hysid.identify_operator(u, y, family="gpi")
+    assert "dead zones" in chosen.details["model_size"]["chosen"]
+    fixed = hysid.identify_operator(u, y, family="gpi", dead_zones=4)
+    sizes = [c["size"] for c in fixed.details["model_size"]["candidates"]]
+    assert sizes and not any("dead zones" in s for s in sizes)
+    assert chosen.fit_percent is not None and fixed.fit_percent is not None
+    with pytest.raises(hysid.ConfigError, match="dead_zones"):
+        hysid.identify_operator(u, y, family="gpi", dead_zones=-1)
+
+
 def test_initial_state_is_the_command_lines():
     """``initial_state=`` is ``--initial-state``: a record that starts at the end of a
     descent is fitted from it, reported and saved; an unknown name is a ConfigError."""

@@ -18,7 +18,8 @@ pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
         choose_grid: args.grid.is_none(),
         choose_thresholds: args.thresholds.is_none(),
         lambda: args.lambda,
-        dead_zones: args.dead_zones as usize,
+        dead_zones: args.dead_zones.map_or(4, |m| m as usize),
+        choose_dead_zones: args.dead_zones.is_none(),
         loop_orientation: args.orientation.map(Into::into),
         initial_state: args.initial_state.into(),
         envelope: args.envelope.into(),
@@ -47,6 +48,7 @@ pub fn family_options(args: &FamilyArgs) -> Result<FamilyOptions> {
             args.grid.map_or("chosen".to_string(), |g| g.to_string()),
             args.lambda,
             args.dead_zones
+                .map_or("chosen".to_string(), |m| m.to_string())
         )
     })?;
     Ok(options)

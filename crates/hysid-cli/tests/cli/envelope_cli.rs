@@ -2,7 +2,8 @@
 //! saturates, the default PI chooses a cubic static envelope, saves it, `hysid simulate`
 //! reproduces the fit, `hysid compensate` gives commands that `simulate` turns back into the
 //! reference, and `hysid export` writes the envelope's helper; a non-PI family refuses the
-//! flag in one line (exit 2).
+//! flag in one line (exit 2). Likewise the generalised PI's static map: its dead zones are
+//! chosen unless `--dead-zones` gives them.
 
 use crate::common::{fails_with, hysid, read_json, Assert};
 use std::fs;
@@ -185,4 +186,46 @@ fn the_envelope_flag_is_a_pi_option() {
         2,
     );
     assert!(err.contains("--envelope applies to pi, not gpi"), "{err}");
+}
+
+/// `--dead-zones`: without it the generalised PI chooses its dead zones with its thresholds
+/// (labels `"…, m dead zones"` / `"…, m quantile dead zones"`) and fits the saturating
+/// record better than the fixed four of `--dead-zones 4`, whose candidates carry none.
+#[test]
+fn the_generalised_pis_dead_zones_are_chosen_unless_given() {
+    let dir = TempDir::new().unwrap();
+    let data = magnet(dir.path());
+    let fit = |extra: &[&str], name: &str| {
+        let report = dir.path().join(name);
+        hysid()
+            .args(["identify", "operator", "--family", "gpi", "--data"])
+            .arg(&data)
+            .args(["--input", "u", "--output", "y", "-q", "--json"])
+            .arg(&report)
+            .args(extra)
+            .assert()
+            .success();
+        read_json(&report)
+    };
+    let chosen = fit(&[], "chosen.json");
+    let size = &chosen["details"]["model_size"];
+    assert!(
+        size["chosen"].as_str().unwrap().contains("dead zones"),
+        "{size}"
+    );
+    let fixed = fit(&["--dead-zones", "4"], "fixed.json");
+    let candidates = fixed["details"]["model_size"]["candidates"]
+        .as_array()
+        .unwrap();
+    assert!(!candidates.is_empty());
+    assert!(candidates
+        .iter()
+        .all(|c| !c["size"].as_str().unwrap().contains("dead zones")));
+    let percent = |r: &serde_json::Value| r["fit"]["fit_percent"].as_f64().unwrap();
+    assert!(
+        percent(&chosen) >= percent(&fixed),
+        "{} against {}",
+        percent(&chosen),
+        percent(&fixed)
+    );
 }

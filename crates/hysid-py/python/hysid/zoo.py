@@ -97,14 +97,17 @@ class _FamilyOptions(NamedTuple):
     threshold_grid: List[float]
     grid: Optional[int]
     lambda_: float
-    dead_zones: int
+    dead_zones: Optional[int]
 
 
 def _family_options(
-    thresholds: Union[int, Sequence[float], None], grid: Optional[int], lambda_: float, dead_zones: int
+    thresholds: Union[int, Sequence[float], None],
+    grid: Optional[int],
+    lambda_: float,
+    dead_zones: Optional[int],
 ) -> _FamilyOptions:
-    """None for ``thresholds`` or ``grid``: chosen from the data, as the command line does
-    without ``--thresholds``/``--grid``."""
+    """None for ``thresholds``, ``grid`` or ``dead_zones``: chosen from the data, as the
+    command line does without ``--thresholds``/``--grid``/``--dead-zones``."""
     count: Optional[int]
     values: List[float]
     if thresholds is None:
@@ -123,7 +126,8 @@ def _family_options(
     if not (math.isfinite(lam) and lam >= 0.0):
         raise ConfigError(f"lambda_={lambda_!r}: the Preisach smoothness must be finite and >= 0")
     grid_count = None if grid is None else check.count(grid, "grid")
-    return _FamilyOptions(count, values, grid_count, lam, check.count(dead_zones, "dead_zones"))
+    zones = None if dead_zones is None else check.count(dead_zones, "dead_zones")
+    return _FamilyOptions(count, values, grid_count, lam, zones)
 
 
 def _family(name: Any, what: str = "family") -> str:
@@ -142,7 +146,7 @@ def identify_operator(
     thresholds: Union[int, Sequence[float], None] = None,
     grid: Optional[int] = None,
     lambda_: float = 1e-6,
-    dead_zones: int = 4,
+    dead_zones: Optional[int] = None,
     orientation: Optional[LoopOrientation] = None,
     initial_state: Optional[InitialStateName] = None,
     envelope: Optional[EnvelopeName] = None,
@@ -162,7 +166,7 @@ def identify_operator(
     > 0); None (the default) chooses the count and placement from the data (held-out
     validation within a work bound, ``docs/zoo.md``), as the command line does without
     ``--thresholds``. ``grid``: Preisach/KP intervals, None (the default) likewise chosen; ``lambda_``: Preisach smoothness; ``dead_zones``: GPI
-    dead zones per side. ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
+    dead zones per side, None (the default) chosen with the thresholds (4, 8 or 12). ``u`` may be a record with ``.u``, ``.y`` (then ``y`` is omitted).
     ``orientation``: the loop's turning sense in the (u, y) plane, ``"ccw"``
     (counter-clockwise: the output lags the input, as a piezo stack or a magnet's B(H)) or
     ``"cw"``; None (default) detects it from the area between the ascending and descending
@@ -206,7 +210,7 @@ def compare(
     thresholds: Union[int, Sequence[float], None] = None,
     grid: Optional[int] = None,
     lambda_: float = 1e-6,
-    dead_zones: int = 4,
+    dead_zones: Optional[int] = None,
     orientation: Optional[LoopOrientation] = None,
     initial_state: Optional[InitialStateName] = None,
     envelope: Optional[EnvelopeName] = None,

@@ -285,7 +285,7 @@ pub fn forward<O: EmitOde + ?Sized>(ode: &O, ns: &Ns, prog: &mut Program) -> Res
 /// Emits the inverse step `ns.inverse(r)` (`differential::invert`): the sample's output as
 /// a function of the new input solved for r by `solve_sample` and its Illinois iteration;
 /// with a declared `history`, the first command's trials v each run it from x₀ at v to the
-/// turn and back (`differential::HistoryRun::state_at`, the turn by [`super::turn_at`]).
+/// turn and back (`differential::HistoryRun::state_at`, the turn by `families::turn_at`).
 pub fn inverse<O: EmitOde + ?Sized>(
     ode: &O,
     history: Option<HistoryRun>,

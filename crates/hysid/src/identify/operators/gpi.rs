@@ -19,12 +19,13 @@
 //! nonlinearities: a modified Prandtl–Ishlinskii approach", European Journal of Control 9
 //! (2003) 407–418.
 
+use super::family::DEAD_ZONE_CANDIDATES;
 use super::family::{FamilyOptions, FamilySetting, Identify};
 use super::linear_support::{
     check_data, core_path, finish, fit_initial_state, orientation, range, solve_weights,
     threshold_grid, unscaled, GramAccumulator, Spread,
 };
-use super::model_size::choose_thresholds;
+use super::model_size::{choose_thresholds, PlayVariant};
 use super::OperatorFit;
 use crate::model::operators::{
     play, validate_thresholds, DeadZones, GeneralizedPi, InitialStateUsed, Orientation,
@@ -44,6 +45,8 @@ pub struct GpiOptions {
     pub dead_zones: usize,
     /// Explicit dead-zone thresholds of S⁻¹: (upper, increasing > 0; lower, decreasing < 0).
     pub dead_zone_grid: Option<(Vec<f64>, Vec<f64>)>,
+    /// The placement of the default dead-zone grid (uniform).
+    pub dead_zone_placement: ZonePlacement,
     /// The orientation; detected from the data when None.
     pub orientation: Option<Orientation>,
     /// The declared initial state the plays start from (None: from 0, demagnetised).
@@ -57,6 +60,7 @@ impl Default for GpiOptions {
             grid: None,
             dead_zones: 4,
             dead_zone_grid: None,
+            dead_zone_placement: ZonePlacement::Uniform,
             orientation: None,
             initial_state: None,
         }
@@ -76,14 +80,38 @@ fn dead_zone(v: &[f64], z: f64) -> Vec<f64> {
         .collect()
 }
 
-/// The default dead-zone thresholds inside the output range.
-fn dead_zone_grid(v: &[f64], m: usize) -> (Vec<f64>, Vec<f64>) {
+/// Where the default dead zones of S⁻¹ lie in the output range [lo, hi], m per side.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ZonePlacement {
+    /// Equally spaced: z⁺ⱼ = j·hi/(m + 1) above 0, z⁻ⱼ = j·lo/(m + 1) below (Kuhnen 2003).
+    #[default]
+    Uniform,
+    /// Where the data are (MODELS.md §4.8): z⁺ⱼ the j/(m + 1) quantile of the positive
+    /// outputs, z⁻ⱼ that of the negative ones. A saturating record (a magnet's field) crowds
+    /// its outputs where the static curve bends, and there S needs its pieces; uniform
+    /// zones spend them on a few samples near 0.
+    Quantile,
+}
+
+/// The default dead-zone thresholds inside the output range ([`ZonePlacement`]), m per
+/// side (fewer where quantiles coincide).
+fn dead_zone_grid(v: &[f64], m: usize, placement: ZonePlacement) -> (Vec<f64>, Vec<f64>) {
     let (lo, hi) = range(v);
     let side = |end: f64| -> Vec<f64> {
-        (1..=m)
-            .map(|j| j as f64 * end / (m + 1) as f64)
-            .filter(|&z| z > lo && z < hi)
-            .collect()
+        let mut zones: Vec<f64> = match placement {
+            ZonePlacement::Uniform => (1..=m).map(|j| j as f64 * end / (m + 1) as f64).collect(),
+            ZonePlacement::Quantile => {
+                let mut beyond: Vec<f64> = v.iter().copied().filter(|&x| x * end > 0.0).collect();
+                beyond.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
+                match beyond.len() {
+                    0 => Vec::new(),
+                    n => (1..=m).map(|j| beyond[j * (n - 1) / (m + 1)]).collect(),
+                }
+            }
+        };
+        zones.retain(|&z| z > lo && z < hi);
+        zones.dedup();
+        zones
     };
     (
         if hi > 0.0 { side(hi) } else { Vec::new() },
@@ -103,7 +131,7 @@ pub fn fit(u: &[f64], y: &[f64], options: &GpiOptions) -> Result<OperatorFit<Gen
     validate_thresholds("r", &grid)?;
     let (upper, lower) = match &options.dead_zone_grid {
         Some(g) => g.clone(),
-        None => dead_zone_grid(&v, options.dead_zones),
+        None => dead_zone_grid(&v, options.dead_zones, options.dead_zone_placement),
     };
     validate_thresholds("zp", &upper)?;
     let neg: Vec<f64> = lower.iter().map(|z| -z).collect();
@@ -199,17 +227,38 @@ impl Identify for GeneralizedPi {
 
     /// With [`FamilyOptions::choose_thresholds`] (and no explicit grid) the threshold count
     /// and placement are chosen on a held-out part as for PI
-    /// ([`model_size`](super::model_size)).
+    /// ([`model_size`](super::model_size)), and with [`FamilyOptions::choose_dead_zones`]
+    /// the dead zones per side of S among [`DEAD_ZONE_CANDIDATES`], uniform and at the
+    /// outputs' quantiles ([`ZonePlacement`]), with them (the static map of a saturating
+    /// record needs more of them, where its outputs crowd).
     fn identify(u: &[f64], y: &[f64], options: &FamilyOptions) -> Result<OperatorFit<Self>> {
         let given = options.given_orientation(u, y)?;
         let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
-            let extra = 2 + 2 * options.dead_zones;
-            return choose_thresholds(u, y, o, extra, &[false], request, |u, y, size, start| {
+            // the dead-zone counts tried with the plays, or the one given (in `extra`)
+            let (extra, variants) = if options.choose_dead_zones {
+                let variants = [ZonePlacement::Uniform, ZonePlacement::Quantile]
+                    .iter()
+                    .flat_map(|&placement| {
+                        DEAD_ZONE_CANDIDATES.map(|m| PlayVariant {
+                            dead_zones: Some((m, placement)),
+                            ..PlayVariant::PLAIN
+                        })
+                    })
+                    .collect();
+                (2, variants)
+            } else {
+                (2 + 2 * options.dead_zones, vec![PlayVariant::PLAIN])
+            };
+            return choose_thresholds(u, y, o, extra, &variants, request, |u, y, size, start| {
                 let settings = GpiOptions {
                     grid: Some(size.grid.clone()),
-                    dead_zones: options.dead_zones,
+                    dead_zones: size.variant.dead_zones.map_or(options.dead_zones, |d| d.0),
+                    dead_zone_placement: size
+                        .variant
+                        .dead_zones
+                        .map_or_else(ZonePlacement::default, |d| d.1),
                     orientation: Some(o),
                     initial_state: start.state,
                     ..GpiOptions::default()

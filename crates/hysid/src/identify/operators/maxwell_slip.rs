@@ -17,7 +17,7 @@ use super::linear_support::{
     check_data, core_path, finish, fit_initial_state, orientation, solve_weights, threshold_grid,
     GramAccumulator, Spread,
 };
-use super::model_size::choose_thresholds;
+use super::model_size::{choose_thresholds, PlayVariant};
 use super::OperatorFit;
 use crate::identify::operator_cascade::{OperatorCascadeIdentification, RANK_ONE};
 use crate::model::operators::{
@@ -149,15 +149,23 @@ impl Identify for MaxwellSlip {
                 Some(o) => o,
                 None => detected_orientation(u, y)?,
             };
-            return choose_thresholds(u, y, o, 2, &[false], request, |u, y, size, start| {
-                let settings = MaxwellSlipOptions {
-                    widths: Some(size.grid.clone()),
-                    orientation: Some(o),
-                    initial_state: start.state,
-                    ..MaxwellSlipOptions::default()
-                };
-                fit(u, y, &settings)
-            });
+            return choose_thresholds(
+                u,
+                y,
+                o,
+                2,
+                &[PlayVariant::PLAIN],
+                request,
+                |u, y, size, start| {
+                    let settings = MaxwellSlipOptions {
+                        widths: Some(size.grid.clone()),
+                        orientation: Some(o),
+                        initial_state: start.state,
+                        ..MaxwellSlipOptions::default()
+                    };
+                    fit(u, y, &settings)
+                },
+            );
         }
         fit_initial_state(request, u, |start| {
             let settings = MaxwellSlipOptions {

@@ -26,6 +26,7 @@
 //! Reference: T. Hastie, R. Tibshirani, J. Friedman, *The Elements of Statistical Learning*,
 //! 2nd ed., Springer 2009, §7.2 (model selection by a validation set).
 
+use super::gpi::ZonePlacement;
 use super::linear_support::{
     first_state, fit_initial_state, geometric_thresholds, threshold_grid, Fit,
 };
@@ -114,14 +115,50 @@ where
     )
 }
 
-/// A play family's candidate size: its thresholds, and whether it carries a static envelope
-/// (the PI's cubic, `model::operators::envelope`; the other play families have none).
+/// What a play family's candidate carries beside its plays: a static envelope (the PI's
+/// cubic, `model::operators::envelope`), and the generalised PI's dead zones per side when
+/// their count is part of the choice (None: fixed, counted in the family's `extra`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PlayVariant {
+    /// A cubic static envelope beside the plays.
+    pub envelope: bool,
+    /// Dead zones per side of the static map S (generalised PI) and their placement,
+    /// chosen with the plays.
+    pub dead_zones: Option<(usize, ZonePlacement)>,
+}
+
+impl PlayVariant {
+    /// The plays alone.
+    pub const PLAIN: Self = Self {
+        envelope: false,
+        dead_zones: None,
+    };
+
+    /// The parameters the variant adds: the envelope's three slope values less a₀, which
+    /// the envelope holds (`identify::operators::pi`), and two per dead zone and side.
+    fn parameters(self) -> usize {
+        usize::from(self.envelope) * ENVELOPE_PARAMETERS + 2 * self.dead_zones.map_or(0, |d| d.0)
+    }
+
+    /// The label's suffix: `" + envelope"`, `", m dead zones"` (uniform),
+    /// `", m quantile dead zones"`, or nothing.
+    fn suffix(self) -> String {
+        let envelope = if self.envelope { " + envelope" } else { "" };
+        match self.dead_zones {
+            Some((m, ZonePlacement::Uniform)) => format!("{envelope}, {m} dead zones"),
+            Some((m, ZonePlacement::Quantile)) => format!("{envelope}, {m} quantile dead zones"),
+            None => envelope.to_string(),
+        }
+    }
+}
+
+/// A play family's candidate size: its thresholds and what it carries beside them.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct PlaySize {
     /// The thresholds r₁ < … < rₙ.
     pub grid: Vec<f64>,
-    /// A cubic static envelope beside the plays.
-    pub envelope: bool,
+    /// The envelope, the dead zones.
+    pub variant: PlayVariant,
 }
 
 /// The parameters a static envelope adds to a candidate: a cubic's three slope values less
@@ -130,16 +167,17 @@ const ENVELOPE_PARAMETERS: usize = crate::model::operators::envelope::CUBIC - 1;
 
 /// The play and stop families' (PI, generalised PI, Maxwell-slip) choice of their
 /// thresholds: the candidates of [`threshold_candidates`] on the core's input
-/// `x`, each with `extra` parameters beside its weights and, for each entry of `envelopes`,
-/// without (false) or with (true) a static envelope, chosen by [`choose`] within
-/// [`PLAY_WORK_BOUND`] fits of the default ten thresholds per entry; `fit` fits a
-/// [`PlaySize`] in the orientation `o`. The choice is recorded in the fit's `model_size`.
+/// `x`, each with `extra` parameters beside its weights and once per entry of `variants`
+/// (without and with a static envelope; the generalised PI's dead-zone counts), chosen by
+/// [`choose`] within [`PLAY_WORK_BOUND`] fits of the default ten thresholds per entry; `fit`
+/// fits a [`PlaySize`] in the orientation `o`. The choice is recorded in the fit's
+/// `model_size`.
 pub(crate) fn choose_thresholds<M, F>(
     u: &[f64],
     y: &[f64],
     o: Orientation,
     extra: usize,
-    envelopes: &[bool],
+    variants: &[PlayVariant],
     request: InitialState,
     fit: F,
 ) -> Result<OperatorFit<M>>
@@ -148,9 +186,10 @@ where
     F: Fn(&[f64], &[f64], &PlaySize, Fit<M>) -> Result<OperatorFit<M>>,
 {
     let (x, _) = o.core_data(u, y);
-    let candidates = threshold_candidates(&x, extra, envelopes)?;
-    let bound = PLAY_WORK_BOUND * envelopes.len().max(1) as f64;
-    choose(u, y, candidates, 10 + extra, bound, request, fit)
+    let candidates = threshold_candidates(&x, extra, variants)?;
+    let bound = PLAY_WORK_BOUND * variants.len().max(1) as f64;
+    let default = 10 + extra + variants.first().map_or(0, |v| v.parameters());
+    choose(u, y, candidates, default, bound, request, fit)
 }
 
 /// The work bound of the threshold-count choice, in fits of the fixed default size
@@ -160,14 +199,15 @@ const PLAY_WORK_BOUND: f64 = 12.0;
 
 /// The candidate threshold grids of the count choice: every count of
 /// [`super::family::THRESHOLD_CANDIDATES`], uniform then geometric
-/// (the geometric one only where it differs), each once per entry of `envelopes`, labelled
-/// `"n uniform"` / `"n geometric"` (`"… + envelope"` with one), with `extra` parameters
-/// beside the n weights (and the envelope's); smallest first (a stable sort by the
-/// parameter count, so that the work bound and a tie favour the smaller model).
+/// (the geometric one only where it differs), each once per entry of `variants`, labelled
+/// `"n uniform"` / `"n geometric"` with the variant's suffix (`" + envelope"`,
+/// `", m dead zones"`), with `extra` parameters beside the n weights (and the variant's);
+/// smallest first (a stable sort by the parameter count, so that the work bound and a tie
+/// favour the smaller model).
 fn threshold_candidates(
     x: &[f64],
     extra: usize,
-    envelopes: &[bool],
+    variants: &[PlayVariant],
 ) -> Result<Vec<Candidate<PlaySize>>> {
     let mut out = Vec::new();
     for &n in &super::family::THRESHOLD_CANDIDATES {
@@ -177,19 +217,15 @@ fn threshold_candidates(
         if geometric != uniform {
             grids.push((geometric, "geometric"));
         }
-        for &envelope in envelopes {
+        for &variant in variants {
             for (grid, placement) in &grids {
-                let (suffix, added) = match envelope {
-                    true => (" + envelope", ENVELOPE_PARAMETERS),
-                    false => ("", 0),
-                };
                 out.push(Candidate {
                     setting: PlaySize {
                         grid: grid.clone(),
-                        envelope,
+                        variant,
                     },
-                    label: format!("{n} {placement}{suffix}"),
-                    parameters: n + extra + added,
+                    label: format!("{n} {placement}{}", variant.suffix()),
+                    parameters: n + extra + variant.parameters(),
                 });
             }
         }

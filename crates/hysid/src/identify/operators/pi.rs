@@ -27,7 +27,7 @@ use super::linear_support::{
     check_data, core_path, finish, fit_initial_state, orientation, solve_weights, threshold_grid,
     unscaled, GramAccumulator, Spread,
 };
-use super::model_size::choose_thresholds;
+use super::model_size::{choose_thresholds, PlayVariant};
 use super::OperatorFit;
 use crate::identify::operator_cascade::{
     monotone_weights, OperatorCascadeIdentification, RANK_ONE,
@@ -219,13 +219,18 @@ impl Identify for PrandtlIshlinskii {
         let request = options.initial_state;
         if options.choose_thresholds && options.threshold_grid.is_none() {
             let o = orientation(u, y, given)?;
-            let envelopes = options.envelope.variants();
-            return choose_thresholds(u, y, o, 2, envelopes, request, |u, y, size, start| {
+            let variants: Vec<PlayVariant> = (options.envelope.variants().iter())
+                .map(|&envelope| PlayVariant {
+                    envelope,
+                    ..PlayVariant::PLAIN
+                })
+                .collect();
+            return choose_thresholds(u, y, o, 2, &variants, request, |u, y, size, start| {
                 let settings = PiOptions {
                     grid: Some(size.grid.clone()),
                     orientation: Some(o),
                     initial_state: start.state,
-                    envelope: size.envelope,
+                    envelope: size.variant.envelope,
                     ..PiOptions::default()
                 };
                 fit(u, y, &settings)

@@ -137,20 +137,7 @@ fn magnet() -> (Vec<f64>, Vec<f64>) {
 fn a_short_magnet_record_gets_small_models_that_beat_a_straight_line() {
     let (u, y) = magnet();
     let (train_u, train_y) = (&u[..170], &y[..170]);
-    // the least-squares straight line y ≈ a + b u on the training rows
-    let n = train_u.len() as f64;
-    let (mu, my) = (
-        train_u.iter().sum::<f64>() / n,
-        train_y.iter().sum::<f64>() / n,
-    );
-    let b = train_u
-        .iter()
-        .zip(train_y)
-        .map(|(a, c)| (a - mu) * (c - my))
-        .sum::<f64>()
-        / train_u.iter().map(|a| (a - mu).powi(2)).sum::<f64>();
-    let line: Vec<f64> = u[170..].iter().map(|a| my + b * (a - mu)).collect();
-    let line_rmse = metrics::mse(&y[170..], &line).sqrt();
+    let line_rmse = line_rmse(&u, &y);
     let rmse = |family: Family| {
         let fitted = fit_operator(family, train_u, train_y, &FamilyOptions::default()).unwrap();
         let choice = fitted.fit.model_size.clone().expect("the size is chosen");
@@ -177,6 +164,76 @@ fn a_short_magnet_record_gets_small_models_that_beat_a_straight_line() {
         pi <= line_rmse / 12.0,
         "pi: {pi} against the line's {line_rmse} ({choice:?})"
     );
+}
+
+/// The generalised PI's static map S on a saturating record: the dead zones per side and
+/// their placement are chosen with the thresholds (4, 8 or 12, uniform or at the outputs'
+/// quantiles, where the saturating field crowds), and the default beats both the line by
+/// the factor 12 and the fixed four uniform zones of before; `--dead-zones`
+/// (`choose_dead_zones` false) fixes them as given.
+#[test]
+fn the_generalised_pi_chooses_its_dead_zones_on_a_saturating_record() {
+    let (u, y) = magnet();
+    let (train_u, train_y) = (&u[..170], &y[..170]);
+    let heldout = |options: &FamilyOptions| {
+        let fitted = fit_operator(Family::Gpi, train_u, train_y, options).unwrap();
+        let choice = fitted.fit.model_size.clone().expect("the size is chosen");
+        let sim = simulate(&fitted, &u);
+        (metrics::mse(&y[170..], &sim[170..]).sqrt(), choice)
+    };
+    let line = line_rmse(&u, &y);
+    let (chosen, choice) = heldout(&FamilyOptions::default());
+    assert!(choice.chosen.contains("dead zones"), "{choice:?}");
+    assert!(
+        choice
+            .candidates
+            .iter()
+            .any(|c| c.size.contains("quantile dead zones")),
+        "{choice:?}"
+    );
+    let fixed = FamilyOptions {
+        choose_dead_zones: false,
+        ..FamilyOptions::default()
+    };
+    let (four, four_choice) = heldout(&fixed);
+    assert!(
+        four_choice
+            .candidates
+            .iter()
+            .all(|c| !c.size.contains("dead zones")),
+        "{four_choice:?}"
+    );
+    println!(
+        "gpi: {} rmse {chosen}, four uniform {four}, line {line}",
+        choice.chosen
+    );
+    assert!(
+        chosen <= line / 12.0,
+        "{chosen} against the line's {line} ({choice:?})"
+    );
+    assert!(
+        chosen < 0.5 * four,
+        "{chosen} against four uniform zones' {four}"
+    );
+}
+
+/// The held-out RMSE (rows 170 …) of the least-squares straight line y ≈ a + b u fitted on
+/// the first 170 rows.
+fn line_rmse(u: &[f64], y: &[f64]) -> f64 {
+    let (train_u, train_y) = (&u[..170], &y[..170]);
+    let n = train_u.len() as f64;
+    let (mu, my) = (
+        train_u.iter().sum::<f64>() / n,
+        train_y.iter().sum::<f64>() / n,
+    );
+    let b = train_u
+        .iter()
+        .zip(train_y)
+        .map(|(a, c)| (a - mu) * (c - my))
+        .sum::<f64>()
+        / train_u.iter().map(|a| (a - mu).powi(2)).sum::<f64>();
+    let line: Vec<f64> = u[170..].iter().map(|a| my + b * (a - mu)).collect();
+    metrics::mse(&y[170..], &line).sqrt()
 }
 
 /// The held-out RMSE of the default Preisach against the straight line's.
