@@ -49,7 +49,7 @@ fn warn_history_beyond_the_inverse(
 ) {
     if let Some(state) = model.history_beyond_the_inverse() {
         tell!(
-            "warning: {} starts after a declared {} history without its turn (history_turn, a file of an earlier version), which the compensator does not run: its first commands follow the operator's own initial state until the reference wipes the memory out; fit the model again to save the turn",
+            "warning: {} starts after a declared {} history without its turn (history_turn, a file of an earlier version), which the compensator does not run: its first commands follow the operator's own initial state until the reference's excursions have made the history irrelevant; fit the model again to save the turn",
             path.display(),
             state.name()
         );

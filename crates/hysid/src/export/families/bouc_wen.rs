@@ -3,10 +3,8 @@
 //! integrated by the differential driver ([`super::differential`]).
 
 use super::differential::{self, EmitOde};
-use super::Emit;
 use crate::export::code::{local, select, Ty};
 use crate::export::program::{Ns, Program};
-use crate::model::operators::differential::HistoryRun;
 use crate::model::operators::BoucWen;
 use crate::Result;
 
@@ -39,16 +37,4 @@ impl EmitOde for BoucWen {
     }
 }
 
-impl Emit for BoucWen {
-    fn emit_forward(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
-        differential::forward(self, ns, prog)
-    }
-    fn emit_inverse(
-        &self,
-        history: Option<HistoryRun>,
-        ns: &Ns,
-        prog: &mut Program,
-    ) -> Result<String> {
-        differential::inverse(self, history, ns, prog)
-    }
-}
+differential::differential_emit!(BoucWen);

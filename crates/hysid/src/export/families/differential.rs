@@ -46,6 +46,31 @@ pub const SINGLE_ABSOLUTE: f64 = 1e-14;
 /// the integration's tolerance, below which the float branch is noise.
 pub const SINGLE_YTOL: f64 = 1e-6;
 
+/// Implements [`super::Emit`] for a differential family (an [`EmitOde`]) through
+/// [`forward`] and [`inverse`]: one line per family.
+macro_rules! differential_emit {
+    ($ty:ty) => {
+        impl $crate::export::families::Emit for $ty {
+            fn emit_forward(
+                &self,
+                ns: &$crate::export::program::Ns,
+                prog: &mut $crate::export::program::Program,
+            ) -> $crate::Result<String> {
+                $crate::export::families::differential::forward(self, ns, prog)
+            }
+            fn emit_inverse(
+                &self,
+                history: Option<$crate::model::operators::differential::HistoryRun>,
+                ns: &$crate::export::program::Ns,
+                prog: &mut $crate::export::program::Program,
+            ) -> $crate::Result<String> {
+                $crate::export::families::differential::inverse(self, history, ns, prog)
+            }
+        }
+    };
+}
+pub(crate) use differential_emit;
+
 /// What a differential family supplies: its equations as helpers.
 pub trait EmitOde: InputOde {
     /// Emits `ns.slope(u, x, d) -> f64`, the library's `InputOde::slope`.
@@ -302,7 +327,7 @@ pub fn inverse<O: EmitOde + ?Sized>(
         prog.bound(format!(
             "The first command runs the declared {} history on each trial: its branch \
              integrates two intervals, to the turn and back, of at most {SUBSTEP_BUDGET} \
-             sub-steps each.",
+             sub-steps each (a first step of up to twice the work of the others' bound).",
             run.history.state.name()
         ));
     }
@@ -339,6 +364,17 @@ pub fn inverse<O: EmitOde + ?Sized>(
                 }
                 Some(run) => {
                     let v = local("v");
+                    // a trial beyond the saved turn fails, as HistoryRun::admits refuses it
+                    if let Some(t) = run.history.turn {
+                        let beyond = ((lit(t) - v.clone()) * lit(run.history.direction()))
+                            .gt(lit(0.0))
+                            .not();
+                        b.if_(beyond, |b| {
+                            b.set_state(&d.fail, Expr::Flag(true));
+                            b.set_state(&br_x, lit(x0));
+                            b.ret(call(&d.output, vec![v.clone(), lit(x0)]));
+                        });
+                    }
                     let turn = b.let_("turn", super::turn_at(run.history, run.reach, v.clone()));
                     let x_turn = b.let_(
                         "x_turn",
@@ -512,7 +548,7 @@ pub fn inverse<O: EmitOde + ?Sized>(
             b.ret(best_v);
         },
     )?;
-    let anchor = ode.anchor_input();
+    let anchor = history.map_or(ode.anchor_input(), |run| run.start(ode));
     prog.function(&ns.name("inverse"), &[("r", Ty::F64)], Some(Ty::F64), |b| {
         b.if_(local("r").is_finite().not(), |b| {
             b.set_state(DIVERGED_FIELD, Expr::Flag(true))

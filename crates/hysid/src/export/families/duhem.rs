@@ -3,10 +3,8 @@
 //! ([`super::differential`]).
 
 use super::differential::{self, EmitOde};
-use super::Emit;
 use crate::export::code::{local, Ty};
 use crate::export::program::{Ns, Program};
-use crate::model::operators::differential::HistoryRun;
 use crate::model::operators::Duhem;
 use crate::Result;
 
@@ -30,16 +28,4 @@ impl EmitOde for Duhem {
     }
 }
 
-impl Emit for Duhem {
-    fn emit_forward(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
-        differential::forward(self, ns, prog)
-    }
-    fn emit_inverse(
-        &self,
-        history: Option<HistoryRun>,
-        ns: &Ns,
-        prog: &mut Program,
-    ) -> Result<String> {
-        differential::inverse(self, history, ns, prog)
-    }
-}
+differential::differential_emit!(Duhem);

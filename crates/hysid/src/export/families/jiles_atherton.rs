@@ -4,10 +4,8 @@
 //! integrated by the differential driver ([`super::differential`]).
 
 use super::differential::{self, EmitOde};
-use super::Emit;
 use crate::export::code::{lit, local, select, Block, Expr, Ty};
 use crate::export::program::{Ns, Program};
-use crate::model::operators::differential::HistoryRun;
 use crate::model::operators::jiles_atherton::MU0;
 use crate::model::operators::{Anhysteretic, JaOutput, JilesAtherton};
 use crate::Result;
@@ -93,16 +91,4 @@ impl EmitOde for JilesAtherton {
     }
 }
 
-impl Emit for JilesAtherton {
-    fn emit_forward(&self, ns: &Ns, prog: &mut Program) -> Result<String> {
-        differential::forward(self, ns, prog)
-    }
-    fn emit_inverse(
-        &self,
-        history: Option<HistoryRun>,
-        ns: &Ns,
-        prog: &mut Program,
-    ) -> Result<String> {
-        differential::inverse(self, history, ns, prog)
-    }
-}
+differential::differential_emit!(JilesAtherton);

@@ -43,7 +43,7 @@ pub struct FamilyOptions {
     /// Smoothness penalty λ of the Preisach fit (1e-6).
     pub lambda: f64,
     /// Dead zones on each side of the generalised PI (4) when they are not chosen
-    /// (`choose_dead_zones` false, or `choose_thresholds` false).
+    /// (`choose_dead_zones` false, `choose_thresholds` false, or a `threshold_grid` given).
     pub dead_zones: usize,
     /// The loop orientation of the linear-in-weights families as their model files store it
     /// (trend and Γ = G or G⁻¹); overrides `loop_orientation`. Detected from the data when

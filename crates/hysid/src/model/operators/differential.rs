@@ -21,7 +21,9 @@
 //! monotone in the new input v for the families here; the inverse finds v with y_k(v) = r_k by
 //! bracketing (doubling steps from u_{k−1}) and the Illinois variant of regula falsi (Dowell &
 //! Jarratt 1971). A reference that no input within the family's inversion span reaches is
-//! clipped to the closest output found and listed.
+//! clipped to the closest output found and listed. The first sample starts from the family's
+//! anchor input; after a declared history ([`HistoryRun`]) its branch is the output after
+//! the history's path v → u_turn → v, searched on the record's side of the saved turn only.
 //!
 //! **Parameter sensitivities.** A family that also implements [`InputOdeSensitivity`] gives
 //! the partial derivatives ∂F/∂x, ∂F/∂θ, ∂h/∂x, ∂h/∂θ and ∂x₀/∂θ; [`simulate_with_sensitivities`]
@@ -579,6 +581,30 @@ impl HistoryRun {
         let at_turn = advance(ode, ode.initial_state(), v, turn)?;
         advance(ode, at_turn, turn, v)
     }
+
+    /// Whether a first command `v` lies strictly on the record's side of the saved turn t
+    /// (below a descending history's, above an ascending one's). Beyond it the turn moves
+    /// with v ([`History::turn_at`]), the branch jumps there and a rate-independent family
+    /// mirrors itself (the path v → t → v has the excursion |t − v| on both sides), so the
+    /// first command's search keeps to this side; without a saved turn, everywhere.
+    pub fn admits(&self, v: f64) -> bool {
+        self.history
+            .turn
+            .is_none_or(|t| (t - v) * self.history.direction() > 0.0)
+    }
+
+    /// Where the first command's search starts: the family's anchor input when
+    /// [`HistoryRun::admits`] it, else the saved turn stepped back towards the record by
+    /// max(reach, 10⁻⁶·max(|t|, 1)).
+    pub fn start<O: InputOde + ?Sized>(&self, ode: &O) -> f64 {
+        let anchor = ode.anchor_input();
+        match self.history.turn {
+            Some(t) if !self.admits(anchor) => {
+                t - self.history.direction() * self.reach.max(1e-6 * t.abs().max(1.0))
+            }
+            _ => anchor,
+        }
+    }
 }
 
 impl InverseStream {
@@ -608,11 +634,15 @@ impl InverseStream {
                 }
                 Some(run) => {
                     let branch = |v: f64| -> Result<(f64, f64)> {
+                        if !run.admits(v) {
+                            return Err(Error::Unsupported(
+                                "a first command beyond the history's turn".into(),
+                            ));
+                        }
                         let xv = run.state_at(ode, v)?;
                         Ok((ode.output(v, xv), xv))
                     };
-                    solve_sample(&branch, ode.anchor_input(), ode, r)
-                        .map_err(|e| at_sample(e, k))?
+                    solve_sample(&branch, run.start(ode), ode, r).map_err(|e| at_sample(e, k))?
                 }
             },
             Some((u_prev, x_prev)) => {

@@ -46,8 +46,10 @@
 //! truncated-power basis 1, t, t², t³, (t − κ)³₊ in t = (u − min u)/(max u − min u), de Boor,
 //! *A Practical Guide to Splines*, 2001, ch. VIII). A function of u alone cannot take up
 //! the loop (it has one value at each u, the loop two), and it cancels from the exact area
-//! between the branches; what it removes is the chords' curvature. Without enough samples
-//! for the spline (fewer than twice its coefficients) y is used as it is.
+//! between the branches; what it removes is the chords' curvature. The knots are the
+//! quantiles of the distinct inputs (fewer knots when the set points repeat few values,
+//! at most the distinct values less five); with fewer samples than twice the spline's
+//! coefficients, or a rank-deficient regression, y is used as it is.
 //!
 //! The loop is counter-clockwise when A > 0, clockwise when A < 0, provided g̃ has the same
 //! sign and |z| ≥ [`MIN_CONFIDENCE`]; otherwise (no reversal, a loop indistinguishable from
@@ -86,10 +88,14 @@ fn without_static_curve(u: &[f64], y: &[f64], lo: f64, hi: f64) -> Option<Vec<f6
     let t: Vec<f64> = u.iter().map(|v| (v - lo) / (hi - lo)).collect();
     let mut sorted = t.clone();
     sorted.sort_by(f64::total_cmp);
-    let wanted = (n / SAMPLES_PER_KNOT).min(STATIC_KNOTS);
+    sorted.dedup();
+    let distinct = sorted.len();
+    let wanted = (n / SAMPLES_PER_KNOT)
+        .min(STATIC_KNOTS)
+        .min(distinct.saturating_sub(5));
     let mut knots: Vec<f64> = Vec::with_capacity(wanted);
     for j in 1..=wanted {
-        let q = sorted[j * (n - 1) / (wanted + 1)];
+        let q = sorted[j * (distinct - 1) / (wanted + 1)];
         if q > 0.0 && q < 1.0 && knots.last().is_none_or(|&k| q > k) {
             knots.push(q);
         }
@@ -106,8 +112,7 @@ fn without_static_curve(u: &[f64], y: &[f64], lo: f64, hi: f64) -> Option<Vec<f6
         _ => (x - knots[j - 4]).max(0.0).powi(3),
     };
     let phi = nalgebra::DMatrix::from_fn(n, p, |i, j| basis(t[i], j));
-    let names: Vec<String> = (0..p).map(|j| format!("spline term {j}")).collect();
-    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let names = vec!["the static curve's spline"; p];
     let (theta, _) =
         crate::numerics::least_squares::least_squares_estimate(&phi, y, &names).ok()?;
     Some(
@@ -292,6 +297,12 @@ pub fn loop_evidence(u: &[f64], y: &[f64]) -> Result<LoopEvidence> {
     let Some((turns, first)) = (hi > lo).then(|| segments(u, h)).flatten() else {
         return Err(undetermined("the input does not move"));
     };
+    let reversals = turns.len().saturating_sub(2);
+    if reversals == 0 {
+        return Err(undetermined(
+            "the input has no reversal (a curve, not a loop)",
+        ));
+    }
     // the noise floor's scale: the output's own range
     let (ylo, yhi) = y
         .iter()
@@ -300,12 +311,6 @@ pub fn loop_evidence(u: &[f64], y: &[f64]) -> Result<LoopEvidence> {
         });
     let detrended = without_static_curve(u, y, lo, hi);
     let y = detrended.as_deref().unwrap_or(y);
-    let reversals = turns.len().saturating_sub(2);
-    if reversals == 0 {
-        return Err(undetermined(
-            "the input has no reversal (a curve, not a loop)",
-        ));
-    }
     let branches: Vec<Branch> = turns
         .windows(2)
         .map(|t| Branch::new(u, y, t[0], t[1]))

@@ -236,8 +236,9 @@ impl OperatorModel {
 
     /// The reference that primes the inverse for a declared `history` saved with its turn
     /// u_turn: Γ's first output at u_turn from the documented initial state. None without a
-    /// history or a saved turn, and for a family whose memory does not wipe out
-    /// ([`OperatorModel::history_reaches_the_inverse`]).
+    /// history or a saved turn, and for a family whose memory does not wipe out (a
+    /// differential one, whose first command runs the history instead:
+    /// [`OperatorModel::history_reaches_the_inverse`]).
     ///
     /// After it the inverse's state is the operator's after the input u_turn, and the first
     /// command u₀ descends (ascends) from there: exactly the state after the history
@@ -266,9 +267,9 @@ impl OperatorModel {
         history.is_some_and(|h| h.turn.is_some())
     }
 
-    /// The inverse stream after the declared `history` (module doc of
-    /// [`OperatorModel::history_reaches_the_inverse`]): primed, run by its first command, or
-    /// from the documented initial state.
+    /// The inverse stream after the declared `history` (as
+    /// [`OperatorModel::history_reaches_the_inverse`] says): primed, run by its first
+    /// command, or from the documented initial state.
     fn inverse_stream_from(&self, history: Option<History>) -> Result<AnyOperatorInverse> {
         if let Some(r) = self.priming_reference(history)? {
             return Ok(Box::new(PrimedInverse::new(self.inverse_stream()?, r)?));
