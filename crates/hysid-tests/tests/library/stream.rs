@@ -225,43 +225,41 @@ fn a_declared_history_streams_as_the_saved_model_simulates_it() {
             // rounding; a differential family to its inverse's tolerance).
             let history = History::of(Some(state), turn);
             assert!(model.history_reaches_the_inverse(history), "{what}");
-            {
-                let reference = fitted.simulate(&[&u[217..]], 1.0, None).unwrap().remove(0);
-                assert_compensates(&fitted, &reference, &format!("{what}, compensated"));
-                primed += 1;
-                let commands = compensate(&fitted, &reference).unwrap();
-                let followed = fitted
-                    .simulate(&[&commands.u], 1.0, None)
-                    .unwrap()
-                    .remove(0);
-                let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                // A differential family's branch y(v) is its integration's, smooth to its
-                // tolerance (1e-10 of the state's scale) as v moves the sub-steps; the
-                // inverse's root is as close as the branch's steps allow.
-                let differential = ["bouc-wen", "duhem", "dahl", "jiles-atherton"]
-                    .contains(&model.family().name());
-                let tolerance = if differential { 1e-9 } else { 1e-12 };
+            let reference = fitted.simulate(&[&u[217..]], 1.0, None).unwrap().remove(0);
+            assert_compensates(&fitted, &reference, &format!("{what}, compensated"));
+            primed += 1;
+            let commands = compensate(&fitted, &reference).unwrap();
+            let followed = fitted
+                .simulate(&[&commands.u], 1.0, None)
+                .unwrap()
+                .remove(0);
+            let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            // A differential family's branch y(v) is its integration's, smooth to its
+            // tolerance (1e-10 of the state's scale) as v moves the sub-steps; the
+            // inverse's root is as close as the branch's steps allow.
+            let differential =
+                ["bouc-wen", "duhem", "dahl", "jiles-atherton"].contains(&model.family().name());
+            let tolerance = if differential { 1e-9 } else { 1e-12 };
+            assert!(
+                commands.clipped.is_empty(),
+                "{what}: {:?}",
+                commands.clipped
+            );
+            for (k, (a, b)) in followed.iter().zip(&reference).enumerate() {
                 assert!(
-                    commands.clipped.is_empty(),
-                    "{what}: {:?}",
-                    commands.clipped
+                    (a - b).abs() <= tolerance * scale,
+                    "{what}: sample {k}: {a} against {b}"
                 );
-                for (k, (a, b)) in followed.iter().zip(&reference).enumerate() {
-                    assert!(
-                        (a - b).abs() <= tolerance * scale,
-                        "{what}: sample {k}: {a} against {b}"
-                    );
-                }
-                // Where the history is not the structure's own start (the Preisach plane's
-                // negative saturation is the ascending one), a linear-in-weights family's own
-                // inverse misses the first samples.
-                let own = FittedModel::operator(model.clone(), no_std(n));
-                let own_start = own.simulate(&[&u[217..]], 1.0, None).unwrap().remove(0);
-                if !differential && own_start[0] != reference[0] {
-                    let missed = compensate(&own, &reference).unwrap().u;
-                    let off = fitted.simulate(&[&missed], 1.0, None).unwrap().remove(0);
-                    assert!((off[0] - reference[0]).abs() > 1e-6 * scale, "{what}");
-                }
+            }
+            // Where the history is not the structure's own start (the Preisach plane's
+            // negative saturation is the ascending one), a linear-in-weights family's own
+            // inverse misses the first samples.
+            let own = FittedModel::operator(model.clone(), no_std(n));
+            let own_start = own.simulate(&[&u[217..]], 1.0, None).unwrap().remove(0);
+            if !differential && own_start[0] != reference[0] {
+                let missed = compensate(&own, &reference).unwrap().u;
+                let off = fitted.simulate(&[&missed], 1.0, None).unwrap().remove(0);
+                assert!((off[0] - reference[0]).abs() > 1e-6 * scale, "{what}");
             }
             // Saved and read back: the state and the turn.
             let text = serde_json::to_string(&fitted.to_file()).unwrap();

@@ -252,13 +252,14 @@ impl Identify for GeneralizedPi {
                 (2 + 2 * options.dead_zones, vec![PlayVariant::PLAIN])
             };
             return choose_thresholds(u, y, o, extra, &variants, request, |u, y, size, start| {
+                let (dead_zones, dead_zone_placement) = size
+                    .variant
+                    .dead_zones
+                    .unwrap_or((options.dead_zones, ZonePlacement::Uniform));
                 let settings = GpiOptions {
                     grid: Some(size.grid.clone()),
-                    dead_zones: size.variant.dead_zones.map_or(options.dead_zones, |d| d.0),
-                    dead_zone_placement: size
-                        .variant
-                        .dead_zones
-                        .map_or_else(ZonePlacement::default, |d| d.1),
+                    dead_zones,
+                    dead_zone_placement,
                     orientation: Some(o),
                     initial_state: start.state,
                     ..GpiOptions::default()

@@ -608,11 +608,11 @@ impl HistoryRun {
 }
 
 impl InverseStream {
-    /// The inverse whose first command starts after `history` (None: from x₀).
-    pub fn after(history: Option<HistoryRun>) -> Self {
+    /// The inverse whose first command starts after `history`.
+    pub fn after(history: HistoryRun) -> Self {
         Self {
             last: None,
-            history,
+            history: Some(history),
         }
     }
 
@@ -666,17 +666,8 @@ impl InverseStream {
 /// sample from the initial state ([`InverseStream`]); unreachable samples are clipped and
 /// listed.
 pub fn invert<O: InputOde + ?Sized>(ode: &O, reference: &[f64]) -> Result<Inversion> {
-    invert_after(ode, None, reference)
-}
-
-/// [`invert`] with the first command after the declared `history` ([`InverseStream::after`]).
-pub fn invert_after<O: InputOde + ?Sized>(
-    ode: &O,
-    history: Option<HistoryRun>,
-    reference: &[f64],
-) -> Result<Inversion> {
     check_signal("reference", reference)?;
-    let mut stream = InverseStream::after(history);
+    let mut stream = InverseStream::default();
     let n = reference.len();
     let (mut u, mut predicted, mut clipped) =
         (Vec::with_capacity(n), Vec::with_capacity(n), Vec::new());

@@ -162,10 +162,7 @@ macro_rules! differential_streaming {
                 use $crate::model::operators::initial_state::History;
                 self.validate()?;
                 let reach = History::reach(self);
-                Ok(Some(Self::Inverse::after(Some(HistoryRun {
-                    history,
-                    reach,
-                }))))
+                Ok(Some(Self::Inverse::after(HistoryRun { history, reach })))
             }
         }
     };

@@ -274,15 +274,12 @@ impl OperatorModel {
         if let Some(r) = self.priming_reference(history)? {
             return Ok(Box::new(PrimedInverse::new(self.inverse_stream()?, r)?));
         }
-        let after = history.filter(|h| h.turn.is_some());
-        match after
-            .map(|h| self.inverse_stream_after(h))
-            .transpose()?
-            .flatten()
-        {
-            Some(inverse) => Ok(inverse),
-            None => self.inverse_stream(),
+        if let Some(h) = history.filter(|_| self.history_reaches_the_inverse(history)) {
+            if let Some(inverse) = self.inverse_stream_after(h)? {
+                return Ok(inverse);
+            }
         }
+        self.inverse_stream()
     }
 
     /// [`OperatorModel::compensator`] after the declared `history`
