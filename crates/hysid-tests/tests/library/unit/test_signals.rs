@@ -87,3 +87,18 @@ pub fn piezo_record() -> (Vec<f64>, Vec<f64>) {
     }
     (u, y)
 }
+
+/// Loop `k` (1–4, amplitudes ≈ 8, 16, 40, 80 A/m) of the vendored Mn-Zn ferrite record
+/// (`data/ferrite`): (H in A/m, B in T), 129 samples from +Hₘₐₓ down to −Hₘₐₓ and back.
+pub fn ferrite_loop(k: usize) -> (Vec<f64>, Vec<f64>) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/ferrite/mnzn_ferrite_bh_loops.csv");
+    let text = std::fs::read_to_string(path).unwrap();
+    let (mut h, mut b) = (Vec::new(), Vec::new());
+    for line in text.lines().skip(1) {
+        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+        h.push(cells[2 * (k - 1)]);
+        b.push(cells[2 * k - 1]);
+    }
+    (h, b)
+}

@@ -164,8 +164,9 @@ pub struct Comparison {
     /// True when the observer stopped the comparison (a time limit): the families after
     /// the stop have rows saying they were not fitted.
     pub stopped: bool,
-    /// The record's loop orientation: the given one, else the one detected on the training
-    /// samples (None when they cannot tell; each row then says what its family did).
+    /// The record's loop orientation: the given one, else the one
+    /// detected on the training samples, else on all the data compared (None when they
+    /// cannot tell; each row then says what its family did).
     #[serde(skip)]
     pub orientation: Option<(LoopOrientation, OrientationSource)>,
 }
@@ -214,6 +215,12 @@ pub fn compare(
         ));
     }
     let (split, train, valid) = split(u, y, validation, options.train_fraction)?;
+    let orientation = record_orientation(train, (u, y), validation, &options.family);
+    // What a family whose training part cannot tell the orientation is given.
+    let fallback = match orientation {
+        Some((l, OrientationSource::Record)) => Some(l),
+        _ => None,
+    };
     // The observer sees "family k/N" and may stop the comparison (a time limit): the
     // families not fitted by then are listed as such, once at least one has a result.
     let observer = &options.family.observer;
@@ -230,16 +237,10 @@ pub fn compare(
                 ),
             ));
         } else {
-            rows.push(row(family, train, valid, &split, &options.family));
+            rows.push(row(family, train, valid, &split, &options.family, fallback));
         }
     }
     observer.report("family", total, total);
-    let orientation = match options.family.loop_orientation {
-        Some(l) => Some((l, OrientationSource::Given)),
-        None => LoopOrientation::detect(train.0, train.1)
-            .ok()
-            .map(|l| (l, OrientationSource::Detected)),
-    };
     let validation_input = scored(&split, valid.0).to_vec();
     let validation_output = scored(&split, valid.1).to_vec();
     Ok(Comparison {
@@ -253,6 +254,35 @@ pub fn compare(
 }
 
 type Signals<'a> = (&'a [f64], &'a [f64]);
+
+/// The loop orientation of a comparison: the given one; else the one detected on the
+/// training samples; else, when they cannot tell (a single loop measured from its tip, whose
+/// training part holds one short return), the one detected on all the data compared — the
+/// record, and the separate validation record when there is one — a single structural
+/// choice, reported as [`OrientationSource::Record`]. None when no data tell it.
+fn record_orientation(
+    train: Signals<'_>,
+    record: Signals<'_>,
+    validation: Option<Signals<'_>>,
+    options: &FamilyOptions,
+) -> Option<(LoopOrientation, OrientationSource)> {
+    if let Some(l) = options.loop_orientation {
+        return Some((l, OrientationSource::Given));
+    }
+    if let Ok(l) = LoopOrientation::detect(train.0, train.1) {
+        return Some((l, OrientationSource::Detected));
+    }
+    let (u, y): (Vec<f64>, Vec<f64>) = match validation {
+        Some(v) => (
+            record.0.iter().chain(v.0).copied().collect(),
+            record.1.iter().chain(v.1).copied().collect(),
+        ),
+        None => (record.0.to_vec(), record.1.to_vec()),
+    };
+    LoopOrientation::detect(&u, &y)
+        .ok()
+        .map(|l| (l, OrientationSource::Record))
+}
 
 fn split<'a>(
     u: &'a [f64],
@@ -303,11 +333,28 @@ fn row(
     valid: Signals<'_>,
     split: &Split,
     options: &FamilyOptions,
+    fallback: Option<LoopOrientation>,
 ) -> CompareRow {
     let failed = |e: Error| CompareRow::failed(family, &e);
-    let fitted = match fit_operator(family, train.0, train.1, options) {
-        Ok(f) => f,
-        Err(e) => return failed(e),
+    let fitted = match (fit_operator(family, train.0, train.1, options), fallback) {
+        (Ok(f), _) => f,
+        // The training part cannot tell the orientation: the one the record tells, so said.
+        (Err(Error::UndeterminedOrientation { .. }), Some(l)) => {
+            let given = FamilyOptions {
+                loop_orientation: Some(l),
+                ..options.clone()
+            };
+            match fit_operator(family, train.0, train.1, &given) {
+                Ok(mut f) => {
+                    if let Some(used) = f.orientation.as_mut() {
+                        used.source = OrientationSource::Record;
+                    }
+                    f
+                }
+                Err(e) => return failed(e),
+            }
+        }
+        (Err(e), _) => return failed(e),
     };
     let simulated = match validation_output(&fitted.fit.model, split, valid) {
         Ok(s) => s,

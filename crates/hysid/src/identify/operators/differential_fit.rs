@@ -360,6 +360,24 @@ pub fn reversals(u: &[f64]) -> usize {
     count
 }
 
+/// Checks that the input `channel` reverses at least once: a hysteresis fit needs an ascending
+/// and a descending branch, and a major loop measured from its tip (a B(H) loop from +Hₘₐₓ
+/// down to −Hₘₐₓ and back) has exactly one reversal. Every operator family asks this of its
+/// record; a size choice's training part (`model_size`) is a part of a record that passed.
+pub(crate) fn check_reversal(channel: &str, u: &[f64]) -> Result<()> {
+    if reversals(u) < 1 {
+        return Err(Error::NotExciting {
+            channel: channel.into(),
+            reason: "it never reverses direction; a hysteresis fit needs an ascending and a \
+                     descending branch (at least one reversal): excite with a periodic or \
+                     decaying oscillating input, or a loop from one end of the range to the \
+                     other and back"
+                .into(),
+        });
+    }
+    Ok(())
+}
+
 /// Checks a record for a fit with `p` parameters: equal lengths, finite samples, at least
 /// max(20, 5p) samples, one reversal of the input (an ascending and a descending branch: a
 /// measured loop from its tip has exactly one), a non-constant output.
@@ -381,15 +399,7 @@ pub fn check_record(family: &str, u: &[f64], y: &[f64], p: usize) -> Result<()> 
             needed,
         });
     }
-    if reversals(u) < 1 {
-        return Err(Error::NotExciting {
-            channel: "input".into(),
-            reason: format!(
-                "it never reverses direction; a {family} fit needs an ascending and a \
-                 descending branch (at least one reversal)"
-            ),
-        });
-    }
+    check_reversal("input", u)?;
     if !crate::data::varies(y) {
         return Err(Error::InvalidData(format!(
             "{family}: the output is constant; there is no loop to fit"

@@ -237,6 +237,9 @@ pub enum OrientationSource {
     Given,
     /// Detected from the area between the branches ([`LoopOrientation::detect`]).
     Detected,
+    /// Detected by `compare` on all the data it compares, when its training part cannot
+    /// tell (a single loop measured from its tip), and given to every family.
+    Record,
     /// A result of the fitted parameters (Duhem: the sign of c − a).
     Fitted,
     /// The family's native orientation, assumed (an operator cascade's start linear in the
@@ -245,11 +248,12 @@ pub enum OrientationSource {
 }
 
 impl OrientationSource {
-    /// `given`, `detected`, `fitted` or `assumed`.
+    /// `given`, `detected`, `record`, `fitted` or `assumed`.
     pub fn name(self) -> &'static str {
         match self {
             OrientationSource::Given => "given",
             OrientationSource::Detected => "detected",
+            OrientationSource::Record => "record",
             OrientationSource::Fitted => "fitted",
             OrientationSource::Assumed => "assumed",
         }

@@ -1,6 +1,7 @@
 //! Shared steps of the linear-in-weights recipes: data checks, threshold grids, the Gram
 //! matrix accumulated in blocks, NNLS with standard deviations, and the fit report.
 
+use super::differential_fit::check_reversal;
 use super::OperatorFit;
 use crate::model::operators::elementary::{check_signal, oriented_simulate_saturating, Core};
 use crate::model::operators::{
@@ -13,7 +14,8 @@ use crate::{Error, Result};
 use nalgebra::{DMatrix, DVector};
 use std::time::Instant;
 
-/// Checks equal lengths, finite samples, enough samples and at least two input reversals.
+/// Checks equal lengths, finite samples, enough samples, a reversal of the input
+/// ([`check_reversal`]) and a varying output.
 pub(crate) fn check_data(u: &[f64], y: &[f64], parameters: usize) -> Result<()> {
     check_signal("u", u)?;
     check_signal("y", y)?;
@@ -32,16 +34,7 @@ pub(crate) fn check_data(u: &[f64], y: &[f64], parameters: usize) -> Result<()> 
             needed,
         });
     }
-    let reversals = count_reversals(u);
-    if reversals < 2 {
-        return Err(Error::NotExciting {
-            channel: "u".into(),
-            reason: format!(
-                "{reversals} reversal(s) of the input; a hysteresis loop needs at least 2 \
-                 (rise, fall, rise); excite with a periodic or decaying oscillating input"
-            ),
-        });
-    }
+    check_reversal("u", u)?;
     if !crate::data::varies(y) {
         return Err(Error::NotExciting {
             channel: "y".into(),
@@ -49,22 +42,6 @@ pub(crate) fn check_data(u: &[f64], y: &[f64], parameters: usize) -> Result<()> 
         });
     }
     Ok(())
-}
-
-/// Number of direction changes of a signal.
-pub(crate) fn count_reversals(x: &[f64]) -> usize {
-    let mut last = 0.0f64;
-    let mut count = 0;
-    for w in x.windows(2) {
-        let d = w[1] - w[0];
-        if d != 0.0 {
-            if last != 0.0 && d.signum() != last.signum() {
-                count += 1;
-            }
-            last = d;
-        }
-    }
-    count
 }
 
 /// (min, max) of a signal.

@@ -38,3 +38,47 @@ fn ranks_and_keeps_failures() {
     let c = compare(&ramp, &ramp, None, &options).unwrap();
     assert!(c.rows.iter().all(|r| r.error.is_some()) && c.best().is_none());
 }
+
+/// A single loop measured from its tip (the vendored Mn-Zn ferrite's largest loop): the
+/// training part, the descent and a third of the return, cannot tell the orientation, so the
+/// comparison detects it on the whole record (counter-clockwise, a B(H) loop) and gives it
+/// to the families that could not tell — every linear-in-weights family is fitted and
+/// scored, its row says `record`; Jiles–Atherton detects its own, Dahl refuses for its
+/// stated reason. Before, eight families failed ("cannot be told").
+#[test]
+fn a_single_loop_takes_the_records_orientation_when_its_training_part_cannot_tell() {
+    use crate::unit::test_signals::ferrite_loop;
+    use hysid::identify::operators::family::OrientationSource;
+    use hysid::model::operators::LoopOrientation;
+    let (h, b) = ferrite_loop(4);
+    assert!(LoopOrientation::detect(&h[..77], &b[..77]).is_err());
+    let options = CompareOptions {
+        families: Family::ALL.to_vec(),
+        ..CompareOptions::default()
+    };
+    let c = compare(&h, &b, None, &options).unwrap();
+    assert_eq!(
+        c.orientation,
+        Some((LoopOrientation::CounterClockwise, OrientationSource::Record))
+    );
+    for family in [
+        Family::Pi,
+        Family::Gpi,
+        Family::MaxwellSlip,
+        Family::Backlash,
+        Family::Preisach,
+        Family::Kp,
+    ] {
+        let row = c.row(family).unwrap();
+        assert_eq!(row.error, None, "{family}");
+        assert_eq!(row.orientation_source, Some("record"), "{family}");
+        assert_eq!(row.orientation, Some("ccw"), "{family}");
+    }
+    assert_eq!(
+        c.row(Family::JilesAtherton).unwrap().orientation_source,
+        Some("detected")
+    );
+    let dahl = c.row(Family::Dahl).unwrap().error.clone().unwrap();
+    assert!(dahl.contains("counter-clockwise"), "{dahl}");
+    assert_eq!(c.best().unwrap().family, "jiles-atherton");
+}
