@@ -171,3 +171,22 @@ def test_operator_cascade_options_are_checked(record):
         hysid.identify_cascade(*record, hysteresis="pi", na=1, nb=1, delay=1, uncertainty="bootstrap")
     with pytest.raises(ValueError, match="unknown"):
         hysid.identify_cascade(*record, hysteresis="ch9", na=1, nb=1, delay=1)
+
+
+def test_a_single_ferrite_loop_is_compared_with_the_records_orientation():
+    """A B(H) loop measured from its tip (the vendored Mn-Zn ferrite's largest, 129 samples):
+    its training part cannot tell the orientation, so the comparison detects it on the whole
+    record and the families that could not tell are fitted with it (their rows say
+    ``record``); none is refused as not exciting."""
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "..", "data", "ferrite", "mnzn_ferrite_bh_loops.csv")
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    h, b = data["H4_A_per_m"], data["B4_T"]
+    families = ["pi", "gpi", "preisach", "kp", "jiles-atherton"]
+    c = hysid.compare(h, b, families=families)
+    assert not c.errors, c.errors
+    rows = {r["family"]: r for r in c.table}
+    for name in ["pi", "gpi", "preisach", "kp"]:
+        assert rows[name]["orientation"] == "ccw" and rows[name]["orientation_source"] == "record"
+    assert rows["jiles-atherton"]["orientation_source"] == "detected"
+    assert (c.orientation, c.orientation_source) == ("ccw", "record")
+    assert c.best == "jiles-atherton"

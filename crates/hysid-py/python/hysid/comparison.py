@@ -28,6 +28,9 @@ class CompareRow(TypedDict):
     fit_time_s: Optional[float]
     converged: Optional[bool]
     termination: Optional[str]
+    orientation: Optional[str]
+    orientation_source: Optional[str]
+    initial_state: Optional[str]
     error: Optional[str]
 
 
@@ -42,6 +45,9 @@ def _row(f: Fields) -> CompareRow:
         "fit_time_s": f.optional("fit_time_s", float),
         "converged": f.optional("converged", bool),
         "termination": f.optional("termination", str),
+        "orientation": f.optional("orientation", str),
+        "orientation_source": f.optional("orientation_source", str),
+        "initial_state": f.optional("initial_state", str),
         "error": f.optional("error", str),
     }
 
@@ -55,7 +61,11 @@ class Comparison:
 
     ``best``: the best family's name (None when every family failed); ``table``: one
     :class:`CompareRow` per family, best first, failed families last (family, validation
-    fit %, RMSE, parameter count, AIC, fit time, …); ``results``: family → :class:`FitResult`
+    fit %, RMSE, parameter count, AIC, fit time, the model's orientation and where it came
+    from, its initial state, …); ``orientation`` and ``orientation_source``: the record's
+    loop turning sense (``"ccw"``/``"cw"``) and ``"given"``, ``"detected"`` (on the
+    training part) or ``"record"`` (on all the data, when the training part cannot tell: a
+    family that could not tell was fitted with it), None when no data tell it; ``results``: family → :class:`FitResult`
     of its fit on the training samples (the families that succeeded, ranked); ``errors``:
     family → the one-line error of those that failed; ``model``: the best family's
     :class:`Model`; ``split``: how the data were split, in words; ``validation``: the
@@ -66,6 +76,8 @@ class Comparison:
 
     best: Optional[str]
     table: List[CompareRow]
+    orientation: Optional[str]
+    orientation_source: Optional[str]
     results: Dict[str, FitResult]
     errors: Dict[str, str]
     model: Optional[Model]
@@ -89,6 +101,8 @@ class Comparison:
         if details is None:
             raise ReportError("report.details is null; a comparison lists its families there")
         self.best = details.optional("best", str)
+        self.orientation = details.optional("orientation", str)
+        self.orientation_source = details.optional("orientation_source", str)
         self.split = details.get("split_text", str)
         stopped = details.absent_or("stopped_by_time_limit_s", float)
         self.termination_code = None if stopped is None else "time_limit"

@@ -73,32 +73,52 @@ pub fn validation_input(n: usize, amplitude: f64) -> Vec<f64> {
         .collect()
 }
 
+/// Columns `input` and `output` (0-based) of the CSV file at `path`, relative to this
+/// crate's folder, its header row skipped.
+fn csv_pair(path: &str, input: usize, output: usize) -> (Vec<f64>, Vec<f64>) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|line| {
+            let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
+            (cells[input], cells[output])
+        })
+        .unzip()
+}
+
 /// The piezo record of `data/piezo` (2 000 samples of the real 150 V, 1 Hz record):
 /// (voltage in V, displacement in µm).
 pub fn piezo_record() -> (Vec<f64>, Vec<f64>) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data/piezo/piezo_150V_1Hz.csv");
-    let text = std::fs::read_to_string(path).unwrap();
-    let (mut u, mut y) = (Vec::new(), Vec::new());
-    for line in text.lines().skip(1) {
-        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
-        u.push(cells[1]);
-        y.push(cells[2]);
-    }
-    (u, y)
+    csv_pair("../../data/piezo/piezo_150V_1Hz.csv", 1, 2)
 }
 
 /// Loop `k` (1–4, amplitudes ≈ 8, 16, 40, 80 A/m) of the vendored Mn-Zn ferrite record
 /// (`data/ferrite`): (H in A/m, B in T), 129 samples from +Hₘₐₓ down to −Hₘₐₓ and back.
 pub fn ferrite_loop(k: usize) -> (Vec<f64>, Vec<f64>) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../data/ferrite/mnzn_ferrite_bh_loops.csv");
-    let text = std::fs::read_to_string(path).unwrap();
-    let (mut h, mut b) = (Vec::new(), Vec::new());
-    for line in text.lines().skip(1) {
-        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
-        h.push(cells[2 * (k - 1)]);
-        b.push(cells[2 * k - 1]);
-    }
-    (h, b)
+    csv_pair(
+        "../../data/ferrite/mnzn_ferrite_bh_loops.csv",
+        2 * (k - 1),
+        2 * k - 1,
+    )
 }
+
+/// The simulated magnet record of `tests/fixtures/records` (its README): 170 set points,
+/// (current in A, field in T).
+pub fn magnet_set_points() -> (Vec<f64>, Vec<f64>) {
+    csv_pair("tests/fixtures/records/magnet_set_points.csv", 1, 2)
+}
+
+/// The linear-in-weights families: their weights solved by NNLS for a fixed structure,
+/// their orientation read from the data (`linear_support`).
+pub const LINEAR_IN_WEIGHTS: [hysid::identify::operators::Family; 6] = {
+    use hysid::identify::operators::Family;
+    [
+        Family::Pi,
+        Family::Gpi,
+        Family::MaxwellSlip,
+        Family::Backlash,
+        Family::Preisach,
+        Family::Kp,
+    ]
+};

@@ -61,14 +61,7 @@ fn a_single_loop_takes_the_records_orientation_when_its_training_part_cannot_tel
         c.orientation,
         Some((LoopOrientation::CounterClockwise, OrientationSource::Record))
     );
-    for family in [
-        Family::Pi,
-        Family::Gpi,
-        Family::MaxwellSlip,
-        Family::Backlash,
-        Family::Preisach,
-        Family::Kp,
-    ] {
+    for family in crate::unit::test_signals::LINEAR_IN_WEIGHTS {
         let row = c.row(family).unwrap();
         assert_eq!(row.error, None, "{family}");
         assert_eq!(row.orientation_source, Some("record"), "{family}");

@@ -435,15 +435,7 @@ fn a_divergence_is_quoted_in_the_records_units() {
 fn a_stalled_refinement_stops_instead_of_grinding() {
     use hysid::identify::operators::{fit_operator, Family, FamilyOptions};
     use hysid::numerics::Termination;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fixtures/records/magnet_set_points.csv");
-    let text = std::fs::read_to_string(path).unwrap();
-    let (mut u, mut y) = (Vec::new(), Vec::new());
-    for line in text.lines().skip(1) {
-        let cells: Vec<f64> = line.split(',').map(|c| c.parse().unwrap()).collect();
-        u.push(cells[1]);
-        y.push(cells[2]);
-    }
+    let (u, y) = crate::unit::test_signals::magnet_set_points();
     let fitted = fit_operator(Family::JilesAtherton, &u, &y, &FamilyOptions::default()).unwrap();
     println!(
         "jiles-atherton: {} iterations, fit {:.4} %, {:?}",

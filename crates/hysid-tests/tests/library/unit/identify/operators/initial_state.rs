@@ -24,14 +24,7 @@ fn record() -> Vec<f64> {
 #[test]
 fn a_record_starting_after_a_descent_is_fitted_from_that_history_and_estimate_finds_it() {
     let u = record();
-    let families = [
-        Family::Pi,
-        Family::Gpi,
-        Family::MaxwellSlip,
-        Family::Backlash,
-        Family::Preisach,
-        Family::Kp,
-    ];
+    let families = crate::unit::test_signals::LINEAR_IN_WEIGHTS;
     let examples = OperatorModel::examples().unwrap();
     for family in families {
         let plant = examples.iter().find(|m| m.family() == family).unwrap();
