@@ -38,8 +38,9 @@ pub fn compare_report(
         // True when the comparison was stopped (a time limit) before every family was
         // fitted; the rows of those not fitted say so.
         "stopped": comparison.stopped,
-        // The record's turning sense (given, or detected on the training samples; null
-        // when they cannot tell); each row holds its own model's.
+        // The record's turning sense (given, detected on the training samples, or on all the
+        // data compared when they cannot tell; null when none tell); each row holds its own
+        // model's.
         "orientation": comparison.orientation.map(|o| o.0.short_name()),
         "orientation_source": comparison.orientation.map(|o| o.1.name()),
         "families": comparison.rows,

@@ -110,7 +110,8 @@ pub struct CompareRow {
     /// The turning sense of the fitted model's loop, `ccw` or `cw` (None when the family
     /// failed, and for ch4/ch6).
     pub orientation: Option<&'static str>,
-    /// Where it came from: `given`, `detected` or `fitted`.
+    /// Where it came from: `given`, `detected`, `record` (the comparison's, detected on all
+    /// its data), `fitted` or `assumed` ([`OrientationSource`]).
     pub orientation_source: Option<&'static str>,
     /// The initial state the fitted model starts from (`demagnetised`, `descending`,
     /// `ascending`, `estimated`; None when the family failed).

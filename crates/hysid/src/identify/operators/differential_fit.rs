@@ -43,10 +43,11 @@
 //!    its criterion is within [`RIVAL_MARGIN`] of the best but does not agree with it to
 //!    [`AGREEMENT`], and its parameters differ: two minima too close to tell apart on the
 //!    subsample). Local searches that agree are one minimum found from several starts. A
-//!    refinement whose criterion fell by less than [`REFINE_STALL_DECREASE`] over its last
-//!    [`STALL_WINDOW`] iterations stops there without a restart (a valley it would crawl
-//!    along for hundreds of iterations; reported as a flat region when the Gauss–Newton
-//!    model still promises a decrease). The sensitivities ∂ŷ/∂θ are integrated
+//!    refinement (of the full record or of a long record's subsample) whose criterion fell
+//!    by less than [`REFINE_STALL_DECREASE`] over its last [`STALL_WINDOW`] iterations
+//!    stops there without a restart (a valley it would crawl along for hundreds of
+//!    iterations; reported as a flat region when the Gauss–Newton model still promises a
+//!    decrease). The sensitivities ∂ŷ/∂θ are integrated
 //!    in u beside the state ([`simulate_with_sensitivities`]): exact derivatives of the
 //!    computed output at the cost of about one simulation, where forward differences need p
 //!    further simulations and lose half the digits. The normal equations JᵀJ, Jᵀr are summed
@@ -160,13 +161,14 @@ pub const RACE_FACTOR: f64 = 4.0;
 pub const STALL_WINDOW: usize = 30;
 /// See [`STALL_WINDOW`].
 pub const STALL_DECREASE: f64 = 1e-3;
-/// A refinement on the full record whose criterion fell by less than this (relative) over
+/// A refinement (on the full record, or on a long record's subsample) whose criterion fell
+/// by less than this (relative) over
 /// its last [`STALL_WINDOW`] iterations has stalled in a valley: it stops there, with no
 /// restart, reported as a flat region when the Gauss–Newton model still promises more
 /// than [`FLAT_THRESHOLD`]. The fit % cannot move in its fifth digit over such a window;
 /// the valley would take hundreds of iterations (magnet-like records of 170 set points:
 /// Jiles–Atherton's refinements ran their 200 iterations at 2·10⁻⁸ per iteration; the fits
-/// took 8.6 and 5.4 s, now 4.0 and 2.2 s, for fit % lower by 0.026 and 0 points).
+/// took 8.4 and 5.4 s, now 3.9 and 2.1 s, for fit % lower by 0.026 and 0 points).
 pub const REFINE_STALL_DECREASE: f64 = 1e-6;
 /// Shape points of the grid scored from the descending and ascending states too when the
 /// initial state is estimated: the best ones from the family's own start.
@@ -372,24 +374,6 @@ pub fn reversals(u: &[f64]) -> usize {
     count
 }
 
-/// Checks that the input `channel` reverses at least once: a hysteresis fit needs an ascending
-/// and a descending branch, and a major loop measured from its tip (a B(H) loop from +Hₘₐₓ
-/// down to −Hₘₐₓ and back) has exactly one reversal. Every operator family asks this of its
-/// record; a size choice's training part (`model_size`) is a part of a record that passed.
-pub(crate) fn check_reversal(channel: &str, u: &[f64]) -> Result<()> {
-    if reversals(u) < 1 {
-        return Err(Error::NotExciting {
-            channel: channel.into(),
-            reason: "it never reverses direction; a hysteresis fit needs an ascending and a \
-                     descending branch (at least one reversal): excite with a periodic or \
-                     decaying oscillating input, or a loop from one end of the range to the \
-                     other and back"
-                .into(),
-        });
-    }
-    Ok(())
-}
-
 /// Checks a record for a fit with `p` parameters: equal lengths, finite samples, at least
 /// max(20, 5p) samples, one reversal of the input (an ascending and a descending branch: a
 /// measured loop from its tip has exactly one), a non-constant output.
@@ -411,7 +395,7 @@ pub fn check_record(family: &str, u: &[f64], y: &[f64], p: usize) -> Result<()> 
             needed,
         });
     }
-    check_reversal("input", u)?;
+    super::check_reversal(u)?;
     if !crate::data::varies(y) {
         return Err(Error::InvalidData(format!(
             "{family}: the output is constant; there is no loop to fit"
@@ -1199,10 +1183,12 @@ fn differs(a: &[f64], b: &[f64], free: &[usize]) -> bool {
         .any(|&i| (a[i] - b[i]).abs() > 1e-3 * a[i].abs().max(b[i].abs()).max(1e-300))
 }
 
-/// Levenberg–Marquardt on the full record from `phi`, restarted where the Gauss–Newton model
-/// still promises a decrease (module doc, stage 5): the report, the termination to publish,
-/// (iterations, evaluations), and whether the observer stopped it. A `polish` that runs out
-/// of iterations is judged by that promise ([`POLISH_ITERATIONS`]).
+/// Levenberg–Marquardt on the full record (or a long record's subsample) from `phi`,
+/// restarted where the Gauss–Newton model still promises a decrease (module doc, stage 5):
+/// the report, the termination to publish, (iterations, evaluations), and whether the
+/// observer stopped it. A `polish` that runs out of iterations ([`POLISH_ITERATIONS`]) and
+/// a run that stalled ([`REFINE_STALL_DECREASE`]) are not restarted and are judged by that
+/// promise: a flat region above [`FLAT_THRESHOLD`], else converged.
 #[allow(clippy::type_complexity)]
 fn refine<F: DifferentialFamily>(
     driver: &Driver<'_, F>,
@@ -1240,15 +1226,11 @@ fn refine<F: DifferentialFamily>(
         // A stalled refinement is out of iterations in effect: a restart would grind on.
         let out_of_iterations = r.termination == Termination::MaxIterations || run.stalled;
         if promise <= RESTART_THRESHOLD || restarts == MAX_RESTARTS || out_of_iterations {
-            let termination = if promise > FLAT_THRESHOLD && (polish || !out_of_iterations) {
+            // A polish out of iterations, or a stall, is judged by the promise alone.
+            let judged = polish || run.stalled;
+            let termination = if promise > FLAT_THRESHOLD && (judged || !out_of_iterations) {
                 Termination::FlatRegion { expected: promise }
-            } else if run.stalled {
-                if promise > FLAT_THRESHOLD {
-                    Termination::FlatRegion { expected: promise }
-                } else {
-                    Termination::ImprovementBelowTolerance { relative: promise }
-                }
-            } else if polish && out_of_iterations {
+            } else if judged && out_of_iterations {
                 Termination::ImprovementBelowTolerance { relative: promise }
             } else {
                 r.termination.clone()

@@ -238,7 +238,8 @@ pub enum OrientationSource {
     /// Detected from the area between the branches ([`LoopOrientation::detect`]).
     Detected,
     /// Detected by `compare` on all the data it compares, when its training part cannot
-    /// tell (a single loop measured from its tip), and given to every family.
+    /// tell (a single loop measured from its tip), and given to each family whose own
+    /// detection on the training part could not tell either.
     Record,
     /// A result of the fitted parameters (Duhem: the sign of c − a).
     Fitted,
@@ -265,7 +266,7 @@ impl OrientationSource {
 pub struct OrientationUsed {
     /// The turning sense of the fitted model's loop in the (u, y) plane.
     pub orientation: LoopOrientation,
-    /// Given, detected, fitted or assumed.
+    /// Given, detected, record (`compare`), fitted or assumed.
     pub source: OrientationSource,
 }
 

@@ -1,7 +1,6 @@
 //! Shared steps of the linear-in-weights recipes: data checks, threshold grids, the Gram
 //! matrix accumulated in blocks, NNLS with standard deviations, and the fit report.
 
-use super::differential_fit::check_reversal;
 use super::OperatorFit;
 use crate::model::operators::elementary::{check_signal, oriented_simulate_saturating, Core};
 use crate::model::operators::{
@@ -15,7 +14,7 @@ use nalgebra::{DMatrix, DVector};
 use std::time::Instant;
 
 /// Checks equal lengths, finite samples, enough samples, a reversal of the input
-/// ([`check_reversal`]) and a varying output.
+/// ([`super::check_reversal`]) and a varying output.
 pub(crate) fn check_data(u: &[f64], y: &[f64], parameters: usize) -> Result<()> {
     check_signal("u", u)?;
     check_signal("y", y)?;
@@ -34,7 +33,7 @@ pub(crate) fn check_data(u: &[f64], y: &[f64], parameters: usize) -> Result<()> 
             needed,
         });
     }
-    check_reversal("u", u)?;
+    super::check_reversal(u)?;
     if !crate::data::varies(y) {
         return Err(Error::NotExciting {
             channel: "y".into(),

@@ -96,3 +96,28 @@ pub struct OperatorFit<M> {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model_size: Option<model_size::ModelSizeChoice>,
 }
+
+/// Checks that the input u reverses at least once by more than
+/// [`REVERSAL_FRACTION`](crate::model::operators::orientation::REVERSAL_FRACTION) of its
+/// range ([`orientation::reversals`](crate::model::operators::orientation::reversals)): a
+/// hysteresis fit needs an ascending and a descending branch, and a major loop measured from
+/// its tip (a B(H) loop from +Hₘₐₓ down to −Hₘₐₓ and back) has exactly one reversal. Every
+/// operator family asks this of its record, the linear-in-weights recipes
+/// (`linear_support::check_data`) and the differential driver
+/// (`differential_fit::check_record`) alike.
+pub(crate) fn check_reversal(u: &[f64]) -> crate::Result<()> {
+    use crate::model::operators::orientation::{reversals, REVERSAL_FRACTION};
+    if reversals(u) < 1 {
+        return Err(crate::Error::NotExciting {
+            channel: "u".into(),
+            reason: format!(
+                "it never reverses direction by more than {} % of its range; a hysteresis fit \
+                 needs an ascending and a descending branch (at least one reversal): excite \
+                 with a periodic or decaying oscillating input, or a loop from one end of the \
+                 range to the other and back",
+                100.0 * REVERSAL_FRACTION
+            ),
+        });
+    }
+    Ok(())
+}

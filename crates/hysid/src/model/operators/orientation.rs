@@ -145,6 +145,22 @@ fn undetermined(reason: impl Into<String>) -> Error {
     }
 }
 
+/// The reversals of `u` by more than [`REVERSAL_FRACTION`] of its range: the turning points
+/// the orientation is read between (a reversal within that fraction is noise or a set
+/// point's overshoot, not a branch).
+pub fn reversals(u: &[f64]) -> usize {
+    let (lo, hi) = u
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if hi <= lo {
+        return 0;
+    }
+    segments(u, REVERSAL_FRACTION * (hi - lo)).map_or(0, |(turns, _)| turns.len().saturating_sub(2))
+}
+
 /// The turning points of `u` (indices of the extremes at which the input reversed by more
 /// than `h`), with the first and last sample; and the direction (+1 up, −1 down) of the first
 /// segment. None when the input never moves by more than `h`.
