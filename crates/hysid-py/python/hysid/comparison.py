@@ -65,9 +65,10 @@ class Comparison:
     from, its initial state, …); ``orientation`` and ``orientation_source``: the record's
     loop turning sense (``"ccw"``/``"cw"``) and ``"given"``, ``"detected"`` (on the
     training part) or ``"record"`` (on all the data, when the training part cannot tell: a
-    family that could not tell was fitted with it), None when no data tell it; ``results``: family → :class:`FitResult`
-    of its fit on the training samples (the families that succeeded, ranked); ``errors``:
-    family → the one-line error of those that failed; ``model``: the best family's
+    family that could not tell was fitted with it), None when no data tell it;
+    ``results``: family → :class:`FitResult` of its fit on the training samples (the
+    families that succeeded, ranked); ``errors``: family → the one-line error of those that
+    failed; ``model``: the best family's
     :class:`Model`; ``split``: how the data were split, in words; ``validation``: the
     scored validation samples (:class:`Record`) and ``simulated``: family → its output on
     them; ``termination_code``: ``"time_limit"`` when the call's ``time_limit`` stopped the

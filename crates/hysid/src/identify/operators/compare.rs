@@ -165,9 +165,9 @@ pub struct Comparison {
     /// True when the observer stopped the comparison (a time limit): the families after
     /// the stop have rows saying they were not fitted.
     pub stopped: bool,
-    /// The record's loop orientation: the given one, else the one
-    /// detected on the training samples, else on all the data compared (None when they
-    /// cannot tell; each row then says what its family did).
+    /// The record's loop orientation: the given one, else the one detected on the training
+    /// samples, else on all the data compared (None when they cannot tell; each row then
+    /// says what its family did).
     #[serde(skip)]
     pub orientation: Option<(LoopOrientation, OrientationSource)>,
 }
@@ -273,16 +273,15 @@ fn record_orientation(
     if let Ok(l) = LoopOrientation::detect(train.0, train.1) {
         return Some((l, OrientationSource::Detected));
     }
-    let (u, y): (Vec<f64>, Vec<f64>) = match validation {
-        Some(v) => (
-            record.0.iter().chain(v.0).copied().collect(),
-            record.1.iter().chain(v.1).copied().collect(),
-        ),
-        None => (record.0.to_vec(), record.1.to_vec()),
+    let detected = match validation {
+        Some(v) => {
+            let u: Vec<f64> = record.0.iter().chain(v.0).copied().collect();
+            let y: Vec<f64> = record.1.iter().chain(v.1).copied().collect();
+            LoopOrientation::detect(&u, &y)
+        }
+        None => LoopOrientation::detect(record.0, record.1),
     };
-    LoopOrientation::detect(&u, &y)
-        .ok()
-        .map(|l| (l, OrientationSource::Record))
+    detected.ok().map(|l| (l, OrientationSource::Record))
 }
 
 fn split<'a>(

@@ -162,9 +162,8 @@ pub const STALL_WINDOW: usize = 30;
 /// See [`STALL_WINDOW`].
 pub const STALL_DECREASE: f64 = 1e-3;
 /// A refinement (on the full record, or on a long record's subsample) whose criterion fell
-/// by less than this (relative) over
-/// its last [`STALL_WINDOW`] iterations has stalled in a valley: it stops there, with no
-/// restart, reported as a flat region when the Gauss–Newton model still promises more
+/// by less than this (relative) over its last [`STALL_WINDOW`] iterations has stalled in a
+/// valley: it stops there, with no restart, reported as a flat region when the Gauss–Newton model still promises more
 /// than [`FLAT_THRESHOLD`]. The fit % cannot move in its fifth digit over such a window;
 /// the valley would take hundreds of iterations (magnet-like records of 170 set points:
 /// Jiles–Atherton's refinements ran their 200 iterations at 2·10⁻⁸ per iteration; the fits
@@ -355,23 +354,6 @@ fn refine_config(config: &LmConfig) -> LmConfig {
         initial_damping: config.initial_damping * SMALL_DAMPING,
         ..config.clone()
     }
-}
-
-/// Number of direction reversals of `u` (sign changes of the non-zero increments).
-pub fn reversals(u: &[f64]) -> usize {
-    let mut last = 0.0;
-    let mut count = 0;
-    for w in u.windows(2) {
-        let d = (w[1] - w[0]).signum();
-        if w[1] == w[0] {
-            continue;
-        }
-        if last != 0.0 && d != last {
-            count += 1;
-        }
-        last = d;
-    }
-    count
 }
 
 /// Checks a record for a fit with `p` parameters: equal lengths, finite samples, at least

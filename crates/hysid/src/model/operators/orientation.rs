@@ -149,6 +149,12 @@ fn undetermined(reason: impl Into<String>) -> Error {
 /// the orientation is read between (a reversal within that fraction is noise or a set
 /// point's overshoot, not a branch).
 pub fn reversals(u: &[f64]) -> usize {
+    turning_points(u).map_or(0, |(_, turns, _)| turns.len().saturating_sub(2))
+}
+
+/// The range (lo, hi) of the finite samples of `u` and its [`segments`] at the threshold
+/// [`REVERSAL_FRACTION`] × (hi − lo); None when the input does not move.
+fn turning_points(u: &[f64]) -> Option<((f64, f64), Vec<usize>, i8)> {
     let (lo, hi) = u
         .iter()
         .filter(|v| v.is_finite())
@@ -156,9 +162,10 @@ pub fn reversals(u: &[f64]) -> usize {
             (a.min(v), b.max(v))
         });
     if hi <= lo {
-        return 0;
+        return None;
     }
-    segments(u, REVERSAL_FRACTION * (hi - lo)).map_or(0, |(turns, _)| turns.len().saturating_sub(2))
+    let (turns, first) = segments(u, REVERSAL_FRACTION * (hi - lo))?;
+    Some(((lo, hi), turns, first))
 }
 
 /// The turning points of `u` (indices of the extremes at which the input reversed by more
@@ -304,13 +311,7 @@ pub fn loop_evidence(u: &[f64], y: &[f64]) -> Result<LoopEvidence> {
     if let Some(k) = u.iter().chain(y).position(|v| !v.is_finite()) {
         return Err(undetermined(format!("sample {} is not finite", k % n)));
     }
-    let (lo, hi) = u
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    let h = REVERSAL_FRACTION * (hi - lo);
-    let Some((turns, first)) = (hi > lo).then(|| segments(u, h)).flatten() else {
+    let Some(((lo, hi), turns, first)) = turning_points(u) else {
         return Err(undetermined("the input does not move"));
     };
     let reversals = turns.len().saturating_sub(2);

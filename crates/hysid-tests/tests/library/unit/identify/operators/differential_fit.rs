@@ -8,7 +8,7 @@
 //! The records are those of `crates/hysid/examples/differential_records.rs` (the benchmark's).
 
 use crate::unit::test_signals::{training_input, validation_input, with_noise};
-use hysid::identify::operators::differential_fit::{decimate, reversals, LoopShape};
+use hysid::identify::operators::differential_fit::{decimate, LoopShape};
 use hysid::identify::operators::{bouc_wen, dahl, duhem, jiles_atherton};
 use hysid::model::operators::differential::{self, InputOde};
 use hysid::model::operators::{
@@ -71,6 +71,21 @@ fn jiles_atherton_truth() -> JilesAtherton {
     let mut m = JilesAtherton::new(2.5e5, 8.0, 5.0, 0.3, 5e-6).unwrap();
     m.m0 = 1e4;
     m
+}
+
+/// Number of direction reversals of `u` (sign changes of the non-zero increments, however
+/// small: the samples decimation must keep).
+fn reversals(u: &[f64]) -> usize {
+    let mut last = 0.0;
+    let mut count = 0;
+    for w in u.windows(2).filter(|w| w[1] != w[0]) {
+        let d = (w[1] - w[0]).signum();
+        if last != 0.0 && d != last {
+            count += 1;
+        }
+        last = d;
+    }
+    count
 }
 
 #[test]
